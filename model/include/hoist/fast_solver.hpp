@@ -1,0 +1,88 @@
+// hoist/fast_solver.hpp -- the production path ("fast").
+//
+// Solves Eq. (15) in multiplier form, exploiting MODEL.md's structure:
+//
+// Longitudinal (hoisting rope q0 + x_c, constraint g0 = U0(1).q0 - x_c = 0):
+//   the constraint row is constant, so x_c = u.q0 (u = U0(1)) is eliminated
+//   exactly with the constant, perfectly conditioned basis [I; u^T]:
+//     (rho1 l I + m u u^T) q0'' + C(l,v) q0' + K(l,v,a) q0 = F0 + u (Fa + m(g - a))
+//   and lambda_0 = Fa + m(g - a) - m x_c''  (the cage equation).
+//   One dense n x n LU per step (C and K change with l, v, a).
+//
+// Lateral/torsional (q1, q2, y_c, theta; constraints g1..g4, Eq. 8):
+//   M, C, K are constant.  Each guide rope's stiffness is diagonalized once,
+//   K_r = V_r diag(kappa_r) V_r^T (M_r = rho2 L I, C_r = u2 L I stay diagonal),
+//   so in modal coordinates z_r = V_r^T q_r the integrator matrix is diagonal
+//   and the KKT system
+//     [S  -G^T] [qdd]   [r]
+//     [G   0  ] [lam] = [d]
+//   is solved by a 4 x 4 Schur complement W = G S^-1 G^T.  The constraints are
+//   enforced at position level at every step (no drift), which stays accurate
+//   over the whole shaft 0 < l < L - 2h where the paper's partition G0 is
+//   ill-conditioned.  Cost per step O(n^2) (the rows G = V^T U(l/L)).
+//
+// No heap allocation in step() (verified by a test with EIGEN_RUNTIME_NO_MALLOC
+// and a counting global operator new).
+#pragma once
+
+#include "hoist/integrator.hpp"
+#include "hoist/solver.hpp"
+
+namespace hoist {
+
+class FastSolver final : public Solver {
+ public:
+  explicit FastSolver(std::shared_ptr<const ShaftModel> model);
+
+  void initialize(double t0, const Kinematics& k0, InitialState init) override;
+  using Solver::initialize;
+  void step(double t1, const Kinematics& k1) override;
+  const CageResponse& response() const override { return resp_; }
+  void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override;
+  void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override;
+  bool finite() const override;
+  Method method() const override { return Method::Fast; }
+
+  // ---- state access (tests, energy checks) --------------------------------
+  /// Lateral state in physical coordinates [q1; q2; y_c; theta] and its rate.
+  void lateralState(VectorXd& q, VectorXd& qd) const;
+  /// Longitudinal state: hoisting-rope modal coordinates q0 and rates.
+  const VectorXd& hoistingRopeCoordinates() const { return y_; }
+  const VectorXd& hoistingRopeRates() const { return yd_; }
+
+ private:
+  void fillConstraintRows(double l);                 // G_ (4 x N) at l
+  void fillConstraintRowDerivatives(double l);       // Gl_, Gll_ (init only)
+  void solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d);
+  void longitudinalOperators(const Kinematics& k);  // Ek_ and scalars at k
+  void updateResponse(double t, const Kinematics& k);
+
+  GeneralizedAlpha ga_;
+  int n_ = 0, N_ = 0;  // modes per rope; lateral size 2n + 2
+  double t_ = 0.0;
+  Kinematics kin_;
+  double h_cached_ = -1.0;
+
+  // lateral constants (modal coordinates), state and workspace
+  VectorXd Md_, Cd_, Kd_, F_;        // diagonal M, C, K and load
+  VectorXd x_, xd_, xdd_, xa_;        // state, rate, acceleration, pseudo-acceleration
+  VectorXd Sd_;                       // M + h gamma ca C + h^2 beta ca K (diagonal)
+  // Constraint Jacobian stored transposed (N x 4, contiguous columns g1..g4)
+  // and its l-derivatives (used for consistent initial accelerations).
+  Eigen::Matrix<double, Eigen::Dynamic, 4> Gt_, Glt_, Gllt_;
+  Eigen::Matrix<double, Eigen::Dynamic, 4> Y_;  // S^-1 G^T
+  VectorXd sa_, sb_, xhat_, vhat_, r_, tmp_;
+  Eigen::Vector4d lam_;
+
+  // longitudinal
+  VectorXd u_;                        // U0_i(1)
+  VectorXd y_, yd_, ydd_, ya_;        // q0 state
+  MatrixXd S0_, Ek_;                  // step matrix, velocity/accel-dependent stiffness
+  Eigen::PartialPivLU<MatrixXd> lu_;
+  VectorXd yhat_, yvhat_, r0_, F0_;
+  double lambda0_ = 0.0;
+
+  CageResponse resp_;
+};
+
+}  // namespace hoist

@@ -1,0 +1,102 @@
+// hoist/solver.hpp -- time stepping of the constrained system, Eq. (15):
+//
+//   M q'' + C q' + K q = F + G(l)^T lambda,     G(l) q = 0.
+//
+// Two interchangeable methods (same inputs, same outputs):
+//   * FastSolver  (the production path, fast_solver.hpp): both subsystems solved
+//     in multiplier (KKT) form with the position-level constraints enforced at
+//     every step -- accurate over the whole shaft 0 < l < L - 2h.
+//   * PaperSolver (the verification path, paper_solver.hpp): the paper's literal
+//     coordinate partition G = (G0 G1), q = Phi q1 (Eqs. 18-24), reduced ODE
+//     Eq. (22), lambda recovered from Eq. (15).  Ill-conditioned near the shaft
+//     ends (MODEL.md) and O(n^3) per step: for checking, not for production.
+// Both use the same implicit, fixed-step generalized-alpha integrator
+// (rho_inf = 1: trapezoidal / Newmark average acceleration) with the equations
+// of motion enforced at t_{n+1}.
+//
+// Sign conventions (MODEL.md): lambda_k is the force the cage exerts on the
+// rope at constraint g_k, positive in +y (+x for lambda_0); the cage feels
+// -lambda_k.  Cage lateral displacement at the top sleeves is y_c - h theta,
+// at the bottom sleeves y_c + h theta.
+#pragma once
+
+#include <array>
+#include <memory>
+
+#include "hoist/profile.hpp"
+#include "hoist/shaft_model.hpp"
+
+namespace hoist {
+
+/// What both solvers report after every step.
+struct CageResponse {
+  double t = 0.0;
+  Kinematics kin;        ///< l, v, a the step ended at
+  double x_c = 0.0;      ///< cage longitudinal displacement (+ down) [m]
+  double y_c = 0.0;      ///< cage lateral displacement [m]
+  double theta = 0.0;    ///< cage rotation [rad]
+  std::array<double, 5> lambda{};  ///< lambda_0 (hoisting rope) .. lambda_4 (sleeves) [N]
+};
+
+enum class Method { Fast, Paper };
+const char* toString(Method m);
+
+class Solver {
+ public:
+  virtual ~Solver() = default;
+
+  /// Set the state at t0 (static equilibrium or rest, see InitialState) and
+  /// compute consistent accelerations and multipliers for kinematics k0.
+  virtual void initialize(double t0, const Kinematics& k0, InitialState init) = 0;
+  void initialize(double t0, const Kinematics& k0) { initialize(t0, k0, model().params().initial); }
+
+  /// Advance to t1 > t, where the prescribed motion is k1.  The fast path does
+  /// not allocate.  Throws std::domain_error if k1.l leaves (0, L - 2h).
+  virtual void step(double t1, const Kinematics& k1) = 0;
+
+  virtual const CageResponse& response() const = 0;
+
+  /// Lateral displacement of both guide ropes at depths x (same size outputs).
+  virtual void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const = 0;
+
+  /// Guide-rope modal coordinates in the sine basis of Eq. (13) (q_1,i and q_2,i).
+  virtual void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const = 0;
+
+  /// All state values finite.
+  virtual bool finite() const = 0;
+
+  virtual Method method() const = 0;
+  const ShaftModel& model() const { return *model_; }
+  const std::shared_ptr<const ShaftModel>& modelPtr() const { return model_; }
+
+ protected:
+  explicit Solver(std::shared_ptr<const ShaftModel> model) : model_(std::move(model)) {}
+  std::shared_ptr<const ShaftModel> model_;
+};
+
+/// Factory: the solver for `method` on `model`.
+std::unique_ptr<Solver> makeSolver(Method method, std::shared_ptr<const ShaftModel> model);
+
+/// Largest |y_i(x)| over both guide ropes, sampled at `samples` evenly spaced
+/// depths (uses a precomputed table; no allocation after the first call for a
+/// given solver is NOT guaranteed -- use GuideRopeEnvelope for real time).
+double maxGuideRopeDeflection(const Solver& s, int samples = 401);
+
+/// Real-time helper: precomputed sine table on a fixed depth grid; evaluate()
+/// allocates nothing.
+class GuideRopeEnvelope {
+ public:
+  GuideRopeEnvelope(const ShaftModel& model, int samples = 401);
+  /// Largest |y1|, |y2| over the grid for the solver's current state.
+  double evaluate(const Solver& s);
+  const VectorXd& depths() const { return x_; }
+  const VectorXd& y1() const { return y1_; }
+  const VectorXd& y2() const { return y2_; }
+
+ private:
+  VectorXd x_;
+  MatrixXd table_;  // samples x n
+  VectorXd q1_, q2_, y1_, y2_;
+};
+
+}  // namespace hoist

@@ -1,0 +1,270 @@
+#include "hoist/fast_solver.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hoist {
+
+FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model)
+    : Solver(std::move(model)), ga_(model_->params().rho_inf) {
+  const ShaftParams& p = model_->params();
+  n_ = p.n;
+  N_ = 2 * n_ + 2;
+  const int n = n_, N = N_;
+  Md_.resize(N);
+  Cd_.resize(N);
+  Kd_.resize(N);
+  F_ = VectorXd::Zero(N);
+  Md_.head(2 * n).setConstant(p.rho2 * p.L);
+  Md_(N - 2) = p.m;
+  Md_(N - 1) = p.J;
+  Cd_.head(2 * n).setConstant(p.u2 * p.L);
+  Cd_.tail(2).setZero();
+  Kd_.head(n) = model_->guideModalStiffness(1);
+  Kd_.segment(n, n) = model_->guideModalStiffness(2);
+  Kd_.tail(2).setZero();
+  F_(N - 1) = p.Fa * p.b;  // moment of the eccentric load; F(y_c) = 0 (Eq. 17)
+  x_ = xd_ = xdd_ = xa_ = Sd_ = xhat_ = vhat_ = r_ = VectorXd::Zero(N);
+  tmp_ = VectorXd::Zero(N);
+  sa_ = sb_ = VectorXd::Zero(n);
+  Gt_ = Glt_ = Gllt_ = Y_ = Eigen::Matrix<double, Eigen::Dynamic, 4>::Zero(N, 4);
+  // Cage columns of g1..g4 (Eq. 8): -y_c +/- h theta.
+  for (int k = 0; k < 4; ++k) Gt_(N - 2, k) = -1.0;
+  Gt_(N - 1, 0) = p.h;
+  Gt_(N - 1, 1) = p.h;
+  Gt_(N - 1, 2) = -p.h;
+  Gt_(N - 1, 3) = -p.h;
+  lam_.setZero();
+
+  u_ = model_->hoistingRope().U1;
+  y_ = yd_ = ydd_ = ya_ = yhat_ = yvhat_ = r0_ = F0_ = VectorXd::Zero(n);
+  S0_ = Ek_ = MatrixXd::Zero(n, n);
+  lu_ = Eigen::PartialPivLU<MatrixXd>(n);
+}
+
+void FastSolver::fillConstraintRows(double l) {
+  const ShaftParams& p = model_->params();
+  const int n = n_;
+  model_->guideModes(l / p.L, sa_);
+  model_->guideModes((l + 2.0 * p.h) / p.L, sb_);
+  const MatrixXd& V1 = model_->guideModalVectors(1);
+  const MatrixXd& V2 = model_->guideModalVectors(2);
+  // g1: y1(l), g2: y2(l), g3: y2(l+2h), g4: y1(l+2h)   (rope blocks, modal coordinates)
+  Gt_.col(0).head(n).noalias() = V1.transpose() * sa_;
+  Gt_.col(1).segment(n, n).noalias() = V2.transpose() * sa_;
+  Gt_.col(2).segment(n, n).noalias() = V2.transpose() * sb_;
+  Gt_.col(3).head(n).noalias() = V1.transpose() * sb_;
+}
+
+void FastSolver::fillConstraintRowDerivatives(double l) {
+  const ShaftParams& p = model_->params();
+  const int n = n_;
+  const MatrixXd& V1 = model_->guideModalVectors(1);
+  const MatrixXd& V2 = model_->guideModalVectors(2);
+  Glt_.setZero();
+  Gllt_.setZero();
+  const double ea = l / p.L, eb = (l + 2.0 * p.h) / p.L;
+  // d/dl U(l/L) = U'(eta)/L ; d2/dl2 = U''(eta)/L^2
+  model_->guideModeSlopes(ea, sa_);
+  model_->guideModeSlopes(eb, sb_);
+  sa_ /= p.L;
+  sb_ /= p.L;
+  Glt_.col(0).head(n).noalias() = V1.transpose() * sa_;
+  Glt_.col(1).segment(n, n).noalias() = V2.transpose() * sa_;
+  Glt_.col(2).segment(n, n).noalias() = V2.transpose() * sb_;
+  Glt_.col(3).head(n).noalias() = V1.transpose() * sb_;
+  model_->guideModeCurvatures(ea, sa_);
+  model_->guideModeCurvatures(eb, sb_);
+  sa_ /= p.L * p.L;
+  sb_ /= p.L * p.L;
+  Gllt_.col(0).head(n).noalias() = V1.transpose() * sa_;
+  Gllt_.col(1).segment(n, n).noalias() = V2.transpose() * sa_;
+  Gllt_.col(2).segment(n, n).noalias() = V2.transpose() * sb_;
+  Gllt_.col(3).head(n).noalias() = V1.transpose() * sb_;
+}
+
+// KKT solve with diagonal S:  S qdd = r + G^T lam,  G qdd = d.
+void FastSolver::solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d) {
+  Y_ = Gt_.array().colwise() / Sd.array();
+  Eigen::Matrix4d W;
+  W.noalias() = Gt_.transpose() * Y_;
+  tmp_ = r.array() / Sd.array();
+  Eigen::Vector4d rhs = d;
+  rhs.noalias() -= Gt_.transpose() * tmp_;
+  lam_ = W.partialPivLu().solve(rhs);
+  xdd_ = tmp_;
+  xdd_.noalias() += Y_ * lam_;
+}
+
+void FastSolver::longitudinalOperators(const Kinematics& k) {
+  const ShaftParams& p = model_->params();
+  const auto& H = model_->hoistingRope();
+  const double rho1 = p.rho1;
+  Ek_ = (rho1 * k.a) * H.A_acc - (p.u1 * k.v) * H.A_vel - (rho1 * k.v * k.v / k.l) * H.A_cent;
+  // F0 + u * F(x_c): hoisting-rope load plus the cage load carried through x_c = u.q0
+  const double Fxc = p.Fa + p.m * (p.g - k.a);
+  F0_ = (-rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
+}
+
+void FastSolver::updateResponse(double t, const Kinematics& k) {
+  const ShaftParams& p = model_->params();
+  resp_.t = t;
+  resp_.kin = k;
+  resp_.x_c = u_.dot(y_);
+  resp_.y_c = x_(N_ - 2);
+  resp_.theta = x_(N_ - 1);
+  const double xcdd = u_.dot(ydd_);
+  lambda0_ = p.Fa + p.m * (p.g - k.a) - p.m * xcdd;
+  resp_.lambda[0] = lambda0_;
+  for (int i = 0; i < 4; ++i) resp_.lambda[i + 1] = lam_(i);
+}
+
+void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) {
+  const ShaftParams& p = model_->params();
+  if (!(k0.l > 0.0 && k0.l < p.maxRopeLength()) || !std::isfinite(k0.v) || !std::isfinite(k0.a))
+    throw std::domain_error("initial rope length " + std::to_string(k0.l) + " m outside (0, L - 2h = " +
+                            std::to_string(p.maxRopeLength()) + ")");
+  const int n = n_, N = N_;
+  t_ = t0;
+  kin_ = k0;
+  h_cached_ = -1.0;
+  fillConstraintRows(k0.l);
+
+  // ---- lateral ------------------------------------------------------------
+  xd_.setZero();
+  if (init == InitialState::Static) {
+    // K x - G^T lam = F,  G x = 0
+    MatrixXd A = MatrixXd::Zero(N + 4, N + 4);
+    A.topLeftCorner(N, N) = Kd_.asDiagonal();
+    A.topRightCorner(N, 4) = -Gt_;
+    A.bottomLeftCorner(4, N) = Gt_.transpose();
+    VectorXd rhs = VectorXd::Zero(N + 4);
+    rhs.head(N) = F_;
+    const VectorXd sol = A.partialPivLu().solve(rhs);
+    x_ = sol.head(N);
+  } else {
+    x_.setZero();
+  }
+  fillConstraintRowDerivatives(k0.l);
+  // Consistent accelerations: G qdd = -2 Gdot qd - Gddot q, Gdot = v G_l, Gddot = a G_l + v^2 G_ll.
+  Eigen::Vector4d d = -2.0 * k0.v * (Glt_.transpose() * xd_) -
+                      (k0.a * (Glt_.transpose() * x_) + k0.v * k0.v * (Gllt_.transpose() * x_));
+  r_ = F_ - Cd_.cwiseProduct(xd_) - Kd_.cwiseProduct(x_);
+  solveLateral(Md_, r_, d);
+  xa_ = xdd_;
+
+  // ---- longitudinal ---------------------------------------------------------
+  yd_.setZero();
+  const auto& H = model_->hoistingRope();
+  if (init == InitialState::Static) {
+    longitudinalOperators({k0.l, 0.0, 0.0});
+    MatrixXd K = MatrixXd(((p.EA / k0.l) * H.k.array().square()).matrix().asDiagonal()) + Ek_;
+    y_ = K.partialPivLu().solve(F0_);
+  } else {
+    y_.setZero();
+  }
+  longitudinalOperators(k0);
+  MatrixXd M = MatrixXd::Identity(n, n) * (p.rho1 * k0.l) + p.m * u_ * u_.transpose();
+  MatrixXd C = MatrixXd::Identity(n, n) * (p.rho1 * k0.v + p.u1 * k0.l) + p.rho1 * k0.v * H.A_gyro;
+  MatrixXd K = MatrixXd(((p.EA / k0.l) * H.k.array().square()).matrix().asDiagonal()) + Ek_;
+  ydd_ = M.partialPivLu().solve(F0_ - C * yd_ - K * y_);
+  ya_ = ydd_;
+
+  updateResponse(t0, k0);
+}
+
+void FastSolver::step(double t1, const Kinematics& k1) {
+  const ShaftParams& p = model_->params();
+  const double h = t1 - t_;
+  if (!(h > 0.0) || !std::isfinite(h)) throw std::invalid_argument("step: t1 must be after the current time");
+  if (!(k1.l > 0.0 && k1.l < p.maxRopeLength()) || !std::isfinite(k1.v) || !std::isfinite(k1.a))
+    throw std::domain_error("step: rope length outside (0, L - 2h) or non-finite kinematics");
+  const GeneralizedAlpha& g = ga_;
+  const double hb = h * h * g.beta * g.ca, hg = h * g.gamma * g.ca;
+
+  // ---- lateral --------------------------------------------------------------
+  if (h != h_cached_) {
+    Sd_ = Md_ + hg * Cd_ + hb * Kd_;
+    h_cached_ = h;
+  }
+  tmp_ = (g.alpha_f * xdd_ - g.alpha_m * xa_) / (1.0 - g.alpha_m);  // abar
+  xhat_ = x_ + h * xd_ + (h * h * (0.5 - g.beta)) * xa_ + (h * h * g.beta) * tmp_;
+  vhat_ = xd_ + (h * (1.0 - g.gamma)) * xa_ + (h * g.gamma) * tmp_;
+  xa_ = tmp_;  // holds abar until the new accelerations are known
+  r_ = F_ - Cd_.cwiseProduct(vhat_) - Kd_.cwiseProduct(xhat_);
+  fillConstraintRows(k1.l);
+  Eigen::Vector4d d;
+  d.noalias() = Gt_.transpose() * xhat_;
+  d *= -1.0 / hb;
+  solveLateral(Sd_, r_, d);
+  xa_ += g.ca * xdd_;
+  x_ = xhat_ + hb * xdd_;
+  xd_ = vhat_ + hg * xdd_;
+
+  // ---- longitudinal -----------------------------------------------------------
+  const auto& H = model_->hoistingRope();
+  longitudinalOperators(k1);
+  r0_ = (g.alpha_f * ydd_ - g.alpha_m * ya_) / (1.0 - g.alpha_m);  // abar (r0_ reused below)
+  yhat_ = y_ + h * yd_ + (h * h * (0.5 - g.beta)) * ya_ + (h * h * g.beta) * r0_;
+  yvhat_ = yd_ + (h * (1.0 - g.gamma)) * ya_ + (h * g.gamma) * r0_;
+  ya_ = r0_;  // holds abar until the new accelerations are known
+  const double cdiag = p.rho1 * k1.v + p.u1 * k1.l;
+  const double kscale = p.EA / k1.l;
+  // r0 = F0 - C vhat - K yhat
+  r0_ = F0_ - cdiag * yvhat_ - kscale * H.k.array().square().matrix().cwiseProduct(yhat_);
+  r0_.noalias() -= (p.rho1 * k1.v) * (H.A_gyro * yvhat_);
+  r0_.noalias() -= Ek_ * yhat_;
+  // S0 = M + hg C + hb K
+  S0_ = (hg * p.rho1 * k1.v) * H.A_gyro + hb * Ek_;
+  S0_.noalias() += p.m * (u_ * u_.transpose());
+  S0_.diagonal().array() += p.rho1 * k1.l + hg * cdiag + hb * kscale * H.k.array().square();
+  lu_.compute(S0_);
+  ydd_.noalias() = lu_.solve(r0_);
+  ya_ += g.ca * ydd_;
+  y_ = yhat_ + hb * ydd_;
+  yd_ = yvhat_ + hg * ydd_;
+
+  t_ = t1;
+  kin_ = k1;
+  updateResponse(t1, k1);
+}
+
+void FastSolver::guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const {
+  q1.resize(n_);
+  q2.resize(n_);
+  q1.noalias() = model_->guideModalVectors(1) * x_.head(n_);
+  q2.noalias() = model_->guideModalVectors(2) * x_.segment(n_, n_);
+}
+
+void FastSolver::guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const {
+  VectorXd q1, q2, U(n_);
+  guideRopeCoordinates(q1, q2);
+  y1.resize(x.size());
+  y2.resize(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    model_->guideModes(x(i) / model_->params().L, U);
+    y1(i) = U.dot(q1);
+    y2(i) = U.dot(q2);
+  }
+}
+
+void FastSolver::lateralState(VectorXd& q, VectorXd& qd) const {
+  q.resize(N_);
+  qd.resize(N_);
+  const MatrixXd& V1 = model_->guideModalVectors(1);
+  const MatrixXd& V2 = model_->guideModalVectors(2);
+  q.head(n_) = V1 * x_.head(n_);
+  q.segment(n_, n_) = V2 * x_.segment(n_, n_);
+  q.tail(2) = x_.tail(2);
+  qd.head(n_) = V1 * xd_.head(n_);
+  qd.segment(n_, n_) = V2 * xd_.segment(n_, n_);
+  qd.tail(2) = xd_.tail(2);
+}
+
+bool FastSolver::finite() const {
+  return x_.allFinite() && xd_.allFinite() && xdd_.allFinite() && y_.allFinite() && yd_.allFinite() &&
+         ydd_.allFinite() && std::isfinite(lambda0_) && lam_.allFinite();
+}
+
+}  // namespace hoist

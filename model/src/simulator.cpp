@@ -1,0 +1,64 @@
+#include "hoist/simulator.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "hoist/fast_solver.hpp"
+#include "hoist/paper_solver.hpp"
+
+namespace hoist {
+
+const char* toString(Method m) { return m == Method::Fast ? "fast" : "paper"; }
+
+std::unique_ptr<Solver> makeSolver(Method method, std::shared_ptr<const ShaftModel> model) {
+  if (method == Method::Paper) return std::make_unique<PaperSolver>(std::move(model));
+  return std::make_unique<FastSolver>(std::move(model));
+}
+
+GuideRopeEnvelope::GuideRopeEnvelope(const ShaftModel& model, int samples) {
+  if (samples < 2) throw std::invalid_argument("GuideRopeEnvelope: need at least 2 samples");
+  const int n = model.n();
+  x_ = VectorXd::LinSpaced(samples, 0.0, model.params().L);
+  table_.resize(samples, n);
+  VectorXd U(n);
+  for (int i = 0; i < samples; ++i) {
+    model.guideModes(x_(i) / model.params().L, U);
+    table_.row(i) = U.transpose();
+  }
+  q1_ = q2_ = VectorXd::Zero(n);
+  y1_ = y2_ = VectorXd::Zero(samples);
+}
+
+double GuideRopeEnvelope::evaluate(const Solver& s) {
+  s.guideRopeCoordinates(q1_, q2_);
+  y1_.noalias() = table_ * q1_;
+  y2_.noalias() = table_ * q2_;
+  return std::max(y1_.cwiseAbs().maxCoeff(), y2_.cwiseAbs().maxCoeff());
+}
+
+double maxGuideRopeDeflection(const Solver& s, int samples) {
+  GuideRopeEnvelope env(s.model(), samples);
+  return env.evaluate(s);
+}
+
+void simulate(Solver& solver, const HoistProfile& profile, const SimulationOptions& opt,
+              const std::function<void(const CageResponse&)>& sink, const std::function<void(double)>& progress) {
+  if (profile.empty()) throw std::invalid_argument("simulate: empty profile");
+  if (!(opt.dt > 0.0) || !std::isfinite(opt.dt)) throw std::invalid_argument("simulate: dt must be > 0");
+  const double t0 = profile.startTime();
+  const double t_end = opt.t_end < 0 ? profile.endTime() : opt.t_end;
+  const long steps = std::lround((t_end - t0) / opt.dt);
+  if (steps < 0) throw std::invalid_argument("simulate: t_end before the profile start");
+  solver.initialize(t0, profile.at(t0), opt.initial);
+  if (sink) sink(solver.response());
+  const long every = std::max(1L, steps / 100);
+  for (long k = 1; k <= steps; ++k) {
+    const double t = t0 + static_cast<double>(k) * opt.dt;
+    solver.step(t, profile.at(t));
+    if (sink) sink(solver.response());
+    if (progress && k % every == 0) progress(static_cast<double>(k) / static_cast<double>(steps));
+  }
+  if (progress) progress(1.0);
+}
+
+}  // namespace hoist
