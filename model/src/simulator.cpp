@@ -41,6 +41,16 @@ double maxGuideRopeDeflection(const Solver& s, int samples) {
   return env.evaluate(s);
 }
 
+int substepsFor(const SimulationOptions& opt) {
+  if (!(opt.max_step >= 0.0) || !std::isfinite(opt.max_step))
+    throw std::invalid_argument("simulate: max_step must be >= 0");
+  if (opt.max_step == 0.0 || opt.max_step >= opt.dt) return 1;
+  const double r = opt.dt / opt.max_step;
+  const double c = std::ceil(r - 1e-9);
+  if (c > 1e6) throw std::invalid_argument("simulate: dt / max_step exceeds 1e6 substeps");
+  return static_cast<int>(c);
+}
+
 void simulate(Solver& solver, const HoistProfile& profile, const SimulationOptions& opt,
               const std::function<void(const CageResponse&)>& sink, const std::function<void(double)>& progress) {
   if (profile.empty()) throw std::invalid_argument("simulate: empty profile");
@@ -52,8 +62,13 @@ void simulate(Solver& solver, const HoistProfile& profile, const SimulationOptio
   solver.initialize(t0, profile.at(t0), opt.initial);
   if (sink) sink(solver.response());
   const long every = std::max(1L, steps / 100);
+  const int sub = substepsFor(opt);
   for (long k = 1; k <= steps; ++k) {
     const double t = t0 + static_cast<double>(k) * opt.dt;
+    for (int j = 1; j < sub; ++j) {
+      const double ts = t0 + (static_cast<double>(k - 1) + static_cast<double>(j) / sub) * opt.dt;
+      solver.step(ts, profile.at(ts));
+    }
     solver.step(t, profile.at(t));
     if (sink) sink(solver.response());
     if (progress && k % every == 0) progress(static_cast<double>(k) / static_cast<double>(steps));
