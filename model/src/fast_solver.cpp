@@ -6,6 +6,11 @@
 
 namespace hoist {
 
+namespace {
+/// Fixed-point sweeps before the dense-LU fallback (each gains ~2.5 digits).
+constexpr int kMaxSweeps = 12;
+}  // namespace
+
 FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model)
     : Solver(std::move(model)), ga_(model_->params().rho_inf) {
   const ShaftParams& p = model_->params();
@@ -39,6 +44,8 @@ FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model)
 
   u_ = model_->hoistingRope().U1;
   y_ = yd_ = ydd_ = ya_ = yhat_ = yvhat_ = r0_ = F0_ = VectorXd::Zero(n);
+  k2_ = model_->hoistingRope().k.array().square();
+  Pd_ = w_ = res_ = dy_ = VectorXd::Zero(n);
   S0_ = Ek_ = MatrixXd::Zero(n, n);
   lu_ = Eigen::PartialPivLU<MatrixXd>(n);
 }
@@ -129,6 +136,8 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   t_ = t0;
   kin_ = k0;
   h_cached_ = -1.0;
+  fallbacks_ = 0;
+  last_iters_ = 0;
   fillConstraintRows(k0.l);
 
   // ---- lateral ------------------------------------------------------------
@@ -212,15 +221,38 @@ void FastSolver::step(double t1, const Kinematics& k1) {
   const double cdiag = p.rho1 * k1.v + p.u1 * k1.l;
   const double kscale = p.EA / k1.l;
   // r0 = F0 - C vhat - K yhat
-  r0_ = F0_ - cdiag * yvhat_ - kscale * H.k.array().square().matrix().cwiseProduct(yhat_);
+  r0_ = F0_ - cdiag * yvhat_ - kscale * k2_.cwiseProduct(yhat_);
   r0_.noalias() -= (p.rho1 * k1.v) * (H.A_gyro * yvhat_);
   r0_.noalias() -= Ek_ * yhat_;
-  // S0 = M + hg C + hb K
-  S0_ = (hg * p.rho1 * k1.v) * H.A_gyro + hb * Ek_;
-  S0_.noalias() += p.m * (u_ * u_.transpose());
-  S0_.diagonal().array() += p.rho1 * k1.l + hg * cdiag + hb * kscale * H.k.array().square();
-  lu_.compute(S0_);
-  ydd_.noalias() = lu_.solve(r0_);
+  // S = M + hg C + hb K = P + E,  P = diag(Pd) + m u u^T,  E = hg rho1 v A_gyro + hb Ek.
+  Ek_ *= hb;
+  Ek_.noalias() += (hg * p.rho1 * k1.v) * H.A_gyro;  // Ek_ now holds E
+  Pd_ = (p.rho1 * k1.l + hg * cdiag) + (hb * kscale) * k2_.array();
+  w_ = u_.cwiseQuotient(Pd_);
+  const double sm = p.m / (1.0 + p.m * u_.dot(w_));  // Sherman-Morrison
+  auto applyPinv = [&](const VectorXd& rhs, VectorXd& out) {
+    out = rhs.cwiseQuotient(Pd_);
+    out -= (sm * u_.dot(out)) * w_;
+  };
+  applyPinv(r0_, ydd_);
+  bool converged = false;
+  int it = 0;
+  for (; it < kMaxSweeps && !converged; ++it) {
+    res_ = r0_ - Pd_.cwiseProduct(ydd_) - (p.m * u_.dot(ydd_)) * u_;
+    res_.noalias() -= Ek_ * ydd_;
+    applyPinv(res_, dy_);
+    ydd_ += dy_;
+    converged = dy_.cwiseAbs().maxCoeff() <= 1e-14 * ydd_.cwiseAbs().maxCoeff() + 1e-300;
+  }
+  last_iters_ = it;
+  if (!converged) {
+    ++fallbacks_;
+    S0_ = Ek_;
+    S0_.noalias() += p.m * (u_ * u_.transpose());
+    S0_.diagonal() += Pd_;
+    lu_.compute(S0_);
+    ydd_.noalias() = lu_.solve(r0_);
+  }
   ya_ += g.ca * ydd_;
   y_ = yhat_ + hb * ydd_;
   yd_ = yvhat_ + hg * ydd_;
