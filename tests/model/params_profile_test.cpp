@@ -129,3 +129,37 @@ TEST(Profile, EmergencyStop) {
 }
 
 }  // namespace
+
+#include "hoist/simulator.hpp"
+
+namespace {
+
+TEST(Simulate, SubstepsSplitTheOutputStep) {
+  SimulationOptions o;
+  o.dt = 0.01;
+  o.max_step = 0.0025;
+  EXPECT_EQ(substepsFor(o), 4);
+  o.max_step = 0.003;
+  EXPECT_EQ(substepsFor(o), 4);
+  o.max_step = 0.0;
+  EXPECT_EQ(substepsFor(o), 1);
+  o.max_step = 0.02;
+  EXPECT_EQ(substepsFor(o), 1);
+  o.max_step = -1;
+  EXPECT_THROW(substepsFor(o), std::invalid_argument);
+}
+
+TEST(Simulate, OutputsEveryDtAndEndsAtProfileEnd) {
+  auto model = std::make_shared<const ShaftModel>(ShaftParams{});
+  auto s = makeSolver(Method::Fast, model);
+  SimulationOptions o;
+  o.dt = 0.05;
+  o.max_step = 0.01;
+  std::vector<double> t;
+  simulate(*s, HoistProfile::trapezoid(), o, [&](const CageResponse& r) { t.push_back(r.t); });
+  ASSERT_EQ(t.size(), 1201u);
+  EXPECT_NEAR(t[1], 0.05, 1e-12);
+  EXPECT_NEAR(t.back(), 60.0, 1e-9);
+}
+
+}  // namespace
