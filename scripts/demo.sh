@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# The digital twin, live: builds the project (scripts/setup.sh), starts the
+# daemon hoist-twind, feeds it the paper's hoist trip (Fig. 2: 50 m -> 300 m
+# in 60 s) from hoist-replay in real time over LCM, and shows once a second
+# the model time, depth, speed, sway, tilt, largest guide-sleeve force,
+# minimum clearance and the active alarms (hoist-monitor).  Everything runs on
+# a private loopback multicast URL (ttl=0: nothing leaves this machine) and is
+# stopped cleanly at the end (or on Ctrl-C).
+#
+#   scripts/demo.sh [--no-setup] [--speed X] [--profile SPEC|FILE]
+#                   [--config FILE] [--port N] [--with-length]
+#
+#   --no-setup     skip scripts/setup.sh (the build must exist)
+#   --speed X      replay X times faster than real time (default 1: 60 s).
+#                  At speed 1 the daemon runs on the wall clock (the real-time
+#                  twin); at any other speed it runs with --clock input, so
+#                  model time follows the replayed profile time.
+#   --profile P    hoist profile (default: paper; see hoist-replay --help)
+#   --config FILE  daemon configuration (default: service/config/demo.toml,
+#                  the paper's shaft with tight clearances so alarms show)
+#   --port N       UDP port of the private LCM URL (default 7690)
+#   --with-length  send the encoder rope length too
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+setup=1
+speed=1
+profile=paper
+config="$here/service/config/demo.toml"
+port=7690
+replay_extra=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --no-setup) setup=0; shift ;;
+    --speed) speed="$2"; shift 2 ;;
+    --profile) profile="$2"; shift 2 ;;
+    --config) config="$2"; shift 2 ;;
+    --port) port="$2"; shift 2 ;;
+    --with-length) replay_extra+=(--with-length); shift ;;
+    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "demo.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
+  esac
+done
+
+if [[ $setup -eq 1 ]]; then
+  if [[ -x "$here/scripts/setup.sh" ]]; then
+    "$here/scripts/setup.sh"
+  else
+    echo "demo.sh: scripts/setup.sh not found; building with cmake" >&2
+    cmake -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+    cmake --build "$here/build" -j"$(nproc)" --target hoist-twind hoist-replay hoist-monitor
+  fi
+fi
+bin="${HOIST_BIN_DIR:-$here/build/bin}"   # HOIST_BIN_DIR: use another build
+for b in hoist-twind hoist-replay hoist-monitor; do
+  if [[ ! -x "$bin/$b" ]]; then
+    echo "demo.sh: $bin/$b not found; run scripts/setup.sh (or drop --no-setup)" >&2
+    exit 2
+  fi
+done
+
+# LCM on one machine needs multicast on the loopback interface.
+multicast_ok() {
+  ip link show lo 2>/dev/null | grep -q MULTICAST && ip route show 2>/dev/null | grep -q '^224\.0\.0\.0/4.* dev lo'
+}
+if ! multicast_ok; then
+  if [[ $(id -u) -eq 0 ]]; then
+    echo "demo.sh: enabling multicast on the loopback interface (ip link / ip route)" >&2
+    ip link set lo multicast on
+    ip route add 224.0.0.0/4 dev lo 2>/dev/null || true
+  fi
+  if ! multicast_ok; then
+    cat >&2 <<'MSG'
+demo.sh: UDP multicast on the loopback interface is off, so LCM cannot work on this machine.
+Enable it as root, then re-run:
+    sudo ip link set lo multicast on
+    sudo ip route add 224.0.0.0/4 dev lo
+MSG
+    exit 1
+  fi
+fi
+
+url="udpm://239.255.76.67:${port}?ttl=0"
+logdir="$(mktemp -d "${TMPDIR:-/tmp}/hoist-demo.XXXXXX")"
+daemon_pid="" monitor_pid=""
+cleanup() {
+  trap - EXIT INT TERM
+  [[ -n "$monitor_pid" ]] && kill -TERM "$monitor_pid" 2>/dev/null || true
+  if [[ -n "$daemon_pid" ]] && kill -0 "$daemon_pid" 2>/dev/null; then
+    kill -TERM "$daemon_pid" 2>/dev/null || true
+    wait "$daemon_pid" 2>/dev/null || true
+  fi
+  [[ -n "$monitor_pid" ]] && wait "$monitor_pid" 2>/dev/null || true
+}
+trap cleanup EXIT
+trap 'echo; echo "demo.sh: interrupted"; cleanup; exit 130' INT TERM
+
+echo "== hoist-twin demo: LCM $url, logs in $logdir"
+clock=wall
+if ! awk -v s="$speed" 'BEGIN { exit !(s == 1) }'; then clock=input; fi
+echo "== daemon: $bin/hoist-twind --config $config --clock $clock --lcm-url '$url'"
+"$bin/hoist-twind" --config "$config" --clock "$clock" --lcm-url "$url" 2> "$logdir/hoist-twind.log" &
+daemon_pid=$!
+"$bin/hoist-monitor" --lcm-url "$url" &
+monitor_pid=$!
+sleep 1.0
+if ! kill -0 "$daemon_pid" 2>/dev/null; then
+  echo "demo.sh: hoist-twind failed to start:" >&2
+  cat "$logdir/hoist-twind.log" >&2
+  exit 1
+fi
+echo "== replay: the $profile trip at speed $speed (Ctrl-C stops everything)"
+"$bin/hoist-replay" --lcm-url "$url" --profile "$profile" --speed "$speed" -q "${replay_extra[@]}"
+sleep 2.2   # the last monitor lines, and the input going stale
+cleanup
+echo "== daemon log (alarms and final health):"
+grep -E "ALARM|alarm:|final health|rejected|  rejected" "$logdir/hoist-twind.log" || true
+echo "== done (full log: $logdir/hoist-twind.log)"

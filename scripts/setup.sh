@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# One-time set-up on a fresh Debian machine, safe to rerun:
+#   1. installs the Debian packages the project needs (skipped when present),
+#   2. makes sure UDP multicast works on loopback (LCM's transport),
+#   3. configures and builds everything into ./build (Release).
+#
+#   scripts/setup.sh [--no-build] [--build-dir DIR] [--build-type TYPE] [--cmake-args "..."]
+#
+# Environment: HOIST_SKIP_APT=1 skips step 1 (for machines set up by hand);
+# JOBS=N sets the build parallelism (default: nproc).
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="$here/build"
+build_type=Release
+do_build=1
+cmake_args=""
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --no-build) do_build=0; shift ;;
+    --build-dir) build_dir="$2"; shift 2 ;;
+    --build-type) build_type="$2"; shift 2 ;;
+    --cmake-args) cmake_args="$2"; shift 2 ;;
+    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "setup.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
+  esac
+done
+say() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
+
+# ---- 1. Debian packages -----------------------------------------------------
+required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev liblcm-bin
+          libglib2.0-dev libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libtomlplusplus-dev
+          libcli11-dev gnuplot-nox python3 iproute2)
+# Java bindings let lcm-spy decode the hoist channels; clang gives the fuzzers.
+optional=(liblcm-java default-jdk-headless clang libclang-rt-14-dev)
+missing=()
+for p in "${required[@]}" "${optional[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [[ ${#missing[@]} -gt 0 && "${HOIST_SKIP_APT:-0}" != 1 ]]; then
+  sudo=""
+  [[ $(id -u) -ne 0 ]] && sudo="sudo"
+  say "installing: ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${required[@]}"
+  # Optional packages one by one: a missing one must not stop the set-up.
+  for p in "${optional[@]}"; do
+    $sudo apt-get install -y -qq --no-install-recommends "$p" >/dev/null 2>&1 ||
+      say "optional package $p not available (continuing without it)"
+  done
+else
+  say "Debian packages: all present"
+fi
+
+# ---- 2. loopback multicast (LCM) ---------------------------------------------
+# LCM's default transport is UDP multicast; with ttl=0 it stays on this host,
+# which needs the loopback interface to accept multicast and a route for
+# 224.0.0.0/4.  Tests and the demo use it.
+multicast_ok() {
+  ip link show lo 2>/dev/null | grep -q MULTICAST &&
+    ip route get 239.255.76.67 2>/dev/null | grep -q "dev lo"
+}
+if multicast_ok; then
+  say "loopback multicast: enabled"
+elif [[ $(id -u) -eq 0 ]] || sudo -n true 2>/dev/null; then
+  sudo=""; [[ $(id -u) -ne 0 ]] && sudo="sudo -n"
+  $sudo ip link set lo multicast on 2>/dev/null || true
+  $sudo ip route replace 224.0.0.0/4 dev lo 2>/dev/null || true
+  if multicast_ok; then say "loopback multicast: enabled now (ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo)"
+  else say "WARNING: could not enable loopback multicast; the LCM integration tests will fail fast"; fi
+else
+  say "WARNING: loopback multicast is off and this user cannot enable it. As root run:"
+  say "    ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo"
+  say "(the LCM integration tests and the demo need it; the other tests do not)"
+fi
+
+# ---- 3. configure and build ---------------------------------------------------
+if [[ $do_build -eq 1 ]]; then
+  jobs="${JOBS:-$(nproc)}"
+  say "configuring $build_dir ($build_type)"
+  # shellcheck disable=SC2086
+  cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" $cmake_args >"$build_dir.configure.log" 2>&1 ||
+    { cat "$build_dir.configure.log"; exit 1; }
+  say "building with $jobs jobs (log: $build_dir.build.log)"
+  if ! cmake --build "$build_dir" -j"$jobs" >"$build_dir.build.log" 2>&1; then
+    tail -50 "$build_dir.build.log"; say "build FAILED (full log: $build_dir.build.log)"; exit 1
+  fi
+  say "built: $(ls "$build_dir/bin" | tr '\n' ' ')"
+fi

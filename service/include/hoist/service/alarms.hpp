@@ -1,0 +1,217 @@
+// hoist/service/alarms.hpp -- clearance alarms of the twin (pure: no I/O, no
+// clock, no allocation after construction).
+//
+// What is measured (MODEL.md conventions; y lateral, theta cage rotation, h
+// cage half height):
+//   top-sleeve excursion      y_top    = y_c - h theta
+//   bottom-sleeve excursion   y_bottom = y_c + h theta
+//   toward +y                 e_pos    = max(y_top, y_bottom)
+//   toward -y                 e_neg    = max(-y_top, -y_bottom)
+//   guide ropes               e_guide  = largest |y_1(x)|, |y_2(x)| over the shaft
+// and compared with configured gaps ([alarms] gap_pos_y, gap_neg_y,
+// guide_rope_gap, metres).  Remaining clearance = gap - excursion.
+//
+// Alarm model (ISA-18.2 / OPC UA Part 9 AlarmConditionType practice):
+//   * every (kind, level) is one binary alarm: CAGE_POS_Y, CAGE_NEG_Y and
+//     GUIDE_ROPE each have a WARNING (warning_fraction * gap) and a CRITICAL
+//     (critical_fraction * gap) alarm; INPUT_STALE is a WARNING, MODEL_FAULT a
+//     CRITICAL;
+//   * the condition comes on when value >= threshold has held for on_delay
+//     and goes off when value < threshold - deadband has held for off_delay
+//     (so a value hovering at the threshold cannot chatter);
+//   * a CRITICAL alarm latches (with latch_critical): it stays active after
+//     its condition is gone until an operator acknowledges it;
+//   * an operator can shelve an alarm for a time (at most max_shelve): while
+//     shelved it raises and clears silently; on unshelve (or expiry) the
+//     current state is announced;
+//   * active, unshelved alarms are re-announced every `reannounce` seconds.
+// Time `now` is whatever monotonic clock the caller uses, in seconds (the
+// daemon passes model time).  Each call appends the resulting events to an
+// AlarmEvents buffer of fixed capacity; the caller publishes and logs them.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace hoist::svc {
+
+enum class AlarmKind : std::uint8_t { CagePosY, CageNegY, GuideRope, InputStale, ModelFault };
+inline constexpr int kAlarmKinds = 5;
+
+/// Values match alarm_t.LEVEL_*.
+enum class AlarmLevel : std::int8_t { None = 0, Warning = 1, Critical = 2 };
+
+/// Values match alarm_t.EVENT_*.
+enum class AlarmEventType : std::int8_t {
+  Raise = 1, Clear = 2, Ack = 3, Shelve = 4, Unshelve = 5, Reannounce = 6
+};
+
+const char* toString(AlarmKind k);        ///< "CAGE_POS_Y", ...
+const char* toString(AlarmLevel l);       ///< "NONE", "WARNING", "CRITICAL"
+const char* toString(AlarmEventType e);   ///< "RAISE", ...
+std::optional<AlarmKind> parseAlarmKind(std::string_view s);  ///< case-sensitive names above
+
+/// The [alarms] section (see docs/service.md).  Lengths in metres, times in seconds.
+struct AlarmConfig {
+  double gap_pos_y = 0.30;         ///< cage to shaft wall / neighbour on the +y side [m]
+  double gap_neg_y = 0.30;         ///< ... on the -y side [m]
+  double guide_rope_gap = 0.30;    ///< allowed guide-rope lateral deflection [m]
+  double warning_fraction = 0.5;   ///< WARNING threshold = fraction * gap, in (0, critical_fraction)
+  double critical_fraction = 0.8;  ///< CRITICAL threshold = fraction * gap, in (warning_fraction, 1]
+  double deadband = 0.02;          ///< hysteresis as a fraction of the gap, in [0, warning_fraction)
+  double on_delay = 0.1;           ///< value must stay over threshold this long to raise [s]
+  double off_delay = 1.0;          ///< value must stay under threshold - deadband this long to clear [s]
+  double reannounce = 10.0;        ///< re-announce active alarms every ... [s]; 0 = never
+  bool latch_critical = true;      ///< CRITICAL stays active until acknowledged
+  double max_shelve = 3600.0;      ///< longest shelve an operator may set [s]
+
+  /// Throws std::invalid_argument("alarms.<key>: ...") for the first bad value.
+  void validate() const;
+};
+
+/// Settings of one binary alarm.
+struct AlarmSettings {
+  double threshold = 1.0;
+  double deadband = 0.0;   ///< absolute, in the value's unit
+  double on_delay = 0.0;
+  double off_delay = 0.0;
+  bool latch = false;
+  double reannounce = 0.0;
+};
+
+struct AlarmEvent {
+  AlarmKind kind = AlarmKind::CagePosY;
+  AlarmLevel level = AlarmLevel::Warning;
+  AlarmEventType type = AlarmEventType::Raise;
+  double t = 0.0;          ///< time of the event [s]
+  double value = 0.0;      ///< last value fed to the alarm
+  double threshold = 0.0;
+  bool active = false;     ///< state after the event
+  bool acked = false;
+  bool shelved = false;
+  bool latched = false;    ///< active only because of the latch
+  double shelved_for = 0.0;  ///< remaining shelve time [s]
+};
+
+/// Fixed-capacity event list (no allocation).  Events beyond the capacity
+/// are dropped and counted in `dropped`.
+class AlarmEvents {
+ public:
+  static constexpr std::size_t kCapacity = 64;
+  void clear() { n_ = 0; dropped_ = 0; }
+  void push(const AlarmEvent& e) {
+    if (n_ < kCapacity) ev_[n_++] = e; else ++dropped_;
+  }
+  std::size_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  std::size_t dropped() const { return dropped_; }
+  const AlarmEvent& operator[](std::size_t i) const { return ev_[i]; }
+  const AlarmEvent* begin() const { return ev_.data(); }
+  const AlarmEvent* end() const { return ev_.data() + n_; }
+
+ private:
+  std::array<AlarmEvent, kCapacity> ev_{};
+  std::size_t n_ = 0, dropped_ = 0;
+};
+
+/// One binary alarm with deadband, on-/off-delay, latching, acknowledgement,
+/// shelving and re-announcement.
+class BinaryAlarm {
+ public:
+  BinaryAlarm() = default;
+  BinaryAlarm(AlarmKind kind, AlarmLevel level, const AlarmSettings& s) { configure(kind, level, s); }
+  void configure(AlarmKind kind, AlarmLevel level, const AlarmSettings& s);
+
+  /// Feed the measured value at time `now` (non-decreasing).  A non-finite
+  /// value counts as over the threshold (fail safe).
+  void update(double now, double value, AlarmEvents& out);
+  /// Operator acknowledgement; false if there was nothing to acknowledge.
+  bool acknowledge(double now, AlarmEvents& out);
+  /// Shelve for `duration` seconds (> 0).  Re-shelving extends/shortens.
+  bool shelve(double now, double duration, AlarmEvents& out);
+  bool unshelve(double now, AlarmEvents& out);
+
+  AlarmKind kind() const { return kind_; }
+  AlarmLevel level() const { return level_; }
+  const AlarmSettings& settings() const { return s_; }
+  bool condition() const { return cond_; }  ///< debounced condition
+  bool active() const { return active_; }
+  bool acked() const { return acked_; }
+  bool shelved() const { return shelved_; }
+  bool latched() const { return active_ && !cond_; }
+  double value() const { return value_; }
+
+ private:
+  void emit(AlarmEventType type, double now, AlarmEvents& out);
+  void announce(double now, AlarmEvents& out);  // publish active_ if it differs from announced_
+  void expireShelve(double now, AlarmEvents& out);
+
+  AlarmKind kind_ = AlarmKind::CagePosY;
+  AlarmLevel level_ = AlarmLevel::Warning;
+  AlarmSettings s_;
+  bool cond_ = false;
+  double pending_since_ = -1.0;  // < 0: raw state agrees with cond_
+  bool pending_valid_ = false;
+  bool active_ = false, acked_ = false, shelved_ = false, announced_ = false;
+  double shelved_until_ = 0.0;
+  double last_announce_ = 0.0;
+  double value_ = 0.0;
+};
+
+/// Clearance figures of one cage state.
+struct Clearance {
+  double y_top = 0.0;            ///< y_c - h theta [m]
+  double y_bottom = 0.0;         ///< y_c + h theta [m]
+  double excursion_pos = 0.0;    ///< max(y_top, y_bottom) [m]
+  double excursion_neg = 0.0;    ///< max(-y_top, -y_bottom) [m]
+  double guide_deflection = 0.0; ///< [m]
+  double clearance_pos = 0.0;    ///< gap_pos_y - excursion_pos [m]
+  double clearance_neg = 0.0;    ///< gap_neg_y - excursion_neg [m]
+  double clearance_guide = 0.0;  ///< guide_rope_gap - guide_deflection [m]
+  double min_clearance = 0.0;    ///< smallest of the three [m]
+};
+
+Clearance computeClearance(double y_c, double theta, double h, double guide_deflection,
+                           const AlarmConfig& cfg);
+
+/// All alarms of the twin.
+class AlarmEngine {
+ public:
+  static constexpr int kSlots = 8;
+
+  explicit AlarmEngine(const AlarmConfig& cfg = {});
+  const AlarmConfig& config() const { return cfg_; }
+
+  void updateClearance(double now, const Clearance& c, AlarmEvents& out);
+  void setInputStale(double now, bool stale, AlarmEvents& out);
+  /// `fault` true for the step where the model state became non-finite.
+  void setModelFault(double now, bool fault, AlarmEvents& out);
+  /// Runs shelve expiry and re-announcement without a new value.
+  void poll(double now, AlarmEvents& out);
+
+  /// Operator commands.  kind empty = all kinds; level None = all levels.
+  /// Return the number of alarms affected.
+  int acknowledge(double now, std::optional<AlarmKind> kind, AlarmLevel level, AlarmEvents& out);
+  int shelve(double now, std::optional<AlarmKind> kind, AlarmLevel level, double duration,
+             AlarmEvents& out);
+  int unshelve(double now, std::optional<AlarmKind> kind, AlarmLevel level, AlarmEvents& out);
+
+  AlarmLevel highestActive() const;  ///< over unshelved active alarms
+  int activeCount() const;
+  int unackedCount() const;
+  int shelvedCount() const;
+  const std::array<BinaryAlarm, kSlots>& alarms() const { return alarms_; }
+  /// The alarm of (kind, level), or nullptr if there is none.
+  const BinaryAlarm* find(AlarmKind kind, AlarmLevel level) const;
+
+ private:
+  template <class F>
+  int forMatching(std::optional<AlarmKind> kind, AlarmLevel level, F&& f);
+  AlarmConfig cfg_;
+  std::array<BinaryAlarm, kSlots> alarms_;
+};
+
+}  // namespace hoist::svc

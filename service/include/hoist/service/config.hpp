@@ -1,0 +1,78 @@
+// hoist/service/config.hpp -- the daemon's configuration: the shaft TOML
+// (sections of INTERFACES.md, parsed by hoist_io) plus [service] and [alarms].
+// Every key is optional; a missing key takes the default below (the shaft's
+// defaults are the paper's values).  Unknown keys, wrong types, non-finite or
+// out-of-range values are errors naming the file, line and dotted key.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include <toml++/toml.h>
+
+#include "hoist/params.hpp"
+#include "hoist/service/alarms.hpp"
+
+namespace hoist::svc {
+
+enum class ClockMode { Wall, Input };
+const char* toString(ClockMode c);
+
+/// The [service] section.  Rates in Hz, times in seconds, lengths in metres.
+struct ServiceConfig {
+  double rate = 100.0;          ///< model step rate with --clock wall, [1, 1000] Hz
+  double cage_rate = 0.0;       ///< HOIST_CAGE publish rate, 0 = every model step; <= rate
+  double shape_rate = 5.0;      ///< HOIST_GUIDE_SHAPE publish rate, 0 = off; <= rate
+  double health_rate = 1.0;     ///< HOIST_HEALTH publish rate, (0, 10]
+  std::string channel_prefix;   ///< prepended to every channel name
+  std::string lcm_url;          ///< used when neither --lcm-url nor LCM_DEFAULT_URL is set
+  ClockMode clock = ClockMode::Wall;  ///< "wall" or "input"
+  double max_speed = 20.0;      ///< input limit |v| [m/s]
+  double max_accel = 10.0;      ///< input limit |a| [m/s^2]
+  double max_length_jump = 0.5; ///< encoder length off its v-prediction by more -> reject [m]
+  double max_time_step = 1.0;   ///< larger utime step within a stream -> reject [s]
+  double stale_timeout = 0.5;   ///< no accepted input for this long -> INPUT_STALE [s]
+  double max_step = 0.0025;     ///< largest integration step: longer ticks/input intervals are substepped [s]; 0 = off (same default as hoist-sim)
+  int shape_points = 101;       ///< depth samples in HOIST_GUIDE_SHAPE, [2, 2001]
+  int envelope_points = 401;    ///< depth samples for the guide-rope deflection alarm, [2, 20001]
+  int log_rate_limit = 5;       ///< log lines per second per rejection reason, [1, 1000]
+  double fault_hold = 1.0;      ///< outputs flagged degraded after a model re-init [s]
+
+  void validate() const;  ///< throws ConfigError naming service.<key>
+};
+
+struct TwinConfig {
+  ShaftParams shaft;
+  ServiceConfig service;
+  AlarmConfig alarms;
+};
+
+/// A configuration error; what() is "<file>:<line>: <key>: <message>" (the
+/// line is omitted when unknown).
+class ConfigError : public std::runtime_error {
+ public:
+  ConfigError(const std::string& source, int line, const std::string& key, const std::string& msg);
+  const std::string& key() const { return key_; }
+
+ private:
+  std::string key_;
+};
+
+/// Parse [service] and [alarms] from `tbl` into `cfg` (other sections are
+/// ignored here).  Throws ConfigError.
+void parseServiceSections(const toml::table& tbl, const std::string& source, TwinConfig& cfg);
+
+/// The whole configuration from a TOML file (shaft sections through hoist_io,
+/// plus [service] and [alarms]).  Throws (ConfigError or hoist_io's error).
+TwinConfig loadTwinConfig(const std::string& path);
+
+/// The effective configuration as TOML (for --print-config).
+std::string toToml(const TwinConfig& cfg);
+
+/// Channel names with the configured prefix.
+struct Channels {
+  std::string winder, cage, shape, alarm, ack, health;
+  explicit Channels(const std::string& prefix = "");
+};
+
+}  // namespace hoist::svc

@@ -1,0 +1,93 @@
+// hoist/service/input_validator.hpp -- checks every winder input before it
+// can reach the model (pure: no I/O, no clock, no allocation).
+//
+// A winder sample (winder_t) carries utime [us], seq, v [m/s], a [m/s^2] and
+// optionally the encoder rope length [m] (MODEL.md: depth down, v > 0
+// descending).  check() classifies one sample against the configured limits
+// and the last ACCEPTED sample of the current stream; accept() makes it the
+// reference.  A stream is restarted with resync() (after the input went
+// stale): the next sample is then checked against the limits only, so a
+// restarted winder gateway (new seq, new time base) is picked up again.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace hoist::svc {
+
+/// Why an input was rejected.  Names (toString) appear in HOIST_HEALTH and logs.
+enum class RejectReason : std::uint8_t {
+  Decode,         ///< "decode": garbage, truncated, or wrong type fingerprint
+  NonFinite,      ///< "non_finite": NaN or infinity in v, a or length
+  VelocityLimit,  ///< "v_limit": |v| > max_speed
+  AccelLimit,     ///< "a_limit": |a| > max_accel
+  DuplicateSeq,   ///< "duplicate_seq": seq equal to or older than the last accepted
+  TimeBackwards,  ///< "time_backwards": utime not after the last accepted utime
+  TimeJump,       ///< "time_jump": utime more than max_time_step after the last accepted
+  LengthRange,    ///< "length_range": rope length outside (0, L - 2h)
+  LengthJump,     ///< "length_jump": encoder length off the v-predicted length by > max_length_jump
+  ModelDomain,    ///< "model_domain": the model refused the step (l left its range)
+};
+inline constexpr int kRejectReasons = 10;
+const char* toString(RejectReason r);
+
+/// One winder input, already decoded.
+struct WinderSample {
+  std::int64_t utime = 0;   ///< [us since the Unix epoch]
+  std::int64_t seq = 0;
+  double v = 0.0;           ///< [m/s]
+  double a = 0.0;           ///< [m/s^2]
+  bool has_length = false;
+  double length = 0.0;      ///< encoder rope length [m], if has_length
+};
+
+struct InputLimits {
+  double max_speed = 20.0;       ///< |v| limit [m/s]
+  double max_accel = 10.0;       ///< |a| limit [m/s^2]
+  double max_length_jump = 0.5;  ///< encoder length vs prediction [m]
+  double max_time_step = 1.0;    ///< largest utime step within a stream [s]
+  double min_length = 0.0;       ///< exclusive lower bound of l [m]
+  double max_length = 384.0;     ///< exclusive upper bound of l (L - 2h) [m]
+};
+
+struct Verdict {
+  bool ok = true;
+  RejectReason reason = RejectReason::Decode;  ///< valid when !ok
+  std::int64_t skipped = 0;  ///< sequence numbers missing before this sample (ok only)
+};
+
+class InputValidator {
+ public:
+  explicit InputValidator(const InputLimits& limits = {}) : lim_(limits) {}
+  const InputLimits& limits() const { return lim_; }
+
+  /// Classify `s`; does not change state.
+  Verdict check(const WinderSample& s) const;
+  /// Make `s` the reference for the following samples.
+  void accept(const WinderSample& s);
+  /// Forget the stream reference (next sample starts a new stream).
+  void resync() { have_last_ = false; }
+  bool hasReference() const { return have_last_; }
+  const WinderSample& last() const { return last_; }
+
+ private:
+  InputLimits lim_;
+  WinderSample last_;
+  bool have_last_ = false;
+};
+
+/// Accepted/rejected counters by reason (plain integers, no allocation).
+struct InputCounters {
+  std::int64_t accepted = 0;
+  std::int64_t seq_gaps = 0;
+  std::array<std::int64_t, kRejectReasons> rejected{};
+  void reject(RejectReason r) { ++rejected[static_cast<int>(r)]; }
+  std::int64_t rejectedTotal() const {
+    std::int64_t n = 0;
+    for (auto v : rejected) n += v;
+    return n;
+  }
+  std::int64_t count(RejectReason r) const { return rejected[static_cast<int>(r)]; }
+};
+
+}  // namespace hoist::svc

@@ -1,0 +1,157 @@
+// hoist/service/twin_core.hpp -- the twin's logic without any I/O: input
+// validation, kinematics following, model stepping and fault recovery,
+// clearance alarms.  hoist-twind wraps it with LCM and timers; tests drive
+// it directly.
+//
+// Kinematics (MODEL.md: l = hoisting-rope length = depth of the cage's top
+// sleeves, v = dl/dt > 0 descending, a = dv/dt):
+//   * when a winder sample carries the encoder length the twin follows it;
+//   * otherwise l is integrated from v, starting at the shaft config's
+//     initial_length (or the first encoder length seen), by the trapezoidal
+//     rule with the a-consistent end correction
+//       l1 = l0 + dt (v0 + v1)/2 + dt^2 (a0 - a1)/12
+//     (exact for piecewise-cubic l, so it reproduces HoistProfile's l).
+//
+// Clocks:
+//   * ClockMode::Input -- onInput() steps the model exactly to each accepted
+//     sample's time t = (utime - utime_first) / 1e6 s; one output per input.
+//     Deterministic: the same input sequence gives bit-identical outputs.
+//   * ClockMode::Wall -- onInput() only stores the latest sample; tick(t)
+//     steps the model to model time t (the daemon's timer).  Between samples
+//     the encoder length is extrapolated with v for at most stale_timeout.
+//     While the input is stale the twin holds l with v = a = 0.
+//
+// Every time-dependent alarm rule (delays, shelving, re-announce) runs on
+// model time.  Staleness is judged on the caller's wall clock (`wall_now`,
+// seconds, monotonic).
+//
+// Real time: after construction nothing here allocates (the solver's fast
+// path, GuideRopeEnvelope and the fixed-size event buffer do not).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "hoist/service/alarms.hpp"
+#include "hoist/service/config.hpp"
+#include "hoist/service/input_validator.hpp"
+#include "hoist/solver.hpp"
+
+namespace hoist::svc {
+
+/// One published cage state (see msgs/cage_state_t.lcm).
+struct CageOutput {
+  double t = 0.0;
+  Kinematics kin;
+  double x_c = 0.0, y_c = 0.0, theta = 0.0;
+  std::array<double, 5> lambda{};
+  Clearance clearance;
+  bool degraded = true;
+  std::int64_t input_seq = -1;
+  std::int64_t input_utime = 0;  ///< utime of the input the state answers (input clock)
+  AlarmLevel alarm_level = AlarmLevel::None;
+};
+
+/// What onInput()/tick() did.
+struct InputResult {
+  bool accepted = false;
+  RejectReason reason = RejectReason::Decode;  ///< valid when !accepted
+  bool stepped = false;        ///< a new output is ready (input clock)
+  bool reinitialized = false;  ///< the model was re-initialized (new stream, fault)
+};
+
+struct TickResult {
+  bool stepped = false;
+  bool fault = false;          ///< non-finite state; model re-initialized
+  bool domain_error = false;   ///< the model refused the kinematics; state held
+};
+
+/// Operator command (alarm_ack_t).
+enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3 };
+
+class TwinCore {
+ public:
+  /// `solver` may be injected (tests); by default makeSolver(Method::Fast).
+  /// Throws ParamError / std::invalid_argument for a bad configuration.
+  TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solver> solver = nullptr);
+
+  /// A winder sample received at wall time `wall_now` [s].
+  InputResult onInput(const WinderSample& s, double wall_now);
+  /// An undecodable message (garbage, truncated, wrong fingerprint).
+  void rejectUndecodable() { counters_.reject(RejectReason::Decode); }
+  /// Wall clock: step the model to model time t (> current).  Input clock: no-op.
+  TickResult tick(double t, double wall_now);
+  /// Staleness, shelve expiry and re-announcement; call at least a few times
+  /// per second (the daemon calls it every tick).
+  void housekeeping(double wall_now);
+  /// Operator command; returns the number of alarms affected.
+  int command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLevel level,
+              double shelve_duration);
+
+  const CageOutput& output() const { return out_; }
+  /// Alarm events since the last clearEvents() (the caller publishes them).
+  const AlarmEvents& events() const { return events_; }
+  void clearEvents() { events_.clear(); }
+
+  /// Evaluate the guide-rope shape on the shape grid (allocation-free);
+  /// read it from shape().depths()/y1()/y2().
+  void evaluateShape() { shape_.evaluate(*solver_); }
+  const GuideRopeEnvelope& shape() const { return shape_; }
+
+  const InputCounters& counters() const { return counters_; }
+  const AlarmEngine& alarms() const { return alarms_; }
+  const TwinConfig& config() const { return cfg_; }
+  ClockMode clock() const { return clock_; }
+  double modelTime() const { return t_; }
+  bool started() const { return started_; }
+  bool stale() const { return stale_; }
+  bool degraded() const { return out_.degraded; }
+  /// Seconds since the last accepted input (-1 if none yet).
+  double inputAge(double wall_now) const { return have_input_ ? wall_now - last_input_wall_ : -1.0; }
+  std::int64_t steps() const { return steps_; }
+  std::int64_t modelFaults() const { return faults_; }
+  std::int64_t modelResets() const { return resets_; }
+  std::int64_t domainErrors() const { return domain_errors_; }
+  const Solver& solver() const { return *solver_; }
+
+ private:
+  bool lengthOk(double l) const { return l > 0.0 && l < lmax_; }
+  Kinematics integrate(const Kinematics& k0, double v1, double a1, double dt) const;
+  void initializeAt(double t, const Kinematics& k);
+  /// Step to (t, k) with substeps; false if the model refused (domain_error).
+  bool advance(double t, const Kinematics& k);
+  /// After a step or init: fault check, clearance, alarms, output.
+  bool finishStep(double t, bool allow_fault_check = true);
+  void setStale(bool stale);
+  bool degradedNow() const;
+
+  TwinConfig cfg_;
+  ClockMode clock_;
+  std::unique_ptr<Solver> solver_;
+  GuideRopeEnvelope envelope_;
+  GuideRopeEnvelope shape_;
+  InputValidator validator_;
+  AlarmEngine alarms_;
+  AlarmEvents events_;
+  InputCounters counters_;
+  CageOutput out_;
+  double lmax_;
+
+  bool started_ = false;        // model initialized
+  double t_ = 0.0;              // model time [s]
+  Kinematics kin_;              // kinematics of the current model state
+  // input stream
+  bool have_input_ = false;     // any input accepted since start
+  bool stream_ = false;         // validator has a reference (not stale)
+  WinderSample last_;           // last accepted sample
+  double last_input_wall_ = 0.0;
+  std::int64_t utime_base_ = 0; // input clock: utime at model time t_base_
+  double t_base_ = 0.0;
+  bool stale_ = false;
+  double start_wall_ = -1.0;
+  double fault_until_ = -1.0;   // degraded until this model time after a re-init
+  bool fault_pending_clear_ = false;
+  std::int64_t steps_ = 0, faults_ = 0, resets_ = 0, domain_errors_ = 0;
+};
+
+}  // namespace hoist::svc

@@ -1,0 +1,127 @@
+// [service] and [alarms] parsing: defaults, errors naming file:line and key.
+#include <gtest/gtest.h>
+
+#include "hoist/service/config.hpp"
+
+using namespace hoist::svc;
+
+namespace {
+
+TwinConfig parse(const std::string& text) {
+  TwinConfig cfg;
+  parseServiceSections(toml::parse(text), "test.toml", cfg);
+  return cfg;
+}
+
+std::string errorOf(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST(ServiceConfig, DefaultsWhenAbsent) {
+  const TwinConfig c = parse("");
+  EXPECT_EQ(c.service.rate, 100.0);
+  EXPECT_EQ(c.service.clock, ClockMode::Wall);
+  EXPECT_EQ(c.alarms.gap_pos_y, 0.30);
+  EXPECT_TRUE(c.alarms.latch_critical);
+}
+
+TEST(ServiceConfig, ReadsEveryKey) {
+  const TwinConfig c = parse(R"(
+[service]
+rate = 200
+cage_rate = 50.0
+shape_rate = 2.0
+health_rate = 2.0
+channel_prefix = "SITE1_"
+lcm_url = "udpm://239.255.76.67:7700?ttl=0"
+clock = "input"
+max_speed = 12.0
+max_accel = 3.0
+max_length_jump = 0.25
+max_time_step = 0.5
+stale_timeout = 0.3
+max_step = 0.005
+shape_points = 51
+envelope_points = 201
+log_rate_limit = 2
+fault_hold = 2.0
+
+[alarms]
+gap_pos_y = 0.2
+gap_neg_y = 0.25
+guide_rope_gap = 0.4
+warning_fraction = 0.4
+critical_fraction = 0.7
+deadband = 0.05
+on_delay = 0.2
+off_delay = 2.0
+reannounce = 0
+latch_critical = false
+max_shelve = 600
+)");
+  EXPECT_EQ(c.service.rate, 200.0);
+  EXPECT_EQ(c.service.cage_rate, 50.0);
+  EXPECT_EQ(c.service.channel_prefix, "SITE1_");
+  EXPECT_EQ(c.service.clock, ClockMode::Input);
+  EXPECT_EQ(c.service.shape_points, 51);
+  EXPECT_EQ(c.service.max_step, 0.005);
+  EXPECT_EQ(c.alarms.gap_neg_y, 0.25);
+  EXPECT_EQ(c.alarms.reannounce, 0.0);
+  EXPECT_FALSE(c.alarms.latch_critical);
+  EXPECT_EQ(c.alarms.max_shelve, 600.0);
+}
+
+TEST(ServiceConfig, UnknownKeyNamesFileLineAndKey) {
+  const std::string e = errorOf("[service]\nrate = 100\nbogus = 1\n");
+  EXPECT_NE(e.find("test.toml:3"), std::string::npos) << e;
+  EXPECT_NE(e.find("service.bogus"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
+}
+
+TEST(ServiceConfig, WrongTypeAndRange) {
+  std::string e = errorOf("[alarms]\ngap_pos_y = \"wide\"\n");
+  EXPECT_NE(e.find("test.toml:2: alarms.gap_pos_y: must be a number"), std::string::npos) << e;
+  e = errorOf("[service]\n\nrate = 5000\n");
+  EXPECT_NE(e.find("test.toml:3: service.rate"), std::string::npos) << e;
+  e = errorOf("[service]\nclock = \"sundial\"\n");
+  EXPECT_NE(e.find("service.clock"), std::string::npos) << e;
+  e = errorOf("[alarms]\nwarning_fraction = 0.9\ncritical_fraction = 0.8\n");
+  EXPECT_NE(e.find("alarms.warning_fraction"), std::string::npos) << e;
+  e = errorOf("[alarms]\ngap_neg_y = nan\n");
+  EXPECT_NE(e.find("alarms.gap_neg_y"), std::string::npos) << e;
+  e = errorOf("service = 3\n");
+  EXPECT_NE(e.find("service"), std::string::npos) << e;
+  e = errorOf("[service]\nshape_points = 1.5\n");
+  EXPECT_NE(e.find("service.shape_points: must be an integer"), std::string::npos) << e;
+  e = errorOf("[service]\nchannel_prefix = \"a b\"\n");
+  EXPECT_NE(e.find("service.channel_prefix"), std::string::npos) << e;
+}
+
+TEST(ServiceConfig, PrintedConfigParsesBack) {
+  TwinConfig c;
+  c.service.rate = 250.0;
+  c.service.channel_prefix = "X_";
+  c.alarms.deadband = 0.03;
+  const std::string text = toToml(c);
+  const TwinConfig d = parse(text);
+  EXPECT_EQ(d.service.rate, 250.0);
+  EXPECT_EQ(d.service.channel_prefix, "X_");
+  EXPECT_EQ(d.alarms.deadband, 0.03);
+}
+
+TEST(Channels, Prefix) {
+  const Channels ch("A_");
+  EXPECT_EQ(ch.winder, "A_HOIST_WINDER");
+  EXPECT_EQ(ch.cage, "A_HOIST_CAGE");
+  EXPECT_EQ(ch.shape, "A_HOIST_GUIDE_SHAPE");
+  EXPECT_EQ(ch.alarm, "A_HOIST_ALARM");
+  EXPECT_EQ(ch.ack, "A_HOIST_ALARM_ACK");
+  EXPECT_EQ(ch.health, "A_HOIST_HEALTH");
+}

@@ -1,0 +1,130 @@
+// Winder input validation (service/input_validator.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "hoist/service/input_validator.hpp"
+
+using namespace hoist::svc;
+
+namespace {
+
+InputLimits limits() {
+  InputLimits l;
+  l.max_speed = 10.0;
+  l.max_accel = 2.0;
+  l.max_length_jump = 0.5;
+  l.max_time_step = 1.0;
+  l.max_length = 384.0;
+  return l;
+}
+
+WinderSample sample(std::int64_t seq, double t, double v = 5.0, double a = 0.0) {
+  WinderSample s;
+  s.seq = seq;
+  s.utime = 1'700'000'000'000'000 + static_cast<std::int64_t>(std::llround(t * 1e6));
+  s.v = v;
+  s.a = a;
+  return s;
+}
+
+WinderSample withLength(WinderSample s, double l) {
+  s.has_length = true;
+  s.length = l;
+  return s;
+}
+
+}  // namespace
+
+TEST(InputValidator, AcceptsAValidStream) {
+  InputValidator v(limits());
+  for (int k = 0; k < 10; ++k) {
+    const auto s = withLength(sample(k, 0.01 * k), 50.0 + 0.05 * k);
+    const Verdict r = v.check(s);
+    ASSERT_TRUE(r.ok) << k;
+    EXPECT_EQ(r.skipped, 0);
+    v.accept(s);
+  }
+}
+
+TEST(InputValidator, RejectsNonFinite) {
+  InputValidator v(limits());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(v.check(sample(0, 0, nan)).reason, RejectReason::NonFinite);
+  EXPECT_EQ(v.check(sample(0, 0, 1.0, inf)).reason, RejectReason::NonFinite);
+  EXPECT_EQ(v.check(withLength(sample(0, 0), nan)).reason, RejectReason::NonFinite);
+  // A NaN length without has_length is ignored.
+  auto s = sample(0, 0);
+  s.length = nan;
+  EXPECT_TRUE(v.check(s).ok);
+}
+
+TEST(InputValidator, RejectsOutOfLimits) {
+  InputValidator v(limits());
+  EXPECT_EQ(v.check(sample(0, 0, 10.5)).reason, RejectReason::VelocityLimit);
+  EXPECT_EQ(v.check(sample(0, 0, -10.5)).reason, RejectReason::VelocityLimit);
+  EXPECT_TRUE(v.check(sample(0, 0, -10.0)).ok);
+  EXPECT_EQ(v.check(sample(0, 0, 1.0, 2.5)).reason, RejectReason::AccelLimit);
+  EXPECT_EQ(v.check(withLength(sample(0, 0), 0.0)).reason, RejectReason::LengthRange);
+  EXPECT_EQ(v.check(withLength(sample(0, 0), -3.0)).reason, RejectReason::LengthRange);
+  EXPECT_EQ(v.check(withLength(sample(0, 0), 384.0)).reason, RejectReason::LengthRange);
+  EXPECT_TRUE(v.check(withLength(sample(0, 0), 383.9)).ok);
+}
+
+TEST(InputValidator, SequenceNumbers) {
+  InputValidator v(limits());
+  v.accept(sample(5, 0.0));
+  EXPECT_EQ(v.check(sample(5, 0.01)).reason, RejectReason::DuplicateSeq);
+  EXPECT_EQ(v.check(sample(4, 0.01)).reason, RejectReason::DuplicateSeq);
+  const Verdict r = v.check(sample(9, 0.01));  // 6, 7, 8 lost: accepted, counted
+  EXPECT_TRUE(r.ok);
+  EXPECT_EQ(r.skipped, 3);
+}
+
+TEST(InputValidator, Time) {
+  InputValidator v(limits());
+  v.accept(sample(0, 1.0));
+  EXPECT_EQ(v.check(sample(1, 1.0)).reason, RejectReason::TimeBackwards);
+  EXPECT_EQ(v.check(sample(1, 0.5)).reason, RejectReason::TimeBackwards);
+  EXPECT_EQ(v.check(sample(1, 2.5)).reason, RejectReason::TimeJump);
+  EXPECT_TRUE(v.check(sample(1, 1.5)).ok);
+  // Extreme utimes must not overflow anything.
+  auto s = sample(1, 0);
+  s.utime = std::numeric_limits<std::int64_t>::max();
+  EXPECT_EQ(v.check(s).reason, RejectReason::TimeJump);
+  s.utime = std::numeric_limits<std::int64_t>::min();
+  EXPECT_EQ(v.check(s).reason, RejectReason::TimeBackwards);
+  s = sample(std::numeric_limits<std::int64_t>::max(), 1.01);
+  EXPECT_TRUE(v.check(s).ok);
+}
+
+TEST(InputValidator, LengthJumpAgainstTheSpeedPrediction) {
+  InputValidator v(limits());
+  v.accept(withLength(sample(0, 0.0, 5.0), 100.0));
+  // After 0.1 s at 5 m/s the length should be 100.5 m.
+  EXPECT_TRUE(v.check(withLength(sample(1, 0.1, 5.0), 100.5)).ok);
+  EXPECT_TRUE(v.check(withLength(sample(1, 0.1, 5.0), 100.9)).ok);
+  EXPECT_EQ(v.check(withLength(sample(1, 0.1, 5.0), 101.1)).reason, RejectReason::LengthJump);
+  EXPECT_EQ(v.check(withLength(sample(1, 0.1, 5.0), 99.9)).reason, RejectReason::LengthJump);
+}
+
+TEST(InputValidator, ResyncStartsANewStream) {
+  InputValidator v(limits());
+  v.accept(withLength(sample(1000, 100.0), 300.0));
+  const auto restarted = withLength(sample(0, 0.0), 50.0);
+  EXPECT_FALSE(v.check(restarted).ok);
+  v.resync();
+  EXPECT_TRUE(v.check(restarted).ok);
+}
+
+TEST(InputCounters, CountByReason) {
+  InputCounters c;
+  c.reject(RejectReason::Decode);
+  c.reject(RejectReason::Decode);
+  c.reject(RejectReason::LengthJump);
+  EXPECT_EQ(c.count(RejectReason::Decode), 2);
+  EXPECT_EQ(c.rejectedTotal(), 3);
+  EXPECT_STREQ(toString(RejectReason::LengthJump), "length_jump");
+}

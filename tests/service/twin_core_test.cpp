@@ -1,0 +1,316 @@
+// TwinCore: the daemon's logic without I/O -- determinism of the input clock,
+// agreement with hoist::simulate(), encoder following, rejections, staleness,
+// model-fault recovery, clearance alarms.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "hoist/service/twin_core.hpp"
+#include "hoist/simulator.hpp"
+
+using namespace hoist;
+using namespace hoist::svc;
+
+namespace {
+
+constexpr std::int64_t kT0 = 1'700'000'000'000'000;
+
+WinderSample sampleAt(const HoistProfile& p, long k, double dt, bool with_length) {
+  const double t = p.startTime() + static_cast<double>(k) * dt;
+  const Kinematics kin = p.at(t);
+  WinderSample s;
+  s.utime = kT0 + std::llround((t - p.startTime()) * 1e6);
+  s.seq = k;
+  s.v = kin.v;
+  s.a = kin.a;
+  s.has_length = with_length;
+  s.length = with_length ? kin.l : 0.0;
+  return s;
+}
+
+TwinConfig smallConfig() {
+  TwinConfig c;
+  c.shaft.n = 12;  // fast tests
+  c.service.envelope_points = 101;
+  c.service.shape_points = 21;
+  return c;
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+/// Wraps the fast solver; reports a non-finite state once when armed.
+class FaultySolver final : public Solver {
+ public:
+  explicit FaultySolver(std::shared_ptr<const ShaftModel> m)
+      : Solver(m), inner_(makeSolver(Method::Fast, m)) {}
+  void initialize(double t0, const Kinematics& k0, InitialState init) override {
+    ++inits;
+    poisoned_ = false;
+    inner_->initialize(t0, k0, init);
+  }
+  void step(double t1, const Kinematics& k1) override {
+    inner_->step(t1, k1);
+    if (arm_at >= 0 && t1 >= arm_at) {
+      poisoned_ = true;
+      arm_at = -1;
+    }
+  }
+  const CageResponse& response() const override {
+    if (!poisoned_) return inner_->response();
+    bad_ = inner_->response();
+    bad_.y_c = std::numeric_limits<double>::quiet_NaN();
+    return bad_;
+  }
+  void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override {
+    inner_->guideRopeShapes(x, y1, y2);
+  }
+  void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override {
+    inner_->guideRopeCoordinates(q1, q2);
+  }
+  bool finite() const override { return !poisoned_ && inner_->finite(); }
+  Method method() const override { return Method::Fast; }
+
+  double arm_at = -1.0;
+  int inits = 0;
+
+ private:
+  std::unique_ptr<Solver> inner_;
+  bool poisoned_ = false;
+  mutable CageResponse bad_;
+};
+
+}  // namespace
+
+TEST(TwinCoreInput, MatchesSimulateStepForStep) {
+  const TwinConfig cfg = smallConfig();
+  const HoistProfile prof = HoistProfile::trapezoid(50.0, 2.0, 1.0, 10.0, 8.0, 0.01);
+  for (bool with_length : {true, false}) {
+    TwinCore core(cfg, ClockMode::Input);
+    auto ref = makeSolver(Method::Fast, std::make_shared<const ShaftModel>(cfg.shaft));
+    std::vector<CageResponse> expect;
+    SimulationOptions opt;
+    opt.dt = 0.01;
+    opt.max_step = cfg.service.max_step;  // the twin substeps like hoist-sim
+    simulate(*ref, prof, opt, [&](const CageResponse& r) { expect.push_back(r); });
+    for (std::size_t k = 0; k < expect.size(); ++k) {
+      const InputResult r = core.onInput(sampleAt(prof, static_cast<long>(k), 0.01, with_length), 0.0);
+      ASSERT_TRUE(r.accepted) << k;
+      ASSERT_TRUE(r.stepped);
+      const CageOutput& o = core.output();
+      const CageResponse& e = expect[k];
+      ASSERT_NEAR(o.t, e.t, 1e-12);
+      ASSERT_NEAR(o.kin.l, e.kin.l, 1e-9) << k;
+      ASSERT_NEAR(o.y_c, e.y_c, 1e-9 * std::fabs(e.y_c) + 1e-15) << k;
+      ASSERT_NEAR(o.theta, e.theta, 1e-9 * std::fabs(e.theta) + 1e-15) << k;
+      ASSERT_NEAR(o.x_c, e.x_c, 1e-9 * std::fabs(e.x_c) + 1e-15) << k;
+      for (int i = 0; i < 5; ++i) ASSERT_NEAR(o.lambda[i], e.lambda[i], 1e-6 * std::fabs(e.lambda[i]) + 1e-9);
+      EXPECT_FALSE(o.degraded);
+    }
+  }
+}
+
+TEST(TwinCoreInput, SameInputsGiveBitIdenticalOutputs) {
+  const TwinConfig cfg = smallConfig();
+  const HoistProfile prof = HoistProfile::emergencyStop(100.0, 5.0, 1.0, 3.0, 3.0, 0.01);
+  TwinCore a(cfg, ClockMode::Input), b(cfg, ClockMode::Input);
+  for (long k = 0; k <= 300; ++k) {
+    const auto s = sampleAt(prof, k, 0.01, false);
+    a.onInput(s, 0.001 * k);
+    b.onInput(s, 5.0 + 0.002 * k);  // different wall timing, same result
+    const CageOutput &x = a.output(), &y = b.output();
+    ASSERT_TRUE(sameBits(x.t, y.t) && sameBits(x.kin.l, y.kin.l) && sameBits(x.y_c, y.y_c) &&
+                sameBits(x.theta, y.theta) && sameBits(x.x_c, y.x_c) &&
+                sameBits(x.clearance.min_clearance, y.clearance.min_clearance))
+        << k;
+    for (int i = 0; i < 5; ++i) ASSERT_TRUE(sameBits(x.lambda[i], y.lambda[i]));
+  }
+}
+
+TEST(TwinCoreInput, FollowsTheEncoderAndIntegratesWithoutIt) {
+  const TwinConfig cfg = smallConfig();
+  TwinCore core(cfg, ClockMode::Input);
+  WinderSample s;
+  s.utime = kT0;
+  s.v = 2.0;
+  s.has_length = true;
+  s.length = 120.0;
+  ASSERT_TRUE(core.onInput(s, 0.0).accepted);
+  EXPECT_DOUBLE_EQ(core.output().kin.l, 120.0);
+  s.utime += 100000;  // 0.1 s
+  s.seq = 1;
+  s.length = 120.2;
+  ASSERT_TRUE(core.onInput(s, 0.1).accepted);
+  EXPECT_DOUBLE_EQ(core.output().kin.l, 120.2);
+  EXPECT_DOUBLE_EQ(core.output().t, 0.1);
+  // Without the encoder: trapezoidal integration of v from the last length.
+  s.utime += 100000;
+  s.seq = 2;
+  s.has_length = false;
+  s.v = 4.0;
+  ASSERT_TRUE(core.onInput(s, 0.2).accepted);
+  EXPECT_NEAR(core.output().kin.l, 120.2 + 0.1 * 0.5 * (2.0 + 4.0), 1e-12);
+}
+
+TEST(TwinCoreInput, RejectionsLeaveTheModelUntouched) {
+  const TwinConfig cfg = smallConfig();
+  TwinCore core(cfg, ClockMode::Input);
+  WinderSample s;
+  s.utime = kT0;
+  s.has_length = true;
+  s.length = 100.0;
+  ASSERT_TRUE(core.onInput(s, 0.0).accepted);
+  const CageOutput before = core.output();
+  WinderSample bad = s;
+  bad.seq = 1;
+  bad.utime += 10000;
+  bad.length = 1000.0;  // beyond L - 2h
+  EXPECT_EQ(core.onInput(bad, 0.01).reason, RejectReason::LengthRange);
+  bad.length = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(core.onInput(bad, 0.01).reason, RejectReason::NonFinite);
+  bad.length = 100.0;
+  bad.v = 1e9;
+  EXPECT_EQ(core.onInput(bad, 0.01).reason, RejectReason::VelocityLimit);
+  bad.v = 0.0;
+  bad.seq = 0;
+  EXPECT_EQ(core.onInput(bad, 0.01).reason, RejectReason::DuplicateSeq);
+  core.rejectUndecodable();
+  EXPECT_EQ(core.counters().rejectedTotal(), 5);
+  EXPECT_EQ(core.counters().accepted, 1);
+  EXPECT_TRUE(sameBits(core.output().y_c, before.y_c));
+  EXPECT_EQ(core.steps(), 0);
+  // Without the encoder the integrated length is range-checked too.
+  WinderSample runaway;
+  runaway.utime = kT0 + 20000;
+  runaway.seq = 2;
+  runaway.v = 19.0;
+  for (int k = 0; k < 2000; ++k) {
+    runaway.utime += 900000;
+    ++runaway.seq;
+    const InputResult r = core.onInput(runaway, 0.02 + k);
+    if (!r.accepted) {
+      EXPECT_EQ(r.reason, RejectReason::LengthRange);
+      break;
+    }
+  }
+  EXPECT_GT(core.counters().count(RejectReason::LengthRange), 1);
+  EXPECT_LT(core.output().kin.l, cfg.shaft.maxRopeLength());
+}
+
+TEST(TwinCoreWall, StaleInputHoldsAndRaisesAnAlarm) {
+  TwinConfig cfg = smallConfig();
+  cfg.service.stale_timeout = 0.5;
+  TwinCore core(cfg, ClockMode::Wall);
+  EXPECT_TRUE(core.degraded());  // no input yet
+  WinderSample s;
+  s.utime = kT0;
+  s.v = 1.0;
+  double wall = 0.0;
+  for (int k = 1; k <= 100; ++k) {
+    wall = 0.01 * k;
+    s.seq = k;
+    s.utime = kT0 + 10000 * k;
+    ASSERT_TRUE(core.onInput(s, wall).accepted);
+    ASSERT_TRUE(core.tick(wall, wall).stepped);
+    core.housekeeping(wall);
+  }
+  EXPECT_FALSE(core.degraded());
+  EXPECT_NEAR(core.output().kin.l, cfg.shaft.l0 + 1.0 - 0.005, 1e-9);  // ramp 0 -> 1 m/s in the first tick
+  EXPECT_EQ(core.alarms().find(AlarmKind::InputStale, AlarmLevel::Warning)->active(), false);
+  // Input stops: after stale_timeout the twin holds l with v = a = 0.
+  for (int k = 101; k <= 200; ++k) {
+    wall = 0.01 * k;
+    core.tick(wall, wall);
+    core.housekeeping(wall);
+  }
+  EXPECT_TRUE(core.stale());
+  EXPECT_TRUE(core.degraded());
+  EXPECT_TRUE(core.alarms().find(AlarmKind::InputStale, AlarmLevel::Warning)->active());
+  EXPECT_EQ(core.output().kin.v, 0.0);
+  const double held = core.output().kin.l;
+  core.tick(2.5, 2.5);
+  EXPECT_EQ(core.output().kin.l, held);
+  // A restarted stream (new seq and time base) is accepted again.
+  s.seq = 0;
+  s.utime = kT0 - 5'000'000;
+  ASSERT_TRUE(core.onInput(s, 2.6).accepted);
+  core.housekeeping(2.6);
+  EXPECT_FALSE(core.stale());
+  EXPECT_FALSE(core.degraded());
+  EXPECT_FALSE(core.alarms().find(AlarmKind::InputStale, AlarmLevel::Warning)->active());
+}
+
+TEST(TwinCoreWall, EncoderJumpOnANewStreamReinitializes) {
+  const TwinConfig cfg = smallConfig();
+  TwinCore core(cfg, ClockMode::Wall);
+  WinderSample s;
+  s.utime = kT0;
+  s.has_length = true;
+  s.length = 200.0;
+  const InputResult r = core.onInput(s, 0.0);
+  ASSERT_TRUE(r.accepted);
+  EXPECT_TRUE(r.reinitialized);
+  EXPECT_DOUBLE_EQ(core.output().kin.l, 200.0);
+  core.tick(0.01, 0.01);
+  EXPECT_NEAR(core.output().kin.l, 200.0, 1e-12);
+}
+
+TEST(TwinCoreFault, NonFiniteStateRaisesModelFaultAndRecovers) {
+  const TwinConfig cfg = smallConfig();
+  auto model = std::make_shared<const ShaftModel>(cfg.shaft);
+  auto solver = std::make_unique<FaultySolver>(model);
+  FaultySolver* fs = solver.get();
+  fs->arm_at = 0.5;
+  TwinCore core(cfg, ClockMode::Input, std::move(solver));
+  const HoistProfile prof = HoistProfile::trapezoid(50.0, 2.0, 1.0, 10.0, 8.0, 0.01);
+  bool saw_raise = false;
+  for (long k = 0; k <= 100; ++k) {
+    ASSERT_TRUE(core.onInput(sampleAt(prof, k, 0.01, true), 0.0).accepted);
+    const CageOutput& o = core.output();
+    ASSERT_TRUE(std::isfinite(o.y_c)) << "a NaN reached the output at k = " << k;
+    for (const AlarmEvent& e : core.events())
+      if (e.kind == AlarmKind::ModelFault && e.type == AlarmEventType::Raise) saw_raise = true;
+    core.clearEvents();
+    if (k == 50) {
+      EXPECT_TRUE(o.degraded);
+    }
+  }
+  EXPECT_TRUE(saw_raise);
+  EXPECT_EQ(core.modelFaults(), 1);
+  EXPECT_EQ(fs->inits, 2);  // start + recovery
+  EXPECT_TRUE(core.solver().finite());
+  // Latched until acknowledged; degraded for fault_hold (1 s) after the fault.
+  EXPECT_EQ(core.alarms().highestActive(), AlarmLevel::Critical);
+  EXPECT_EQ(core.command(AlarmAction::Ack, AlarmKind::ModelFault, AlarmLevel::None, 0.0), 1);
+  EXPECT_EQ(core.alarms().highestActive(), AlarmLevel::None);
+}
+
+TEST(TwinCoreAlarms, TightGapRaisesAClearanceWarning) {
+  TwinConfig cfg = smallConfig();
+  // Static excursion of the paper's cage at l = 50 m with 12 modes: ~7.5 mm
+  // toward +y at the bottom sleeves (~11 mm with 50 modes).  A 10 mm gap with
+  // a 60 % warning (6 mm) and 90 % critical (9 mm) must raise the WARNING only.
+  cfg.alarms.gap_pos_y = 0.010;
+  cfg.alarms.warning_fraction = 0.6;
+  cfg.alarms.critical_fraction = 0.9;
+  cfg.alarms.on_delay = 0.05;
+  TwinCore core(cfg, ClockMode::Input);
+  const HoistProfile prof = HoistProfile::trapezoid(50.0, 2.0, 1.0, 10.0, 8.0, 0.01);
+  int raises = 0;
+  for (long k = 0; k <= 20; ++k) {
+    core.onInput(sampleAt(prof, k, 0.01, true), 0.0);
+    for (const AlarmEvent& e : core.events())
+      if (e.kind == AlarmKind::CagePosY && e.type == AlarmEventType::Raise) {
+        ++raises;
+        EXPECT_EQ(e.level, AlarmLevel::Warning);
+        EXPECT_NEAR(e.t, 0.05, 1e-9);  // after the on-delay
+      }
+    core.clearEvents();
+  }
+  EXPECT_EQ(raises, 1);
+  EXPECT_EQ(core.output().alarm_level, AlarmLevel::Warning);
+  EXPECT_LT(core.output().clearance.clearance_pos, 0.010 * 0.4);
+  EXPECT_GT(core.output().clearance.clearance_pos, 0.010 * 0.1);
+  EXPECT_NEAR(core.output().clearance.min_clearance, core.output().clearance.clearance_pos, 1e-15);
+}

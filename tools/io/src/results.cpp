@@ -1,0 +1,42 @@
+#include "hoist/io/results.hpp"
+
+#include <ostream>
+
+namespace hoist::io {
+
+void writeResultHeader(std::ostream& out) { out << kResultHeader << '\n'; }
+
+void writeResultRow(std::ostream& out, const CageResponse& r) {
+  std::string s;
+  s.reserve(256);
+  const double cols[] = {r.t,     r.kin.l,     r.kin.v,     r.kin.a,     r.x_c,       r.y_c,
+                         r.theta, r.lambda[0], r.lambda[1], r.lambda[2], r.lambda[3], r.lambda[4]};
+  bool first = true;
+  for (double c : cols) {
+    if (!first) s += ',';
+    first = false;
+    appendNumber(s, c);
+  }
+  s += '\n';
+  out << s;
+}
+
+void writeShapeHeader(std::ostream& out) { out << kShapeHeader << '\n'; }
+
+void writeShapeRows(std::ostream& out, double t, const VectorXd& x, const VectorXd& y1, const VectorXd& y2) {
+  std::string s;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    s.clear();
+    appendNumber(s, t);
+    s += ',';
+    appendNumber(s, x[i]);
+    s += ',';
+    appendNumber(s, y1[i]);
+    s += ',';
+    appendNumber(s, y2[i]);
+    s += '\n';
+    out << s;
+  }
+}
+
+}  // namespace hoist::io

@@ -1,0 +1,223 @@
+// hoist-replay -- publishes the winder input HOIST_WINDER (winder_t) for
+// hoist-twind, in real time or faster.
+//
+//   hoist-replay [--profile FILE|SPEC | --lcm-log FILE] [--speed X] [--rate HZ]
+//                [--lcm-url URL] [--with-length] [--channel-prefix P]
+//
+// Sources:
+//   * a synthetic profile SPEC (hoist_io): `paper` (the default: the paper's
+//     Fig. 2 trapezoid, 50 m -> 300 m in 60 s), `trapezoid:...`, `scurve:...`,
+//     `estop:...`; or a profile CSV (t, v, a [, l]; INTERFACES.md).  Sampled
+//     at --rate (default 100 Hz) at t_k = t0 + k / rate, k = 0 .. round((t_end -
+//     t0) * rate), exactly the times hoist-sim --dt 1/rate steps to;
+//   * an LCM log (lcm-logger): every event whose channel ends in HOIST_WINDER
+//     is re-published with its recorded timing, payload unchanged (so
+//     `hoist-twind --clock input` reproduces the recorded run), unless
+//     --restamp rewrites utime to the replay's wall clock.
+// Message k carries seq = k and utime = (wall time at start, us) + round((t_k -
+// t0) * 1e6): utime follows PROFILE time whatever the speed, so that
+// `hoist-twind --clock input` steps the model exactly by the profile's dt.
+// --speed X publishes X times faster than real time (0 = as fast as possible;
+// over UDP a too fast stream may overrun the receiver's socket buffer, which
+// the daemon counts as sequence gaps).  Sleeps follow an absolute schedule
+// (clock_nanosleep TIMER_ABSTIME), so timing errors do not accumulate.
+// Progress is shown on a terminal only.  Ctrl-C stops cleanly (status 130).
+#include <CLI/CLI.hpp>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <vector>
+
+#include "hoist/io/profile.hpp"
+#include "hoist/service/lcm_util.hpp"
+#include "hoist/winder_t.hpp"
+#include "hoist/io/config.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t g_signal = 0;
+void onSignal(int sig) { g_signal = sig; }
+
+/// Sleep until the absolute CLOCK_MONOTONIC time `deadline_ns`; false if a
+/// signal asked us to stop.
+bool sleepUntil(std::int64_t deadline_ns) {
+  timespec ts{static_cast<time_t>(deadline_ns / 1000000000), static_cast<long>(deadline_ns % 1000000000)};
+  while (!g_signal) {
+    const int r = clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+    if (r == 0) return true;
+    if (r != EINTR) return true;
+  }
+  return false;
+}
+
+std::int64_t monotonicNs() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+class Progress {
+ public:
+  explicit Progress(bool on) : on_(on) {}
+  void update(double t, double t0, double t1, long sent) {
+    if (!on_) return;
+    const std::int64_t now = monotonicNs();
+    if (now - last_ < 200000000) return;
+    last_ = now;
+    const double f = t1 > t0 ? (t - t0) / (t1 - t0) : 1.0;
+    std::fprintf(stderr, "\rhoist-replay: t = %8.2f / %.2f s  %5.1f %%  %ld messages ", t, t1, 100.0 * f, sent);
+    std::fflush(stderr);
+  }
+  void done() {
+    if (on_) std::fputc('\n', stderr);
+  }
+
+ private:
+  bool on_;
+  std::int64_t last_ = 0;
+};
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "hoist-replay: publish the winder input (LCM channel HOIST_WINDER) for hoist-twind from\n"
+      "a synthetic hoist profile, a profile CSV or an LCM log, in real time or at --speed X.\n"
+      "With no source it plays the paper's trapezoid (Fig. 2: 50 m -> 300 m, 60 s)."};
+  std::string profile_arg, log_path, url, prefix, config_path;
+  double speed = 1.0, rate = 100.0;
+  bool with_length = false, restamp = false, quiet = false;
+  auto* prof = app.add_option("--profile", profile_arg,
+                              "profile CSV file, or SPEC: paper | trapezoid:... | scurve:... | estop:... "
+                              "(see hoist-sim --help)");
+  auto* logopt = app.add_option("--lcm-log", log_path, "re-publish HOIST_WINDER events of this LCM log")
+                     ->check(CLI::ExistingFile);
+  prof->excludes(logopt);
+  logopt->excludes(prof);
+  app.add_option("--speed", speed, "playback speed factor; 0 = as fast as possible (default 1)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--rate", rate, "messages per second of profile time (default 100)")
+      ->check(CLI::Range(0.1, 10000.0));
+  app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
+  app.add_option("--channel-prefix", prefix, "prepended to the channel name (HOIST_WINDER)");
+  app.add_option("--config", config_path,
+                 "shaft TOML: hoisting_rope.initial_length starts profiles that have no l column")
+      ->check(CLI::ExistingFile);
+  app.add_flag("--with-length", with_length, "include the encoder rope length l in every message");
+  app.add_flag("--restamp", restamp, "--lcm-log: rewrite utime to the replay's wall clock");
+  app.add_flag("-q,--quiet", quiet, "no progress display");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+
+  url = hoist::svc::resolveLcmUrl(url);
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::cerr << "hoist-replay: cannot open LCM at " << hoist::svc::describeLcmUrl(url) << "\n";
+    return 1;
+  }
+  const std::string channel = prefix + "HOIST_WINDER";
+  struct sigaction sa {};
+  sa.sa_handler = onSignal;  // no SA_RESTART: interrupt the sleep
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  Progress progress(!quiet && isatty(STDERR_FILENO));
+  const std::int64_t start_ns = monotonicNs();
+  const std::int64_t start_utime = hoist::svc::wallUtime();
+  long sent = 0, failed = 0;
+  std::vector<std::uint8_t> buf(256);
+  hoist::winder_t msg{};
+
+  if (!log_path.empty()) {
+    lcm::LogFile log(log_path, "r");
+    if (!log.good()) {
+      std::cerr << "hoist-replay: cannot open " << log_path << " as an LCM log\n";
+      return 1;
+    }
+    std::int64_t first_ts = 0, first_utime = 0;
+    bool first = true;
+    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+      if (g_signal) break;
+      if (!endsWith(ev->channel, "HOIST_WINDER")) continue;
+      if (first) {
+        first_ts = ev->timestamp;
+        first = false;
+      }
+      const double t_rel = static_cast<double>(ev->timestamp - first_ts) * 1e-6;
+      if (speed > 0.0 && !sleepUntil(start_ns + static_cast<std::int64_t>(t_rel / speed * 1e9))) break;
+      const void* data = ev->data;
+      int len = ev->datalen;
+      if (restamp) {
+        if (msg.decode(ev->data, 0, ev->datalen) != ev->datalen) {
+          ++failed;
+          continue;
+        }
+        if (sent == 0) first_utime = msg.utime;
+        msg.utime = start_utime + (msg.utime - first_utime);
+        len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+        data = buf.data();
+      }
+      if (lcm.publish(channel, data, static_cast<unsigned>(len)) != 0) ++failed;
+      else ++sent;
+      progress.update(t_rel, 0.0, t_rel, sent);
+    }
+  } else {
+    double l0 = 50.0;
+    try {
+      if (!config_path.empty())
+        l0 = hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(config_path), config_path,
+                                            {"service", "alarms"}).l0;
+    } catch (const std::exception& e) {
+      std::cerr << "hoist-replay: " << e.what() << "\n";
+      return 2;
+    }
+    hoist::HoistProfile profile;
+    try {
+      profile = hoist::io::loadProfile(profile_arg.empty() ? std::string("paper") : profile_arg, l0);
+    } catch (const std::exception& e) {
+      std::cerr << "hoist-replay: " << e.what() << "\n";
+      return 2;
+    }
+    const double t0 = profile.startTime(), t1 = profile.endTime();
+    const double dt = 1.0 / rate;
+    const long steps = std::lround((t1 - t0) / dt);
+    for (long k = 0; k <= steps && !g_signal; ++k) {
+      const double t = t0 + static_cast<double>(k) * dt;
+      if (speed > 0.0 && !sleepUntil(start_ns + static_cast<std::int64_t>((t - t0) / speed * 1e9))) break;
+      const hoist::Kinematics kin = profile.at(t);
+      msg.utime = start_utime + std::llround((t - t0) * 1e6);
+      msg.seq = k;
+      msg.v = kin.v;
+      msg.a = kin.a;
+      msg.has_length = with_length;
+      msg.length = with_length ? kin.l : 0.0;
+      const int len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      if (len < 0 || lcm.publish(channel, buf.data(), static_cast<unsigned>(len)) != 0) ++failed;
+      else ++sent;
+      progress.update(t, t0, t1, sent);
+    }
+  }
+  progress.done();
+  if (g_signal) {
+    std::cerr << "hoist-replay: stopped by signal after " << sent << " messages\n";
+    return 128 + g_signal;
+  }
+  if (!quiet)
+    std::cerr << "hoist-replay: published " << sent << " messages on " << channel
+              << (failed ? " (" + std::to_string(failed) + " failed)" : std::string()) << "\n";
+  return failed ? 1 : 0;
+}

@@ -1,0 +1,341 @@
+// hoist-sim -- run the cable-guided hoist model of Wang et al. (2016) over a
+// whole hoist profile as fast as possible and write the cage response.
+//
+//   hoist-sim [--config FILE] --profile FILE|SPEC --out FILE.csv [--dt 0.01]
+//             [--modes N] [--initial static|rest] [--method fast|paper]
+//             [--shape-out FILE.csv --shape-times 18,36,60]
+//   hoist-sim study ...        (runs hoist-study: the paper's parameter studies)
+//
+// Phases, each timed in the summary: load (config, profile), setup (mode
+// integrals, solver), solve (time stepping, rows kept in memory), output.
+// Exit status: 0 done, 2 bad input (config, profile, options), 1 the run
+// failed (non-finite state, write error).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "hoist/io/config.hpp"
+#include "hoist/io/profile.hpp"
+#include "hoist/io/results.hpp"
+#include "hoist/shaft_model.hpp"
+#include "hoist/simulator.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+struct Options {
+  std::string config, profile = "paper", out, shape_out, shape_times = "18,36,60", write_profile;
+  double dt = 0.01, max_step = 0.0025, t_end = -1.0, rho_inf = -1.0;
+  int modes = 0, shape_points = 401;
+  std::string initial, method = "fast";
+  bool quiet = false, print_config = false;
+};
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::vector<double> parseTimes(const std::string& s) {
+  std::vector<double> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t pos = 0;
+    double v = 0;
+    try {
+      v = std::stod(item, &pos);
+    } catch (...) {
+      pos = 0;
+    }
+    while (pos < item.size() && item[pos] == ' ') ++pos;
+    if (item.empty() || pos != item.size() || !std::isfinite(v))
+      throw UsageError("--shape-times: expected comma-separated seconds, got '" + item + "'");
+    out.push_back(v);
+  }
+  if (out.empty()) throw UsageError("--shape-times: no times given");
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// One progress line on a terminal, rewritten in place.
+class Progress {
+ public:
+  explicit Progress(bool on) : on_(on), start_(Clock::now()) {}
+  void update(double frac, double t_model) {
+    if (!on_) return;
+    const double el = secondsSince(start_);
+    const int width = 30, filled = static_cast<int>(frac * width);
+    const double eta = frac > 0.01 ? el * (1.0 - frac) / frac : 0.0;
+    std::fprintf(stderr, "\r  [%.*s%*s] %3.0f%%  t = %7.2f s  elapsed %5.1f s  eta %5.1f s ", filled,
+                 "==============================", width - filled, "", frac * 100.0, t_model, el, eta);
+    std::fflush(stderr);
+  }
+  void done() {
+    if (on_) std::fprintf(stderr, "\r%*s\r", 90, "");
+  }
+
+ private:
+  bool on_;
+  Clock::time_point start_;
+};
+
+struct Peak {
+  double value = 0.0, t = 0.0;
+  void see(double v, double t_) {
+    if (std::abs(v) > value) {
+      value = std::abs(v);
+      t = t_;
+    }
+  }
+};
+
+/// Runs `hoist-study` (next to this executable) with the remaining arguments.
+int runStudy(int argc, char** argv) {
+  std::string self(4096, '\0');
+  const ssize_t n = ::readlink("/proc/self/exe", self.data(), self.size() - 1);
+  std::string dir = n > 0 ? self.substr(0, static_cast<std::size_t>(n)) : std::string(argv[0]);
+  dir = dir.substr(0, dir.find_last_of('/') + 1);
+  const std::string study = dir + "hoist-study";
+  std::vector<char*> args;
+  args.push_back(const_cast<char*>(study.c_str()));
+  for (int i = 2; i < argc; ++i) args.push_back(argv[i]);
+  args.push_back(nullptr);
+  ::execv(study.c_str(), args.data());
+  std::cerr << "hoist-sim: cannot run " << study << ": " << std::strerror(errno) << "\n";
+  return 2;
+}
+
+int run(const Options& o) {
+  const auto t_load = Clock::now();
+  // ---- load -------------------------------------------------------------
+  hoist::ShaftParams p;
+  if (!o.config.empty()) p = hoist::io::loadShaftConfig(o.config);
+  if (o.modes != 0) p.n = o.modes;
+  if (!o.initial.empty()) p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
+  if (o.rho_inf >= 0.0) p.rho_inf = o.rho_inf;
+  try {
+    p.validate();
+  } catch (const hoist::ParamError& e) {
+    throw UsageError(std::string("invalid parameter (from the command line) ") + e.what());
+  }
+  if (o.print_config) {
+    std::cout << hoist::io::toToml(p);
+    return 0;
+  }
+  const hoist::HoistProfile profile = hoist::io::loadProfile(o.profile, p.l0);
+  if (!o.write_profile.empty()) {
+    std::ofstream pf(o.write_profile);
+    hoist::io::writeProfileCsv(pf, profile);
+    if (!pf.flush()) throw std::runtime_error("cannot write " + o.write_profile);
+    if (!o.quiet) std::cerr << "hoist-sim: profile written to " << o.write_profile << "\n";
+    if (o.out.empty()) return 0;
+  }
+  if (o.out.empty()) throw UsageError("--out FILE.csv is required (or --write-profile / --print-config alone)");
+  const double t0 = profile.startTime();
+  const double t_end = o.t_end < 0 ? profile.endTime() : o.t_end;
+  if (!(t_end > t0)) throw UsageError("--t-end must be after the profile start");
+  hoist::HoistProfile checked = profile;
+  {
+    // Only the part that will be simulated must stay in the shaft.
+    std::vector<hoist::ProfileSample> part;
+    for (const auto& s : profile.samples())
+      if (s.t <= t_end + o.dt) part.push_back(s);
+    if (part.size() >= 2) hoist::io::checkProfileInShaft(hoist::HoistProfile(part), p, o.profile);
+    else hoist::io::checkProfileInShaft(profile, p, o.profile);
+  }
+  hoist::SimulationOptions sim;
+  sim.dt = o.dt;
+  sim.max_step = o.max_step;
+  sim.t_end = t_end;
+  sim.method = o.method == "paper" ? hoist::Method::Paper : hoist::Method::Fast;
+  sim.initial = p.initial;
+  int sub = 1;
+  try {
+    sub = hoist::substepsFor(sim);
+  } catch (const std::exception& e) {
+    throw UsageError(std::string("--max-step: ") + e.what());
+  }
+  std::vector<double> shape_times;
+  if (!o.shape_out.empty()) {
+    shape_times = parseTimes(o.shape_times);
+    for (double ts : shape_times)
+      if (ts < t0 - 1e-9 || ts > t_end + 1e-9)
+        throw UsageError("--shape-times: " + std::to_string(ts) + " s is outside the run [" + std::to_string(t0) +
+                         ", " + std::to_string(t_end) + "] s");
+  }
+  // Open outputs before the long part so a bad path fails at once.
+  std::ofstream out(o.out);
+  if (!out) throw std::runtime_error("cannot open --out " + o.out + " for writing");
+  std::ofstream shape_file;
+  if (!o.shape_out.empty()) {
+    shape_file.open(o.shape_out);
+    if (!shape_file) throw std::runtime_error("cannot open --shape-out " + o.shape_out + " for writing");
+  }
+  const double load_s = secondsSince(t_load);
+
+  // ---- setup ------------------------------------------------------------
+  const auto t_setup = Clock::now();
+  auto model = std::make_shared<const hoist::ShaftModel>(p);
+  auto solver = hoist::makeSolver(sim.method, model);
+  const double setup_s = secondsSince(t_setup);
+
+  const long steps = std::lround((t_end - t0) / o.dt);
+  if (!o.quiet)
+    std::cerr << "hoist-sim: " << hoist::toString(sim.method) << " path, n = " << p.n << ", initial = "
+              << hoist::toString(p.initial) << ", t = " << t0 << " .. " << t_end << " s, dt = " << o.dt << " s ("
+              << sub << " substep" << (sub > 1 ? "s" : "") << " of " << o.dt / sub << " s), " << steps
+              << " output steps\n";
+
+  // ---- solve --------------------------------------------------------------
+  std::vector<hoist::CageResponse> rows;
+  rows.reserve(static_cast<std::size_t>(steps) + 1);
+  const hoist::VectorXd xs = hoist::VectorXd::LinSpaced(std::max(2, o.shape_points), 0.0, p.L);
+  hoist::VectorXd y1(xs.size()), y2(xs.size());
+  std::string shapes;
+  std::size_t next_shape = 0;
+  Peak pk_y, pk_th, pk_x, pk_l[5];
+  Progress progress(!o.quiet && ::isatty(2));
+  const auto t_solve = Clock::now();
+  bool failed = false;
+  double fail_t = 0;
+  struct Diverged {};
+  try {
+    hoist::simulate(
+        *solver, profile, sim,
+        [&](const hoist::CageResponse& r) {
+          if (!solver->finite() || !std::isfinite(r.y_c) || !std::isfinite(r.theta) || !std::isfinite(r.x_c)) {
+            failed = true;
+            fail_t = r.t;
+            throw Diverged{};
+          }
+          rows.push_back(r);
+          pk_x.see(r.x_c, r.t);
+          pk_y.see(r.y_c, r.t);
+          pk_th.see(r.theta, r.t);
+          for (int k = 0; k < 5; ++k) pk_l[k].see(r.lambda[static_cast<std::size_t>(k)], r.t);
+          while (next_shape < shape_times.size() && r.t >= shape_times[next_shape] - 0.5 * o.dt) {
+            solver->guideRopeShapes(xs, y1, y2);
+            std::ostringstream os;
+            hoist::io::writeShapeRows(os, r.t, xs, y1, y2);
+            shapes += os.str();
+            ++next_shape;
+          }
+        },
+        [&](double f) { progress.update(f, t0 + f * (t_end - t0)); });
+  } catch (const Diverged&) {
+  } catch (const std::domain_error& e) {
+    progress.done();
+    throw std::runtime_error(std::string("the model left its domain: ") + e.what());
+  }
+  progress.done();
+  const double solve_s = secondsSince(t_solve);
+  if (failed) {
+    std::cerr << "hoist-sim: error: the state became non-finite at t = " << fail_t
+              << " s (unstable parameters or step; try a smaller --dt / --max-step). " << rows.size()
+              << " good rows are written.\n";
+  }
+
+  // ---- output -----------------------------------------------------------
+  const auto t_out = Clock::now();
+  hoist::io::writeResultHeader(out);
+  for (const auto& r : rows) hoist::io::writeResultRow(out, r);
+  out.flush();
+  if (!out) throw std::runtime_error("write error on " + o.out);
+  if (shape_file.is_open()) {
+    hoist::io::writeShapeHeader(shape_file);
+    shape_file << shapes;
+    shape_file.flush();
+    if (!shape_file) throw std::runtime_error("write error on " + o.shape_out);
+  }
+  const double out_s = secondsSince(t_out);
+
+  if (!o.quiet) {
+    const double total_steps = rows.empty() ? 0.0 : static_cast<double>(rows.size() - 1) * sub;
+    std::fprintf(stderr,
+                 "hoist-sim: wrote %zu rows to %s%s%s\n"
+                 "  peak |x_c|      = %.4e m    at t = %.2f s\n"
+                 "  peak |y_c|      = %.4e m    at t = %.2f s\n"
+                 "  peak |theta|    = %.4e rad  at t = %.2f s\n"
+                 "  peak |lambda_0| = %.4e N    at t = %.2f s\n",
+                 rows.size(), o.out.c_str(), o.shape_out.empty() ? "" : ", shapes to ", o.shape_out.c_str(), pk_x.value,
+                 pk_x.t, pk_y.value, pk_y.t, pk_th.value, pk_th.t, pk_l[0].value, pk_l[0].t);
+    for (int k = 1; k < 5; ++k)
+      std::fprintf(stderr, "  peak |lambda_%d| = %.4e N    at t = %.2f s\n", k, pk_l[k].value, pk_l[k].t);
+    std::fprintf(stderr,
+                 "  time: load %.3f s, setup %.3f s, solve %.3f s (%.0f steps/s, %.2f us/step), output %.3f s\n",
+                 load_s, setup_s, solve_s, total_steps / std::max(solve_s, 1e-9),
+                 1e6 * solve_s / std::max(total_steps, 1.0), out_s);
+  }
+  return failed ? 1 : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "study") return runStudy(argc, argv);
+  Options o;
+  CLI::App app{
+      "hoist-sim: lateral, torsional and longitudinal vibration of a cable-guided hoist\n"
+      "(Wang, Cao, Zhu, Peng & Li 2016) over a whole hoist profile, as fast as possible.\n"
+      "Writes t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4 per output step.\n"
+      "Also: 'hoist-sim study NAME ...' runs the paper's parameter studies (hoist-study --help).",
+      "hoist-sim"};
+  app.add_option("--config", o.config, "shaft TOML (INTERFACES.md); missing keys take the paper's values")
+      ->check(CLI::ExistingFile);
+  app.add_option("--profile", o.profile, std::string("hoist profile CSV or SPEC (default: paper)\n") +
+                                             hoist::io::profileSpecHelp());
+  app.add_option("--out", o.out, "result CSV to write");
+  app.add_option("--dt", o.dt, "output time step [s]")->capture_default_str()->check(CLI::Range(1e-6, 1.0));
+  app.add_option("--max-step", o.max_step,
+                 "largest integration step [s]; each --dt is split into equal substeps no longer than this "
+                 "(0: integrate with --dt). The default keeps the constraint forces within 0.5 % for a rest start")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--t-end", o.t_end, "stop at this time [s] (default: the profile's end)");
+  app.add_option("--modes", o.modes, "assumed modes per rope n (overrides model.modes)")
+      ->check(CLI::Range(1, hoist::kMaxModes));
+  app.add_option("--initial", o.initial, "initial state (overrides model.initial)")
+      ->check(CLI::IsMember({"static", "rest"}));
+  app.add_option("--method", o.method,
+                 "fast: structured KKT solver (default); paper: the paper's literal partition, Eqs. (18)-(24)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"fast", "paper"}));
+  app.add_option("--rho-inf", o.rho_inf, "generalized-alpha spectral radius (overrides model.rho_inf)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--shape-out", o.shape_out, "guide-rope shape CSV (t,x,y1,y2) at --shape-times");
+  app.add_option("--shape-times", o.shape_times, "comma-separated times [s] for --shape-out")->capture_default_str();
+  app.add_option("--shape-points", o.shape_points, "depth samples per shape")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 100000));
+  app.add_option("--write-profile", o.write_profile, "also write the profile used as CSV t,l,v,a");
+  app.add_flag("--print-config", o.print_config, "print the effective shaft configuration as TOML and exit");
+  app.add_flag("-q,--quiet", o.quiet, "no progress or summary");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  try {
+    return run(o);
+  } catch (const hoist::io::InputError& e) {
+    std::cerr << "hoist-sim: error: " << e.what() << "\n";
+    return 2;
+  } catch (const UsageError& e) {
+    std::cerr << "hoist-sim: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "hoist-sim: error: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,182 @@
+#include "output.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace hoist::study::out {
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* f) const {
+    if (f) std::fclose(f);
+  }
+};
+using File = std::unique_ptr<std::FILE, FileCloser>;
+
+File openOut(const std::string& path) {
+  File f(std::fopen(path.c_str(), "w"));
+  if (!f) throw std::runtime_error(path + ": cannot open for writing: " + std::strerror(errno));
+  return f;
+}
+
+void finish(File& f, const std::string& path) {
+  if (std::ferror(f.get()) || std::fclose(f.release()) != 0)
+    throw std::runtime_error(path + ": write failed");
+}
+
+std::string csvQuote(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::string gpQuote(const std::string& s) {  // single-quoted gnuplot string
+  std::string q;
+  for (char c : s) q += c == '\'' ? std::string("''") : std::string(1, c);
+  return "'" + q + "'";
+}
+
+}  // namespace
+
+void writeTraceCsv(const std::string& path, const Trace& tr) {
+  File f = openOut(path);
+  std::fprintf(f.get(), "t,l,v,a,x_c,y_c,theta,lambda_0,lambda_1,lambda_2,lambda_3,lambda_4\n");
+  for (std::size_t i = 0; i < tr.size(); ++i)
+    std::fprintf(f.get(), "%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", tr.t[i],
+                 tr.l[i], tr.v[i], tr.a[i], tr.x_c[i], tr.y_c[i], tr.theta[i], tr.lambda[0][i],
+                 tr.lambda[1][i], tr.lambda[2][i], tr.lambda[3][i], tr.lambda[4][i]);
+  finish(f, path);
+}
+
+void writeShapesCsv(const std::string& path, const std::vector<Shape>& shapes) {
+  File f = openOut(path);
+  std::fprintf(f.get(), "t,x,y1,y2\n");
+  for (const auto& s : shapes) {
+    for (std::size_t i = 0; i < s.x.size(); ++i)
+      std::fprintf(f.get(), "%.6g,%.9g,%.9g,%.9g\n", s.t, s.x[i], s.y1[i], s.y2[i]);
+  }
+  finish(f, path);
+}
+
+void writeSummaryCsv(const std::string& path, const Study& study, const std::vector<RunResult>& runs,
+                     const std::vector<MetricSet>& metrics) {
+  File f = openOut(path);
+  std::fprintf(f.get(), "run,label,key,value,Tb1,Tb2,m,J,Fa,b,n,initial,status");
+  const MetricSet* first = nullptr;
+  for (const auto& m : metrics)
+    if (!m.items().empty()) {
+      first = &m;
+      break;
+    }
+  if (first)
+    for (const auto& kv : first->items()) std::fprintf(f.get(), ",%s", kv.first.c_str());
+  std::fprintf(f.get(), "\n");
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const auto& r = runs[i];
+    const auto& p = r.spec.params;
+    std::fprintf(f.get(), "%zu,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%s,%s", i + 1,
+                 csvQuote(r.spec.label).c_str(), csvQuote(study.key).c_str(), r.spec.value, p.Tb1,
+                 p.Tb2, p.m, p.J, p.Fa, p.b, p.n, toString(p.initial),
+                 r.ok() ? "ok" : csvQuote("failed: " + r.error).c_str());
+    if (first)
+      for (const auto& kv : first->items())
+        std::fprintf(f.get(), ",%.9g", metrics[i].has(kv.first) ? metrics[i].get(kv.first) : std::nan(""));
+    std::fprintf(f.get(), "\n");
+  }
+  finish(f, path);
+}
+
+void writeAdvisorCsv(const std::string& path, const std::vector<AdvisorPoint>& pts) {
+  File f = openOut(path);
+  std::fprintf(f.get(), "total,split,Tb1,Tb2,peak_excursion,peak_sleeve_force,peak_y_c,peak_theta,feasible\n");
+  for (const auto& p : pts)
+    std::fprintf(f.get(), "%.9g,%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", p.total, p.split,
+                 p.split * p.total, (1.0 - p.split) * p.total, p.peaks.excursion, p.peaks.sleeve_force,
+                 p.peaks.y_c, p.peaks.theta, p.feasible ? 1 : 0);
+  finish(f, path);
+}
+
+void writeGnuplotScript(const std::string& dir, const Figure& fig) {
+  const std::string path = (std::filesystem::path(dir) / (fig.name + ".gp")).string();
+  File f = openOut(path);
+  std::FILE* o = f.get();
+  const int rows = static_cast<int>((fig.panels.size() + static_cast<std::size_t>(fig.cols) - 1) /
+                                    static_cast<std::size_t>(fig.cols));
+  std::fprintf(o, "# %s\n# Written by hoist-study; re-render with:  cd %s && gnuplot %s.gp\n",
+               fig.title.c_str(), dir.c_str(), fig.name.c_str());
+  std::fprintf(o,
+               "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
+               "  set terminal pngcairo size %d,%d font ',9' linewidth 1.2\n"
+               "} else {\n  set terminal png size %d,%d\n}\nset termoption noenhanced\n",
+               fig.width, fig.height, fig.width, fig.height);
+  std::fprintf(o, "set output %s\nset datafile separator ','\nset grid\nset key %s samplen 2\n",
+               gpQuote(fig.name + ".png").c_str(), fig.key.c_str());
+  std::fprintf(o, "set multiplot layout %d,%d title %s\n", rows, fig.cols, gpQuote(fig.title).c_str());
+  for (const auto& p : fig.panels) {
+    std::fprintf(o, "set xlabel %s\nset ylabel %s\n", gpQuote(p.xlabel).c_str(), gpQuote(p.ylabel).c_str());
+    if (!p.extra.empty()) std::fprintf(o, "%s\n", p.extra.c_str());
+    std::fprintf(o, "plot ");
+    for (std::size_t i = 0; i < p.series.size(); ++i) {
+      const auto& s = p.series[i];
+      std::fprintf(o, "%s%s using %s with %s title %s", i ? ", \\\n     " : "", gpQuote(s.file).c_str(),
+                   s.using_.c_str(), s.style.c_str(), gpQuote(s.title).c_str());
+    }
+    std::fprintf(o, "\n");
+    if (!p.extra.empty()) std::fprintf(o, "unset logscale; unset arrow; unset label; set autoscale\n");
+  }
+  std::fprintf(o, "unset multiplot\n");
+  finish(f, path);
+}
+
+std::string findGnuplot() {
+  const char* env = std::getenv("PATH");
+  std::stringstream ss(env ? env : "/usr/bin:/bin");
+  std::string dir;
+  while (std::getline(ss, dir, ':')) {
+    if (dir.empty()) continue;
+    const std::string p = dir + "/gnuplot";
+    if (::access(p.c_str(), X_OK) == 0) return p;
+  }
+  return "";
+}
+
+bool runGnuplot(const std::string& gnuplot, const std::string& dir, const std::string& script,
+                std::string& err) {
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    err = std::string("fork failed: ") + std::strerror(errno);
+    return false;
+  }
+  if (pid == 0) {
+    if (::chdir(dir.c_str()) != 0) ::_exit(126);
+    // gnuplot's own warnings go to our stderr; stdout is not used.
+    const int devnull = ::open("/dev/null", O_WRONLY);
+    if (devnull >= 0) ::dup2(devnull, STDOUT_FILENO);
+    ::execl(gnuplot.c_str(), "gnuplot", script.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) {
+      err = std::string("waitpid failed: ") + std::strerror(errno);
+      return false;
+    }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return true;
+  err = "gnuplot " + script + " in " + dir + " failed (status " +
+        std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
+  return false;
+}
+
+}  // namespace hoist::study::out
