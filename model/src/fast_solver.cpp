@@ -127,6 +127,45 @@ void FastSolver::updateResponse(double t, const Kinematics& k) {
   for (int i = 0; i < 4; ++i) resp_.lambda[i + 1] = lam_(i);
 }
 
+// When the winder already moves at t = 0 (v != 0), zero velocities violate the
+// velocity-level constraints  G qd + v G_l q = 0  (the sleeves slide along
+// deflected ropes).  The paper's reduced system (Eq. 22) starts from
+// q1' = 0 in its independent coordinates; Eq. (24) then gives
+//   qd = v Phi' q1  =>  qd_dependent = -G0^-1 v G_l q,  qd_independent = 0,
+// with the dependent coordinates of Eq. (19): the first two assumed modes of
+// each guide rope (y_c and theta are independent, so they start at rest).
+// Our rope coordinates are modal (q_sine = V eta), so the dependent
+// directions are eta = V^T e_0 and V^T e_1 of each rope.  Near the shaft ends,
+// where that partition is singular (as the paper's method is), the
+// mass-weighted least-norm velocity is used instead.
+void FastSolver::consistentInitialVelocity(double v) {
+  xd_.setZero();
+  if (v == 0.0) return;
+  const int n = n_, N = N_;
+  const Eigen::Vector4d rhs = -v * (Glt_.transpose() * x_);
+  if (rhs.cwiseAbs().maxCoeff() == 0.0) return;
+  if (n >= 2) {
+    const MatrixXd& V1 = model_->guideModalVectors(1);
+    const MatrixXd& V2 = model_->guideModalVectors(2);
+    MatrixXd D = MatrixXd::Zero(N, 4);
+    D.col(0).head(n) = V1.row(0).transpose();
+    D.col(1).head(n) = V1.row(1).transpose();
+    D.col(2).segment(n, n) = V2.row(0).transpose();
+    D.col(3).segment(n, n) = V2.row(1).transpose();
+    const Eigen::Matrix4d B = Gt_.transpose() * D;
+    Eigen::JacobiSVD<Eigen::Matrix4d> svd(B);
+    const auto& sv = svd.singularValues();
+    if (sv(3) > 1e-8 * sv(0)) {
+      xd_ = D * B.partialPivLu().solve(rhs);
+      return;
+    }
+  }
+  const VectorXd Minv = Md_.cwiseInverse();
+  const MatrixXd MG = Minv.asDiagonal() * Gt_;
+  const Eigen::Matrix4d S = Gt_.transpose() * MG;
+  xd_ = MG * S.ldlt().solve(rhs);
+}
+
 void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) {
   const ShaftParams& p = model_->params();
   if (!(k0.l > 0.0 && k0.l < p.maxRopeLength()) || !std::isfinite(k0.v) || !std::isfinite(k0.a))
@@ -156,6 +195,7 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
     x_.setZero();
   }
   fillConstraintRowDerivatives(k0.l);
+  consistentInitialVelocity(k0.v);
   // Consistent accelerations: G qdd = -2 Gdot qd - Gddot q, Gdot = v G_l, Gddot = a G_l + v^2 G_ll.
   Eigen::Vector4d d = -2.0 * k0.v * (Glt_.transpose() * xd_) -
                       (k0.a * (Glt_.transpose() * x_) + k0.v * k0.v * (Gllt_.transpose() * x_));

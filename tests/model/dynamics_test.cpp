@@ -235,6 +235,26 @@ TEST(Dynamics, FastAndPaperPathsAgreeAtPaperResolution) {
   for (int k : {-3, -2, -1, 0, 1, 2, 3, 4}) EXPECT_LT(hoist::test::nrms(col(f, k), col(q, k)), 1e-3) << k;
 }
 
+TEST(Dynamics, StartingInMotionGivesConsistentVelocities) {
+  // The winder already runs at 5 m/s at t = 0 (emergency-stop profile): zero
+  // velocities would violate G qd + v G_l q = 0 and the sleeve forces would
+  // start with a spurious, dt-dependent impulse (hundreds of N).  Both paths
+  // start from the paper's reduced state (q1' = 0): they agree, and the
+  // result no longer depends on the step.
+  ShaftParams p;
+  p.n = 20;
+  const auto prof = HoistProfile::emergencyStop(50.0, 5.0, 1.0, 3.0, 3.0, 0.01);
+  const auto f = run(p, prof, 0.01, InitialState::Static, Method::Fast, 2.0, 0.0025);
+  const auto q = run(p, prof, 0.01, InitialState::Static, Method::Paper, 2.0, 0.0025);
+  const auto fine = run(p, prof, 0.01, InitialState::Static, Method::Fast, 2.0, 0.01 / 16);
+  for (int k : {-3, -2, -1, 0, 1, 2, 3, 4}) {
+    EXPECT_LT(hoist::test::nrms(col(f, k), col(q, k)), 1e-3) << "fast vs paper, column " << k;
+    EXPECT_LT(hoist::test::nrms(col(f, k), col(fine, k)), 2e-3) << "dt vs dt/16, column " << k;
+  }
+  // Static sleeve force is -Fa b / (4 h) = -31.25 N; no start impulse.
+  for (const auto& r : f) EXPECT_LT(std::abs(r.lambda[1] + 31.25), 5.0) << "t = " << r.t;
+}
+
 TEST(Dynamics, RopeLengthOutsideTheShaftIsRejected) {
   const ShaftParams p;
   auto model = std::make_shared<const ShaftModel>(p);

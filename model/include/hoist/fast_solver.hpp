@@ -67,6 +67,8 @@ class FastSolver final : public Solver {
   void updateResponse(double t, const Kinematics& k);
 
   GeneralizedAlpha ga_;
+  /// Velocities at t0 consistent with the constraints when v(t0) != 0 (see .cpp).
+  void consistentInitialVelocity(double v);
   int n_ = 0, N_ = 0;  // modes per rope; lateral size 2n + 2
   double t_ = 0.0;
   Kinematics kin_;

@@ -1,0 +1,192 @@
+// hoist-sim as a program: INTERFACES.md's contract (columns, exit status 2 on
+// bad input with a message naming the key/line), and agreement with the
+// independent reference solutions in tests/data at the default settings.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_util.hpp"
+
+namespace fs = std::filesystem;
+using hoist::test::nrms;
+using hoist::test::readCsv;
+using hoist::test::Table;
+
+namespace {
+
+struct SimRun {
+  int status = -1;
+  std::string output;  // stdout + stderr
+};
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) {
+    if (c == '\'') q.append("'\\''");
+    else q.push_back(c);
+  }
+  q.push_back('\'');
+  return q;
+}
+
+SimRun sim(const std::vector<std::string>& args) {
+  std::string cmd = quote(HOIST_SIM);
+  for (const auto& a : args) cmd += " " + quote(a);
+  cmd += " 2>&1";
+  SimRun r;
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+class SimCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(HOIST_TEST_WORK_DIR) / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  fs::path dir_;
+};
+
+const std::string kData = HOIST_TEST_DATA_DIR;
+
+void expectMatchesReference(const Table& got, const Table& ref, double tol) {
+  ASSERT_EQ(got.rows.size(), ref.rows.size());
+  for (const char* c : {"x_c", "y_c", "theta", "lambda_0", "lambda_1", "lambda_2", "lambda_3", "lambda_4"}) {
+    const double e = nrms(got.column(c), ref.column(c));
+    EXPECT_LT(e, tol) << c;
+    ::testing::Test::RecordProperty(std::string("nrms_") + c, std::to_string(e));
+  }
+}
+
+}  // namespace
+
+TEST_F(SimCli, HeaderIsTheContract) {
+  const SimRun r = sim({"--profile", "trapezoid:t_end=1", "--out", path("o.csv"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(path("o.csv"));
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "t,l,v,a,x_c,y_c,theta,lambda_0,lambda_1,lambda_2,lambda_3,lambda_4");
+  const Table t = readCsv(path("o.csv"));
+  EXPECT_EQ(t.rows.size(), 101u);
+  EXPECT_NEAR(t.rows.back()[0], 1.0, 1e-12);
+}
+
+TEST_F(SimCli, PaperCaseStaticStartMatchesReference) {
+  const SimRun r = sim({"--config", kData + "/c1-paper/shaft.toml", "--profile", kData + "/c1-paper/profile.csv", "--out",
+                     path("o.csv"), "--shape-out", path("s.csv")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("peak |y_c|"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("steps/s"), std::string::npos) << r.output;
+  // The contract is 2 %; we are far inside it at the default dt = 0.01.
+  expectMatchesReference(readCsv(path("o.csv")), readCsv(kData + "/c1-paper/reference.csv"), 2e-3);
+
+  // Shapes at 18, 36, 60 s (paper Fig. 4) against shape.csv.
+  const Table s = readCsv(path("s.csv"));
+  const Table ref = readCsv(kData + "/c1-paper/shape.csv");
+  ASSERT_EQ(s.cols, (std::vector<std::string>{"t", "x", "y1", "y2"}));
+  ASSERT_EQ(s.rows.size(), 3 * ref.rows.size());
+  const char* cols[3][2] = {{"y1_t18", "y2_t18"}, {"y1_t36", "y2_t36"}, {"y1_t60", "y2_t60"}};
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> y1, y2;
+    for (std::size_t i = 0; i < ref.rows.size(); ++i) {
+      const auto& row = s.rows[k * ref.rows.size() + i];
+      EXPECT_NEAR(row[1], ref.rows[i][0], 1e-9);
+      y1.push_back(row[2]);
+      y2.push_back(row[3]);
+    }
+    EXPECT_LT(nrms(y1, ref.column(cols[k][0])), 2e-3) << cols[k][0];
+    EXPECT_LT(nrms(y2, ref.column(cols[k][1])), 2e-3) << cols[k][1];
+  }
+}
+
+TEST_F(SimCli, PaperCaseRestStartMatchesReference) {
+  const SimRun r = sim({"--config", kData + "/c1-paper-rest/shaft.toml", "--profile", "paper", "--out", path("o.csv"),
+                     "-q"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  expectMatchesReference(readCsv(path("o.csv")), readCsv(kData + "/c1-paper-rest/reference.csv"), 1e-2);
+}
+
+TEST_F(SimCli, PaperMethodAgreesWithFastMethod) {
+  const SimRun a = sim({"--profile", "paper", "--t-end", "3", "--out", path("fast.csv"), "-q", "--modes", "20"});
+  const SimRun b = sim({"--profile", "paper", "--t-end", "3", "--out", path("paper.csv"), "-q", "--modes", "20",
+                     "--method", "paper"});
+  ASSERT_EQ(a.status, 0) << a.output;
+  ASSERT_EQ(b.status, 0) << b.output;
+  const Table f = readCsv(path("fast.csv")), p = readCsv(path("paper.csv"));
+  ASSERT_EQ(f.rows.size(), 301u);
+  for (const char* c : {"x_c", "y_c", "theta", "lambda_0", "lambda_1", "lambda_3"})
+    EXPECT_LT(nrms(p.column(c), f.column(c)), 1e-3) << c;
+}
+
+TEST_F(SimCli, CommandLineOverridesTheConfig) {
+  const std::string cfg = write("c.toml", "[model]\nmodes = 30\ninitial = \"static\"\n");
+  const SimRun r = sim({"--config", cfg, "--modes", "12", "--initial", "rest", "--print-config"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("modes = 12"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("initial = \"rest\""), std::string::npos) << r.output;
+}
+
+TEST_F(SimCli, WriteProfileWritesThePaperTrapezoid) {
+  const SimRun r = sim({"--profile", "paper", "--write-profile", path("p.csv")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Table p = readCsv(path("p.csv")), ref = readCsv(kData + "/c1-paper/profile.csv");
+  ASSERT_EQ(p.rows.size(), ref.rows.size());
+  for (std::size_t i = 0; i < p.rows.size(); ++i)
+    for (int j = 0; j < 4; ++j) ASSERT_NEAR(p.rows[i][j], ref.rows[i][j], 1e-9) << i << "," << j;
+}
+
+TEST_F(SimCli, BadInputExitsWithStatus2AndNamesTheProblem) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string expect;
+  };
+  const std::string bad_key = write("k.toml", "[cage]\nmass = 800\ninertia = 870\nhalf_hieght = 8\n");
+  const std::string bad_val = write("v.toml", "[load]\neccentric_force = nan\n");
+  const std::string bad_csv = write("p.csv", "t,v,a\n0,0,0\n0.5,0,0\n0.4,0,0\n");
+  const std::string no_col = write("q.csv", "t,l,v\n0,50,0\n1,50,0\n");
+  const std::vector<Case> cases = {
+      {{"--config", bad_key, "--out", path("o.csv")}, "k.toml:4: cage.half_hieght: unknown key (did you mean 'half_height'?)"},
+      {{"--config", bad_val, "--out", path("o.csv")}, "v.toml:2: load.eccentric_force"},
+      {{"--profile", bad_csv, "--out", path("o.csv")}, "p.csv:4: t:"},
+      {{"--profile", no_col, "--out", path("o.csv")}, "q.csv:1: a: required column missing"},
+      {{"--profile", "trapezoid:travel=340,t_end=100", "--out", path("o.csv")}, "leaves the shaft"},
+      {{"--profile", "trapzoid", "--out", path("o.csv")}, "did you mean 'trapezoid'"},
+      {{"--out", path("o.csv"), "--dt", "-1"}, "--dt"},
+      {{"--out", path("o.csv"), "--method", "exact"}, "--method"},
+      {{"--out", path("o.csv"), "--modes", "0"}, "--modes"},
+      {{"--out", path("o.csv"), "--shape-out", path("s.csv"), "--shape-times", "18,x"}, "--shape-times"},
+      {{"--out", path("o.csv"), "--shape-out", path("s.csv"), "--shape-times", "100"}, "outside the run"},
+      {{"--profile", "paper"}, "--out"},
+      {{"--config", path("missing.toml"), "--out", path("o.csv")}, "missing.toml"},
+  };
+  for (const auto& c : cases) {
+    const SimRun r = sim(c.args);
+    EXPECT_EQ(r.status, 2) << c.args[1] << ":\n" << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << "want '" << c.expect << "' in:\n" << r.output;
+  }
+}
+
+TEST_F(SimCli, HelpDescribesTheOptions) {
+  const SimRun r = sim({"--help"});
+  EXPECT_EQ(r.status, 0);
+  for (const char* opt : {"--config", "--profile", "--out", "--dt", "--modes", "--initial", "--method", "--shape-out",
+                          "--shape-times", "trapezoid:"})
+    EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+}
