@@ -8,7 +8,10 @@
 // (untimed) when the trip ends.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <memory>
+#include <vector>
 
 #include "hoist/simulator.hpp"
 
@@ -45,6 +48,44 @@ void BM_PaperStep(benchmark::State& state) { stepBench(state, Method::Paper); }
 
 BENCHMARK(BM_FastStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Arg(400)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PaperStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
+// n = 400 costs seconds per step on the paper path: a few iterations only.
+BENCHMARK(BM_PaperStep)->Arg(400)->Unit(benchmark::kMicrosecond)->Iterations(3);
+
+/// Distribution of single fast steps over the paper's whole trip (5500 steps
+/// per iteration): p50 / p99 / p99.9 / max in microseconds as counters.  The
+/// benchmark time itself is the mean.
+void BM_FastStepLatency(benchmark::State& state) {
+  ShaftParams p;
+  p.n = static_cast<int>(state.range(0));
+  auto model = std::make_shared<const ShaftModel>(p);
+  auto s = makeSolver(Method::Fast, model);
+  const HoistProfile prof = HoistProfile::trapezoid();
+  const double dt = 0.01;
+  std::vector<double> us;
+  us.reserve(1 << 20);
+  for (auto _ : state) {
+    state.PauseTiming();
+    s->initialize(0.0, prof.at(0.0));
+    state.ResumeTiming();
+    for (long k = 1; k <= 5500; ++k) {
+      const double t = k * dt;
+      const auto kin = prof.at(t);
+      const auto a = std::chrono::steady_clock::now();
+      s->step(t, kin);
+      const auto b = std::chrono::steady_clock::now();
+      if (us.size() < us.capacity()) us.push_back(std::chrono::duration<double, std::micro>(b - a).count());
+    }
+    benchmark::DoNotOptimize(s->response().lambda[1]);
+  }
+  std::sort(us.begin(), us.end());
+  auto q = [&](double f) { return us.empty() ? 0.0 : us[std::min(us.size() - 1, static_cast<std::size_t>(f * us.size()))]; };
+  state.counters["p50_us"] = q(0.5);
+  state.counters["p99_us"] = q(0.99);
+  state.counters["p999_us"] = q(0.999);
+  state.counters["max_us"] = us.empty() ? 0.0 : us.back();
+  state.counters["steps"] = static_cast<double>(us.size());
+}
+BENCHMARK(BM_FastStepLatency)->Arg(50)->Arg(200)->Unit(benchmark::kMillisecond);
 
 /// The paper's run: n = 50, dt = 0.01 s, 60 s (6000 steps), static start,
 /// including set-up (model precomputation) and initialization.
@@ -60,6 +101,22 @@ void BM_PaperCaseFast(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PaperCaseFast)->Unit(benchmark::kMillisecond);
+
+/// The same run at hoist-sim's defaults: output every 0.01 s, integrated with
+/// 2.5 ms substeps (24000 steps).
+void BM_PaperCaseFastSubsteps(benchmark::State& state) {
+  const HoistProfile prof = HoistProfile::trapezoid();
+  for (auto _ : state) {
+    auto model = std::make_shared<const ShaftModel>(ShaftParams{});
+    auto s = makeSolver(Method::Fast, model);
+    SimulationOptions o;
+    o.max_step = 0.0025;
+    double acc = 0;
+    simulate(*s, prof, o, [&](const CageResponse& r) { acc += r.y_c; });
+    benchmark::DoNotOptimize(acc);
+  }
+}
+BENCHMARK(BM_PaperCaseFastSubsteps)->Unit(benchmark::kMillisecond);
 
 /// Model set-up (closed-form integrals, eigen-decomposition of the guide ropes).
 void BM_ModelSetup(benchmark::State& state) {

@@ -9,7 +9,10 @@ def main(path):
     with open(path) as f:
         data = json.load(f)
     med = {}
+    counters = {}
     for b in data["benchmarks"]:
+        if b.get("aggregate_name") == "median" or b.get("aggregate_name") is None:
+            counters[b.get("run_name", b["name"]).split("/min_time")[0].split("/iterations")[0]] = b
         if b.get("aggregate_name") not in ("median", None):
             continue
         name = b.get("run_name", b["name"])
@@ -55,6 +58,18 @@ def main(path):
     if case:
         out.append(f"Whole paper case (n = 50, dt = 0.01 s, 60 s = 6000 steps, set-up included), fast path: "
                    f"**{case / 1e3:.1f} ms**.\n")
+    case2 = med.get("BM_PaperCaseFastSubsteps")
+    if case2:
+        out.append(f"The same run at hoist-sim's defaults (2.5 ms substeps, 24000 steps): **{case2 / 1e3:.1f} ms**.\n")
+    lat = [(n, counters.get(f"BM_FastStepLatency/{n}")) for n in (50, 200)]
+    if any(b for _, b in lat):
+        out.append("Single fast steps over the whole trip (distribution of 5500-step runs, µs):\n")
+        out.append("| n | p50 | p99 | p99.9 | max |")
+        out.append("|---:|---:|---:|---:|---:|")
+        for n, b in lat:
+            if b:
+                out.append(f"| {n} | {b.get('p50_us', 0):.2f} | {b.get('p99_us', 0):.2f} | {b.get('p999_us', 0):.2f} | {b.get('max_us', 0):.1f} |")
+        out.append("")
     for n in (50, 200):
         s = med.get(f"BM_ModelSetup/{n}")
         if s:

@@ -119,7 +119,9 @@ int run(const Options& o) {
   const auto t_load = Clock::now();
   // ---- load -------------------------------------------------------------
   hoist::ShaftParams p;
-  if (!o.config.empty()) p = hoist::io::loadShaftConfig(o.config);
+  // A daemon configuration (shaft + [service]/[alarms]) is accepted as well;
+  // hoist-twind validates those sections.
+  if (!o.config.empty()) p = hoist::io::loadShaftConfig(o.config, {"service", "alarms"});
   if (o.modes != 0) p.n = o.modes;
   if (!o.initial.empty()) p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
   if (o.rho_inf >= 0.0) p.rho_inf = o.rho_inf;

@@ -159,7 +159,8 @@ std::pair<double, double> parseRange(const std::string& opt, const std::string& 
 // hoist_io's errors (ConfigError) already name file:line:key.
 ShaftParams studyLoadConfig(const std::string& path) {
   try {
-    return hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(path), path, {});
+    // A daemon configuration is a shaft file plus [service]/[alarms]: accept it.
+    return hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(path), path, {"service", "alarms"});
   } catch (const std::exception& e) {
     throw UsageError(std::string("--config: ") + e.what());
   }

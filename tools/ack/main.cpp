@@ -1,0 +1,77 @@
+// hoist-alarm-ack -- send one operator command to hoist-twind's alarms.
+//
+//   hoist-alarm-ack [--kind CAGE_POS_Y|...|*] [--level warning|critical|both]
+//                   [--shelve SECONDS | --unshelve] [--user NAME]
+//                   [--lcm-url URL] [--channel-prefix P]
+//
+// Default: acknowledge every active alarm ("*", both levels).  The daemon
+// answers on HOIST_ALARM with an ACK / SHELVE / UNSHELVE event (watch it with
+// hoist-monitor).  Exit status: 0 sent, 1 LCM failure, 2 bad usage.
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/service/lcm_util.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"hoist-alarm-ack: acknowledge, shelve or unshelve hoist-twind alarms (one HOIST_ALARM_ACK message)",
+               "hoist-alarm-ack"};
+  std::string kind = "*", level = "both", user, url, prefix;
+  double shelve = 0.0;
+  bool unshelve = false;
+  app.add_option("--kind", kind,
+                 "alarm kind: CAGE_POS_Y, CAGE_NEG_Y, GUIDE_ROPE, INPUT_STALE, MODEL_FAULT, or * for all")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"*", "CAGE_POS_Y", "CAGE_NEG_Y", "GUIDE_ROPE", "INPUT_STALE", "MODEL_FAULT"}));
+  app.add_option("--level", level, "warning, critical or both")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"warning", "critical", "both"}));
+  auto* sh = app.add_option("--shelve", shelve, "shelve for this many seconds instead of acknowledging")
+                 ->check(CLI::PositiveNumber);
+  app.add_flag("--unshelve", unshelve, "end a shelve early")->excludes(sh);
+  app.add_option("--user", user, "operator name (logged by the daemon; default: $USER)");
+  app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
+  app.add_option("--channel-prefix", prefix, "prefix of the daemon's channels");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  if (user.empty()) {
+    const char* u = std::getenv("USER");
+    user = u ? u : "operator";
+  }
+  hoist::alarm_ack_t m;
+  m.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                std::chrono::system_clock::now().time_since_epoch())
+                .count();
+  m.kind = kind;
+  m.level = level == "warning" ? 1 : level == "critical" ? 2 : 0;
+  m.action = unshelve ? hoist::alarm_ack_t::ACTION_UNSHELVE
+                      : (shelve > 0 ? hoist::alarm_ack_t::ACTION_SHELVE : hoist::alarm_ack_t::ACTION_ACK);
+  m.shelve_duration = shelve;
+  m.user = user;
+  url = hoist::svc::resolveLcmUrl(url);
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::cerr << "hoist-alarm-ack: cannot open LCM (" << (url.empty() ? "default URL" : url)
+              << "); is loopback multicast enabled? (scripts/setup.sh)\n";
+    return 1;
+  }
+  const std::string channel = prefix + "HOIST_ALARM_ACK";
+  if (lcm.publish(channel, &m) != 0) {
+    std::cerr << "hoist-alarm-ack: publish on " << channel << " failed\n";
+    return 1;
+  }
+  std::cout << "sent " << (unshelve ? "UNSHELVE" : shelve > 0 ? "SHELVE" : "ACK") << " kind=" << kind
+            << " level=" << level << (shelve > 0 ? " for " + std::to_string(shelve) + " s" : "") << " user=" << user
+            << " on " << channel << "\n";
+  return 0;
+}
