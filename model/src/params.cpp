@@ -64,6 +64,25 @@ void ShaftParams::validate() const {
   // constraints (Eq. 8) to hold.  A static tilt estimate is Fa b / (torsional
   // stiffness); we cannot bound it cheaply here, so only reject absurd offsets.
   if (std::abs(b) > L) throw ParamError("load.offset", "|b| must be smaller than the guide-rope length");
+  // Physically impossible ropes.  The hoisting rope carries the cage and its
+  // own weight; its static strain at the longest admissible length,
+  // (m + rho1 (L - 2h)) g / EA, must stay below 2 % (a steel wire rope breaks
+  // at about 1-2 %; the paper's rope is at 0.06 %), else the linear-elastic
+  // model describes a rope that has already parted.
+  const double strain = (m + rho1 * maxRopeLength()) * g / EA;
+  if (!(strain < 0.02))
+    throw ParamError("hoisting_rope.axial_stiffness",
+                     "too low for the load: the static strain (m + rho1 (L - 2h)) g / EA would be " +
+                         fmt(100.0 * strain) + " % (a steel rope parts at about 2 %; EA = " + fmt(EA) + " N)");
+  // The guide ropes are tensioned by weights at their lower end; a preload
+  // far below the rope's own weight leaves the lower part nearly slack (wave
+  // speed -> 0) and the cage unguided.  Require Tb >= 1 % of rho2 g L.
+  const double rope_weight = rho2 * g * L;
+  for (double tb : {Tb1, Tb2})
+    if (tb < 0.01 * rope_weight)
+      throw ParamError("guide_ropes.preload",
+                       "preload " + fmt(tb) + " N is too low for the guide rope's own weight rho2 g L = " +
+                           fmt(rope_weight) + " N: it must be at least 1 % of it (the rope would hang slack)");
 }
 
 }  // namespace hoist

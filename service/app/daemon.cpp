@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "hoist/service/lcm_util.hpp"
+#include "hoist/service/winder_decode.hpp"
 
 namespace hoist::svc {
 
@@ -202,22 +203,14 @@ void Daemon::logReject(RejectReason r, const char* detail) {
 
 void Daemon::onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
   const double wall = wallNow();
-  const auto size = static_cast<int>(rbuf->data_size);
-  const int used = winder_in_.decode(rbuf->data, 0, size);
-  if (used < 0 || used != size) {
+  WinderSample s;
+  const WinderDecode dec = decodeWinder(rbuf->data, rbuf->data_size, winder_in_, s);
+  if (dec != WinderDecode::Ok) {
     core_.rejectUndecodable();
-    std::snprintf(text_, sizeof text_, "%d bytes: %s", size,
-                  used < 0 ? "not a hoist.winder_t (bad fingerprint or truncated)" : "trailing bytes");
+    std::snprintf(text_, sizeof text_, "%u bytes: %s", static_cast<unsigned>(rbuf->data_size), describe(dec));
     logReject(RejectReason::Decode, text_);
     return;
   }
-  WinderSample s;
-  s.utime = winder_in_.utime;
-  s.seq = winder_in_.seq;
-  s.v = winder_in_.v;
-  s.a = winder_in_.a;
-  s.has_length = winder_in_.has_length;
-  s.length = winder_in_.length;
 
   const auto t0 = Clock::now();
   const InputResult res = core_.onInput(s, wall);
@@ -310,6 +303,11 @@ void Daemon::onTick(const boost::system::error_code& ec) {
     k = passed;
   }
   const double wall = duration<double>(now - start_).count();
+  if (opt_.inject_fault_at >= 0.0 && !fault_injected_ && wall >= opt_.inject_fault_at) {
+    fault_injected_ = true;
+    log_->warn("test: injecting a model fault (non-finite state) at wall time {:.3f} s", wall);
+    core_.injectFault();
+  }
 
   if (core_.clock() == ClockMode::Wall) {
     const double t = static_cast<double>(k) / opt_.cfg.service.rate;
@@ -328,7 +326,7 @@ void Daemon::onTick(const boost::system::error_code& ec) {
         log_->warn("model refused the kinematics at t = {:.3f} s (l = {:.3f} m); holding the rope length{}",
                    t, core_.output().kin.l, suppressed ? fmt::format(" [{} similar suppressed]", suppressed) : std::string());
     }
-    if (r.stepped) {
+    if (r.stepped && core_.hasInput()) {
       const std::int64_t utime = wallUtime();
       if (k % cage_div_ == 0) publishCage(utime);
       if (opt_.cfg.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime);
@@ -363,7 +361,8 @@ void Daemon::stop(const char* why) {
 // ---- outputs -----------------------------------------------------------------
 
 bool Daemon::publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len) {
-  if (lcm_.publish(channel, buf.data(), static_cast<unsigned int>(len)) != 0) {
+  const bool injected = opt_.fail_publish_every > 0 && ++publish_attempts_ % opt_.fail_publish_every == 0;
+  if (injected || lcm_.publish(channel, buf.data(), static_cast<unsigned int>(len)) != 0) {
     ++publish_failures_;
     std::int64_t suppressed = 0;
     if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
@@ -440,7 +439,7 @@ void Daemon::drainAlarmEvents() {
   if (ev.empty()) return;
   const std::int64_t utime = wallUtime();
   for (const AlarmEvent& e : ev) {
-    describe(e, opt_.cfg.alarms, opt_.cfg.service.stale_timeout, text_, sizeof text_);
+    describe(e, opt_.cfg.alarms, core_.staleTimeout(), text_, sizeof text_);
     alarm_msg_.utime = utime;
     alarm_msg_.id = alarm_id_++;
     alarm_msg_.t = e.t;

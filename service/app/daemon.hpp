@@ -41,6 +41,9 @@ struct DaemonOptions {
   TwinConfig cfg;          ///< effective configuration (command line applied)
   std::string lcm_url;     ///< resolved URL ("" = LCM default)
   double duration = 0.0;   ///< stop after this many seconds (0 = run until signalled)
+  // Test-only fault injection (hidden options, tests/hardening):
+  double inject_fault_at = -1.0;  ///< wall time [s] at which the model state is treated as non-finite once
+  int fail_publish_every = 0;     ///< every N-th LCM publish is treated as failed (0 = never)
 };
 
 class Daemon {
@@ -96,6 +99,8 @@ class Daemon {
   LatencyHistogram step_hist_, late_hist_;      // this health window
   LatencyHistogram step_total_, late_total_;    // whole run (final report)
   std::int64_t publish_failures_ = 0, nonfinite_blocked_ = 0, alarm_events_ = 0;
+  std::int64_t publish_attempts_ = 0;
+  bool fault_injected_ = false;
   std::int64_t cage_seq_ = 0, alarm_id_ = 0;
   LogRateLimiter<kRejectReasons + 2> reject_log_{5};
 

@@ -44,6 +44,11 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
+  // Test-only fault injection (tests/hardening); hidden from --help.
+  double inject_fault_at = -1.0;
+  int fail_publish_every = 0;
+  app.add_option("--test-inject-fault-at", inject_fault_at)->group("");
+  app.add_option("--test-fail-publish-every", fail_publish_every)->group("")->check(CLI::NonNegativeNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -82,6 +87,8 @@ int main(int argc, char** argv) {
   }
   opt.lcm_url = resolveLcmUrl(lcm_url, opt.cfg.service.lcm_url);
   opt.duration = duration;
+  opt.inject_fault_at = inject_fault_at;
+  opt.fail_publish_every = fail_publish_every;
 
   // Asynchronous, non-blocking logger: a full queue drops the oldest line
   // instead of stalling the tick.

@@ -60,6 +60,8 @@ void ServiceConfig::validate() const {
   checkRange("max_length_jump", max_length_jump, 0.0, 1e4, true);
   checkRange("max_time_step", max_time_step, 0.0, 3600.0, true);
   checkRange("stale_timeout", stale_timeout, 0.0, 3600.0, true);
+  checkRange("stale_periods", stale_periods, 0.0, 1000.0);
+  checkRange("stale_min", stale_min, 0.0, 3600.0);
   checkRange("max_step", max_step, 0.0, 10.0);
   checkRange("shape_points", shape_points, 2, 2001);
   checkRange("envelope_points", envelope_points, 2, 20001);
@@ -180,6 +182,8 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   sr.number("max_length_jump", s.max_length_jump);
   sr.number("max_time_step", s.max_time_step);
   sr.number("stale_timeout", s.stale_timeout);
+  sr.number("stale_periods", s.stale_periods);
+  sr.number("stale_min", s.stale_min);
   sr.number("max_step", s.max_step);
   sr.integer("shape_points", s.shape_points);
   sr.integer("envelope_points", s.envelope_points);
@@ -254,6 +258,7 @@ std::string toToml(const TwinConfig& c) {
      << "\"\nclock = \"" << toString(s.clock) << "\"\nmax_speed = " << Num{s.max_speed}
      << "\nmax_accel = " << Num{s.max_accel} << "\nmax_length_jump = " << Num{s.max_length_jump}
      << "\nmax_time_step = " << Num{s.max_time_step} << "\nstale_timeout = " << Num{s.stale_timeout}
+     << "\nstale_periods = " << Num{s.stale_periods} << "\nstale_min = " << Num{s.stale_min}
      << "\nmax_step = " << Num{s.max_step} << "\nshape_points = " << s.shape_points
      << "\nenvelope_points = " << s.envelope_points << "\nlog_rate_limit = " << s.log_rate_limit
      << "\nfault_hold = " << Num{s.fault_hold} << "\n\n";

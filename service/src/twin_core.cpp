@@ -107,11 +107,12 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
   (void)allow_fault_check;
   const double h = cfg_.shaft.h;
   for (int attempt = 0; attempt < 2; ++attempt) {
-    bool ok = solver_->finite();
+    bool ok = solver_->finite() && !inject_fault_;
+    inject_fault_ = false;
     if (ok) {
       const CageResponse& r = solver_->response();
       const double gdef = envelope_.evaluate(*solver_);
-      out_.t = t;
+      out_.t = t - t_pub_offset_;
       out_.kin = r.kin;
       out_.x_c = r.x_c;
       out_.y_c = r.y_c;
@@ -149,6 +150,12 @@ bool TwinCore::degradedNow() const {
   return !have_input_ || stale_ || t_ < fault_until_;
 }
 
+double TwinCore::staleTimeout() const {
+  const ServiceConfig& s = cfg_.service;
+  if (clock_ != ClockMode::Wall || !(s.stale_periods > 0.0) || !(period_est_ > 0.0)) return s.stale_timeout;
+  return std::min(s.stale_timeout, std::max(s.stale_min, s.stale_periods * period_est_));
+}
+
 void TwinCore::setStale(bool stale) {
   stale_ = stale;
   alarms_.setInputStale(t_, stale, events_);
@@ -172,6 +179,9 @@ InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
   };
   if (!v.ok) return reject(v.reason);
   const bool new_stream = !validator_.hasReference();
+  // Input period of this stream, from the sender's time stamps (immune to
+  // network jitter); lost messages only make the estimate more lenient.
+  const double period = new_stream ? 0.0 : static_cast<double>(s.utime - validator_.last().utime) * 1e-6;
 
   if (clock_ == ClockMode::Input) {
     double t;
@@ -216,15 +226,35 @@ InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
     validator_.accept(s);
     last_ = s;
     last_input_wall_ = wall_now;
+    const bool first_input = !have_input_;
     have_input_ = true;
     stream_ = true;
     if (stale_) setStale(false);
-    if (new_stream && s.has_length && std::fabs(s.length - kin_.l) > cfg_.service.max_length_jump) {
+    if (first_input) {
+      // The twin idled at rest at l0 until now.  Start the trip here: the
+      // model is re-initialized at this input's kinematics (consistent with
+      // a winder already moving), and the published time t counts from this
+      // instant, so HOIST_CAGE.t is trip time, comparable with hoist-sim for
+      // the same profile.
+      const Kinematics k{s.has_length ? s.length : kin_.l, s.v, s.a};
+      if (lengthOk(k.l)) {
+        const auto resets = resets_;
+        res.reinitialized = s.has_length && std::fabs(s.length - kin_.l) > cfg_.service.max_length_jump;
+        // The trip starts when the input arrived (the daemon's wall clock
+        // and its tick times share one time base), not at the last tick.
+        const double t0 = std::max(t_, wall_now);
+        t_pub_offset_ = t0;
+        initializeAt(t0, k);
+        resets_ = resets;
+      }
+    } else if (new_stream && s.has_length && std::fabs(s.length - kin_.l) > cfg_.service.max_length_jump) {
       initializeAt(t_, Kinematics{s.length, s.v, s.a});
       res.reinitialized = true;
     }
     out_.degraded = degradedNow();
   }
+  if (new_stream) period_est_ = 0.0;
+  else if (period > 0.0) period_est_ = period_est_ > 0.0 ? 0.9 * period_est_ + 0.1 * period : period;
   ++counters_.accepted;
   counters_.seq_gaps += v.skipped;
   res.accepted = true;
@@ -239,7 +269,7 @@ TickResult TwinCore::tick(double t, double wall_now) {
   if (!have_input_ || stale_) {
     k = Kinematics{kin_.l, 0.0, 0.0};
   } else if (last_.has_length) {
-    const double tau = std::clamp(wall_now - last_input_wall_, 0.0, cfg_.service.stale_timeout);
+    const double tau = std::clamp(wall_now - last_input_wall_, 0.0, staleTimeout());
     k = Kinematics{last_.length + last_.v * tau, last_.v, last_.a};
   } else {
     k = integrate(kin_, last_.v, last_.a, dt);
@@ -264,7 +294,7 @@ void TwinCore::housekeeping(double wall_now) {
   if (start_wall_ < 0.0) start_wall_ = wall_now;
   bool stale_now;
   if (have_input_)
-    stale_now = wall_now - last_input_wall_ > cfg_.service.stale_timeout;
+    stale_now = wall_now - last_input_wall_ > staleTimeout();
   else
     stale_now = clock_ == ClockMode::Wall && wall_now - start_wall_ > cfg_.service.stale_timeout;
   if (stale_now && !stale_) setStale(true);

@@ -211,12 +211,15 @@ TEST(TwinCoreWall, StaleInputHoldsAndRaisesAnAlarm) {
     wall = 0.01 * k;
     s.seq = k;
     s.utime = kT0 + 10000 * k;
-    ASSERT_TRUE(core.onInput(s, wall).accepted);
+    ASSERT_TRUE(core.onInput(s, wall - 0.001).accepted);  // inputs arrive just before the ticks
     ASSERT_TRUE(core.tick(wall, wall).stepped);
     core.housekeeping(wall);
   }
   EXPECT_FALSE(core.degraded());
-  EXPECT_NEAR(core.output().kin.l, cfg.shaft.l0 + 1.0 - 0.005, 1e-9);  // ramp 0 -> 1 m/s in the first tick
+  // The first input (wall = 0.009) starts the trip at 1 m/s: by the tick at
+  // wall = 1.0 the trip has lasted 0.991 s.
+  EXPECT_NEAR(core.output().kin.l, cfg.shaft.l0 + 0.991, 1e-9);
+  EXPECT_NEAR(core.output().t, 0.991, 1e-12);  // trip time, from the first input
   EXPECT_EQ(core.alarms().find(AlarmKind::InputStale, AlarmLevel::Warning)->active(), false);
   // Input stops: after stale_timeout the twin holds l with v = a = 0.
   for (int k = 101; k <= 200; ++k) {

@@ -31,7 +31,13 @@ struct ServiceConfig {
   double max_accel = 10.0;      ///< input limit |a| [m/s^2]
   double max_length_jump = 0.5; ///< encoder length off its v-prediction by more -> reject [m]
   double max_time_step = 1.0;   ///< larger utime step within a stream -> reject [s]
-  double stale_timeout = 0.5;   ///< no accepted input for this long -> INPUT_STALE [s]
+  double stale_timeout = 0.5;   ///< no accepted input for this long -> INPUT_STALE [s] (upper bound)
+  /// --clock wall: INPUT_STALE already after this many input periods without
+  /// an accepted input (the period is estimated from the stream's utime
+  /// steps), but never sooner than stale_min nor later than stale_timeout.
+  /// 0 = off (stale_timeout only).  --clock input always uses stale_timeout.
+  double stale_periods = 3.0;
+  double stale_min = 0.02;      ///< floor of the period-relative timeout [s]
   double max_step = 0.0025;     ///< largest integration step: longer ticks/input intervals are substepped [s]; 0 = off (same default as hoist-sim)
   int shape_points = 101;       ///< depth samples in HOIST_GUIDE_SHAPE, [2, 2001]
   int envelope_points = 401;    ///< depth samples for the guide-rope deflection alarm, [2, 20001]

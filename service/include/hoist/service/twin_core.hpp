@@ -79,6 +79,10 @@ class TwinCore {
   InputResult onInput(const WinderSample& s, double wall_now);
   /// An undecodable message (garbage, truncated, wrong fingerprint).
   void rejectUndecodable() { counters_.reject(RejectReason::Decode); }
+  /// Test hook (fault injection): the state after the next model step or
+  /// initialization is treated as non-finite, exercising the MODEL_FAULT
+  /// path (alarm, re-initialization, degraded outputs) end to end.
+  void injectFault() { inject_fault_ = true; }
   /// Wall clock: step the model to model time t (> current).  Input clock: no-op.
   TickResult tick(double t, double wall_now);
   /// Staleness, shelve expiry and re-announcement; call at least a few times
@@ -108,6 +112,15 @@ class TwinCore {
   bool degraded() const { return out_.degraded; }
   /// Seconds since the last accepted input (-1 if none yet).
   double inputAge(double wall_now) const { return have_input_ ? wall_now - last_input_wall_ : -1.0; }
+  /// Any input accepted since start (the wall-clock twin publishes cage
+  /// output only from its first input on: before that it has no trip).
+  bool hasInput() const { return have_input_; }
+  /// The staleness timeout in force [s]: stale_timeout, or with --clock wall
+  /// stale_periods input periods (clamped to [stale_min, stale_timeout]) once
+  /// the current stream's period is known.
+  double staleTimeout() const;
+  /// Estimated input period of the current stream [s] (0 until known).
+  double inputPeriod() const { return period_est_; }
   std::int64_t steps() const { return steps_; }
   std::int64_t modelFaults() const { return faults_; }
   std::int64_t modelResets() const { return resets_; }
@@ -145,12 +158,15 @@ class TwinCore {
   bool stream_ = false;         // validator has a reference (not stale)
   WinderSample last_;           // last accepted sample
   double last_input_wall_ = 0.0;
+  double period_est_ = 0.0;     // input period estimate (EWMA of utime steps) [s]
   std::int64_t utime_base_ = 0; // input clock: utime at model time t_base_
   double t_base_ = 0.0;
+  double t_pub_offset_ = 0.0;   // wall clock: model time of the first input (published t counts from it)
   bool stale_ = false;
   double start_wall_ = -1.0;
   double fault_until_ = -1.0;   // degraded until this model time after a re-init
   bool fault_pending_clear_ = false;
+  bool inject_fault_ = false;
   std::int64_t steps_ = 0, faults_ = 0, resets_ = 0, domain_errors_ = 0;
 };
 
