@@ -32,9 +32,16 @@ required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev
           libcli11-dev gnuplot-nox python3 iproute2)
 # Java bindings let lcm-spy decode the hoist channels; clang gives the fuzzers.
 optional=(liblcm-java default-jdk-headless clang libclang-rt-14-dev)
+installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 missing=()
-for p in "${required[@]}" "${optional[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+for p in "${required[@]}"; do installed "$p" || missing+=("$p"); done
+# An optional package is not needed when what it provides is already there.
+for p in "${optional[@]}"; do
+  case "$p" in
+    default-jdk-headless) command -v javac >/dev/null 2>&1 && continue ;;
+    clang) command -v clang++ >/dev/null 2>&1 && continue ;;
+  esac
+  installed "$p" || missing+=("$p")
 done
 if [[ ${#missing[@]} -gt 0 && "${HOIST_SKIP_APT:-0}" != 1 ]]; then
   sudo=""
@@ -45,6 +52,7 @@ if [[ ${#missing[@]} -gt 0 && "${HOIST_SKIP_APT:-0}" != 1 ]]; then
   $sudo apt-get install -y -qq --no-install-recommends "${required[@]}"
   # Optional packages one by one: a missing one must not stop the set-up.
   for p in "${optional[@]}"; do
+    [[ " ${missing[*]} " == *" $p "* ]] || continue
     $sudo apt-get install -y -qq --no-install-recommends "$p" >/dev/null 2>&1 ||
       say "optional package $p not available (continuing without it)"
   done
