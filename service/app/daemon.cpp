@@ -89,6 +89,19 @@ void describe(const AlarmEvent& e, const AlarmConfig& cfg, double stale_timeout,
   }
 }
 
+/// At most `max` characters of `s`, non-printable ones replaced by '?' (for
+/// logging strings that come from the network).
+std::string printable(const std::string& s, std::size_t max = 64) {
+  std::string o;
+  o.reserve(std::min(s.size(), max) + 3);
+  for (std::size_t i = 0; i < s.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    o.push_back(c >= 32 && c < 127 ? static_cast<char>(c) : '?');
+  }
+  if (s.size() > max) o += "...";
+  return o;
+}
+
 int divider(double rate, double sub_rate) {
   if (!(sub_rate > 0.0)) return 1;
   return std::max(1, static_cast<int>(std::lround(rate / sub_rate)));
@@ -240,20 +253,27 @@ void Daemon::onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& /*chann
 void Daemon::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
   hoist::alarm_ack_t ack;  // operator commands are rare: allocation is fine here
   const auto size = static_cast<int>(rbuf->data_size);
+  // Anyone on the group can send commands (docs/security.md): their log lines
+  // are rate-limited, and the sender's strings are shortened and made
+  // printable before they reach the log.
+  std::int64_t suppressed = 0;
+  const bool may_log = reject_log_.allow(kRejectReasons + 2, wallNow(), suppressed);
+  if (may_log && suppressed > 0) log_->warn("{} alarm-command log lines suppressed", suppressed);
   if (ack.decode(rbuf->data, 0, size) != size) {
-    log_->warn("ignored undecodable alarm command ({} bytes) on {}", size, ch_.ack);
+    if (may_log) log_->warn("ignored undecodable alarm command ({} bytes) on {}", size, ch_.ack);
     return;
   }
+  ack.user = printable(ack.user);
   std::optional<AlarmKind> kind;
   if (!ack.kind.empty() && ack.kind != "*") {
     kind = parseAlarmKind(ack.kind);
     if (!kind) {
-      log_->warn("ignored alarm command from '{}': unknown alarm kind '{}'", ack.user, ack.kind);
+      if (may_log) log_->warn("ignored alarm command from '{}': unknown alarm kind '{}'", ack.user, printable(ack.kind));
       return;
     }
   }
   if (ack.level < 0 || ack.level > 2) {
-    log_->warn("ignored alarm command from '{}': bad level {}", ack.user, int(ack.level));
+    if (may_log) log_->warn("ignored alarm command from '{}': bad level {}", ack.user, int(ack.level));
     return;
   }
   const auto level = static_cast<AlarmLevel>(ack.level);
@@ -263,16 +283,16 @@ void Daemon::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*
     case hoist::alarm_ack_t::ACTION_SHELVE: action = AlarmAction::Shelve; break;
     case hoist::alarm_ack_t::ACTION_UNSHELVE: action = AlarmAction::Unshelve; break;
     default:
-      log_->warn("ignored alarm command from '{}': bad action {}", ack.user, int(ack.action));
+      if (may_log) log_->warn("ignored alarm command from '{}': bad action {}", ack.user, int(ack.action));
       return;
   }
   if (action == AlarmAction::Shelve && !(std::isfinite(ack.shelve_duration) && ack.shelve_duration > 0.0)) {
-    log_->warn("ignored shelve from '{}': shelve_duration must be > 0 s", ack.user);
+    if (may_log) log_->warn("ignored shelve from '{}': shelve_duration must be > 0 s", ack.user);
     return;
   }
   const int n = core_.command(action, kind, level, ack.shelve_duration);
   const char* what = action == AlarmAction::Ack ? "acknowledge" : action == AlarmAction::Shelve ? "shelve" : "unshelve";
-  log_->info("operator '{}': {} {}/{}{} -> {} alarm(s)", ack.user, what,
+  if (may_log) log_->info("operator '{}': {} {}/{}{} -> {} alarm(s)", ack.user, what,
              kind ? toString(*kind) : "*", level == AlarmLevel::None ? "*" : toString(level),
              action == AlarmAction::Shelve ? fmt::format(" for {} s", std::min(ack.shelve_duration, opt_.cfg.alarms.max_shelve)) : std::string(),
              n);

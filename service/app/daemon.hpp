@@ -102,7 +102,7 @@ class Daemon {
   std::int64_t publish_attempts_ = 0;
   bool fault_injected_ = false;
   std::int64_t cage_seq_ = 0, alarm_id_ = 0;
-  LogRateLimiter<kRejectReasons + 2> reject_log_{5};
+  LogRateLimiter<kRejectReasons + 3> reject_log_{5};  // + domain error, publish, alarm commands
 
   // preallocated messages and encode buffers
   hoist::winder_t winder_in_;

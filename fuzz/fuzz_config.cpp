@@ -1,0 +1,45 @@
+// libFuzzer target: the shaft/daemon configuration loader.
+//   hoist::io::parseToml + shaftParamsFromToml (+ the daemon's [service] and
+//   [alarms] sections).  Every input must either load or throw a
+//   std::exception with a non-empty message; a loaded configuration must
+//   survive a toToml round trip unchanged.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string_view>
+
+#include "hoist/io/config.hpp"
+#include "hoist/service/config.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  toml::table tbl;
+  try {
+    tbl = hoist::io::parseToml(text, "fuzz.toml");
+  } catch (const std::exception& e) {
+    if (!*e.what()) std::abort();
+    return 0;
+  }
+  hoist::ShaftParams p;
+  try {
+    p = hoist::io::shaftParamsFromToml(tbl, "fuzz.toml", {"service", "alarms"});
+  } catch (const std::exception& e) {
+    if (!*e.what()) std::abort();
+    return 0;
+  }
+  // Round trip: what we print we must read back identically.
+  const hoist::ShaftParams q = hoist::io::shaftParamsFromToml(hoist::io::parseToml(hoist::io::toToml(p), "rt"), "rt");
+  if (!(q.rho1 == p.rho1 && q.EA == p.EA && q.u1 == p.u1 && q.l0 == p.l0 && q.L == p.L && q.rho2 == p.rho2 &&
+        q.u2 == p.u2 && q.Tb1 == p.Tb1 && q.Tb2 == p.Tb2 && q.m == p.m && q.J == p.J && q.h == p.h &&
+        q.Fa == p.Fa && q.b == p.b && q.n == p.n && q.g == p.g && q.initial == p.initial && q.rho_inf == p.rho_inf))
+    std::abort();
+  try {
+    hoist::svc::TwinConfig cfg;
+    cfg.shaft = p;
+    hoist::svc::parseServiceSections(tbl, "fuzz.toml", cfg);
+    (void)hoist::svc::toToml(cfg);
+  } catch (const std::exception& e) {
+    if (!*e.what()) std::abort();
+  }
+  return 0;
+}
