@@ -2,9 +2,10 @@
 # Set-up (scripts/setup.sh: packages, loopback multicast, build) and the whole
 # test suite with CTest.  Exit status 0 only when every test passed.
 #
-#   scripts/test.sh [--no-setup] [-L LABEL] [-R REGEX] [--sanitize address|thread]
+#   scripts/test.sh [--no-setup] [-L LABEL] [-R REGEX] [-E REGEX] [--sanitize address|thread]
 #
-# Labels: model, io, service, tools, study, integration, lcm, sim.
+# Labels: model, io, sim, service, tools, study, integration, lcm, realtime, hardening,
+# soak (the 2-minute soak; leave it out with -E soak).
 # --sanitize builds into build-asan / build-tsan (HOIST_SANITIZE) and tests there.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -24,7 +25,7 @@ while [[ $# -gt 0 ]]; do
       esac
       setup_args+=(--build-dir "$build_dir" --build-type RelWithDebInfo
                    --cmake-args "-DHOIST_SANITIZE=$2 -DHOIST_BUILD_BENCH=OFF"); shift 2 ;;
-    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "test.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -48,6 +48,25 @@ FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model)
   Pd_ = w_ = res_ = dy_ = VectorXd::Zero(n);
   S0_ = Ek_ = MatrixXd::Zero(n, n);
   lu_ = Eigen::PartialPivLU<MatrixXd>(n);
+
+  initA_ = MatrixXd::Zero(N + 4, N + 4);
+  initLu_ = Eigen::PartialPivLU<MatrixXd>(N + 4);
+  initRhs_ = initSol_ = VectorXd::Zero(N + 4);
+  // Directions of the paper partition's dependent coordinates (modes 1 and 2
+  // of each guide rope), used by consistentInitialVelocity().
+  D_ = MG_ = Eigen::Matrix<double, Eigen::Dynamic, 4>::Zero(N, 4);
+  if (n >= 2) {
+    const MatrixXd& V1 = model_->guideModalVectors(1);
+    const MatrixXd& V2 = model_->guideModalVectors(2);
+    D_.col(0).head(n) = V1.row(0).transpose();
+    D_.col(1).head(n) = V1.row(1).transpose();
+    D_.col(2).segment(n, n) = V2.row(0).transpose();
+    D_.col(3).segment(n, n) = V2.row(1).transpose();
+  }
+  MG_ = Md_.cwiseInverse().asDiagonal() * Gt_;  // cage rows only depend on h: refreshed per use
+  initM_ = initC_ = initK_ = MatrixXd::Zero(n, n);
+  initLuN_ = Eigen::PartialPivLU<MatrixXd>(n);
+  initRhsN_ = VectorXd::Zero(n);
 }
 
 void FastSolver::fillConstraintRows(double l) {
@@ -139,31 +158,26 @@ void FastSolver::updateResponse(double t, const Kinematics& k) {
 // where that partition is singular (as the paper's method is), the
 // mass-weighted least-norm velocity is used instead.
 void FastSolver::consistentInitialVelocity(double v) {
+  // Allocation-free: D_ and MG_ are preallocated; every 4 x 4 object is fixed-size.
   xd_.setZero();
   if (v == 0.0) return;
-  const int n = n_, N = N_;
+  const int n = n_;
   const Eigen::Vector4d rhs = -v * (Glt_.transpose() * x_);
   if (rhs.cwiseAbs().maxCoeff() == 0.0) return;
   if (n >= 2) {
-    const MatrixXd& V1 = model_->guideModalVectors(1);
-    const MatrixXd& V2 = model_->guideModalVectors(2);
-    MatrixXd D = MatrixXd::Zero(N, 4);
-    D.col(0).head(n) = V1.row(0).transpose();
-    D.col(1).head(n) = V1.row(1).transpose();
-    D.col(2).segment(n, n) = V2.row(0).transpose();
-    D.col(3).segment(n, n) = V2.row(1).transpose();
-    const Eigen::Matrix4d B = Gt_.transpose() * D;
+    const Eigen::Matrix4d B = Gt_.transpose() * D_;
     Eigen::JacobiSVD<Eigen::Matrix4d> svd(B);
     const auto& sv = svd.singularValues();
     if (sv(3) > 1e-8 * sv(0)) {
-      xd_ = D * B.partialPivLu().solve(rhs);
+      const Eigen::Vector4d c = B.partialPivLu().solve(rhs);
+      xd_.noalias() = D_ * c;
       return;
     }
   }
-  const VectorXd Minv = Md_.cwiseInverse();
-  const MatrixXd MG = Minv.asDiagonal() * Gt_;
-  const Eigen::Matrix4d S = Gt_.transpose() * MG;
-  xd_ = MG * S.ldlt().solve(rhs);
+  MG_ = Md_.cwiseInverse().asDiagonal() * Gt_;
+  const Eigen::Matrix4d S = Gt_.transpose() * MG_;
+  const Eigen::Vector4d c = S.ldlt().solve(rhs);
+  xd_.noalias() = MG_ * c;
 }
 
 void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) {
@@ -171,7 +185,7 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   if (!(k0.l > 0.0 && k0.l < p.maxRopeLength()) || !std::isfinite(k0.v) || !std::isfinite(k0.a))
     throw std::domain_error("initial rope length " + std::to_string(k0.l) + " m outside (0, L - 2h = " +
                             std::to_string(p.maxRopeLength()) + ")");
-  const int n = n_, N = N_;
+  const int N = N_;
   t_ = t0;
   kin_ = k0;
   h_cached_ = -1.0;
@@ -183,14 +197,16 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   xd_.setZero();
   if (init == InitialState::Static) {
     // K x - G^T lam = F,  G x = 0
-    MatrixXd A = MatrixXd::Zero(N + 4, N + 4);
-    A.topLeftCorner(N, N) = Kd_.asDiagonal();
+    MatrixXd& A = initA_;
+    A.setZero();
+    A.topLeftCorner(N, N).diagonal() = Kd_;
     A.topRightCorner(N, 4) = -Gt_;
     A.bottomLeftCorner(4, N) = Gt_.transpose();
-    VectorXd rhs = VectorXd::Zero(N + 4);
-    rhs.head(N) = F_;
-    const VectorXd sol = A.partialPivLu().solve(rhs);
-    x_ = sol.head(N);
+    initRhs_.setZero();
+    initRhs_.head(N) = F_;
+    initLu_.compute(A);
+    initSol_ = initLu_.solve(initRhs_);
+    x_ = initSol_.head(N);
   } else {
     x_.setZero();
   }
@@ -208,16 +224,27 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   const auto& H = model_->hoistingRope();
   if (init == InitialState::Static) {
     longitudinalOperators({k0.l, 0.0, 0.0});
-    MatrixXd K = MatrixXd(((p.EA / k0.l) * H.k.array().square()).matrix().asDiagonal()) + Ek_;
-    y_ = K.partialPivLu().solve(F0_);
+    initK_ = Ek_;
+    initK_.diagonal() += (p.EA / k0.l) * k2_;
+    initLuN_.compute(initK_);
+    y_ = initLuN_.solve(F0_);
   } else {
     y_.setZero();
   }
   longitudinalOperators(k0);
-  MatrixXd M = MatrixXd::Identity(n, n) * (p.rho1 * k0.l) + p.m * u_ * u_.transpose();
-  MatrixXd C = MatrixXd::Identity(n, n) * (p.rho1 * k0.v + p.u1 * k0.l) + p.rho1 * k0.v * H.A_gyro;
-  MatrixXd K = MatrixXd(((p.EA / k0.l) * H.k.array().square()).matrix().asDiagonal()) + Ek_;
-  ydd_ = M.partialPivLu().solve(F0_ - C * yd_ - K * y_);
+  // M ydd = F0 - C yd - K y with M = rho1 l I + m u u^T,
+  // C = (rho1 v + u1 l) I + rho1 v A_gyro, K = (EA / l) diag(k^2) + Ek.
+  initM_.noalias() = p.m * u_ * u_.transpose();
+  initM_.diagonal().array() += p.rho1 * k0.l;
+  initC_ = (p.rho1 * k0.v) * H.A_gyro;
+  initC_.diagonal().array() += p.rho1 * k0.v + p.u1 * k0.l;
+  initK_ = Ek_;
+  initK_.diagonal() += (p.EA / k0.l) * k2_;
+  initRhsN_ = F0_;
+  initRhsN_.noalias() -= initC_ * yd_;
+  initRhsN_.noalias() -= initK_ * y_;
+  initLuN_.compute(initM_);
+  ydd_ = initLuN_.solve(initRhsN_);
   ya_ = ydd_;
 
   updateResponse(t0, k0);

@@ -1,7 +1,10 @@
 // hoist-twind -- the real-time digital twin daemon of the cable-guided hoist.
 //
-//   hoist-twind [--config FILE] [--lcm-url URL] [--clock wall|input] [--rate HZ]
+//   hoist-twind [--config FILE]... [--lcm-url URL] [--clock wall|input] [--rate HZ]
+//               [--mlockall] [--rt-priority N] [--cpus LIST] [--report FILE]
 //
+// Several --config files host several shafts in one process (one loop), each
+// with its own [service].channel_prefix.
 // Subscribes to HOIST_WINDER (winder_t) and HOIST_ALARM_ACK (alarm_ack_t);
 // publishes HOIST_CAGE, HOIST_GUIDE_SHAPE, HOIST_ALARM and HOIST_HEALTH (see
 // msgs/*.lcm and docs/service.md).  Exit status: 0 after a clean stop
@@ -9,8 +12,9 @@
 // command line or configuration.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
-#include <spdlog/async.h>
+#include <set>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -25,11 +29,14 @@ int main(int argc, char** argv) {
       "publishes the cage state (HOIST_CAGE), guide-rope shape (HOIST_GUIDE_SHAPE), clearance\n"
       "alarms (HOIST_ALARM; commands on HOIST_ALARM_ACK) and its own health (HOIST_HEALTH).\n"
       "Runs with the paper's shaft when given no --config."};
-  std::string config_path, lcm_url, clock, prefix, log_level = "info";
+  std::vector<std::string> config_paths;
+  std::string lcm_url, clock, prefix, log_level = "info", cpus, report;
   double rate = 0.0, duration = 0.0;
-  bool print_config = false;
-  app.add_option("--config", config_path,
-                 "shaft TOML (+ [service], [alarms]); default: the paper's shaft")
+  int rt_priority = 0;
+  bool print_config = false, mlock = false;
+  app.add_option("--config", config_paths,
+                 "shaft TOML (+ [service], [alarms]); default: the paper's shaft.  Repeat it to host "
+                 "several shafts in one process, each with its own [service].channel_prefix")
       ->check(CLI::ExistingFile);
   app.add_option("--lcm-url", lcm_url,
                  "LCM URL; default: $LCM_DEFAULT_URL, else [service].lcm_url, else LCM's default");
@@ -38,12 +45,21 @@ int main(int argc, char** argv) {
                  "each input's utime (deterministic replays)")
       ->check(CLI::IsMember({"wall", "input"}));
   app.add_option("--rate", rate, "model step rate with --clock wall [Hz], 1..1000 (default 100)");
-  app.add_option("--channel-prefix", prefix, "prepended to every channel name (default [service].channel_prefix)");
+  app.add_option("--channel-prefix", prefix,
+                 "prepended to every channel name (default [service].channel_prefix; one shaft only)");
   app.add_option("--duration", duration, "stop after this many seconds (default: run until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
+  auto* rt = app.add_option_group("real time", "optional; each is reported at start-up and the daemon runs without it if refused");
+  rt->add_flag("--mlockall", mlock, "lock all memory (mlockall) so the loop never page-faults");
+  rt->add_option("--rt-priority", rt_priority, "run the loop thread SCHED_FIFO at this priority, 1..99")
+      ->check(CLI::Range(1, 99));
+  rt->add_option("--cpus", cpus, "pin the loop thread to these CPUs, e.g. 1 or 2-3");
+  app.add_option("--report", report,
+                 "at stop, write a run report (JSON: step time and tick lateness histograms with "
+                 "p50/p99/p99.9/max per shaft, deadline misses, counters, real-time settings) to FILE");
   // Test-only fault injection (tests/hardening); hidden from --help.
   double inject_fault_at = -1.0;
   int fail_publish_every = 0;
@@ -57,45 +73,78 @@ int main(int argc, char** argv) {
   }
 
   DaemonOptions opt;
+  std::string shaft_url;  // the one [service].lcm_url all shafts agree on
   try {
-    if (!config_path.empty()) opt.cfg = loadTwinConfig(config_path);
-    if (!clock.empty()) opt.cfg.service.clock = clock == "input" ? ClockMode::Input : ClockMode::Wall;
-    if (rate > 0.0) {
-      opt.cfg.service.rate = rate;
-      // Publish rates follow a lower --rate rather than failing validation.
-      opt.cfg.service.cage_rate = std::min(opt.cfg.service.cage_rate, rate);
-      opt.cfg.service.shape_rate = std::min(opt.cfg.service.shape_rate, rate);
-    } else if (app.count("--rate")) {
-      throw std::invalid_argument("--rate: must be in [1, 1000] Hz");
+    if (config_paths.empty()) config_paths.push_back("");
+    if (config_paths.size() > 1 && app.count("--channel-prefix"))
+      throw std::invalid_argument("--channel-prefix: only with a single --config (each shaft's file sets its own [service].channel_prefix)");
+    std::set<std::string> prefixes;
+    std::string first_url_from;
+    for (std::size_t i = 0; i < config_paths.size(); ++i) {
+      const std::string& path = config_paths[i];
+      const std::string where = path.empty() ? "(paper defaults)" : path;
+      TwinConfig cfg = path.empty() ? TwinConfig{} : loadTwinConfig(path);
+      if (!clock.empty()) cfg.service.clock = clock == "input" ? ClockMode::Input : ClockMode::Wall;
+      if (rate > 0.0) {
+        cfg.service.rate = rate;
+        // Publish rates follow a lower --rate rather than failing validation.
+        cfg.service.cage_rate = std::min(cfg.service.cage_rate, rate);
+        cfg.service.shape_rate = std::min(cfg.service.shape_rate, rate);
+      } else if (app.count("--rate")) {
+        throw std::invalid_argument("--rate: must be in [1, 1000] Hz");
+      }
+      if (app.count("--channel-prefix")) cfg.service.channel_prefix = prefix;
+      try {
+        cfg.service.validate();
+      } catch (const std::invalid_argument& e) {
+        std::string what = e.what();
+        if (what.rfind("service.rate", 0) == 0) what = "--rate: " + what;
+        throw std::invalid_argument(what);
+      }
+      cfg.shaft.validate();
+      if (!prefixes.insert(cfg.service.channel_prefix).second)
+        throw std::invalid_argument(where + ": service.channel_prefix: \"" + cfg.service.channel_prefix +
+                                    "\" is already used by another --config (each shaft needs its own)");
+      if (i == 0) {
+        shaft_url = cfg.service.lcm_url;
+        first_url_from = where;
+      } else if (cfg.service.lcm_url != shaft_url && lcm_url.empty()) {
+        throw std::invalid_argument(where + ": service.lcm_url: \"" + cfg.service.lcm_url + "\" differs from \"" +
+                                    shaft_url + "\" in " + first_url_from +
+                                    " (one process has one LCM instance; give --lcm-url to override)");
+      }
+      std::string label;
+      if (config_paths.size() > 1)
+        label = cfg.service.channel_prefix.empty() ? std::filesystem::path(path).stem().string()
+                                                   : cfg.service.channel_prefix;
+      opt.shafts.push_back(std::move(cfg));
+      opt.labels.push_back(label);
     }
-    if (app.count("--channel-prefix")) opt.cfg.service.channel_prefix = prefix;
-    try {
-      opt.cfg.service.validate();
-    } catch (const std::invalid_argument& e) {
-      std::string what = e.what();
-      if (what.rfind("service.rate", 0) == 0) what = "--rate: " + what;
-      throw std::invalid_argument(what);
-    }
-    opt.cfg.shaft.validate();
+    if (!cpus.empty()) opt.realtime.cpus = parseCpuList(cpus, "--cpus");
   } catch (const std::exception& e) {
     std::cerr << "hoist-twind: configuration error: " << e.what() << "\n";
     return 2;
   }
   if (print_config) {
-    std::cout << toToml(opt.cfg);
+    for (std::size_t i = 0; i < opt.shafts.size(); ++i) {
+      if (opt.shafts.size() > 1) std::cout << (i ? "\n" : "") << "# ---- --config " << config_paths[i] << "\n";
+      std::cout << toToml(opt.shafts[i]);
+    }
     return 0;
   }
-  opt.lcm_url = resolveLcmUrl(lcm_url, opt.cfg.service.lcm_url);
+  opt.lcm_url = resolveLcmUrl(lcm_url, shaft_url);
   opt.duration = duration;
-  opt.inject_fault_at = inject_fault_at;
-  opt.fail_publish_every = fail_publish_every;
+  opt.hooks.inject_fault_at = inject_fault_at;
+  opt.hooks.fail_publish_every = fail_publish_every;
+  opt.realtime.mlockall = mlock;
+  opt.realtime.fifo_priority = rt_priority;
+  opt.report_path = report;
+  for (int i = 0; i < argc; ++i) opt.command_line += (i ? " " : "") + std::string(argv[i]);
 
-  // Asynchronous, non-blocking logger: a full queue drops the oldest line
-  // instead of stalling the tick.
-  spdlog::init_thread_pool(8192, 1);
+  // The loop thread never writes to the terminal itself: its lines go
+  // through RtLog's ring to a writer thread (daemon.hpp).
   auto sink = std::make_shared<spdlog::sinks::stderr_color_sink_mt>();
-  auto log = std::make_shared<spdlog::async_logger>("hoist-twind", sink, spdlog::thread_pool(),
-                                                    spdlog::async_overflow_policy::overrun_oldest);
+  auto log = std::make_shared<spdlog::logger>("hoist-twind", sink);
   log->set_level(spdlog::level::from_str(log_level));
   log->set_pattern("%Y-%m-%d %H:%M:%S.%e [%^%l%$] %v");
   log->flush_on(spdlog::level::info);

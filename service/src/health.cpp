@@ -27,6 +27,11 @@ void LatencyHistogram::reset() {
   max_ = 0.0;
 }
 
+double LatencyHistogram::binLowerUs(int b) {
+  if (b <= 0) return 0.0;
+  return kMinUs * std::pow(10.0, static_cast<double>(b - 1) / kBinsPerDecade);
+}
+
 double LatencyHistogram::quantile(double q) const {
   if (count_ == 0) return 0.0;
   q = std::clamp(q, 0.0, 1.0);

@@ -97,6 +97,16 @@ class FastSolver final : public Solver {
   double lambda0_ = 0.0;
 
   CageResponse resp_;
+
+  // initialize() workspace, sized in the constructor so that re-initializing
+  // (a new winder stream, recovery from a model fault) allocates nothing.
+  MatrixXd initA_;                          // static KKT matrix (N + 4)^2
+  Eigen::PartialPivLU<MatrixXd> initLu_;    // its factorization
+  VectorXd initRhs_, initSol_;              // (N + 4)
+  Eigen::Matrix<double, Eigen::Dynamic, 4> D_, MG_;  // dependent-coordinate directions; M^-1 G^T
+  MatrixXd initM_, initC_, initK_;          // longitudinal n x n
+  Eigen::PartialPivLU<MatrixXd> initLuN_;
+  VectorXd initRhsN_;
 };
 
 }  // namespace hoist

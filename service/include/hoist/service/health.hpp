@@ -25,6 +25,10 @@ class LatencyHistogram {
   double max() const { return count_ ? max_ : 0.0; }
   /// q in [0, 1]; 0 when empty.  Never more than max().
   double quantile(double q) const;
+  /// Raw bin counts (for reports): bin 0 holds samples below kMinUs, bin b in
+  /// [1, kBins-2] holds [binLowerUs(b), binLowerUs(b+1)), the last bin the rest.
+  std::int64_t binCount(int b) const { return bins_[static_cast<std::size_t>(b)]; }
+  static double binLowerUs(int b);
 
  private:
   std::array<std::int64_t, kBins> bins_{};

@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""Markdown real-time report from hoist-twind run reports (--report JSON) and
+hoist-replay --timing-test reports.
+
+  rt_report.py [--title T] [--minutes M] [--command C] TAG DAEMON.json TIMING.md [TAG JSON MD ...]
+
+Used by bench/rt_report.sh and bench/multishaft.sh."""
+import argparse
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def fmt_us(x):
+    if x >= 1000:
+        return f"{x / 1000:.2f} ms"
+    if x >= 10:
+        return f"{x:.0f} µs"
+    return f"{x:.1f} µs"
+
+
+def merged(bins, per_decade=5):
+    """20 bins per decade -> `per_decade` bins: [(lower, upper, count)]."""
+    out = {}
+    for lower, count in bins:
+        if lower <= 0:
+            key = -1
+        else:
+            key = math.floor(math.log10(lower / 0.1) * per_decade + 1e-9)
+        out[key] = out.get(key, 0) + count
+    rows = []
+    for key in sorted(out):
+        if key < 0:
+            rows.append((0.0, 0.1, out[key]))
+        else:
+            lo = 0.1 * 10 ** (key / per_decade)
+            hi = 0.1 * 10 ** ((key + 1) / per_decade)
+            rows.append((lo, hi, out[key]))
+    return rows
+
+
+def ascii_hist(h, width=50):
+    rows = merged(h.get("bins", []))
+    if not rows:
+        return "(no samples)"
+    total = sum(c for _, _, c in rows)
+    # log-scaled bar lengths so one-in-a-million tail bins stay visible
+    lmax = math.log10(max(c for _, _, c in rows) + 1)
+    lines = []
+    for lo, hi, c in rows:
+        bar = "#" * max(1, int(round(width * math.log10(c + 1) / lmax)))
+        lines.append(f"{fmt_us(lo):>9} - {fmt_us(hi):<9} {c:>10}  {100.0 * c / total:8.4f} %  {bar}")
+    return "\n".join(lines)
+
+
+def verdict(md_path):
+    try:
+        with open(md_path) as f:
+            first = f.readline().strip()
+        return first.replace("VERDICT:", "").strip() or "?"
+    except OSError:
+        return "(no timing-test report)"
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--title", default="Real-time report")
+    ap.add_argument("--minutes", default="")
+    ap.add_argument("--command", default="")
+    ap.add_argument("--out-dir", default=".", help="directory of the Markdown file (for relative links)")
+    ap.add_argument("items", nargs="+")
+    a = ap.parse_args()
+    if len(a.items) % 3:
+        sys.exit("rt_report.py: arguments come in triples TAG JSON MD")
+    points = []
+    for i in range(0, len(a.items), 3):
+        tag, js, md = a.items[i:i + 3]
+        with open(js) as f:
+            points.append((tag, json.load(f), md))
+
+    first = points[0][1]
+    out = [f"# {a.title}", ""]
+    out.append(f"Produced by `{a.command.strip()}` on {first.get('date', '?')}; host `{first.get('host', '?')}`, "
+               f"{cpu_model()}, {first.get('cpus_online', '?')} CPUs online, Linux {platform.release()}.")
+    out.append("")
+    out.append(f"Real-time settings of the daemon: memory lock **{first['realtime']['memory_lock']}**, "
+               f"scheduling **{first['realtime']['scheduling']}**, affinity **{first['realtime']['affinity']}**.")
+    out.append("")
+    out.append("Step time = one model step (with `[service].max_step` substeps) plus alarm evaluation, as "
+               "timed by the daemon; tick lateness = start of a shaft's tick minus its deadline on the absolute "
+               "schedule; a deadline miss = a whole period skipped.  Quantiles come from logarithmic histograms "
+               "(20 bins per decade, about 6 % resolution).  The feeder (`hoist-replay --timing-test`) runs on "
+               "another CPU and publishes the winder stream at the step rate over UDP multicast on loopback.")
+    out.append("")
+    out.append("| point | run | ticks | deadline misses | step p50 / p99 / p99.9 / max | lateness p50 / p99 / p99.9 / max | timing test |")
+    out.append("|---|---|---|---|---|---|---|")
+    for tag, r, md in points:
+        for s in r["shafts"]:
+            st, lt = s["step_us"], s["late_us"]
+            label = tag if len(r["shafts"]) == 1 else f"{tag} {s['label']}"
+            out.append(
+                f"| {label} ({s['rate_hz']:g} Hz, n = {s['modes']}) | {r['duration_s'] / 60:.1f} min | {s['ticks']} | "
+                f"**{s['deadline_misses']}** | {fmt_us(st['p50'])} / {fmt_us(st['p99'])} / {fmt_us(st['p999'])} / "
+                f"{fmt_us(st['max'])} | {fmt_us(lt['p50'])} / {fmt_us(lt['p99'])} / {fmt_us(lt['p999'])} / "
+                f"{fmt_us(lt['max'])} | {verdict(md)} ([report]({os.path.relpath(md, a.out_dir)})) |")
+    out.append("")
+    for tag, r, md in points:
+        for s in r["shafts"]:
+            out.append(f"## {tag}: {s['rate_hz']:g} Hz, n = {s['modes']}")
+            out.append("")
+            out.append(f"Inputs accepted {s['inputs_accepted']}, rejected {s['inputs_rejected']}, sequence gaps "
+                       f"{s['sequence_gaps']}; alarm events {s['alarm_events']}; model faults {s['model_faults']}; "
+                       f"publish failures {s['publish_failures']}; log lines dropped {r.get('log_lines_dropped', 0)}.")
+            out.append("")
+            out.append("Step time (count per bin, log-scaled bars):")
+            out.append("```")
+            out.append(ascii_hist(s["step_us"]))
+            out.append("```")
+            out.append("Tick lateness:")
+            out.append("```")
+            out.append(ascii_hist(s["late_us"]))
+            out.append("```")
+            out.append("")
+    print("\n".join(out))
+
+
+if __name__ == "__main__":
+    main()

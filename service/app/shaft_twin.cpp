@@ -1,0 +1,501 @@
+// One shaft of hoist-twind: see shaft_twin.hpp.
+#include "shaft_twin.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/service/lcm_util.hpp"
+#include "hoist/service/winder_decode.hpp"
+
+namespace hoist::svc {
+
+using std::chrono::duration;
+
+namespace {
+
+bool finiteAll(const hoist::cage_state_t& m) {
+  bool ok = std::isfinite(m.t) && std::isfinite(m.l) && std::isfinite(m.v) && std::isfinite(m.a) &&
+            std::isfinite(m.x_c) && std::isfinite(m.y_c) && std::isfinite(m.theta) &&
+            std::isfinite(m.y_top) && std::isfinite(m.y_bottom) &&
+            std::isfinite(m.guide_deflection) && std::isfinite(m.clearance_pos_y) &&
+            std::isfinite(m.clearance_neg_y) && std::isfinite(m.clearance_guide) &&
+            std::isfinite(m.min_clearance);
+  for (double v : m.lambda) ok = ok && std::isfinite(v);
+  return ok;
+}
+
+bool finiteAll(const hoist::guide_shape_t& m) {
+  bool ok = std::isfinite(m.t) && std::isfinite(m.l) && std::isfinite(m.h);
+  for (int i = 0; i < m.n; ++i)
+    ok = ok && std::isfinite(m.x[i]) && std::isfinite(m.y1[i]) && std::isfinite(m.y2[i]);
+  return ok;
+}
+
+bool finiteAll(const hoist::alarm_t& m) {
+  return std::isfinite(m.t) && std::isfinite(m.value) && std::isfinite(m.threshold) &&
+         std::isfinite(m.shelved_for);
+}
+
+bool finiteAll(const hoist::health_t& m) {
+  return std::isfinite(m.uptime) && std::isfinite(m.t) && std::isfinite(m.rate) &&
+         std::isfinite(m.window) && std::isfinite(m.step_p50_us) && std::isfinite(m.step_p99_us) &&
+         std::isfinite(m.step_max_us) && std::isfinite(m.late_p50_us) &&
+         std::isfinite(m.late_p99_us) && std::isfinite(m.late_max_us) && std::isfinite(m.input_age);
+}
+
+/// A readable one-line description of an alarm event (no allocation).
+void describe(const AlarmEvent& e, const AlarmConfig& cfg, double stale_timeout, char* buf,
+              std::size_t n) {
+  const char* verb = "";
+  switch (e.type) {
+    case AlarmEventType::Raise: verb = "raised"; break;
+    case AlarmEventType::Clear: verb = "cleared"; break;
+    case AlarmEventType::Ack: verb = "acknowledged"; break;
+    case AlarmEventType::Shelve: verb = "shelved"; break;
+    case AlarmEventType::Unshelve: verb = "unshelved"; break;
+    case AlarmEventType::Reannounce: verb = "still active"; break;
+  }
+  char state[96];
+  std::snprintf(state, sizeof state, "%s%s%s", e.latched ? " [latched until acknowledged]" : "",
+                e.shelved ? " [shelved]" : "", (e.active && !e.acked) ? " [unacknowledged]" : "");
+  switch (e.kind) {
+    case AlarmKind::CagePosY:
+    case AlarmKind::CageNegY:
+    case AlarmKind::GuideRope: {
+      const bool guide = e.kind == AlarmKind::GuideRope;
+      const double gap = e.kind == AlarmKind::CagePosY   ? cfg.gap_pos_y
+                         : e.kind == AlarmKind::CageNegY ? cfg.gap_neg_y
+                                                         : cfg.guide_rope_gap;
+      std::snprintf(buf, n, "%s %s %s: %s %.1f mm (threshold %.1f mm of gap %.1f mm, clearance %.1f mm)%s",
+                    toString(e.kind), toString(e.level), verb,
+                    guide ? "guide-rope deflection" : (e.kind == AlarmKind::CagePosY ? "cage excursion toward +y" : "cage excursion toward -y"),
+                    e.value * 1e3, e.threshold * 1e3, gap * 1e3, (gap - e.value) * 1e3, state);
+      break;
+    }
+    case AlarmKind::InputStale:
+      std::snprintf(buf, n, "%s %s %s: no valid winder input for more than %.3g s; outputs degraded (l held, v = a = 0)%s",
+                    toString(e.kind), toString(e.level), verb, stale_timeout, state);
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: winder input is back%s", toString(e.kind),
+                      toString(e.level), state);
+      break;
+    case AlarmKind::ModelFault:
+      std::snprintf(buf, n, "%s %s %s: non-finite model state, model re-initialized at static equilibrium%s",
+                    toString(e.kind), toString(e.level), verb, state);
+      break;
+  }
+}
+
+/// At most `max` characters of `s`, non-printable ones replaced by '?' (for
+/// logging strings that come from the network).
+std::string printable(const std::string& s, std::size_t max = 64) {
+  std::string o;
+  o.reserve(std::min(s.size(), max) + 3);
+  for (std::size_t i = 0; i < s.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    o.push_back(c >= 32 && c < 127 ? static_cast<char>(c) : '?');
+  }
+  if (s.size() > max) o += "...";
+  return o;
+}
+
+int divider(double rate, double sub_rate) {
+  if (!(sub_rate > 0.0)) return 1;
+  return std::max(1, static_cast<int>(std::lround(rate / sub_rate)));
+}
+
+}  // namespace
+
+ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks)
+    : cfg_(cfg),
+      label_(label.empty() ? std::string() : "[" + label + "] "),
+      lcm_(lcm),
+      log_(log),
+      hooks_(hooks),
+      ch_(cfg_.service.channel_prefix),
+      core_(cfg_, cfg_.service.clock) {
+  const ServiceConfig& s = cfg_.service;
+  cage_div_ = divider(s.rate, s.cage_rate);
+  shape_div_ = divider(s.rate, s.shape_rate);
+  reject_log_.setLimit(s.log_rate_limit);
+
+  // Preallocate every outgoing message and its buffer.
+  const GuideRopeEnvelope& sh = core_.shape();
+  shape_msg_.n = static_cast<int32_t>(sh.depths().size());
+  shape_msg_.x.assign(sh.depths().data(), sh.depths().data() + sh.depths().size());
+  shape_msg_.y1.assign(shape_msg_.n, 0.0);
+  shape_msg_.y2.assign(shape_msg_.n, 0.0);
+  shape_msg_.h = cfg_.shaft.h;
+  health_msg_.clock = toString(s.clock);
+  health_msg_.rate = s.rate;
+  health_msg_.n_reasons = kRejectReasons;
+  health_msg_.reject_reason.resize(kRejectReasons);
+  health_msg_.rejected.assign(kRejectReasons, 0);
+  for (int i = 0; i < kRejectReasons; ++i)
+    health_msg_.reject_reason[i] = toString(static_cast<RejectReason>(i));
+  alarm_msg_.kind.reserve(64);
+  alarm_msg_.message.reserve(sizeof text_);
+  cage_buf_.resize(static_cast<std::size_t>(cage_msg_.getEncodedSize()) + 64);
+  shape_buf_.resize(static_cast<std::size_t>(shape_msg_.getEncodedSize()) + 64);
+  alarm_buf_.resize(static_cast<std::size_t>(alarm_msg_.getEncodedSize()) + 64 + sizeof text_);
+  health_buf_.resize(static_cast<std::size_t>(health_msg_.getEncodedSize()) + 256);
+  text_[0] = '\0';
+}
+
+void ShaftTwin::subscribe() {
+  lcm_.subscribe(ch_.winder, &ShaftTwin::onWinder, this);
+  lcm_.subscribe(ch_.ack, &ShaftTwin::onAck, this);
+}
+
+void ShaftTwin::start(Clock::time_point start, double health_phase) {
+  start_ = start;
+  // Shafts of one daemon spread their health messages over the second.
+  last_health_wall_ = -health_phase;
+}
+
+double ShaftTwin::wallNow() const { return duration<double>(Clock::now() - start_).count(); }
+
+// ---- LCM input ---------------------------------------------------------------
+
+void ShaftTwin::logReject(RejectReason r, const char* detail) {
+  std::int64_t suppressed = 0;
+  if (!reject_log_.allow(static_cast<int>(r), wallNow(), suppressed)) return;
+  if (suppressed > 0)
+    log_.warn("{}rejected winder input ({}): {} [{} similar suppressed]", label_, toString(r), detail, suppressed);
+  else
+    log_.warn("{}rejected winder input ({}): {}", label_, toString(r), detail);
+}
+
+void ShaftTwin::onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  const double wall = wallNow();
+  WinderSample s;
+  const WinderDecode dec = decodeWinder(rbuf->data, rbuf->data_size, winder_in_, s);
+  if (dec != WinderDecode::Ok) {
+    core_.rejectUndecodable();
+    std::snprintf(text_, sizeof text_, "%u bytes: %s", static_cast<unsigned>(rbuf->data_size), describe(dec));
+    logReject(RejectReason::Decode, text_);
+    return;
+  }
+
+  const auto t0 = Clock::now();
+  const InputResult res = core_.onInput(s, wall);
+  const auto t1 = Clock::now();
+  if (!res.accepted) {
+    std::snprintf(text_, sizeof text_, "seq %lld utime %lld v %g a %g%s%g",
+                  static_cast<long long>(s.seq), static_cast<long long>(s.utime), s.v, s.a,
+                  s.has_length ? " length " : " (no length) ", s.has_length ? s.length : 0.0);
+    logReject(res.reason, text_);
+  }
+  if (res.reinitialized)
+    log_.info("{}new winder stream (seq {}): model re-initialized at l = {} m", label_, s.seq,
+              core_.output().kin.l);
+  if (res.stepped) {
+    const double us = duration<double, std::micro>(t1 - t0).count();
+    step_hist_.add(us);
+    step_total_.add(us);
+    publishCage(s.utime);
+    const double rate = cfg_.service.shape_rate;
+    if (rate > 0.0 && core_.modelTime() - last_shape_t_ >= 1.0 / rate - 1e-9) {
+      last_shape_t_ = core_.modelTime();
+      publishShape(s.utime);
+    }
+  }
+  drainAlarmEvents();
+}
+
+void ShaftTwin::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  // Operator commands are rare and outside the tick: decoding them into the
+  // message's std::strings may allocate.
+  hoist::alarm_ack_t ack;
+  const auto size = static_cast<int>(rbuf->data_size);
+  // Anyone on the group can send commands (docs/security.md): their log lines
+  // are rate-limited, and the sender's strings are shortened and made
+  // printable before they reach the log.
+  std::int64_t suppressed = 0;
+  const bool may_log = reject_log_.allow(kRejectReasons + 2, wallNow(), suppressed);
+  if (may_log && suppressed > 0) log_.warn("{}{} alarm-command log lines suppressed", label_, suppressed);
+  if (ack.decode(rbuf->data, 0, size) != size) {
+    if (may_log) log_.warn("{}ignored undecodable alarm command ({} bytes) on {}", label_, size, ch_.ack);
+    return;
+  }
+  ack.user = printable(ack.user);
+  std::optional<AlarmKind> kind;
+  if (!ack.kind.empty() && ack.kind != "*") {
+    kind = parseAlarmKind(ack.kind);
+    if (!kind) {
+      if (may_log)
+        log_.warn("{}ignored alarm command from '{}': unknown alarm kind '{}'", label_, ack.user, printable(ack.kind));
+      return;
+    }
+  }
+  if (ack.level < 0 || ack.level > 2) {
+    if (may_log) log_.warn("{}ignored alarm command from '{}': bad level {}", label_, ack.user, int(ack.level));
+    return;
+  }
+  const auto level = static_cast<AlarmLevel>(ack.level);
+  AlarmAction action;
+  switch (ack.action) {
+    case hoist::alarm_ack_t::ACTION_ACK: action = AlarmAction::Ack; break;
+    case hoist::alarm_ack_t::ACTION_SHELVE: action = AlarmAction::Shelve; break;
+    case hoist::alarm_ack_t::ACTION_UNSHELVE: action = AlarmAction::Unshelve; break;
+    default:
+      if (may_log) log_.warn("{}ignored alarm command from '{}': bad action {}", label_, ack.user, int(ack.action));
+      return;
+  }
+  if (action == AlarmAction::Shelve && !(std::isfinite(ack.shelve_duration) && ack.shelve_duration > 0.0)) {
+    if (may_log) log_.warn("{}ignored shelve from '{}': shelve_duration must be > 0 s", label_, ack.user);
+    return;
+  }
+  const int n = core_.command(action, kind, level, ack.shelve_duration);
+  const char* what = action == AlarmAction::Ack ? "acknowledge" : action == AlarmAction::Shelve ? "shelve" : "unshelve";
+  char for_s[48] = "";
+  if (action == AlarmAction::Shelve)
+    std::snprintf(for_s, sizeof for_s, " for %g s", std::min(ack.shelve_duration, cfg_.alarms.max_shelve));
+  if (may_log)
+    log_.info("{}operator '{}': {} {}/{}{} -> {} alarm(s)", label_, ack.user, what, kind ? toString(*kind) : "*",
+              level == AlarmLevel::None ? "*" : toString(level), for_s, n);
+  drainAlarmEvents();
+}
+
+// ---- the tick ------------------------------------------------------------------
+
+void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped) {
+  const auto now = Clock::now();
+  const double late_us = std::max(0.0, duration<double, std::micro>(now - deadline).count());
+  late_hist_.add(late_us);
+  late_total_.add(late_us);
+  ++ticks_;
+  deadline_misses_ += skipped;
+  const double wall = duration<double>(now - start_).count();
+  if (hooks_.inject_fault_at >= 0.0 && !fault_injected_ && wall >= hooks_.inject_fault_at) {
+    fault_injected_ = true;
+    log_.warn("{}test: injecting a model fault (non-finite state) at wall time {:.3f} s", label_, wall);
+    core_.injectFault();
+  }
+
+  if (core_.clock() == ClockMode::Wall) {
+    const double t = static_cast<double>(k) / cfg_.service.rate;
+    const auto t0 = Clock::now();
+    const TickResult r = core_.tick(t, wall);
+    core_.housekeeping(wall);
+    const auto t1 = Clock::now();
+    if (r.stepped) {
+      const double us = duration<double, std::micro>(t1 - t0).count();
+      step_hist_.add(us);
+      step_total_.add(us);
+    }
+    if (r.domain_error) {
+      std::int64_t suppressed = 0;
+      if (reject_log_.allow(kRejectReasons, wall, suppressed))
+        log_.warn("{}model refused the kinematics at t = {:.3f} s (l = {:.3f} m); holding the rope length [{} similar suppressed]",
+                  label_, t, core_.output().kin.l, suppressed);
+    }
+    if (r.stepped && core_.hasInput()) {
+      const std::int64_t utime = wallUtime();
+      if (k % cage_div_ == 0) publishCage(utime);
+      if (cfg_.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime);
+    }
+  } else {
+    core_.housekeeping(wall);
+  }
+  drainAlarmEvents();
+
+  if (wall - last_health_wall_ >= 1.0 / cfg_.service.health_rate - 0.5 / cfg_.service.rate) publishHealth();
+}
+
+// ---- outputs -----------------------------------------------------------------
+
+bool ShaftTwin::publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len) {
+  const bool injected = hooks_.fail_publish_every > 0 && ++publish_attempts_ % hooks_.fail_publish_every == 0;
+  if (injected || lcm_.publish(channel, buf.data(), static_cast<unsigned int>(len)) != 0) {
+    ++publish_failures_;
+    std::int64_t suppressed = 0;
+    if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
+      log_.error("{}LCM publish failed on {} [{} similar suppressed]", label_, channel, suppressed);
+    return false;
+  }
+  return true;
+}
+
+template <class Msg>
+bool ShaftTwin::encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf) {
+  if (!finiteAll(msg)) {
+    ++nonfinite_blocked_;
+    std::int64_t suppressed = 0;
+    if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
+      log_.error("{}withheld a message on {}: non-finite value", label_, channel);
+    return false;
+  }
+  const int need = msg.getEncodedSize();
+  if (need > static_cast<int>(buf.size())) {
+    ++publish_failures_;
+    log_.error("{}message on {} too large for its buffer ({} > {} bytes)", label_, channel, need, buf.size());
+    return false;
+  }
+  const int len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  if (len < 0) {
+    ++publish_failures_;
+    return false;
+  }
+  return publishBytes(channel, buf, len);
+}
+
+void ShaftTwin::publishCage(std::int64_t utime) {
+  const CageOutput& o = core_.output();
+  cage_msg_.utime = utime;
+  cage_msg_.seq = cage_seq_++;
+  cage_msg_.input_seq = o.input_seq;
+  cage_msg_.t = o.t;
+  cage_msg_.l = o.kin.l;
+  cage_msg_.v = o.kin.v;
+  cage_msg_.a = o.kin.a;
+  cage_msg_.x_c = o.x_c;
+  cage_msg_.y_c = o.y_c;
+  cage_msg_.theta = o.theta;
+  for (int i = 0; i < 5; ++i) cage_msg_.lambda[i] = o.lambda[i];
+  cage_msg_.y_top = o.clearance.y_top;
+  cage_msg_.y_bottom = o.clearance.y_bottom;
+  cage_msg_.guide_deflection = o.clearance.guide_deflection;
+  cage_msg_.clearance_pos_y = o.clearance.clearance_pos;
+  cage_msg_.clearance_neg_y = o.clearance.clearance_neg;
+  cage_msg_.clearance_guide = o.clearance.clearance_guide;
+  cage_msg_.min_clearance = o.clearance.min_clearance;
+  cage_msg_.alarm_level = static_cast<int8_t>(o.alarm_level);
+  cage_msg_.degraded = o.degraded;
+  encodeAndPublish(ch_.cage, cage_msg_, cage_buf_);
+}
+
+void ShaftTwin::publishShape(std::int64_t utime) {
+  core_.evaluateShape();
+  const GuideRopeEnvelope& sh = core_.shape();
+  shape_msg_.utime = utime;
+  shape_msg_.t = core_.output().t;
+  shape_msg_.l = core_.output().kin.l;
+  for (int i = 0; i < shape_msg_.n; ++i) {
+    shape_msg_.y1[i] = sh.y1()(i);
+    shape_msg_.y2[i] = sh.y2()(i);
+  }
+  encodeAndPublish(ch_.shape, shape_msg_, shape_buf_);
+}
+
+void ShaftTwin::drainAlarmEvents() {
+  const AlarmEvents& ev = core_.events();
+  if (ev.empty()) return;
+  const std::int64_t utime = wallUtime();
+  for (const AlarmEvent& e : ev) {
+    describe(e, cfg_.alarms, core_.staleTimeout(), text_, sizeof text_);
+    alarm_msg_.utime = utime;
+    alarm_msg_.id = alarm_id_++;
+    alarm_msg_.t = e.t;
+    alarm_msg_.kind.assign(toString(e.kind));
+    alarm_msg_.level = static_cast<int8_t>(e.level);
+    alarm_msg_.event = static_cast<int8_t>(e.type);
+    alarm_msg_.active = e.active;
+    alarm_msg_.acked = e.acked;
+    alarm_msg_.shelved = e.shelved;
+    alarm_msg_.latched = e.latched;
+    alarm_msg_.value = e.value;
+    alarm_msg_.threshold = e.threshold;
+    alarm_msg_.shelved_for = e.shelved_for;
+    alarm_msg_.message.assign(text_);
+    if (encodeAndPublish(ch_.alarm, alarm_msg_, alarm_buf_)) ++alarm_events_;
+    switch (e.type) {
+      case AlarmEventType::Reannounce: log_.debug("{}alarm: {} (t = {:.2f} s)", label_, text_, e.t); break;
+      case AlarmEventType::Raise:
+        if (e.level == AlarmLevel::Critical) log_.error("{}ALARM {} (t = {:.2f} s)", label_, text_, e.t);
+        else log_.warn("{}ALARM {} (t = {:.2f} s)", label_, text_, e.t);
+        break;
+      default: log_.info("{}alarm: {} (t = {:.2f} s)", label_, text_, e.t); break;
+    }
+  }
+  if (ev.dropped() > 0) log_.error("{}{} alarm events dropped (event buffer full)", label_, ev.dropped());
+  core_.clearEvents();
+}
+
+void ShaftTwin::publishHealth(bool final_report) {
+  const double wall = wallNow();
+  const InputCounters& c = core_.counters();
+  const AlarmEngine& al = core_.alarms();
+  health_msg_.utime = wallUtime();
+  health_msg_.uptime = std::max(0.0, wall);
+  health_msg_.t = core_.modelTime();
+  health_msg_.window = std::max(0.0, wall - std::max(0.0, last_health_wall_));
+  health_msg_.ticks = ticks_;
+  health_msg_.steps = core_.steps();
+  health_msg_.deadline_misses = deadline_misses_;
+  health_msg_.step_p50_us = step_hist_.quantile(0.5);
+  health_msg_.step_p99_us = step_hist_.quantile(0.99);
+  health_msg_.step_max_us = step_hist_.max();
+  health_msg_.late_p50_us = late_hist_.quantile(0.5);
+  health_msg_.late_p99_us = late_hist_.quantile(0.99);
+  health_msg_.late_max_us = late_hist_.max();
+  health_msg_.input_age = core_.inputAge(wall);
+  health_msg_.accepted = c.accepted;
+  health_msg_.seq_gaps = c.seq_gaps;
+  health_msg_.rejected_total = c.rejectedTotal();
+  for (int i = 0; i < kRejectReasons; ++i) health_msg_.rejected[i] = c.rejected[i];
+  health_msg_.alarms_active = al.activeCount();
+  health_msg_.alarms_unacked = al.unackedCount();
+  health_msg_.alarms_shelved = al.shelvedCount();
+  health_msg_.alarm_events = alarm_events_;
+  health_msg_.model_faults = core_.modelFaults();
+  health_msg_.model_resets = core_.modelResets();
+  health_msg_.publish_failures = publish_failures_;
+  health_msg_.nonfinite_blocked = nonfinite_blocked_;
+  health_msg_.degraded = core_.degraded();
+  encodeAndPublish(ch_.health, health_msg_, health_buf_);
+  if (!final_report)
+    log_.debug("{}health: t={:.2f} s steps={} step p50/p99/max={:.0f}/{:.0f}/{:.0f} us late "
+               "p50/p99/max={:.0f}/{:.0f}/{:.0f} us misses={} inputs ok={} rejected={} gaps={} "
+               "alarms active={} faults={} publish failures={}{}",
+               label_, health_msg_.t, health_msg_.steps, health_msg_.step_p50_us, health_msg_.step_p99_us,
+               health_msg_.step_max_us, health_msg_.late_p50_us, health_msg_.late_p99_us,
+               health_msg_.late_max_us, deadline_misses_, c.accepted, c.rejectedTotal(), c.seq_gaps,
+               health_msg_.alarms_active, health_msg_.model_faults, publish_failures_,
+               health_msg_.degraded ? " DEGRADED" : "");
+  step_hist_.reset();
+  late_hist_.reset();
+  last_health_wall_ = wall;
+}
+
+void ShaftTwin::logFinal() {
+  const InputCounters& c = core_.counters();
+  log_.info("{}final health: t={:.2f} s ticks={} steps={} over the whole run: step p50/p99/p99.9/max="
+            "{:.1f}/{:.1f}/{:.1f}/{:.0f} us, tick lateness p50/p99/p99.9/max={:.0f}/{:.0f}/{:.0f}/{:.0f} us, "
+            "deadline misses={}; inputs accepted={} rejected={} sequence gaps={}; alarms "
+            "active={} events={}; model faults={} resets={}; publish failures={} withheld "
+            "(non-finite)={}{}",
+            label_, core_.modelTime(), ticks_, core_.steps(), step_total_.quantile(0.5),
+            step_total_.quantile(0.99), step_total_.quantile(0.999), step_total_.max(),
+            late_total_.quantile(0.5), late_total_.quantile(0.99), late_total_.quantile(0.999),
+            late_total_.max(), deadline_misses_, c.accepted, c.rejectedTotal(), c.seq_gaps,
+            core_.alarms().activeCount(), alarm_events_, core_.modelFaults(), core_.modelResets(),
+            publish_failures_, nonfinite_blocked_, core_.degraded() ? " DEGRADED" : "");
+  for (int i = 0; i < kRejectReasons; ++i)
+    if (c.rejected[i] > 0) log_.info("{}  rejected {}: {}", label_, toString(static_cast<RejectReason>(i)), c.rejected[i]);
+}
+
+ShaftRunStats ShaftTwin::runStats() const {
+  ShaftRunStats s;
+  const InputCounters& c = core_.counters();
+  s.label = label_.empty() ? (cfg_.service.channel_prefix.empty() ? "default" : cfg_.service.channel_prefix)
+                           : label_.substr(1, label_.size() - 3);
+  s.ticks = ticks_;
+  s.steps = core_.steps();
+  s.deadline_misses = deadline_misses_;
+  s.accepted = c.accepted;
+  s.rejected = c.rejectedTotal();
+  s.seq_gaps = c.seq_gaps;
+  s.alarm_events = alarm_events_;
+  s.model_faults = core_.modelFaults();
+  s.publish_failures = publish_failures_;
+  s.nonfinite_blocked = nonfinite_blocked_;
+  s.step = &step_total_;
+  s.late = &late_total_;
+  return s;
+}
+
+}  // namespace hoist::svc

@@ -1,0 +1,125 @@
+// ShaftTwin: one shaft hosted by hoist-twind -- its configuration, channels
+// (prefix + HOIST_*), TwinCore (the model, input validation, alarms), every
+// outgoing LCM message with its preallocated encode buffer, and its
+// statistics.  The Daemon owns the io_context, the LCM instance and the
+// schedule; it calls
+//   * onWinder()/onAck() from LCM's dispatch (subscribed in subscribe()),
+//   * tick() once per period of the shaft's rate group (absolute schedule),
+// all on the one io_context thread.
+//
+// Real time: after start-up nothing here allocates, takes a lock that another
+// thread can hold, or does I/O other than lcm::LCM::publish (a sendmsg on the
+// UDP socket, under LCM's own transmit mutex which only this thread takes).
+// Log lines go to the RtLog ring (rt_log.hpp).  tests/service/
+// daemon_no_alloc_test.cpp checks the whole loop with a counting allocator.
+#pragma once
+
+#include <utility>  // before Asio headers elsewhere: Boost 1.74 uses std::exchange
+
+#include <chrono>
+#include <cstdint>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <vector>
+
+#include "hoist/alarm_t.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/guide_shape_t.hpp"
+#include "hoist/health_t.hpp"
+#include "hoist/service/config.hpp"
+#include "hoist/service/health.hpp"
+#include "hoist/service/twin_core.hpp"
+#include "hoist/winder_t.hpp"
+#include "rt_log.hpp"
+
+namespace hoist::svc {
+
+/// Test-only fault injection (hidden command-line options, tests/hardening).
+struct TestHooks {
+  double inject_fault_at = -1.0;  ///< wall time [s] at which the model state is treated as non-finite once
+  int fail_publish_every = 0;     ///< every N-th LCM publish is treated as failed (0 = never)
+};
+
+/// Whole-run figures of one shaft (for --report and the final health line).
+struct ShaftRunStats {
+  std::string label;
+  std::int64_t ticks = 0, steps = 0, deadline_misses = 0;
+  std::int64_t accepted = 0, rejected = 0, seq_gaps = 0;
+  std::int64_t alarm_events = 0, model_faults = 0, publish_failures = 0, nonfinite_blocked = 0;
+  const LatencyHistogram* step = nullptr;  ///< model step time [us]
+  const LatencyHistogram* late = nullptr;  ///< tick lateness [us]
+};
+
+class ShaftTwin {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// `label` names the shaft in log lines ("" for a daemon with one shaft).
+  ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks);
+  ShaftTwin(const ShaftTwin&) = delete;
+  ShaftTwin& operator=(const ShaftTwin&) = delete;
+
+  /// Subscribe to the input channels on `lcm` (before the loop starts).
+  void subscribe();
+  /// The loop starts: wall times are measured from `start`.
+  void start(Clock::time_point start, double health_phase);
+  /// One period of the schedule: deadline index k (model time k / rate with
+  /// --clock wall), the deadline this tick was scheduled for (lateness is
+  /// measured from it), and how many deadlines the schedule skipped just
+  /// before k (missed ticks).
+  void tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped);
+  void publishHealth(bool final_report = false);
+  /// The final health line and per-reason rejection counts, in the log.
+  void logFinal();
+
+  const TwinConfig& config() const { return cfg_; }
+  const Channels& channels() const { return ch_; }
+  const std::string& label() const { return label_; }
+  ShaftRunStats runStats() const;
+
+ private:
+  void onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void onAck(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  double wallNow() const;
+  void publishCage(std::int64_t utime);
+  void publishShape(std::int64_t utime);
+  void drainAlarmEvents();
+  bool publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len);
+  template <class Msg>
+  bool encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf);
+  void logReject(RejectReason r, const char* detail);
+
+  TwinConfig cfg_;
+  std::string label_;  ///< "[label] " or ""
+  lcm::LCM& lcm_;
+  RtLog& log_;
+  TestHooks hooks_;
+  Channels ch_;
+  TwinCore core_;
+
+  Clock::time_point start_{};
+  int cage_div_ = 1, shape_div_ = 1;
+  double last_shape_t_ = -1e300;  ///< input clock: model time of the last shape message
+  double last_health_wall_ = 0.0;
+  std::int64_t ticks_ = 0, deadline_misses_ = 0;
+
+  // statistics
+  LatencyHistogram step_hist_, late_hist_;    // this health window
+  LatencyHistogram step_total_, late_total_;  // whole run (final report)
+  std::int64_t publish_failures_ = 0, nonfinite_blocked_ = 0, alarm_events_ = 0;
+  std::int64_t publish_attempts_ = 0;
+  bool fault_injected_ = false;
+  std::int64_t cage_seq_ = 0, alarm_id_ = 0;
+  LogRateLimiter<kRejectReasons + 3> reject_log_{5};  // + domain error, publish, alarm commands
+
+  // preallocated messages and encode buffers
+  hoist::winder_t winder_in_;
+  hoist::cage_state_t cage_msg_;
+  hoist::guide_shape_t shape_msg_;
+  hoist::alarm_t alarm_msg_;
+  hoist::health_t health_msg_;
+  std::vector<std::uint8_t> cage_buf_, shape_buf_, alarm_buf_, health_buf_;
+  char text_[256];
+};
+
+}  // namespace hoist::svc
