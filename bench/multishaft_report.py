@@ -16,6 +16,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--command", default="")
     ap.add_argument("--seconds", default="")
+    ap.add_argument("--max-step", default="")
     ap.add_argument("--out-dir", default=".")
     ap.add_argument("items", nargs="+")
     a = ap.parse_args()
@@ -38,13 +39,14 @@ def main():
                "winder streams at the step rate by `hoist-replay --timing-test --shafts N` on another CPU. "
                f"Real-time settings: memory lock {first['realtime']['memory_lock']}, scheduling "
                f"{first['realtime']['scheduling']}, affinity {first['realtime']['affinity']}.  "
-               f"{a.seconds} s per row.  Lateness is measured at the start of each shaft's own step, so it "
+               f"`[service] max_step` = {a.max_step} s.  {a.seconds} s per row.  Lateness is measured at the start of each shaft's own step, so it "
                "includes the work of the shafts stepped before it in the same tick.")
     out.append("")
-    out.append("| twins | deadline misses (all shafts) | worst tick lateness p99 / p99.9 / max | step p50 / p99 (all shafts) | CPU used | inputs lost | timing test |")
-    out.append("|---|---|---|---|---|---|---|")
+    out.append("| twins | deadline misses (all shafts) | worst tick lateness p99 / p99.9 / max | step p50 / p99 (all shafts) | CPU used | steal | inputs lost | timing test |")
+    out.append("|---|---|---|---|---|---|---|---|")
     best = None
-    for n, r, md, cpu in rows:
+    for n, r, md, cpu_steal in rows:
+        cpu, _, steal = cpu_steal.partition("/")
         sh = r["shafts"]
         misses = sum(s["deadline_misses"] for s in sh)
         lp99 = max(s["late_us"]["p99"] for s in sh)
@@ -55,15 +57,18 @@ def main():
         gaps = sum(s["sequence_gaps"] for s in sh)
         v = verdict(md)
         out.append(f"| {n} | **{misses}** | {fmt_us(lp99)} / {fmt_us(lp999)} / {fmt_us(lmax)} | {fmt_us(sp50)} / "
-                   f"{fmt_us(sp99)} | {cpu} % | {gaps} | {v} ([report]({os.path.relpath(md, a.out_dir)})) |")
+                   f"{fmt_us(sp99)} | {cpu} % | {steal or '?'} s | {gaps} | {v} ([report]({os.path.relpath(md, a.out_dir)})) |")
         if misses == 0 and (best is None or n > best):
             best = n
     out.append("")
     if best is None:
         out.append("No count ran without a deadline miss.")
     else:
-        out.append(f"**Largest count without a deadline miss: {best} twins on one core.**  (\"CPU used\" is the "
-                   "process's user + system time over the run, 100 % = the whole core.)")
+        out.append(f"**Largest count without a deadline miss: {best} twins on one core.**")
+    out.append("")
+    out.append("\"CPU used\" is the process's user + system time over the run (100 % = the whole core); "
+               "\"steal\" is the time the hypervisor gave the daemon's virtual CPU to something else during "
+               "the run (`/proc/stat`); \"inputs lost\" counts sequence gaps seen by the daemon.")
     print("\n".join(out))
 
 

@@ -117,11 +117,38 @@ def main():
                 f"**{s['deadline_misses']}** | {fmt_us(st['p50'])} / {fmt_us(st['p99'])} / {fmt_us(st['p999'])} / "
                 f"{fmt_us(st['max'])} | {fmt_us(lt['p50'])} / {fmt_us(lt['p99'])} / {fmt_us(lt['p999'])} / "
                 f"{fmt_us(lt['max'])} | {verdict(md)} ([report]({os.path.relpath(md, a.out_dir)})) |")
+    base_rows = []
+    for tag, r, md in points:
+        bp = md.replace(".timing.md", ".baseline.json")
+        if os.path.exists(bp):
+            with open(bp) as f:
+                b = json.load(f)
+            lt = b["late_us"]
+            base_rows.append(f"| {tag} ({b['rate_hz']:g} Hz, no work) | {b['seconds'] / 60:.1f} min | {b['ticks']} | "
+                             f"**{b['deadline_misses']}** | - | {fmt_us(lt['p50'])} / {fmt_us(lt['p99'])} / "
+                             f"{fmt_us(lt['p999'])} / {fmt_us(lt['max'])} | {b['scheduling']}, {b['affinity']} |")
+    if base_rows:
+        out.append("")
+        out.append("**The bare machine**, measured just before each point with `hoist-wakeup-latency` (a "
+                   "cyclictest-like loop: the same absolute schedule, the same CPU and real-time settings, no "
+                   "work at all).  Wake-ups it gets late, the daemon gets late too:")
+        out.append("")
+        out.append("| point | run | ticks | deadline misses | - | lateness p50 / p99 / p99.9 / max | settings |")
+        out.append("|---|---|---|---|---|---|---|")
+        out.extend(base_rows)
     out.append("")
     for tag, r, md in points:
         for s in r["shafts"]:
             out.append(f"## {tag}: {s['rate_hz']:g} Hz, n = {s['modes']}")
             out.append("")
+            sp = md.replace(".timing.md", ".steal")
+            if os.path.exists(sp):
+                with open(sp) as f:
+                    steal = float(f.read().strip() or 0)
+                out.append(f"Steal time on the daemon's CPU during the run (`/proc/stat`: time the hypervisor gave "
+                           f"this virtual CPU's slot to something else): **{steal:.2f} s** "
+                           f"({100.0 * steal / max(r['duration_s'], 1e-9):.2f} % of the run).")
+                out.append("")
             out.append(f"Inputs accepted {s['inputs_accepted']}, rejected {s['inputs_rejected']}, sequence gaps "
                        f"{s['sequence_gaps']}; alarm events {s['alarm_events']}; model faults {s['model_faults']}; "
                        f"publish failures {s['publish_failures']}; log lines dropped {r.get('log_lines_dropped', 0)}.")

@@ -23,8 +23,8 @@ if [[ ! -x "$bin" ]]; then
   echo "bench.sh: $bin not found; build first (scripts/setup.sh)" >&2
   exit 2
 fi
-json="$(mktemp)"
-trap 'rm -f "$json"' EXIT
+# The raw results stay in build/ (re-format with scripts/bench_report.py).
+json="$here/build/bench.json"
 echo "running $bin ($reps repetitions; a few minutes) ..." >&2
 "$bin" --benchmark_repetitions="$reps" --benchmark_report_aggregates_only=true \
   --benchmark_out="$json" --benchmark_out_format=json "${extra[@]}" >&2

@@ -16,7 +16,8 @@ def main(path):
         if b.get("aggregate_name") not in ("median", None):
             continue
         name = b.get("run_name", b["name"])
-        name = "/".join(part for part in name.split("/") if not part.startswith("min_time:"))
+        name = "/".join(part for part in name.split("/")
+                        if not part.startswith(("min_time:", "iterations:", "repeats:")))
         unit = {"ns": 1e-3, "us": 1.0, "ms": 1e3, "s": 1e6}[b.get("time_unit", "ns")]
         med[name] = b["real_time"] * unit  # microseconds
     ctx = data.get("context", {})
