@@ -65,6 +65,13 @@ bool Daemon::start() {
   for (auto& s : shafts_) s->subscribe();
   lcm_fd_.assign(lcm_.getFileno());
   armLcm();
+  // The stop signals are handled on this (the loop) thread; hoist-twind's
+  // main() blocks them before any helper thread exists (see main.cpp).
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
   signals_.async_wait([this](const boost::system::error_code& ec, int sig) {
     if (!ec) stop(sig == SIGINT ? "SIGINT" : "SIGTERM");
   });

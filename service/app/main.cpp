@@ -11,6 +11,7 @@
 // (SIGINT/SIGTERM/--duration), 1 if LCM cannot be opened, 2 for a bad
 // command line or configuration.
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -149,6 +150,18 @@ int main(int argc, char** argv) {
   log->set_pattern("%Y-%m-%d %H:%M:%S.%e [%^%l%$] %v");
   log->flush_on(spdlog::level::info);
   spdlog::register_logger(log);
+
+  // SIGINT/SIGTERM must reach the loop thread: block them here, before the
+  // Daemon starts its helper threads (LCM's receive thread, the log writer),
+  // which inherit the mask; Daemon::start() unblocks them on the loop thread.
+  // Otherwise the kernel may deliver a signal to a helper thread that a
+  // SCHED_FIFO loop pinned to the same CPU starves when overloaded, and the
+  // stop request would never be seen.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
   int rc = 0;
   try {
