@@ -11,15 +11,19 @@
 #
 #   scripts/soak.sh [--duration S] [--build-dir DIR] [--out DIR] [--port P]
 #                   [--rate HZ] [--rss-bound-kb K] [--warmup S] [--config FILE]
-#                   [--sample S] [--no-rt]
+#                   [--sample S] [--no-rt] [--timing-informational]
 #
 # Defaults: 3600 s, build/, OUT = BUILD/soak, port 7722, 1000 Hz, 2048 kB,
 # warm-up max(30 s, 10 % of the run), RSS sampled every 10 s (2 s for runs
 # under 10 min).  As root the daemon runs SCHED_FIFO 10 (chrt) unless --no-rt.
+# --timing-informational reports the deadline-miss checks without failing on
+# them (CTest's 2-minute soak: these machines are shared and noisy; timing is
+# judged by bench/rt_report.sh and hoist-replay --timing-test).
 # Exit status 0 when every check passed.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 duration=3600; build_dir="$here/build"; out=""; port=7722; rate=1000; rss_bound=2048
+timing_info=()
 warmup=""; config="$here/service/config/demo.toml"; sample=""; rt=1
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -33,7 +37,8 @@ while [[ $# -gt 0 ]]; do
     --config) config="$2"; shift 2 ;;
     --sample) sample="$2"; shift 2 ;;
     --no-rt) rt=0; shift ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --timing-informational) timing_info=(--timing-informational); shift ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "soak.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -103,7 +108,7 @@ echo "[soak] replay exit $replay_rc, daemon exit $daemon_rc"
 "$bin/hoist-log2csv" "$out/run.lcmlog" --out-dir "$out/csv" >"$out/log2csv.log" 2>&1 || echo "[soak] hoist-log2csv failed (see $out/log2csv.log)"
 rc=0
 python3 "$here/scripts/soak_check.py" "$out" --sent "$sent" --warmup "$warmup" \
-  --rss-bound-kb "$rss_bound" --duration "$duration" \
+  --rss-bound-kb "$rss_bound" --duration "$duration" "${timing_info[@]}" \
   --label "($duration s, $rate Hz, $(basename "$config"), ${launcher[*]:-normal scheduling})" || rc=$?
 {
   echo "- $( [[ $replay_rc -eq 0 ]] && echo PASS || echo FAIL ) hoist-replay exit status $replay_rc"

@@ -42,6 +42,10 @@ def main():
     ap.add_argument("--storm-frac", type=float, default=0.2)
     ap.add_argument("--duration", type=float, default=0.0)
     ap.add_argument("--label", default="")
+    ap.add_argument("--timing-informational", action="store_true",
+                    help="report the deadline-miss checks as INFO instead of failing on them "
+                         "(CTest's 2-minute soak on shared, noisy machines: timing belongs to "
+                         "bench/rt_report.sh and the timing test, not to a unit test)")
     a = ap.parse_args()
 
     fails, lines = [], []
@@ -138,10 +142,17 @@ def main():
         if dt + dm > 0 and dm > a.storm_frac * (dt + dm):
             storms.append((float(health[i]["uptime"]), dm, dt))
     frac = misses / max(1, ticks + misses)
-    check(frac <= a.max_miss_frac,
-          "deadline misses %d of %d ticks (%.4f %%, bound %.3f %%)" % (misses, ticks, 100 * frac, 100 * a.max_miss_frac))
-    check(not storms, "no deadline-miss storm (window with > %.0f %% missed): %s"
-          % (100 * a.storm_frac, storms[:5] if storms else "none"))
+
+    def timing_check(ok, what):
+        if a.timing_informational:
+            lines.append("INFO (timing, not judged here) " + ("within: " if ok else "outside: ") + what)
+        else:
+            check(ok, what)
+
+    timing_check(frac <= a.max_miss_frac,
+                 "deadline misses %d of %d ticks (%.4f %%, bound %.3f %%)" % (misses, ticks, 100 * frac, 100 * a.max_miss_frac))
+    timing_check(not storms, "no deadline-miss storm (window with > %.0f %% missed): %s"
+                 % (100 * a.storm_frac, storms[:5] if storms else "none"))
     p99 = max(float(r["step_p99_us"]) for r in health)
     smax = max(float(r["step_max_us"]) for r in health)
     lmax = max(float(r["late_max_us"]) for r in health)
