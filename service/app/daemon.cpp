@@ -96,7 +96,6 @@ bool Daemon::start() {
                c.shaft.L, c.shaft.h, c.shaft.l0);
   }
   if (n > 1) out_->info("hoist-twind started: {} shafts on one loop, {} schedule(s)", n, groups_.size());
-  for (std::size_t i = 0; i < n; ++i) shafts_[i]->publishHealth();  // announce ourselves at once
   started_ = true;
   return true;
 }

@@ -152,7 +152,8 @@ void ShaftTwin::subscribe() {
 
 void ShaftTwin::start(Clock::time_point start, double health_phase) {
   start_ = start;
-  // Shafts of one daemon spread their health messages over the second.
+  publishHealth();  // announce ourselves at once
+  // Shafts of one daemon spread their later health messages over the period.
   last_health_wall_ = -health_phase;
 }
 

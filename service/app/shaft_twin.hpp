@@ -61,7 +61,9 @@ class ShaftTwin {
 
   /// Subscribe to the input channels on `lcm` (before the loop starts).
   void subscribe();
-  /// The loop starts: wall times are measured from `start`.
+  /// The loop starts: wall times are measured from `start`; publishes a
+  /// first HOIST_HEALTH at once, the next ones `health_phase` s earlier than
+  /// a full period later (the shafts of one daemon spread them out).
   void start(Clock::time_point start, double health_phase);
   /// One period of the schedule: deadline index k (model time k / rate with
   /// --clock wall), the deadline this tick was scheduled for (lateness is
