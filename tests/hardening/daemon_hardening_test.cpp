@@ -28,8 +28,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string urlFor(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
-
 std::int64_t nowUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
@@ -90,18 +88,9 @@ class DaemonHardening : public ::testing::Test {
   std::unique_ptr<Process> startDaemon(std::vector<std::string> extra, const std::string& log_name) {
     std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--log-level", "info"};
     argv.insert(argv.end(), extra.begin(), extra.end());
-    auto p = std::make_unique<Process>(argv, (dir_ / log_name).string());
-    EXPECT_TRUE(p->started());
-    const std::size_t before = listener_->count("HOIST_HEALTH");
-    EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > before; }, 10s))
-        << "hoist-twind did not come up; its log:\n" << readFile((dir_ / log_name).string());
-    listener_->pump(200ms);
-    return p;
+    return startDaemonAndWait(*listener_, argv, (dir_ / log_name).string());
   }
-  void stopDaemon(Process& p, const std::string& log_name) {
-    p.signal(SIGTERM);
-    EXPECT_EQ(p.wait(10s), 0) << readFile((dir_ / log_name).string());
-  }
+  void stopDaemon(Process& p, const std::string& log_name) { stopDaemonCleanly(p, (dir_ / log_name).string()); }
   /// The latest health report satisfying pred (waits up to `timeout`).
   hoist::health_t waitHealth(const std::function<bool(const hoist::health_t&)>& pred, std::chrono::milliseconds timeout) {
     hoist::health_t h{};

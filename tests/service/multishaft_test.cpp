@@ -21,8 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string urlFor(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
-
 std::string writeConfig(const fs::path& dir, const std::string& name, const std::string& body) {
   const auto path = (dir / name).string();
   std::ofstream(path) << body;

@@ -28,8 +28,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string urlFor(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
-
 /// A 3 s trip: a = +1 for 1 s, cruise at 1 m/s, a = -1 for 1 s, from l = 80 m,
 /// sampled every 10 ms (t, v, a, l).
 std::string writeProfile(const fs::path& dir) {
@@ -64,22 +62,10 @@ class LcmIntegration : public ::testing::Test {
   std::unique_ptr<Process> startDaemon(std::vector<std::string> extra, const std::string& log_name) {
     std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--log-level", "info"};
     argv.insert(argv.end(), extra.begin(), extra.end());
-    auto p = std::make_unique<Process>(argv, (dir_ / log_name).string());
-    EXPECT_TRUE(p->started());
-    // The daemon publishes HOIST_HEALTH at once when it is up.
-    const std::size_t before = listener_->count("HOIST_HEALTH");
-    EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > before; }, 10s))
-        << "hoist-twind did not come up; its log:\n" << readFile((dir_ / log_name).string());
-    // LCM 1.3.1's UDP receiver may still drop the first datagrams right after
-    // it comes up (seen as a missing first few inputs): let it settle.
-    listener_->pump(200ms);
-    return p;
+    return startDaemonAndWait(*listener_, argv, (dir_ / log_name).string());
   }
 
-  void stopDaemon(Process& p, const std::string& log_name) {
-    p.signal(SIGTERM);
-    EXPECT_EQ(p.wait(10s), 0) << readFile((dir_ / log_name).string());
-  }
+  void stopDaemon(Process& p, const std::string& log_name) { stopDaemonCleanly(p, (dir_ / log_name).string()); }
 
   int replay(std::vector<std::string> extra) {
     std::vector<std::string> argv{HOIST_REPLAY, "--lcm-url", url_, "-q"};

@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
@@ -214,6 +216,32 @@ inline std::filesystem::path testDir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+/// The tests' LCM URL on `port`: UDP multicast on loopback, host-local.
+inline std::string urlFor(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
+
+/// Starts the daemon command line `argv` (output to `log`) and waits up to
+/// 10 s for its next message on `health_channel` (hoist-twind publishes one
+/// at once when it is up).  LCM 1.3.1's UDP receiver may still drop the first
+/// datagrams right after it comes up (seen as a missing first few inputs), so
+/// the listener then keeps receiving for 200 ms to let it settle.
+inline std::unique_ptr<Process> startDaemonAndWait(Listener& listener, const std::vector<std::string>& argv,
+                                                   const std::string& log,
+                                                   const std::string& health_channel = "HOIST_HEALTH") {
+  auto p = std::make_unique<Process>(argv, log);
+  EXPECT_TRUE(p->started());
+  const std::size_t before = listener.count(health_channel);
+  EXPECT_TRUE(listener.waitFor([&] { return listener.count(health_channel) > before; }, 10s))
+      << "hoist-twind did not come up; its log:\n" << readFile(log);
+  listener.pump(200ms);
+  return p;
+}
+
+/// SIGTERM, then a clean exit (status 0) within 10 s.
+inline void stopDaemonCleanly(Process& p, const std::string& log) {
+  p.signal(SIGTERM);
+  EXPECT_EQ(p.wait(10s), 0) << readFile(log);
 }
 
 }  // namespace hoist::test

@@ -20,8 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string urlFor(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
-
 std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
 
 class TimingTest : public ::testing::Test {
@@ -43,19 +41,12 @@ class TimingTest : public ::testing::Test {
       argv.push_back("--channel-prefix");
       argv.push_back(prefix);
     }
-    auto p = std::make_unique<Process>(argv, (dir_ / log_name).string());
-    EXPECT_TRUE(p->started());
-    const std::string ch = prefix + "HOIST_HEALTH";
-    EXPECT_TRUE(listener_->waitFor([&] { return listener_->count(ch) > 0; }, 10s))
-        << "hoist-twind did not come up; its log:\n" << readFile((dir_ / log_name).string());
-    listener_->pump(200ms);
-    return p;
+    return startDaemonAndWait(*listener_, argv, (dir_ / log_name).string(), prefix + "HOIST_HEALTH");
   }
 
   void stopDaemon(Process& p, const std::string& log_name) {
     EXPECT_TRUE(p.running()) << "hoist-twind died during the test:\n" << readFile((dir_ / log_name).string());
-    p.signal(SIGTERM);
-    EXPECT_EQ(p.wait(10s), 0) << readFile((dir_ / log_name).string());
+    stopDaemonCleanly(p, (dir_ / log_name).string());
   }
 
   /// hoist-replay --timing-test with `extra`; returns the exit status, the
