@@ -90,7 +90,7 @@ bool Daemon::start() {
     const TwinConfig& c = s.config();
     out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}, input {}, outputs {} {} {} {}, "
                "n={} modes, L={} m, h={} m, l0={} m",
-               s.label().empty() ? "" : "[" + s.label() + "] ", n == 1 ? "started" : "shaft",
+               s.tag(), n == 1 ? "started" : "shaft",
                toString(c.service.clock), c.service.rate, describeLcmUrl(opt_.lcm_url), s.channels().winder,
                s.channels().cage, s.channels().shape, s.channels().alarm, s.channels().health, c.shaft.n,
                c.shaft.L, c.shaft.h, c.shaft.l0);

@@ -92,8 +92,6 @@ class RtLog {
     out_->flush();
   }
 
-  spdlog::logger& out() { return *out_; }
-
  private:
   struct Slot {
     std::array<char, kText> text{};

@@ -111,7 +111,8 @@ int divider(double rate, double sub_rate) {
 
 ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks)
     : cfg_(cfg),
-      label_(label.empty() ? std::string() : "[" + label + "] "),
+      label_(std::move(label)),
+      tag_(label_.empty() ? std::string() : "[" + label_ + "] "),
       lcm_(lcm),
       log_(log),
       hooks_(hooks),
@@ -165,9 +166,9 @@ void ShaftTwin::logReject(RejectReason r, const char* detail) {
   std::int64_t suppressed = 0;
   if (!reject_log_.allow(static_cast<int>(r), wallNow(), suppressed)) return;
   if (suppressed > 0)
-    log_.warn("{}rejected winder input ({}): {} [{} similar suppressed]", label_, toString(r), detail, suppressed);
+    log_.warn("{}rejected winder input ({}): {} [{} similar suppressed]", tag_, toString(r), detail, suppressed);
   else
-    log_.warn("{}rejected winder input ({}): {}", label_, toString(r), detail);
+    log_.warn("{}rejected winder input ({}): {}", tag_, toString(r), detail);
 }
 
 void ShaftTwin::onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
@@ -191,7 +192,7 @@ void ShaftTwin::onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& /*ch
     logReject(res.reason, text_);
   }
   if (res.reinitialized)
-    log_.info("{}new winder stream (seq {}): model re-initialized at l = {} m", label_, s.seq,
+    log_.info("{}new winder stream (seq {}): model re-initialized at l = {} m", tag_, s.seq,
               core_.output().kin.l);
   if (res.stepped) {
     const double us = duration<double, std::micro>(t1 - t0).count();
@@ -217,9 +218,9 @@ void ShaftTwin::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*chann
   // printable before they reach the log.
   std::int64_t suppressed = 0;
   const bool may_log = reject_log_.allow(kRejectReasons + 2, wallNow(), suppressed);
-  if (may_log && suppressed > 0) log_.warn("{}{} alarm-command log lines suppressed", label_, suppressed);
+  if (may_log && suppressed > 0) log_.warn("{}{} alarm-command log lines suppressed", tag_, suppressed);
   if (ack.decode(rbuf->data, 0, size) != size) {
-    if (may_log) log_.warn("{}ignored undecodable alarm command ({} bytes) on {}", label_, size, ch_.ack);
+    if (may_log) log_.warn("{}ignored undecodable alarm command ({} bytes) on {}", tag_, size, ch_.ack);
     return;
   }
   ack.user = printable(ack.user);
@@ -228,12 +229,12 @@ void ShaftTwin::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*chann
     kind = parseAlarmKind(ack.kind);
     if (!kind) {
       if (may_log)
-        log_.warn("{}ignored alarm command from '{}': unknown alarm kind '{}'", label_, ack.user, printable(ack.kind));
+        log_.warn("{}ignored alarm command from '{}': unknown alarm kind '{}'", tag_, ack.user, printable(ack.kind));
       return;
     }
   }
   if (ack.level < 0 || ack.level > 2) {
-    if (may_log) log_.warn("{}ignored alarm command from '{}': bad level {}", label_, ack.user, int(ack.level));
+    if (may_log) log_.warn("{}ignored alarm command from '{}': bad level {}", tag_, ack.user, int(ack.level));
     return;
   }
   const auto level = static_cast<AlarmLevel>(ack.level);
@@ -243,11 +244,11 @@ void ShaftTwin::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*chann
     case hoist::alarm_ack_t::ACTION_SHELVE: action = AlarmAction::Shelve; break;
     case hoist::alarm_ack_t::ACTION_UNSHELVE: action = AlarmAction::Unshelve; break;
     default:
-      if (may_log) log_.warn("{}ignored alarm command from '{}': bad action {}", label_, ack.user, int(ack.action));
+      if (may_log) log_.warn("{}ignored alarm command from '{}': bad action {}", tag_, ack.user, int(ack.action));
       return;
   }
   if (action == AlarmAction::Shelve && !(std::isfinite(ack.shelve_duration) && ack.shelve_duration > 0.0)) {
-    if (may_log) log_.warn("{}ignored shelve from '{}': shelve_duration must be > 0 s", label_, ack.user);
+    if (may_log) log_.warn("{}ignored shelve from '{}': shelve_duration must be > 0 s", tag_, ack.user);
     return;
   }
   const int n = core_.command(action, kind, level, ack.shelve_duration);
@@ -256,7 +257,7 @@ void ShaftTwin::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*chann
   if (action == AlarmAction::Shelve)
     std::snprintf(for_s, sizeof for_s, " for %g s", std::min(ack.shelve_duration, cfg_.alarms.max_shelve));
   if (may_log)
-    log_.info("{}operator '{}': {} {}/{}{} -> {} alarm(s)", label_, ack.user, what, kind ? toString(*kind) : "*",
+    log_.info("{}operator '{}': {} {}/{}{} -> {} alarm(s)", tag_, ack.user, what, kind ? toString(*kind) : "*",
               level == AlarmLevel::None ? "*" : toString(level), for_s, n);
   drainAlarmEvents();
 }
@@ -273,7 +274,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   const double wall = duration<double>(now - start_).count();
   if (hooks_.inject_fault_at >= 0.0 && !fault_injected_ && wall >= hooks_.inject_fault_at) {
     fault_injected_ = true;
-    log_.warn("{}test: injecting a model fault (non-finite state) at wall time {:.3f} s", label_, wall);
+    log_.warn("{}test: injecting a model fault (non-finite state) at wall time {:.3f} s", tag_, wall);
     core_.injectFault();
   }
 
@@ -292,7 +293,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
       std::int64_t suppressed = 0;
       if (reject_log_.allow(kRejectReasons, wall, suppressed))
         log_.warn("{}model refused the kinematics at t = {:.3f} s (l = {:.3f} m); holding the rope length [{} similar suppressed]",
-                  label_, t, core_.output().kin.l, suppressed);
+                  tag_, t, core_.output().kin.l, suppressed);
     }
     if (r.stepped && core_.hasInput()) {
       const std::int64_t utime = wallUtime();
@@ -315,7 +316,7 @@ bool ShaftTwin::publishBytes(const std::string& channel, const std::vector<std::
     ++publish_failures_;
     std::int64_t suppressed = 0;
     if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
-      log_.error("{}LCM publish failed on {} [{} similar suppressed]", label_, channel, suppressed);
+      log_.error("{}LCM publish failed on {} [{} similar suppressed]", tag_, channel, suppressed);
     return false;
   }
   return true;
@@ -327,13 +328,13 @@ bool ShaftTwin::encodeAndPublish(const std::string& channel, const Msg& msg, std
     ++nonfinite_blocked_;
     std::int64_t suppressed = 0;
     if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
-      log_.error("{}withheld a message on {}: non-finite value", label_, channel);
+      log_.error("{}withheld a message on {}: non-finite value", tag_, channel);
     return false;
   }
   const int need = msg.getEncodedSize();
   if (need > static_cast<int>(buf.size())) {
     ++publish_failures_;
-    log_.error("{}message on {} too large for its buffer ({} > {} bytes)", label_, channel, need, buf.size());
+    log_.error("{}message on {} too large for its buffer ({} > {} bytes)", tag_, channel, need, buf.size());
     return false;
   }
   const int len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
@@ -404,15 +405,15 @@ void ShaftTwin::drainAlarmEvents() {
     alarm_msg_.message.assign(text_);
     if (encodeAndPublish(ch_.alarm, alarm_msg_, alarm_buf_)) ++alarm_events_;
     switch (e.type) {
-      case AlarmEventType::Reannounce: log_.debug("{}alarm: {} (t = {:.2f} s)", label_, text_, e.t); break;
+      case AlarmEventType::Reannounce: log_.debug("{}alarm: {} (t = {:.2f} s)", tag_, text_, e.t); break;
       case AlarmEventType::Raise:
-        if (e.level == AlarmLevel::Critical) log_.error("{}ALARM {} (t = {:.2f} s)", label_, text_, e.t);
-        else log_.warn("{}ALARM {} (t = {:.2f} s)", label_, text_, e.t);
+        if (e.level == AlarmLevel::Critical) log_.error("{}ALARM {} (t = {:.2f} s)", tag_, text_, e.t);
+        else log_.warn("{}ALARM {} (t = {:.2f} s)", tag_, text_, e.t);
         break;
-      default: log_.info("{}alarm: {} (t = {:.2f} s)", label_, text_, e.t); break;
+      default: log_.info("{}alarm: {} (t = {:.2f} s)", tag_, text_, e.t); break;
     }
   }
-  if (ev.dropped() > 0) log_.error("{}{} alarm events dropped (event buffer full)", label_, ev.dropped());
+  if (ev.dropped() > 0) log_.error("{}{} alarm events dropped (event buffer full)", tag_, ev.dropped());
   core_.clearEvents();
 }
 
@@ -452,7 +453,7 @@ void ShaftTwin::publishHealth(bool final_report) {
     log_.debug("{}health: t={:.2f} s steps={} step p50/p99/max={:.0f}/{:.0f}/{:.0f} us late "
                "p50/p99/max={:.0f}/{:.0f}/{:.0f} us misses={} inputs ok={} rejected={} gaps={} "
                "alarms active={} faults={} publish failures={}{}",
-               label_, health_msg_.t, health_msg_.steps, health_msg_.step_p50_us, health_msg_.step_p99_us,
+               tag_, health_msg_.t, health_msg_.steps, health_msg_.step_p50_us, health_msg_.step_p99_us,
                health_msg_.step_max_us, health_msg_.late_p50_us, health_msg_.late_p99_us,
                health_msg_.late_max_us, deadline_misses_, c.accepted, c.rejectedTotal(), c.seq_gaps,
                health_msg_.alarms_active, health_msg_.model_faults, publish_failures_,
@@ -469,21 +470,20 @@ void ShaftTwin::logFinal() {
             "deadline misses={}; inputs accepted={} rejected={} sequence gaps={}; alarms "
             "active={} events={}; model faults={} resets={}; publish failures={} withheld "
             "(non-finite)={}{}",
-            label_, core_.modelTime(), ticks_, core_.steps(), step_total_.quantile(0.5),
+            tag_, core_.modelTime(), ticks_, core_.steps(), step_total_.quantile(0.5),
             step_total_.quantile(0.99), step_total_.quantile(0.999), step_total_.max(),
             late_total_.quantile(0.5), late_total_.quantile(0.99), late_total_.quantile(0.999),
             late_total_.max(), deadline_misses_, c.accepted, c.rejectedTotal(), c.seq_gaps,
             core_.alarms().activeCount(), alarm_events_, core_.modelFaults(), core_.modelResets(),
             publish_failures_, nonfinite_blocked_, core_.degraded() ? " DEGRADED" : "");
   for (int i = 0; i < kRejectReasons; ++i)
-    if (c.rejected[i] > 0) log_.info("{}  rejected {}: {}", label_, toString(static_cast<RejectReason>(i)), c.rejected[i]);
+    if (c.rejected[i] > 0) log_.info("{}  rejected {}: {}", tag_, toString(static_cast<RejectReason>(i)), c.rejected[i]);
 }
 
 ShaftRunStats ShaftTwin::runStats() const {
   ShaftRunStats s;
   const InputCounters& c = core_.counters();
-  s.label = label_.empty() ? (cfg_.service.channel_prefix.empty() ? "default" : cfg_.service.channel_prefix)
-                           : label_.substr(1, label_.size() - 3);
+  s.label = !label_.empty() ? label_ : cfg_.service.channel_prefix.empty() ? "default" : cfg_.service.channel_prefix;
   s.ticks = ticks_;
   s.steps = core_.steps();
   s.deadline_misses = deadline_misses_;

@@ -14,8 +14,6 @@
 // daemon_no_alloc_test.cpp checks the whole loop with a counting allocator.
 #pragma once
 
-#include <utility>  // before Asio headers elsewhere: Boost 1.74 uses std::exchange
-
 #include <chrono>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
@@ -77,6 +75,8 @@ class ShaftTwin {
   const TwinConfig& config() const { return cfg_; }
   const Channels& channels() const { return ch_; }
   const std::string& label() const { return label_; }
+  /// "[label] " for log lines, "" for a daemon with one shaft.
+  const std::string& tag() const { return tag_; }
   ShaftRunStats runStats() const;
 
  private:
@@ -92,7 +92,8 @@ class ShaftTwin {
   void logReject(RejectReason r, const char* detail);
 
   TwinConfig cfg_;
-  std::string label_;  ///< "[label] " or ""
+  std::string label_;  ///< as given ("" for a daemon with one shaft)
+  std::string tag_;    ///< log-line prefix: "[label] " or ""
   lcm::LCM& lcm_;
   RtLog& log_;
   TestHooks hooks_;

@@ -139,6 +139,7 @@ TEST(MultiShaft, ThreeShaftsOneProcessOwnChannelsAlarmsAndRates) {
   const std::string log = readFile((dir / "twind.log").string());
   EXPECT_NE(log.find("3 shafts on one loop, 2 schedule(s)"), std::string::npos) << log;
   EXPECT_NE(log.find("[south/] final health"), std::string::npos) << log;
+  EXPECT_NE(log.find("] [south/] hoist-twind shaft: clock=wall rate=200 Hz"), std::string::npos) << log;
 }
 
 TEST(MultiShaft, ConflictingConfigurationsAreRefusedNamingTheKey) {
