@@ -23,7 +23,7 @@ bool finiteAll(const hoist::cage_state_t& m) {
             std::isfinite(m.guide_deflection) && std::isfinite(m.clearance_pos_y) &&
             std::isfinite(m.clearance_neg_y) && std::isfinite(m.clearance_guide) &&
             std::isfinite(m.min_clearance);
-  for (double v : m.lambda) ok = ok && std::isfinite(v);
+  for (double v : m.lambdas) ok = ok && std::isfinite(v);
   return ok;
 }
 
@@ -357,7 +357,7 @@ void ShaftTwin::publishCage(std::int64_t utime) {
   cage_msg_.x_c = o.x_c;
   cage_msg_.y_c = o.y_c;
   cage_msg_.theta = o.theta;
-  for (int i = 0; i < 5; ++i) cage_msg_.lambda[i] = o.lambda[i];
+  for (int i = 0; i < 5; ++i) cage_msg_.lambdas[i] = o.lambda[i];
   cage_msg_.y_top = o.clearance.y_top;
   cage_msg_.y_bottom = o.clearance.y_bottom;
   cage_msg_.guide_deflection = o.clearance.guide_deflection;
@@ -394,7 +394,7 @@ void ShaftTwin::drainAlarmEvents() {
     alarm_msg_.t = e.t;
     alarm_msg_.kind.assign(toString(e.kind));
     alarm_msg_.level = static_cast<int8_t>(e.level);
-    alarm_msg_.event = static_cast<int8_t>(e.type);
+    alarm_msg_.event_type = static_cast<int8_t>(e.type);
     alarm_msg_.active = e.active;
     alarm_msg_.acked = e.acked;
     alarm_msg_.shelved = e.shelved;

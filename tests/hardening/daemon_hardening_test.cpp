@@ -61,7 +61,7 @@ bool finiteCage(const hoist::cage_state_t& c) {
             std::isfinite(c.x_c) && std::isfinite(c.y_c) && std::isfinite(c.theta) &&
             std::isfinite(c.min_clearance) && std::isfinite(c.clearance_pos_y) &&
             std::isfinite(c.clearance_neg_y) && std::isfinite(c.clearance_guide);
-  for (double v : c.lambda) ok = ok && std::isfinite(v);
+  for (double v : c.lambdas) ok = ok && std::isfinite(v);
   return ok;
 }
 
@@ -273,7 +273,7 @@ TEST_F(DaemonHardening, InputStopsAndResumes) {
   auto events = [&](int event) {
     std::vector<hoist::alarm_t> out;
     for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
-      if (a.kind == "INPUT_STALE" && a.event == event) out.push_back(a);
+      if (a.kind == "INPUT_STALE" && a.event_type == event) out.push_back(a);
     return out;
   };
   stream(100);
@@ -342,7 +342,7 @@ TEST_F(DaemonHardening, InjectedModelFaultRecoversWithoutNaN) {
   }
   auto faultRaised = [&] {
     for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
-      if (a.kind == "MODEL_FAULT" && a.event == hoist::alarm_t::EVENT_RAISE && a.level == hoist::alarm_t::LEVEL_CRITICAL)
+      if (a.kind == "MODEL_FAULT" && a.event_type == hoist::alarm_t::EVENT_RAISE && a.level == hoist::alarm_t::LEVEL_CRITICAL)
         return true;
     return false;
   };

@@ -212,7 +212,7 @@ TEST_F(LcmIntegration, CageOutputMatchesHoistSim) {
   for (std::size_t k = 0; k < cage.size(); ++k) {
     const auto& c = cage[k];
     const double got[12] = {c.t, c.l, c.v, c.a, c.x_c, c.y_c, c.theta,
-                            c.lambda[0], c.lambda[1], c.lambda[2], c.lambda[3], c.lambda[4]};
+                            c.lambdas[0], c.lambdas[1], c.lambdas[2], c.lambdas[3], c.lambdas[4]};
     for (int j = 0; j < 12; ++j) {
       const double want = sim[k][j];
       // Relative to the column's scale (hoist-sim may print fewer digits).
@@ -334,7 +334,7 @@ TEST_F(LcmIntegration, HostileInputIsRejectedAndCounted) {
   for (const auto& c : listener_->decoded<hoist::cage_state_t>("HOIST_CAGE")) {
     ASSERT_TRUE(std::isfinite(c.y_c) && std::isfinite(c.theta) && std::isfinite(c.l) &&
                 std::isfinite(c.min_clearance));
-    for (double v : c.lambda) ASSERT_TRUE(std::isfinite(v));
+    for (double v : c.lambdas) ASSERT_TRUE(std::isfinite(v));
   }
   const auto last = listener_->decoded<hoist::cage_state_t>("HOIST_CAGE").back();
   EXPECT_NEAR(last.l, 100.0, 1e-9);  // following the encoder
@@ -356,7 +356,7 @@ TEST_F(LcmIntegration, AlarmAcknowledgeAndShelve) {
   auto d = startDaemon({"--config", cfg, "--clock", "wall"}, "twind.log");
   auto find = [&](const char* kind, int level, int event) {
     for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
-      if (a.kind == kind && a.level == level && a.event == event) return true;
+      if (a.kind == kind && a.level == level && a.event_type == event) return true;
     return false;
   };
   using A = hoist::alarm_t;
@@ -376,7 +376,7 @@ TEST_F(LcmIntegration, AlarmAcknowledgeAndShelve) {
   command("CAGE_POS_Y", A::LEVEL_CRITICAL, hoist::alarm_ack_t::ACTION_ACK, 0.0);
   ASSERT_TRUE(listener_->waitFor([&] { return find("CAGE_POS_Y", A::LEVEL_CRITICAL, A::EVENT_ACK); }, 5s));
   for (const auto& a : listener_->decoded<A>("HOIST_ALARM"))
-    if (a.event == A::EVENT_ACK) {
+    if (a.event_type == A::EVENT_ACK) {
       EXPECT_TRUE(a.acked);
       EXPECT_TRUE(a.active);  // the condition is still there
     }

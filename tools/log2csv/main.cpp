@@ -164,7 +164,7 @@ class Converter {
     std::ostringstream os;
     os << num(m.t) << ',' << num(m.l) << ',' << num(m.v) << ',' << num(m.a) << ',' << num(m.x_c)
        << ',' << num(m.y_c) << ',' << num(m.theta);
-    for (double v : m.lambda) os << ',' << num(v);
+    for (double v : m.lambdas) os << ',' << num(v);
     os << ',' << m.utime << ',' << m.seq << ',' << m.input_seq << ',' << num(m.y_top) << ','
        << num(m.y_bottom) << ',' << num(m.guide_deflection) << ',' << num(m.clearance_pos_y) << ','
        << num(m.clearance_neg_y) << ',' << num(m.clearance_guide) << ',' << num(m.min_clearance)
@@ -201,7 +201,7 @@ class Converter {
     static const char* levels[] = {"NONE", "WARNING", "CRITICAL"};
     static const char* events[] = {"?", "RAISE", "CLEAR", "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE"};
     const char* lvl = (m.level >= 0 && m.level <= 2) ? levels[m.level] : "?";
-    const char* evn = (m.event >= 1 && m.event <= 6) ? events[m.event] : "?";
+    const char* evn = (m.event_type >= 1 && m.event_type <= 6) ? events[m.event_type] : "?";
     w->out << m.utime << ',' << m.id << ',' << num(m.t) << ',' << csvQuote(m.kind) << ',' << lvl << ','
            << evn << ',' << int(m.active) << ',' << int(m.acked) << ',' << int(m.shelved) << ','
            << int(m.latched) << ',' << num(m.value) << ',' << num(m.threshold) << ','

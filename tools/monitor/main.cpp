@@ -43,7 +43,7 @@ class Monitor {
     const std::string key = m->kind + "/" + ((m->level >= 0 && m->level <= 2) ? lv[m->level] : "?");
     if (m->active && !m->shelved) active_[key] = true;
     else active_.erase(key);
-    if (m->event != hoist::alarm_t::EVENT_REANNOUNCE) {
+    if (m->event_type != hoist::alarm_t::EVENT_REANNOUNCE) {
       std::printf("  >> [t=%7.2f s] %s\n", m->t, m->message.c_str());
       std::fflush(stdout);
     }
@@ -65,7 +65,7 @@ class Monitor {
       return;
     }
     double fmax = 0.0;
-    for (int i = 1; i < 5; ++i) fmax = std::max(fmax, std::fabs(cage_.lambda[i]));
+    for (int i = 1; i < 5; ++i) fmax = std::max(fmax, std::fabs(cage_.lambdas[i]));
     std::string alarms;
     for (const auto& [k, on] : active_) alarms += (alarms.empty() ? "" : " ") + k;
     if (alarms.empty()) alarms = "none";
