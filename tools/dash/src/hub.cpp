@@ -163,6 +163,7 @@ void Hub::addPrefix(const std::string& prefix) {
   }
   prefix_list_.push_back(prefix);
   std::vector<const Channel*> added;
+  auto pending = pending_alarms_.extract(prefix);
   for (const auto& t : msg::allTypes()) {
     const std::string suffix = channelSuffixOfType(t.name);
     if (suffix.empty()) continue;
@@ -175,6 +176,7 @@ void Hub::addPrefix(const std::string& prefix) {
     ch.schema = schemaText(t.schema);
     auto& stored = channels_[ch.topic] = std::move(ch);
     by_id_[stored.id] = &stored;
+    if (suffix == "HOIST_ALARM" && !pending.empty()) stored.table = std::move(pending.mapped());
     added.push_back(&stored);
     if (suffix == "HOIST_CAGE") {
       // The decimated cage channel: min/max of every numeric field per interval.
@@ -299,6 +301,14 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
       ch = channelFor(channel);
     }
     if (ch == nullptr) {
+      // An alarm of a shaft not announced yet (its first HOIST_HEALTH is up
+      // to a second away): keep it for the alarm list, bounded.
+      if (opt_.discover && suffix == "HOIST_ALARM" &&
+          (pending_alarms_.count(prefix) || pending_alarms_.size() < opt_.max_prefixes)) {
+        auto& t = pending_alarms_[prefix];
+        const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
+        if (t.size() < 64 || t.count(key)) t[key] = std::make_shared<const std::string>(j.dump());
+      }
       count("lcm_ignored_prefix");
       return;
     }

@@ -132,6 +132,7 @@ class Hub {
   std::map<std::string, Channel> channels_;             // by topic
   std::map<std::uint32_t, Channel*> by_id_;
   std::map<std::string, MinMaxDecimator> decimators_;   // by prefix
+  std::map<std::string, std::map<std::string, std::shared_ptr<const std::string>>> pending_alarms_;
   std::uint32_t next_id_ = 1;
   std::map<std::string, std::uint64_t> counters_;
   std::string session_id_;

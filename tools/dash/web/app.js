@@ -187,7 +187,7 @@
   }
 
   // ---- trends -------------------------------------------------------------------
-  function chartSize(host) { return { width: Math.max(300, host.clientWidth || 600), height: 110 }; }
+  function chartSize(host) { return { width: Math.max(300, host.clientWidth || 600), height: 112 }; }
 
   function makeCharts(s, host) {
     const D = s.data;
@@ -205,7 +205,9 @@
       box.append(plotEl);
       host.append(box);
       const scales = { x: { time: true } };
-      const axes = [{ stroke: "#8a96a3", grid: { stroke: "#252c34" } }, { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60 }];
+      const hms = (u, vals) => vals.map((v) => new Date(v * 1000).toLocaleTimeString([], { hour12: false }));
+      const axes = [{ stroke: "#8a96a3", grid: { stroke: "#252c34" }, values: hms, size: 24 },
+                    { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60 }];
       if (series.some((sr) => sr[4] === "l")) {
         scales.l = {};
         axes.push({ scale: "l", side: 1, stroke: "#fca5a5", grid: { show: false }, size: 50 });
@@ -290,6 +292,7 @@
 
   // ---- alarms (ISA-18.2 states) ---------------------------------------------------
   function onAlarm(s, a) {
+    for (const k of ["active", "acked", "shelved", "latched"]) a[k] = Boolean(a[k]);
     s.alarms.set(`${a.kind}/${a.level}`, a);
     renderAlarms(s);
   }

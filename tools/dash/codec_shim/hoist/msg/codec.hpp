@@ -65,7 +65,7 @@ DecodeStatus checkedDecode(const void* data, std::size_t size, T& out) {
 }
 
 inline nlohmann::json toJson(const winder_t& m) {
-  return {{"utime", m.utime}, {"seq", m.seq}, {"v", m.v}, {"a", m.a}, {"has_length", m.has_length}, {"length", m.length}};
+  return {{"utime", m.utime}, {"seq", m.seq}, {"v", m.v}, {"a", m.a}, {"has_length", m.has_length != 0}, {"length", m.length}};
 }
 inline nlohmann::json toJson(const cage_state_t& m) {
   return {{"utime", m.utime}, {"seq", m.seq}, {"instance_id", m.instance_id}, {"input_seq", m.input_seq},
@@ -73,15 +73,15 @@ inline nlohmann::json toJson(const cage_state_t& m) {
           {"lambdas", std::vector<double>(m.lambdas, m.lambdas + 5)}, {"y_top", m.y_top}, {"y_bottom", m.y_bottom},
           {"guide_deflection", m.guide_deflection}, {"clearance_pos_y", m.clearance_pos_y},
           {"clearance_neg_y", m.clearance_neg_y}, {"clearance_guide", m.clearance_guide},
-          {"min_clearance", m.min_clearance}, {"alarm_level", m.alarm_level}, {"degraded", m.degraded}};
+          {"min_clearance", m.min_clearance}, {"alarm_level", m.alarm_level}, {"degraded", m.degraded != 0}};
 }
 inline nlohmann::json toJson(const guide_shape_t& m) {
   return {{"utime", m.utime}, {"t", m.t}, {"l", m.l}, {"h", m.h}, {"n", m.n}, {"x", m.x}, {"y1", m.y1}, {"y2", m.y2}};
 }
 inline nlohmann::json toJson(const alarm_t& m) {
   return {{"utime", m.utime}, {"id", m.id}, {"t", m.t}, {"kind", m.kind}, {"level", m.level},
-          {"event_type", m.event_type}, {"active", m.active}, {"acked", m.acked}, {"shelved", m.shelved},
-          {"latched", m.latched}, {"value", m.value}, {"threshold", m.threshold}, {"shelved_for", m.shelved_for},
+          {"event_type", m.event_type}, {"active", m.active != 0}, {"acked", m.acked != 0}, {"shelved", m.shelved != 0},
+          {"latched", m.latched != 0}, {"value", m.value}, {"threshold", m.threshold}, {"shelved_for", m.shelved_for},
           {"message", m.message}, {"user", m.user}};
 }
 inline nlohmann::json toJson(const alarm_ack_t& m) {
@@ -99,7 +99,7 @@ inline nlohmann::json toJson(const health_t& m) {
           {"alarms_unacked", m.alarms_unacked}, {"alarms_shelved", m.alarms_shelved},
           {"alarm_events", m.alarm_events}, {"model_faults", m.model_faults}, {"model_resets", m.model_resets},
           {"publish_failures", m.publish_failures}, {"nonfinite_blocked", m.nonfinite_blocked},
-          {"degraded", m.degraded}};
+          {"degraded", m.degraded != 0}};
 }
 
 template <class T>
