@@ -220,17 +220,20 @@ int main(int argc, char** argv) {
   };
   waitTick();
 
+  // Stop by closing everything: io.run() returns once the sessions' handlers
+  // have run (a forced io.stop() would leave sessions to die after the server).
+  net::signal_set signals(io, SIGINT, SIGTERM);
+  net::steady_timer end_timer(io);
   auto stopAll = [&]() {
     server.stop();
     tick.cancel();
     lcm_fd.cancel();
-    io.stop();
+    signals.cancel();
+    end_timer.cancel();
   };
-  net::signal_set signals(io, SIGINT, SIGTERM);
   signals.async_wait([&](boost::system::error_code e, int) {
     if (!e) stopAll();
   });
-  net::steady_timer end_timer(io);
   if (duration > 0.0) {
     end_timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(duration)));
     end_timer.async_wait([&](boost::system::error_code e) {
@@ -249,6 +252,8 @@ int main(int argc, char** argv) {
                  read_only ? "watch the shaft" : "acknowledge and shelve alarms (consider --read-only)");
 
   io.run();
+  io.restart();
+  io.run_for(std::chrono::seconds(1));  // anything still completing
   spdlog::info("stopped; counters: {}", hub.stats()["counters"].dump());
   return 0;
 }

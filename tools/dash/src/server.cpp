@@ -105,7 +105,7 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public Client,
       Hub& hub = server_.hub();
       if (ec == websocket::error::closed || ec == net::error::eof || ec == net::error::operation_aborted ||
           ec == net::error::connection_reset) {
-        // normal end of a connection
+        spdlog::debug("client {}: closed ({}: {})", peer(), ec.category().name(), ec.message());
       } else if (ec == websocket::error::message_too_big || ec == websocket::error::buffer_overflow) {
         hub.count("ws_rejected_oversized");
         spdlog::warn("client {}: message over {} bytes, closed (1009)", peer(), server_.limits().max_ws_message);
