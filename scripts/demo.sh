@@ -110,7 +110,7 @@ if ! awk -v s="$speed" 'BEGIN { exit !(s == 1) }'; then clock=input; fi
 if [[ $dash -eq 1 ]]; then
   if [[ -x "$bin/hoist-dash" ]]; then
     # Before the daemon, so that the page sees its first alarms.
-    "$bin/hoist-dash" --port "$dash_port" --lcm-url "$url" --config "$config" \
+    "$bin/hoist-dash" --port "$dash_port" --lcm-url "$url" \
         > "$logdir/hoist-dash.out" 2> "$logdir/hoist-dash.log" &
     dash_pid=$!
     for _ in $(seq 1 30); do

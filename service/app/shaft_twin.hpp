@@ -24,6 +24,7 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/bus/channels.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/health.hpp"
 #include "hoist/service/twin_core.hpp"
@@ -73,15 +74,20 @@ class ShaftTwin {
   void logFinal();
 
   const TwinConfig& config() const { return cfg_; }
-  const Channels& channels() const { return ch_; }
+  const bus::Channels& channels() const { return ch_; }
   const std::string& label() const { return label_; }
   /// "[label] " for log lines, "" for a daemon with one shaft.
   const std::string& tag() const { return tag_; }
   ShaftRunStats runStats() const;
 
  private:
+  // LCM callbacks: no exception escapes them (a throw is counted as
+  // "handler_exception" in HOIST_HEALTH and logged, rate-limited).
   void onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void onAck(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void handleWinder(const lcm::ReceiveBuffer* rbuf);
+  void handleAck(const lcm::ReceiveBuffer* rbuf);
+  void handlerFailed(const char* what, const char* channel);
   double wallNow() const;
   void publishCage(std::int64_t utime);
   void publishShape(std::int64_t utime);
@@ -97,7 +103,7 @@ class ShaftTwin {
   lcm::LCM& lcm_;
   RtLog& log_;
   TestHooks hooks_;
-  Channels ch_;
+  bus::Channels ch_;
   TwinCore core_;
 
   Clock::time_point start_{};
@@ -110,6 +116,11 @@ class ShaftTwin {
   LatencyHistogram step_hist_, late_hist_;    // this health window
   LatencyHistogram step_total_, late_total_;  // whole run (final report)
   std::int64_t publish_failures_ = 0, nonfinite_blocked_ = 0, alarm_events_ = 0;
+  // Extra HOIST_HEALTH reasons after the winder reasons (not in rejected_total,
+  // which counts winder inputs): undecodable alarm commands, and exceptions
+  // caught in an LCM callback.
+  static constexpr int kExtraReasons = 2;
+  std::int64_t command_decode_rejects_ = 0, handler_exceptions_ = 0;
   std::int64_t publish_attempts_ = 0;
   bool fault_injected_ = false;
   std::int64_t cage_seq_ = 0, alarm_id_ = 0;

@@ -206,7 +206,7 @@ TEST_F(HubTest, ClientPublishesAlarmAckAfterValidation) {
   hub.onClientText(c, Json{{"op", "advertise"},
                            {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}, {"schemaName", "hoist.alarm_ack_t"}}}}}
                           .dump());
-  hub.onClientBinary(c, clientMessage(5, {{"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 2}, {"shelve_duration", 600.0}, {"user", "ann"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 2}, {"shelve_duration", 600.0}, {"user", "ann"}}));
   ASSERT_EQ(pub.size(), 1u);
   EXPECT_EQ(pub[0].channel, "HOIST_ALARM_ACK");
   alarm_ack_t a{};
@@ -218,10 +218,10 @@ TEST_F(HubTest, ClientPublishesAlarmAckAfterValidation) {
   EXPECT_EQ(a.utime, 1'700'000'000'000'000LL);  // the server's clock, in us
 
   // Invalid: no user, bad kind, bad action; unadvertised channel; other topics.
-  hub.onClientBinary(c, clientMessage(5, {{"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"user", ""}}));
-  hub.onClientBinary(c, clientMessage(5, {{"kind", "../x"}, {"level", 1}, {"action", 1}, {"user", "a"}}));
-  hub.onClientBinary(c, clientMessage(5, {{"kind", "X"}, {"level", 1}, {"action", 9}, {"user", "a"}}));
-  hub.onClientBinary(c, clientMessage(6, {{"kind", "X"}, {"level", 1}, {"action", 1}, {"user", "a"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", ""}}));
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "../x"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", "a"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "X"}, {"level", 1}, {"action", 9}, {"shelve_duration", 0.0}, {"user", "a"}}));
+  hub.onClientBinary(c, clientMessage(6, {{"utime", 0}, {"kind", "X"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", "a"}}));
   hub.onClientText(c, Json{{"op", "advertise"}, {"channels", {{{"id", 8}, {"topic", "HOIST_WINDER"}, {"encoding", "json"}}}}}.dump());
   EXPECT_EQ(pub.size(), 1u);
   EXPECT_EQ(hub.counter("commands_rejected_invalid"), 3u);
@@ -238,7 +238,7 @@ TEST_F(HubTest, ReadOnlyRefusesEveryCommand) {
   EXPECT_TRUE(c.text[0]["capabilities"].empty());
   EXPECT_FALSE(c.text[0].contains("supportedEncodings"));
   hub.onClientText(c, Json{{"op", "advertise"}, {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}}}}}.dump());
-  hub.onClientBinary(c, clientMessage(5, {{"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"user", "x"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", "x"}}));
   EXPECT_TRUE(pub.empty());
   EXPECT_EQ(hub.counter("commands_rejected_read_only"), 2u);
 }

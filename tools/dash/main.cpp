@@ -3,7 +3,7 @@
 // hoist LCM channels of one or several shafts.  See docs/dashboard.md.
 //
 //   hoist-dash [--bind ADDR] [--port N] [--read-only] [--channel-prefix P]...
-//              [--config FILE]... [--lcm-url URL] [--web-root DIR] ...
+//              [--lcm-url URL] [--web-root DIR] [--warning-fraction F] ...
 //
 // One thread, one Asio loop: the LCM file descriptor, the HTTP/WebSocket
 // server (Boost.Beast) and the 25 Hz decimation timer.
@@ -19,8 +19,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
-#include "hoist/service/config.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
 #include "src/hub.hpp"
 #include "src/server.hpp"
 #include "src/static_files.hpp"
@@ -71,7 +70,8 @@ int main(int argc, char** argv) {
   std::string bind = "127.0.0.1", url, web_root, log_level = "info";
   int port = 8080;
   bool read_only = false;
-  std::vector<std::string> prefixes, configs, origins;
+  std::vector<std::string> prefixes, origins;
+  double warning_fraction = 0.5, critical_fraction = 0.8;
   double rate = 25.0, duration = 0.0;
   std::size_t max_clients = 64, max_msg = 64 * 1024, max_queue_kb = 2048;
   app.add_option("--bind", bind, "address to listen on (default 127.0.0.1: this machine only)");
@@ -82,10 +82,12 @@ int main(int argc, char** argv) {
   app.add_option("--channel-prefix", prefixes,
                  "shaft channel prefix (repeatable; '' is the default shaft); default: discover the "
                  "prefixes from the *HOIST_HEALTH channels");
-  app.add_option("--config", configs,
-                 "a hoist-twind configuration (repeatable): its channel prefix, and its alarm fractions "
-                 "for the clearance thresholds on the page")
-      ->check(CLI::ExistingFile);
+  app.add_option("--warning-fraction", warning_fraction,
+                 "WARNING level as a fraction of the gap, for the clearance thresholds drawn until the daemon's "
+                 "first alarm tells (default 0.5, hoist-twind's default [alarms] warning_fraction)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--critical-fraction", critical_fraction, "CRITICAL level likewise (default 0.8)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
   app.add_option("--web-root", web_root, "directory of the page (default: <prefix>/share/hoist-twin/dash)");
   app.add_option("--rate", rate, "display rate of the decimated cage channel [Hz] (default 25)")
@@ -113,29 +115,10 @@ int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::from_str(log_level));
   spdlog::set_pattern("%Y-%m-%d %H:%M:%S.%e [%^%l%$] hoist-dash: %v");
 
-  // Shafts from the daemon configurations: prefix and alarm fractions.
   Hub::Options opt;
   opt.read_only = read_only;
   Json meta = Json::object();
-  for (const auto& path : configs) {
-    try {
-      const auto cfg = hoist::svc::loadTwinConfig(path);
-      const std::string& p = cfg.service.channel_prefix;
-      meta[p] = Json{{"warning_fraction", cfg.alarms.warning_fraction},
-                     {"critical_fraction", cfg.alarms.critical_fraction},
-                     {"gap_pos_y", cfg.alarms.gap_pos_y},
-                     {"gap_neg_y", cfg.alarms.gap_neg_y},
-                     {"guide_rope_gap", cfg.alarms.guide_rope_gap},
-                     {"config", path}};
-      if (std::find(prefixes.begin(), prefixes.end(), p) == prefixes.end()) prefixes.push_back(p);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "hoist-dash: --config %s: %s\n", path.c_str(), e.what());
-      return 2;
-    }
-  }
-  const hoist::svc::AlarmConfig defaults{};
-  meta["*"] = Json{{"warning_fraction", defaults.warning_fraction},
-                   {"critical_fraction", defaults.critical_fraction}};
+  meta["*"] = Json{{"warning_fraction", warning_fraction}, {"critical_fraction", critical_fraction}};
   for (const auto& p : prefixes) {
     if (p.size() > 64 || p.find_first_of(" \t\r\n") != std::string::npos) {
       std::fprintf(stderr, "hoist-dash: --channel-prefix '%s': at most 64 characters, no white space\n", p.c_str());
@@ -161,10 +144,10 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  url = hoist::svc::resolveLcmUrl(url);
+  url = hoist::bus::resolveLcmUrl(url);
   lcm::LCM lcm(url);
   if (!lcm.good()) {
-    std::fprintf(stderr, "hoist-dash: cannot open LCM at %s\n", hoist::svc::describeLcmUrl(url).c_str());
+    std::fprintf(stderr, "hoist-dash: cannot open LCM at %s\n", hoist::bus::describeLcmUrl(url).c_str());
     return 1;
   }
 
@@ -244,7 +227,7 @@ int main(int argc, char** argv) {
 
   const std::string shown = addr.is_v6() ? "[" + bind + "]" : bind;
   std::printf("hoist-dash: serving http://%s:%u/ (LCM %s, %s, shafts: %s)\n", shown.c_str(), server.port(),
-              hoist::svc::describeLcmUrl(url).c_str(), read_only ? "read-only" : "operator commands enabled",
+              hoist::bus::describeLcmUrl(url).c_str(), read_only ? "read-only" : "operator commands enabled",
               prefixes.empty() ? "discovered from *HOIST_HEALTH" : Json(prefixes).dump().c_str());
   std::fflush(stdout);
   if (!addr.is_loopback())

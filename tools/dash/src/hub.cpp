@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "hoist/alarm_ack_t.hpp"
+#include "hoist/bus/channels.hpp"
 #include "hoist/msg/codec.hpp"
 
 namespace hoist::dash {
@@ -14,11 +15,17 @@ namespace {
 
 // Suffix of the LCM channel of each hoist type (INTERFACES.md).
 const std::vector<std::pair<std::string, std::string>>& typeSuffixes() {
+  using namespace hoist::bus;
   static const std::vector<std::pair<std::string, std::string>> v{
-      {"hoist.winder_t", "HOIST_WINDER"},       {"hoist.cage_state_t", "HOIST_CAGE"},
-      {"hoist.guide_shape_t", "HOIST_GUIDE_SHAPE"}, {"hoist.alarm_t", "HOIST_ALARM"},
-      {"hoist.alarm_ack_t", "HOIST_ALARM_ACK"}, {"hoist.health_t", "HOIST_HEALTH"},
-      {"hoist.forecast_t", "HOIST_FORECAST"},   {"hoist.trip_plan_t", "HOIST_TRIP_PLAN"}};
+      {"hoist.winder_t", std::string(kChannelWinder)},
+      {"hoist.cage_state_t", std::string(kChannelCage)},
+      {"hoist.guide_shape_t", std::string(kChannelGuideShape)},
+      {"hoist.alarm_t", std::string(kChannelAlarm)},
+      {"hoist.alarm_ack_t", std::string(kChannelAlarmAck)},
+      {"hoist.health_t", std::string(kChannelHealth)},
+      // INTERFACES.md "Additions": the forecast's channels, once their types exist.
+      {"hoist.forecast_t", "HOIST_FORECAST"},
+      {"hoist.trip_plan_t", "HOIST_TRIP_PLAN"}};
   return v;
 }
 

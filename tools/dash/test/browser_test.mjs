@@ -12,7 +12,7 @@
 import fs from "node:fs";
 import path from "node:path";
 import puppeteer from "puppeteer-core";
-import { binDir, check, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir, demoConfig } from "./harness.mjs";
+import { binDir, check, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
 
 const args = process.argv.slice(2);
 const lcmPort = Number(args.find((a) => /^\d+$/.test(a)) || 7871);
@@ -25,7 +25,7 @@ console.log(`work dir ${dir}, LCM ${lcmUrl(lcmPort)}`);
 
 const lcm = lcmUrl(lcmPort);
 // The dashboards first (the daemon announces an alarm once, then every 30 s).
-const dash = await startDash(dir, lcm, ["--config", demoConfig]);
+const dash = await startDash(dir, lcm, []);
 const ro = await startDash(dir, lcm, ["--read-only"], "hoist-dash-ro");
 const twin = await startTwin(dir, lcm, { replay: false });  // at rest at 50 m: the +y WARNING is on
 

@@ -71,9 +71,9 @@ check(after - n <= 2, `unsubscribe stops the stream (${after - n} more after 300
 
 // A command through clientPublish, as Foxglove's Publish panel would send it.
 const cid = client.advertise({ topic: "HOIST_ALARM_ACK", encoding: "json", schemaName: "hoist.alarm_ack_t" });
-client.sendMessage(cid, new TextEncoder().encode(JSON.stringify({ kind: "CAGE_NEG_Y", level: 0, action: 1, shelve_duration: 0, user: "protocol-test" })));
+client.sendMessage(cid, new TextEncoder().encode(JSON.stringify({ utime: 0, kind: "CAGE_NEG_Y", level: 0, action: 1, shelve_duration: 0, user: "protocol-test" })));
 await waitFor(() => statuses.some((s) => /sent acknowledge CAGE_NEG_Y/.test(s.message)), 3000, "the server's confirmation");
-client.sendMessage(cid, new TextEncoder().encode(JSON.stringify({ kind: "../etc", level: 9, action: 7, user: "" })));
+client.sendMessage(cid, new TextEncoder().encode(JSON.stringify({ utime: 0, kind: "../etc", level: 9, action: 7, shelve_duration: 0, user: "" })));
 await waitFor(() => statuses.some((s) => s.level === 2 && /rejected command/.test(s.message)), 3000, "rejection of a bad command");
 check(true, "client publish: a valid HOIST_ALARM_ACK is confirmed, an invalid one rejected");
 await sleep(300);

@@ -168,7 +168,7 @@
     const tab = el("button", { "data-shaft": prefix, onclick: () => select(prefix) }, el("span", { class: "dot" }), label);
     $("#tabs").append(tab);
     s = { prefix, root, banner, canvas, ro, alarmsBody, tab, lastMsg: -1e12, everData: false, cage: null, shape: null,
-          health: null, alarms: new Map(), dirty: true, charts: [], data: null, gap: null };
+          health: null, alarms: new Map(), thr: {}, dirty: true, charts: [], data: null, gap: null };
     s.data = { x: [], y_c: [], theta: [], l1: [], l2: [], l3: [], l4: [], l0: [], clr: [], warn: [], crit: [], v: [], l: [] };
     makeCharts(s, trends);
     state.shafts.set(prefix, s);
@@ -264,12 +264,21 @@
     s.dirty = true;
   }
 
-  function thresholds(s) {
+  // Excursion threshold [m] of a cage side at a level: from the daemon's own
+  // alarms once one was announced (alarm_t.threshold), else the fraction of
+  // the gap given to hoist-dash (--warning-fraction, --critical-fraction).
+  function sideThr(s, side, level) {
+    const t = s.thr[`${side === "pos" ? "CAGE_POS_Y" : "CAGE_NEG_Y"}/${level}`];
+    if (t > 0) return t;
     const m = state.meta[s.prefix] || state.meta["*"] || {};
-    const wf = m.warning_fraction ?? 0.5, cf = m.critical_fraction ?? 0.8;
+    return (level === 1 ? (m.warning_fraction ?? 0.5) : (m.critical_fraction ?? 0.8)) * s.gap[side];
+  }
+
+  // WARNING / CRITICAL on the min-clearance trend: clearance = gap - excursion.
+  function thresholds(s) {
     if (!s.gap) return [NaN, NaN];
-    const g = Math.min(s.gap.pos, s.gap.neg) * 1e3;
-    return [(1 - wf) * g, (1 - cf) * g];
+    const clr = (level) => 1e3 * Math.min(s.gap.pos - sideThr(s, "pos", level), s.gap.neg - sideThr(s, "neg", level));
+    return [clr(1), clr(2)];
   }
 
   function renderReadouts(s, m) {
@@ -293,6 +302,7 @@
   // ---- alarms (ISA-18.2 states) ---------------------------------------------------
   function onAlarm(s, a) {
     for (const k of ["active", "acked", "shelved", "latched"]) a[k] = Boolean(a[k]);
+    if ((a.kind === "CAGE_POS_Y" || a.kind === "CAGE_NEG_Y") && a.threshold > 0) s.thr[`${a.kind}/${a.level}`] = a.threshold;
     s.alarms.set(`${a.kind}/${a.level}`, a);
     renderAlarms(s);
   }
@@ -418,10 +428,9 @@
       g.fillText(`${d.toFixed(0)}`, 0, Y(d) + 3);
     }
     // Clearance limits (cage sides): the gap (CRITICAL at the wall), WARNING dashed.
-    const meta = state.meta[s.prefix] || state.meta["*"] || {};
     if (s.gap) {
       const lines = [[s.gap.pos, "#ef4444", []], [-s.gap.neg, "#ef4444", []],
-                     [s.gap.pos * (meta.warning_fraction ?? 0.5), "#f0b429", [5, 4]], [-s.gap.neg * (meta.warning_fraction ?? 0.5), "#f0b429", [5, 4]]];
+                     [sideThr(s, "pos", 1), "#f0b429", [5, 4]], [-sideThr(s, "neg", 1), "#f0b429", [5, 4]]];
       for (const [y, col, dash] of lines) {
         const px = cx + (y > 0 ? half : -half) + y * ls;
         g.strokeStyle = col; g.setLineDash(dash); g.beginPath(); g.moveTo(px, top); g.lineTo(px, bot); g.stroke();
