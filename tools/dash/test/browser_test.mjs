@@ -31,8 +31,8 @@ const twin = await startTwin(dir, lcm, { replay: false });  // at rest at 50 m: 
 
 const browser = await puppeteer.launch({
   executablePath: chromium, headless: true,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1000"],
-  defaultViewport: { width: 1500, height: 1000 },
+  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1180"],
+  defaultViewport: { width: 1500, height: 1180 },
 });
 const page = await browser.newPage();
 const errors = [];
@@ -93,7 +93,8 @@ const shown = await page.evaluate(() => {
 console.log(`page shows after ${Date.now() - t0} ms:`, shown);
 check(shown.now_us - shown.utime < 500e3, `displayed cage state is current (${((shown.now_us - shown.utime) / 1e3).toFixed(0)} ms old)`);
 
-await sleep(1000);
+await page.select("#window", "10");  // the 10-s trend window for the screenshot
+await sleep(2500);
 await page.screenshot({ path: shot });
 console.log(`screenshot: ${shot}`);
 
