@@ -91,7 +91,8 @@ const shown = await page.evaluate(() => {
   return { utime: Number(r.dataset.utime), l: f("l"), y_c: f("y_c"), now_us: Date.now() * 1000 };
 });
 console.log(`page shows after ${Date.now() - t0} ms:`, shown);
-check(shown.now_us - shown.utime < 500e3, `displayed cage state is current (${((shown.now_us - shown.utime) / 1e3).toFixed(0)} ms old)`);
+// ~0.1 s on an idle machine; the bound allows for a loaded CI machine.
+check(shown.now_us - shown.utime < 2000e3, `displayed cage state is current (${((shown.now_us - shown.utime) / 1e3).toFixed(0)} ms old)`);
 
 await page.select("#window", "10");  // the 10-s trend window for the screenshot
 await sleep(2500);

@@ -206,7 +206,7 @@
       host.append(box);
       const scales = { x: { time: true } };
       const hms = (u, vals) => vals.map((v) => new Date(v * 1000).toLocaleTimeString([], { hour12: false }));
-      const axes = [{ stroke: "#8a96a3", grid: { stroke: "#252c34" }, values: hms, size: 24 },
+      const axes = [{ stroke: "#8a96a3", grid: { stroke: "#252c34" }, values: hms, size: 24, space: 90 },
                     { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60 }];
       if (series.some((sr) => sr[4] === "l")) {
         scales.l = {};
