@@ -471,9 +471,10 @@
     const now = performance.now();
     for (const s of state.shafts.values()) {
       const age = now - s.lastMsg;
-      const st = !s.everData && age > STALE_AFTER_MS ? "nodata" : age > STALE_AFTER_MS ? "stale" : "ok";
+      const st = !s.everData ? "nodata" : age > STALE_AFTER_MS ? "stale" : "ok";
       s.banner.dataset.state = st;
-      s.banner.textContent = st === "nodata" ? `NO DATA from ${s.prefix || "default shaft"}`
+      s.banner.textContent = st === "nodata"
+        ? `NO DATA: no cage state from ${s.prefix || "the default shaft"}${s.health && age <= STALE_AFTER_MS ? " (the daemon is up, waiting for winder input)" : ""}`
         : st === "stale" ? `STALE: no data for ${s.lastMsg < 0 ? "—" : (age / 1000).toFixed(1) + " s"}; values below are old` : "";
       const was = s.root.classList.contains("stale");
       s.root.classList.toggle("stale", st !== "ok");
