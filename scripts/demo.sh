@@ -5,10 +5,12 @@
 # the model time, depth, speed, sway, tilt, largest guide-sleeve force,
 # minimum clearance and the active alarms (hoist-monitor).  Everything runs on
 # a private loopback multicast URL (ttl=0: nothing leaves this machine) and is
-# stopped cleanly at the end (or on Ctrl-C).
+# stopped cleanly at the end (or on Ctrl-C).  The live dashboard (hoist-dash)
+# runs alongside: open the URL it prints in a browser.
 #
 #   scripts/demo.sh [--no-setup] [--speed X] [--profile SPEC|FILE]
 #                   [--config FILE] [--port N] [--with-length]
+#                   [--dash-port N] [--no-dash]
 #
 #   --no-setup     skip scripts/setup.sh (the build must exist)
 #   --speed X      replay X times faster than real time (default 1: 60 s).
@@ -20,6 +22,8 @@
 #                  the paper's shaft with tight clearances so alarms show)
 #   --port N       UDP port of the private LCM URL (default 7690)
 #   --with-length  send the encoder rope length too
+#   --dash-port N  TCP port of the dashboard, http://127.0.0.1:N/ (default 8080)
+#   --no-dash      do not start the dashboard
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 setup=1
@@ -27,6 +31,8 @@ speed=1
 profile=paper
 config="$here/service/config/demo.toml"
 port=7690
+dash_port=8080
+dash=1
 replay_extra=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -36,7 +42,9 @@ while [[ $# -gt 0 ]]; do
     --config) config="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
     --with-length) replay_extra+=(--with-length); shift ;;
-    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --dash-port) dash_port="$2"; shift 2 ;;
+    --no-dash) dash=0; shift ;;
+    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -81,15 +89,17 @@ fi
 
 url="udpm://239.255.76.67:${port}?ttl=0"
 logdir="$(mktemp -d "${TMPDIR:-/tmp}/hoist-demo.XXXXXX")"
-daemon_pid="" monitor_pid=""
+daemon_pid="" monitor_pid="" dash_pid=""
 cleanup() {
   trap - EXIT INT TERM
+  [[ -n "$dash_pid" ]] && kill -TERM "$dash_pid" 2>/dev/null || true
   [[ -n "$monitor_pid" ]] && kill -TERM "$monitor_pid" 2>/dev/null || true
   if [[ -n "$daemon_pid" ]] && kill -0 "$daemon_pid" 2>/dev/null; then
     kill -TERM "$daemon_pid" 2>/dev/null || true
     wait "$daemon_pid" 2>/dev/null || true
   fi
   [[ -n "$monitor_pid" ]] && wait "$monitor_pid" 2>/dev/null || true
+  [[ -n "$dash_pid" ]] && wait "$dash_pid" 2>/dev/null || true
 }
 trap cleanup EXIT
 trap 'echo; echo "demo.sh: interrupted"; cleanup; exit 130' INT TERM
@@ -97,6 +107,29 @@ trap 'echo; echo "demo.sh: interrupted"; cleanup; exit 130' INT TERM
 echo "== hoist-twin demo: LCM $url, logs in $logdir"
 clock=wall
 if ! awk -v s="$speed" 'BEGIN { exit !(s == 1) }'; then clock=input; fi
+if [[ $dash -eq 1 ]]; then
+  if [[ -x "$bin/hoist-dash" ]]; then
+    # Before the daemon, so that the page sees its first alarms.
+    "$bin/hoist-dash" --port "$dash_port" --lcm-url "$url" \
+        > "$logdir/hoist-dash.out" 2> "$logdir/hoist-dash.log" &
+    dash_pid=$!
+    for _ in $(seq 1 30); do
+      grep -q serving "$logdir/hoist-dash.out" 2>/dev/null && break
+      kill -0 "$dash_pid" 2>/dev/null || break
+      sleep 0.1
+    done
+    if grep -q serving "$logdir/hoist-dash.out" 2>/dev/null; then
+      dash_url=$(grep -o 'http://[^ ]*' "$logdir/hoist-dash.out" | head -1)
+      echo "== dashboard: open $dash_url in a browser (hoist-dash; log $logdir/hoist-dash.log)"
+    else
+      echo "demo.sh: the dashboard did not start (port $dash_port in use? try --dash-port N):" >&2
+      cat "$logdir/hoist-dash.log" >&2
+      dash_pid=""
+    fi
+  else
+    echo "demo.sh: $bin/hoist-dash not built; running without the dashboard" >&2
+  fi
+fi
 echo "== daemon: $bin/hoist-twind --config $config --clock $clock --lcm-url '$url'"
 "$bin/hoist-twind" --config "$config" --clock "$clock" --lcm-url "$url" 2> "$logdir/hoist-twind.log" &
 daemon_pid=$!

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # One-time set-up on a fresh Debian machine, safe to rerun:
 #   1. installs the Debian packages the project needs (skipped when present),
+#      and the dashboard's npm packages (tools/dash: `npm ci`, package-lock.json),
 #   2. makes sure UDP multicast works on loopback (LCM's transport),
 #   3. configures and builds everything into ./build (Release).
 #
@@ -30,6 +31,9 @@ say() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
 required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev liblcm-bin
           libglib2.0-dev libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libtomlplusplus-dev
           libcli11-dev nlohmann-json3-dev gnuplot-nox python3 iproute2)
+# hoist-dash's page (uPlot from npm) and its browser tests (headless Chromium
+# driven by puppeteer-core, the @foxglove/ws-protocol client): Node, npm, Chromium.
+dashboard=(nodejs npm chromium fonts-dejavu-core)
 # Java bindings let lcm-spy decode the hoist channels; clang gives the fuzzers.
 optional=(liblcm-java default-jdk-headless clang libclang-rt-14-dev)
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
@@ -40,6 +44,14 @@ for p in "${optional[@]}"; do
   case "$p" in
     default-jdk-headless) command -v javac >/dev/null 2>&1 && continue ;;
     clang) command -v clang++ >/dev/null 2>&1 && continue ;;
+  esac
+  installed "$p" || missing+=("$p")
+done
+for p in "${dashboard[@]}"; do
+  case "$p" in
+    nodejs) command -v node >/dev/null 2>&1 && continue ;;
+    npm) command -v npm >/dev/null 2>&1 && continue ;;   # e.g. NodeSource's nodejs ships npm
+    chromium) command -v chromium >/dev/null 2>&1 && continue ;;
   esac
   installed "$p" || missing+=("$p")
 done
@@ -56,8 +68,27 @@ if [[ ${#missing[@]} -gt 0 && "${HOIST_SKIP_APT:-0}" != 1 ]]; then
     $sudo apt-get install -y -qq --no-install-recommends "$p" >/dev/null 2>&1 ||
       say "optional package $p not available (continuing without it)"
   done
+  for p in "${dashboard[@]}"; do
+    [[ " ${missing[*]} " == *" $p "* ]] || continue
+    $sudo apt-get install -y -qq --no-install-recommends "$p" >/dev/null 2>&1 ||
+      say "WARNING: package $p not available: the dashboard's browser tests will be skipped"
+  done
 else
   say "Debian packages: all present"
+fi
+
+# ---- 1b. npm packages of the dashboard (exact versions from package-lock.json) --
+dash="$here/tools/dash"
+if [[ -f "$dash/package-lock.json" ]]; then
+  if ! command -v npm >/dev/null 2>&1; then
+    say "WARNING: npm not found: hoist-dash's page will have no charts and its browser tests are skipped"
+  elif [[ -f "$dash/node_modules/.package-lock.json" && "$dash/node_modules/.package-lock.json" -nt "$dash/package-lock.json" ]]; then
+    say "npm packages (tools/dash): up to date"
+  else
+    say "npm ci in tools/dash (uPlot, puppeteer-core, @foxglove/ws-protocol, ws)"
+    (cd "$dash" && npm ci --no-audit --no-fund --loglevel=error) ||
+      { say "npm ci failed in $dash"; exit 1; }
+  fi
 fi
 
 # ---- 2. loopback multicast (LCM) ---------------------------------------------

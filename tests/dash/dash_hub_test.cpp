@@ -1,0 +1,303 @@
+// hoist-dash's protocol hub, without network or LCM: Foxglove protocol
+// messages in and out of a recording client, min/max decimation, command
+// validation, the static-file lookup's traversal checks.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/health_t.hpp"
+#include "hub.hpp"
+#include "static_files.hpp"
+
+namespace hoist::dash {
+namespace {
+
+struct RecClient : Client {
+  std::vector<Json> text;
+  std::vector<std::string> data;
+  void sendText(std::shared_ptr<const std::string> f) override { text.push_back(Json::parse(*f)); }
+  void sendData(std::shared_ptr<const std::string> f) override { data.push_back(*f); }
+  const Json* lastStatus() const {
+    for (auto it = text.rbegin(); it != text.rend(); ++it)
+      if ((*it)["op"] == "status") return &*it;
+    return nullptr;
+  }
+};
+
+template <class T>
+std::vector<std::uint8_t> encode(const T& m) {
+  std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
+  EXPECT_GE(m.encode(b.data(), 0, static_cast<int>(b.size())), 0);
+  return b;
+}
+
+struct Published {
+  std::string channel;
+  std::vector<std::uint8_t> bytes;
+};
+
+class HubTest : public ::testing::Test {
+ protected:
+  Hub make(bool read_only, std::vector<std::string> prefixes = {""}) {
+    Hub::Options o;
+    o.read_only = read_only;
+    o.prefixes = std::move(prefixes);
+    o.discover = o.prefixes.empty();
+    return Hub(
+        o, [this](const std::string& ch, const std::vector<std::uint8_t>& b) {
+          pub.push_back({ch, b});
+          return true;
+        },
+        [] { return std::uint64_t{1'700'000'000'000'000'000ULL}; });
+  }
+  std::uint32_t channelId(const RecClient& c, const std::string& topic) {
+    for (const auto& m : c.text)
+      if (m["op"] == "advertise")
+        for (const auto& ch : m["channels"])
+          if (ch["topic"] == topic) return ch["id"].get<std::uint32_t>();
+    ADD_FAILURE() << "no channel " << topic;
+    return 0;
+  }
+  std::vector<Published> pub;
+};
+
+TEST_F(HubTest, ServerInfoThenAdvertiseOfEveryHoistChannelWithJsonSchema) {
+  Hub hub = make(false, {"north/"});
+  RecClient c;
+  hub.addClient(c);
+  ASSERT_GE(c.text.size(), 2u);
+  EXPECT_EQ(c.text[0]["op"], "serverInfo");
+  EXPECT_EQ(c.text[0]["capabilities"], Json::array({"clientPublish"}));
+  EXPECT_EQ(c.text[1]["op"], "advertise");
+  std::vector<std::string> topics;
+  for (const auto& ch : c.text[1]["channels"]) {
+    topics.push_back(ch["topic"]);
+    EXPECT_EQ(ch["encoding"], "json");
+    EXPECT_EQ(ch["schemaEncoding"], "jsonschema");
+    const Json schema = Json::parse(ch["schema"].get<std::string>());
+    EXPECT_EQ(schema["type"], "object") << ch["topic"];
+  }
+  for (const char* t : {"north/HOIST_WINDER", "north/HOIST_CAGE", "north/HOIST_GUIDE_SHAPE", "north/HOIST_ALARM",
+                        "north/HOIST_ALARM_ACK", "north/HOIST_HEALTH", "north/HOIST_CAGE/decimated"})
+    EXPECT_NE(std::find(topics.begin(), topics.end(), t), topics.end()) << t;
+}
+
+TEST_F(HubTest, SubscribeDeliversMessageDataWithTheClientsIdAndUnsubscribeStops) {
+  Hub hub = make(false);
+  RecClient c;
+  hub.addClient(c);
+  const auto id = channelId(c, "HOIST_CAGE");
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 42}, {"channelId", id}}}}}.dump());
+  cage_state_t m{};
+  m.utime = 123456789;
+  m.l = 123.25;
+  m.y_c = -0.0042;
+  m.lambdas[0] = 8000.5;
+  const auto bytes = encode(m);
+  hub.onLcm("HOIST_CAGE", bytes.data(), bytes.size());
+  ASSERT_EQ(c.data.size(), 1u);
+  const std::string& f = c.data[0];
+  ASSERT_GT(f.size(), 13u);
+  EXPECT_EQ(static_cast<std::uint8_t>(f[0]), 0x01);
+  std::uint32_t sub = 0;
+  std::memcpy(&sub, f.data() + 1, 4);  // little-endian host
+  EXPECT_EQ(sub, 42u);
+  const Json j = Json::parse(f.substr(13));
+  EXPECT_EQ(j["utime"], 123456789);
+  EXPECT_DOUBLE_EQ(j["l"].get<double>(), 123.25);
+  EXPECT_DOUBLE_EQ(j["y_c"].get<double>(), -0.0042);
+  EXPECT_DOUBLE_EQ(j["lambdas"][0].get<double>(), 8000.5);
+
+  hub.onClientText(c, Json{{"op", "unsubscribe"}, {"subscriptionIds", {42}}}.dump());
+  hub.onLcm("HOIST_CAGE", bytes.data(), bytes.size());
+  EXPECT_EQ(c.data.size(), 1u);
+}
+
+TEST_F(HubTest, GarbageAndWrongTypesFromLcmAreCountedNotForwarded) {
+  Hub hub = make(false);
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", channelId(c, "HOIST_CAGE")}}}}}.dump());
+  const std::vector<std::uint8_t> junk{1, 2, 3};
+  hub.onLcm("HOIST_CAGE", junk.data(), junk.size());
+  health_t h{};
+  const auto hb = encode(h);
+  hub.onLcm("HOIST_CAGE", hb.data(), hb.size());  // a health_t on the cage channel
+  cage_state_t m{};
+  auto cb = encode(m);
+  cb.resize(cb.size() - 10);  // truncated
+  hub.onLcm("HOIST_CAGE", cb.data(), cb.size());
+  EXPECT_TRUE(c.data.empty());
+  EXPECT_EQ(hub.counter("lcm_rejected_unknown_type"), 1u);
+  EXPECT_EQ(hub.counter("lcm_rejected_wrong_type"), 1u);
+  EXPECT_EQ(hub.counter("lcm_decoded"), 0u);
+  std::uint64_t decode_fail = 0;
+  const Json counters = hub.stats()["counters"];
+  for (const auto& [k, v] : counters.items())
+    if (k.rfind("lcm_rejected_decode_", 0) == 0) decode_fail += v.get<std::uint64_t>();
+  EXPECT_EQ(decode_fail, 1u);
+}
+
+TEST_F(HubTest, PrefixesAreDiscoveredFromHealthAndEarlierAlarmsKept) {
+  Hub hub = make(false, {});
+  RecClient c;
+  hub.addClient(c);
+  EXPECT_TRUE(hub.prefixes().empty());
+  cage_state_t m{};
+  const auto cb = encode(m);
+  hub.onLcm("south/HOIST_CAGE", cb.data(), cb.size());
+  EXPECT_TRUE(hub.prefixes().empty());  // only HOIST_HEALTH announces a shaft
+  health_t h{};
+  const auto hb = encode(h);
+  hub.onLcm("south/HOIST_HEALTH", hb.data(), hb.size());
+  ASSERT_EQ(hub.prefixes().size(), 1u);
+  EXPECT_EQ(hub.prefixes()[0], "south/");
+  EXPECT_NE(channelId(c, "south/HOIST_CAGE"), 0u);  // advertised to the connected client
+}
+
+TEST_F(HubTest, DecimatedChannelKeepsEachIntervalsMinAndMax) {
+  Hub hub = make(false);
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 7}, {"channelId", channelId(c, "HOIST_CAGE/decimated")}}}}}.dump());
+  const double ys[] = {0.001, 0.009, -0.004, 0.002};  // a one-sample peak of 9 mm and dip of -4 mm
+  for (int i = 0; i < 4; ++i) {
+    cage_state_t m{};
+    m.utime = 1000 + i;
+    m.t = 0.01 * i;
+    m.y_c = ys[i];
+    m.lambdas[2] = 10.0 * i;
+    m.degraded = i == 1;
+    const auto b = encode(m);
+    hub.onLcm("HOIST_CAGE", b.data(), b.size());
+  }
+  hub.flushDecimated();
+  ASSERT_EQ(c.data.size(), 1u);
+  const Json d = Json::parse(c.data[0].substr(13));
+  EXPECT_EQ(d["count"], 4);
+  EXPECT_DOUBLE_EQ(d["max"]["y_c"].get<double>(), 0.009);
+  EXPECT_DOUBLE_EQ(d["min"]["y_c"].get<double>(), -0.004);
+  EXPECT_DOUBLE_EQ(d["max"]["lambdas"][2].get<double>(), 30.0);
+  EXPECT_DOUBLE_EQ(d["min"]["lambdas"][2].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(d["last"]["y_c"].get<double>(), 0.002);
+  EXPECT_EQ(d["first"]["utime"], 1000);
+  EXPECT_TRUE(d["max"]["degraded"].get<bool>());
+  EXPECT_FALSE(d["min"]["degraded"].get<bool>());
+  hub.flushDecimated();  // nothing new: nothing sent
+  EXPECT_EQ(c.data.size(), 1u);
+}
+
+std::string clientMessage(std::uint32_t chan, const Json& j) {
+  std::string f(5, '\0');
+  f[0] = 1;
+  for (int i = 0; i < 4; ++i) f[1 + i] = static_cast<char>((chan >> (8 * i)) & 0xff);
+  return f + j.dump();
+}
+
+TEST_F(HubTest, ClientPublishesAlarmAckAfterValidation) {
+  Hub hub = make(false);
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "advertise"},
+                           {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}, {"schemaName", "hoist.alarm_ack_t"}}}}}
+                          .dump());
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 2}, {"shelve_duration", 600.0}, {"user", "ann"}}));
+  ASSERT_EQ(pub.size(), 1u);
+  EXPECT_EQ(pub[0].channel, "HOIST_ALARM_ACK");
+  alarm_ack_t a{};
+  ASSERT_GE(a.decode(pub[0].bytes.data(), 0, static_cast<int>(pub[0].bytes.size())), 0);
+  EXPECT_EQ(a.kind, "CAGE_POS_Y");
+  EXPECT_EQ(a.action, 2);  // ACTION_SHELVE
+  EXPECT_EQ(a.user, "ann");
+  EXPECT_DOUBLE_EQ(a.shelve_duration, 600.0);
+  EXPECT_EQ(a.utime, 1'700'000'000'000'000LL);  // the server's clock, in us
+
+  // Invalid: no user, bad kind, bad action; unadvertised channel; other topics.
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", ""}}));
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "../x"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", "a"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "X"}, {"level", 1}, {"action", 9}, {"shelve_duration", 0.0}, {"user", "a"}}));
+  hub.onClientBinary(c, clientMessage(6, {{"utime", 0}, {"kind", "X"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", "a"}}));
+  hub.onClientText(c, Json{{"op", "advertise"}, {"channels", {{{"id", 8}, {"topic", "HOIST_WINDER"}, {"encoding", "json"}}}}}.dump());
+  EXPECT_EQ(pub.size(), 1u);
+  EXPECT_EQ(hub.counter("commands_rejected_invalid"), 3u);
+  EXPECT_EQ(hub.counter("commands_rejected_unadvertised"), 1u);
+  EXPECT_EQ(hub.counter("commands_rejected_topic"), 1u);
+  ASSERT_NE(c.lastStatus(), nullptr);
+  EXPECT_EQ((*c.lastStatus())["level"], 2);
+}
+
+TEST_F(HubTest, ReadOnlyRefusesEveryCommand) {
+  Hub hub = make(true);
+  RecClient c;
+  hub.addClient(c);
+  EXPECT_TRUE(c.text[0]["capabilities"].empty());
+  EXPECT_FALSE(c.text[0].contains("supportedEncodings"));
+  hub.onClientText(c, Json{{"op", "advertise"}, {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}}}}}.dump());
+  hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"shelve_duration", 0.0}, {"user", "x"}}));
+  EXPECT_TRUE(pub.empty());
+  EXPECT_EQ(hub.counter("commands_rejected_read_only"), 2u);
+}
+
+TEST_F(HubTest, BadClientMessagesGetAnErrorStatusAndAreCounted) {
+  Hub hub = make(false);
+  RecClient c;
+  hub.addClient(c);
+  const auto cage = channelId(c, "HOIST_CAGE");
+  for (const char* s : {"{", "[]", "{\"op\":3}", "{\"op\":\"nope\"}", "{\"op\":\"fetchAsset\"}",
+                        "{\"op\":\"subscribe\"}", "{\"op\":\"subscribe\",\"subscriptions\":[{\"id\":-1,\"channelId\":1}]}",
+                        "{\"op\":\"unsubscribe\",\"subscriptionIds\":[99]}"}) {
+    const std::size_t n = c.text.size();
+    hub.onClientText(c, s);
+    ASSERT_EQ(c.text.size(), n + 1) << s;
+    EXPECT_EQ(c.text.back()["op"], "status") << s;
+  }
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", cage}}}}}.dump());
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", cage}}}}}.dump());  // id reused
+  hub.onClientBinary(c, std::string("\x05", 1));
+  hub.onClientBinary(c, std::string("\x01\x00", 2));
+  EXPECT_EQ(hub.counter("ws_rejected_bad_json"), 3u);
+  EXPECT_EQ(hub.counter("ws_rejected_unknown_op"), 1u);
+  EXPECT_EQ(hub.counter("ws_rejected_unsupported_op"), 1u);
+  EXPECT_EQ(hub.counter("ws_rejected_bad_request"), 5u);
+  EXPECT_EQ(hub.counter("ws_rejected_unknown_binary_op"), 1u);
+}
+
+TEST(StaticFilesTest, OnlyKnownFilesTraversalRefusedInEveryEncoding) {
+  StaticFiles f;
+  f.add("/index.html", "<html>", "text/html");
+  f.add("/vendor/uPlot.iife.min.js", "x", "text/javascript");
+  const StaticFile* p = nullptr;
+  EXPECT_EQ(f.lookup("/", &p), StaticFiles::Verdict::Found);
+  EXPECT_EQ(p->body, "<html>");
+  EXPECT_EQ(f.lookup("/vendor/uPlot.iife.min.js?v=1", &p), StaticFiles::Verdict::Found);
+  EXPECT_EQ(f.lookup("/%76endor/uPlot.iife.min.js", &p), StaticFiles::Verdict::Found);
+  for (const char* t : {"/../../etc/passwd", "/%2e%2e/etc/passwd", "/%2E%2E%2Fetc%2Fpasswd", "/%252e%252e/etc/passwd",
+                        "/vendor/../index.html", "/..", "/a/..", "/..\\x", "/x%5c..%5cy", "/index.html%00"})
+    EXPECT_EQ(f.lookup(t, &p), StaticFiles::Verdict::Traversal) << t;
+  for (const char* t : {"", "index.html", "/%zz", "/%4"}) EXPECT_EQ(f.lookup(t, &p), StaticFiles::Verdict::BadRequest) << t;
+  EXPECT_EQ(f.lookup("/etc/passwd", &p), StaticFiles::Verdict::NotFound);
+  EXPECT_EQ(f.lookup("/index.htm", &p), StaticFiles::Verdict::NotFound);
+}
+
+TEST(ValidateAckTest, Fields) {
+  EXPECT_EQ(validateAckFields("CAGE_POS_Y", 1, 1, 0, "ann"), "");
+  EXPECT_EQ(validateAckFields("*", 0, 3, 0, "ann"), "");
+  EXPECT_NE(validateAckFields("", 1, 1, 0, "ann"), "");
+  EXPECT_NE(validateAckFields(std::string(65, 'A'), 1, 1, 0, "ann"), "");
+  EXPECT_NE(validateAckFields("cage", 1, 1, 0, "ann"), "");
+  EXPECT_NE(validateAckFields("X", 3, 1, 0, "ann"), "");
+  EXPECT_NE(validateAckFields("X", 1, 0, 0, "ann"), "");
+  EXPECT_NE(validateAckFields("X", 1, 2, 0, "ann"), "");        // shelve needs a duration
+  EXPECT_NE(validateAckFields("X", 1, 2, 1e300 * 1e300, "ann"), "");
+  EXPECT_EQ(validateAckFields("X", 1, 2, 600, "ann"), "");
+  EXPECT_NE(validateAckFields("X", 1, 1, 0, ""), "");
+  EXPECT_NE(validateAckFields("X", 1, 1, 0, "a\nb"), "");
+}
+
+}  // namespace
+}  // namespace hoist::dash

@@ -1,0 +1,544 @@
+// Foxglove WebSocket protocol v1 over the hoist LCM channels (see hub.hpp).
+#include "hub.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/bus/channels.hpp"
+#include "hoist/msg/codec.hpp"
+
+namespace hoist::dash {
+
+namespace {
+
+// Suffix of the LCM channel of each hoist type (INTERFACES.md).
+const std::vector<std::pair<std::string, std::string>>& typeSuffixes() {
+  using namespace hoist::bus;
+  static const std::vector<std::pair<std::string, std::string>> v{
+      {"hoist.winder_t", std::string(kChannelWinder)},
+      {"hoist.cage_state_t", std::string(kChannelCage)},
+      {"hoist.guide_shape_t", std::string(kChannelGuideShape)},
+      {"hoist.alarm_t", std::string(kChannelAlarm)},
+      {"hoist.alarm_ack_t", std::string(kChannelAlarmAck)},
+      {"hoist.health_t", std::string(kChannelHealth)},
+      // INTERFACES.md "Additions": the forecast's channels, once their types exist.
+      {"hoist.forecast_t", "HOIST_FORECAST"},
+      {"hoist.trip_plan_t", "HOIST_TRIP_PLAN"}};
+  return v;
+}
+
+bool endsWith(const std::string& s, const std::string& suf) {
+  return s.size() >= suf.size() && s.compare(s.size() - suf.size(), suf.size(), suf) == 0;
+}
+
+template <class S>
+std::string schemaText(const S& s) {
+  if constexpr (std::is_same_v<std::decay_t<S>, Json>) return s.dump();
+  else return std::string(s);
+}
+
+std::string frameHeader(std::uint8_t op, std::uint32_t id, std::uint64_t ns) {
+  std::string h(13, '\0');
+  h[0] = static_cast<char>(op);
+  for (int i = 0; i < 4; ++i) h[1 + i] = static_cast<char>((id >> (8 * i)) & 0xff);
+  for (int i = 0; i < 8; ++i) h[5 + i] = static_cast<char>((ns >> (8 * i)) & 0xff);
+  return h;
+}
+
+bool isUint32(const Json& j) {
+  return j.is_number_unsigned() || (j.is_number_integer() && j.get<std::int64_t>() >= 0 &&
+                                     j.get<std::int64_t>() <= 0xffffffffLL);
+}
+
+}  // namespace
+
+std::string channelSuffixOfType(const std::string& type_name) {
+  for (const auto& [t, s] : typeSuffixes())
+    if (t == type_name) return s;
+  return "";
+}
+
+std::string hoistSuffixOf(const std::string& channel) {
+  std::string best;
+  for (const auto& [t, s] : typeSuffixes())
+    if (endsWith(channel, s) && s.size() > best.size()) best = s;
+  return best;
+}
+
+std::string validateAckFields(const std::string& kind, int level, int action, double shelve_duration,
+                              const std::string& user) {
+  if (kind.empty() || kind.size() > 64) return "kind must have 1..64 characters";
+  for (char ch : kind)
+    if (!((ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '*'))
+      return "kind may contain only A-Z, 0-9, '_' and '*'";
+  if (level < 0 || level > 2) return "level must be 0 (both), 1 (WARNING) or 2 (CRITICAL)";
+  if (action != alarm_ack_t::ACTION_ACK && action != alarm_ack_t::ACTION_SHELVE &&
+      action != alarm_ack_t::ACTION_UNSHELVE)
+    return "action must be 1 (ACK), 2 (SHELVE) or 3 (UNSHELVE)";
+  if (action == alarm_ack_t::ACTION_SHELVE && !(std::isfinite(shelve_duration) && shelve_duration > 0.0 &&
+                                                 shelve_duration <= 1e6))
+    return "shelve_duration must be in (0, 1e6] s";
+  if (user.empty() || user.size() > 64) return "user must have 1..64 characters (enter your name)";
+  for (unsigned char ch : user)
+    if (ch < 0x20 || ch == 0x7f) return "user may not contain control characters";
+  return "";
+}
+
+// ---- MinMaxDecimator -----------------------------------------------------------
+
+void MinMaxDecimator::foldMin(Json& acc, const Json& v) {
+  if (acc.is_object() && v.is_object()) {
+    for (auto it = acc.begin(); it != acc.end(); ++it) {
+      const auto f = v.find(it.key());
+      if (f != v.end()) foldMin(it.value(), *f);
+    }
+  } else if (acc.is_array() && v.is_array() && acc.size() == v.size()) {
+    for (std::size_t i = 0; i < acc.size(); ++i) foldMin(acc[i], v[i]);
+  } else if (acc.is_number() && v.is_number()) {
+    if (v.get<double>() < acc.get<double>()) acc = v;
+  } else if (acc.is_boolean() && v.is_boolean()) {
+    acc = acc.get<bool>() && v.get<bool>();
+  }
+}
+
+void MinMaxDecimator::foldMax(Json& acc, const Json& v) {
+  if (acc.is_object() && v.is_object()) {
+    for (auto it = acc.begin(); it != acc.end(); ++it) {
+      const auto f = v.find(it.key());
+      if (f != v.end()) foldMax(it.value(), *f);
+    }
+  } else if (acc.is_array() && v.is_array() && acc.size() == v.size()) {
+    for (std::size_t i = 0; i < acc.size(); ++i) foldMax(acc[i], v[i]);
+  } else if (acc.is_number() && v.is_number()) {
+    if (v.get<double>() > acc.get<double>()) acc = v;
+  } else if (acc.is_boolean() && v.is_boolean()) {
+    acc = acc.get<bool>() || v.get<bool>();
+  }
+}
+
+void MinMaxDecimator::add(const Json& sample) {
+  if (count_ == 0) {
+    // Only numbers and booleans are folded; strings are dropped from min/max.
+    Json keep = Json::object();
+    if (sample.is_object())
+      for (auto it = sample.begin(); it != sample.end(); ++it)
+        if (it->is_number() || it->is_boolean() || it->is_array()) keep[it.key()] = *it;
+    min_ = max_ = keep;
+    first_ = Json{{"t", sample.value("t", 0.0)}, {"utime", sample.value("utime", std::int64_t{0})}};
+  } else {
+    foldMin(min_, sample);
+    foldMax(max_, sample);
+  }
+  last_ = sample;
+  ++count_;
+}
+
+Json MinMaxDecimator::take() {
+  Json out{{"count", count_}, {"first", first_}, {"last", last_}, {"min", min_}, {"max", max_}};
+  count_ = 0;
+  first_ = last_ = min_ = max_ = Json();
+  return out;
+}
+
+// ---- Hub ------------------------------------------------------------------------
+
+Hub::Hub(Options opt, Publisher publish, Clock clock)
+    : opt_(std::move(opt)), publish_(std::move(publish)), clock_(std::move(clock)) {
+  session_id_ = std::to_string(clock_());
+  for (const auto& p : opt_.prefixes) addPrefix(p);
+}
+
+std::uint64_t Hub::counter(const std::string& what) const {
+  const auto it = counters_.find(what);
+  return it == counters_.end() ? 0 : it->second;
+}
+
+Json Hub::stats() const {
+  Json c = Json::object();
+  for (const auto& [k, v] : counters_) c[k] = v;
+  return Json{{"clients", clients_.size()}, {"prefixes", prefix_list_}, {"read_only", opt_.read_only},
+              {"channels", channels_.size()}, {"counters", c}};
+}
+
+void Hub::addPrefix(const std::string& prefix) {
+  if (std::find(prefix_list_.begin(), prefix_list_.end(), prefix) != prefix_list_.end()) return;
+  if (prefix_list_.size() >= opt_.max_prefixes) {
+    count("prefix_limit_reached");
+    return;
+  }
+  prefix_list_.push_back(prefix);
+  std::vector<const Channel*> added;
+  auto pending = pending_alarms_.extract(prefix);
+  for (const auto& t : msg::allTypes()) {
+    const std::string suffix = channelSuffixOfType(t.name);
+    if (suffix.empty()) continue;
+    Channel ch;
+    ch.id = next_id_++;
+    ch.topic = prefix + suffix;
+    ch.prefix = prefix;
+    ch.suffix = suffix;
+    ch.schema_name = t.name;
+    ch.schema = schemaText(t.schema);
+    auto& stored = channels_[ch.topic] = std::move(ch);
+    by_id_[stored.id] = &stored;
+    if (suffix == "HOIST_ALARM" && !pending.empty()) stored.table = std::move(pending.mapped());
+    added.push_back(&stored);
+    if (suffix == "HOIST_CAGE") {
+      // The decimated cage channel: min/max of every numeric field per interval.
+      Json cage_schema = Json::parse(stored.schema, nullptr, false);
+      Channel d;
+      d.id = next_id_++;
+      d.topic = prefix + kDecimatedSuffix;
+      d.prefix = prefix;
+      d.suffix = kDecimatedSuffix;
+      d.schema_name = "hoist_dash.cage_decimated";
+      d.schema = Json{{"type", "object"},
+                      {"title", "hoist_dash.cage_decimated"},
+                      {"description",
+                       "HOIST_CAGE decimated by hoist-dash to the display rate: per interval the message count, "
+                       "the first message's t and utime, the last message whole, and the smallest and largest "
+                       "value of every numeric field (booleans: AND in min, OR in max)"},
+                      {"properties",
+                       {{"count", {{"type", "integer"}}},
+                        {"first", {{"type", "object"}}},
+                        {"last", cage_schema},
+                        {"min", {{"type", "object"}}},
+                        {"max", {{"type", "object"}}}}}}
+                     .dump();
+      auto& sd = channels_[d.topic] = std::move(d);
+      by_id_[sd.id] = &sd;
+      added.push_back(&sd);
+    }
+  }
+  const auto adv = std::make_shared<const std::string>(advertiseOf(added).dump());
+  for (Client* c : clients_) c->sendText(adv);
+}
+
+Hub::Channel* Hub::channelFor(const std::string& topic) {
+  const auto it = channels_.find(topic);
+  return it == channels_.end() ? nullptr : &it->second;
+}
+
+Json Hub::advertiseOf(const std::vector<const Channel*>& chans) const {
+  Json arr = Json::array();
+  for (const Channel* ch : chans)
+    arr.push_back({{"id", ch->id},
+                   {"topic", ch->topic},
+                   {"encoding", "json"},
+                   {"schemaName", ch->schema_name},
+                   {"schema", ch->schema},
+                   {"schemaEncoding", "jsonschema"}});
+  return Json{{"op", "advertise"}, {"channels", arr}};
+}
+
+void Hub::addClient(Client& c) {
+  clients_.insert(&c);
+  count("ws_clients_accepted");
+  Json caps = Json::array();
+  Json info{{"op", "serverInfo"}, {"name", "hoist-dash"}, {"sessionId", session_id_}};
+  if (!opt_.read_only) {
+    caps.push_back("clientPublish");
+    info["supportedEncodings"] = Json::array({"json"});
+  }
+  info["capabilities"] = caps;
+  info["metadata"] = Json{{"read_only", opt_.read_only ? "true" : "false"},
+                          {"shafts", opt_.shaft_meta.dump()},
+                          {"decimated_suffix", kDecimatedSuffix}};
+  c.sendText(std::make_shared<const std::string>(info.dump()));
+  std::vector<const Channel*> all;
+  for (const auto& [topic, ch] : channels_) all.push_back(&ch);
+  std::sort(all.begin(), all.end(), [](const Channel* a, const Channel* b) { return a->id < b->id; });
+  c.sendText(std::make_shared<const std::string>(advertiseOf(all).dump()));
+}
+
+void Hub::removeClient(Client& c) { clients_.erase(&c); }
+
+void Hub::sendTo(Client& c, std::uint32_t sub_id, const std::string& payload) {
+  auto frame = std::make_shared<std::string>(frameHeader(0x01, sub_id, clock_()));
+  frame->append(payload);
+  c.sendData(std::move(frame));
+}
+
+void Hub::broadcast(Channel& ch, const std::shared_ptr<const std::string>& payload) {
+  for (Client* c : clients_) {
+    const auto it = c->by_chan_.find(ch.id);
+    if (it != c->by_chan_.end()) sendTo(*c, it->second, *payload);
+  }
+}
+
+void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) {
+  count("lcm_messages");
+  if (size > opt_.max_lcm_bytes) {
+    count("lcm_rejected_oversized");
+    return;
+  }
+  const std::string suffix = hoistSuffixOf(channel);
+  if (suffix.empty()) {
+    count("lcm_ignored_channel");
+    return;
+  }
+  const msg::TypeInfo* type = msg::findByFingerprint(data, size);
+  if (type == nullptr) {
+    count("lcm_rejected_unknown_type");
+    return;
+  }
+  if (channelSuffixOfType(type->name) != suffix) {
+    count("lcm_rejected_wrong_type");
+    return;
+  }
+  Json j;
+  msg::DecodeStatus st{};
+  bool ok = false;
+  try {
+    ok = type->bytesToJson(data, size, j, st);
+  } catch (...) {
+    ok = false;
+  }
+  if (!ok) {
+    count(std::string("lcm_rejected_decode_") + msg::toString(st));
+    return;
+  }
+  const std::string prefix = channel.substr(0, channel.size() - suffix.size());
+  Channel* ch = channelFor(channel);
+  if (ch == nullptr) {
+    if (opt_.discover && suffix == "HOIST_HEALTH") {
+      addPrefix(prefix);
+      ch = channelFor(channel);
+    }
+    if (ch == nullptr) {
+      // An alarm of a shaft not announced yet (its first HOIST_HEALTH is up
+      // to a second away): keep it for the alarm list, bounded.
+      if (opt_.discover && suffix == "HOIST_ALARM" &&
+          (pending_alarms_.count(prefix) || pending_alarms_.size() < opt_.max_prefixes)) {
+        auto& t = pending_alarms_[prefix];
+        const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
+        if (t.size() < 64 || t.count(key)) t[key] = std::make_shared<const std::string>(j.dump());
+      }
+      count("lcm_ignored_prefix");
+      return;
+    }
+  }
+  count("lcm_decoded");
+  const auto payload = std::make_shared<const std::string>(j.dump());
+  if (suffix == "HOIST_HEALTH" || suffix == "HOIST_GUIDE_SHAPE" || suffix == "HOIST_FORECAST") ch->latest = payload;
+  if (suffix == "HOIST_ALARM") {
+    const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
+    if (ch->table.size() < 64 || ch->table.count(key)) ch->table[key] = payload;
+    else count("alarm_table_full");
+  }
+  if (suffix == "HOIST_CAGE") decimators_[prefix].add(j);
+  broadcast(*ch, payload);
+}
+
+void Hub::flushDecimated() {
+  for (auto& [prefix, dec] : decimators_) {
+    if (dec.empty()) continue;
+    const auto payload = std::make_shared<const std::string>(dec.take().dump());
+    if (Channel* ch = channelFor(prefix + kDecimatedSuffix)) broadcast(*ch, payload);
+  }
+}
+
+void Hub::status(Client& c, int level, const std::string& msg) {
+  c.sendText(std::make_shared<const std::string>(Json{{"op", "status"}, {"level", level}, {"message", msg}}.dump()));
+}
+
+void Hub::onClientText(Client& c, std::string_view text) {
+  Json j = Json::parse(text.begin(), text.end(), nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("op") || !j["op"].is_string()) {
+    count("ws_rejected_bad_json");
+    status(c, 2, "rejected: a text frame must be a JSON object with a string field \"op\"");
+    return;
+  }
+  const std::string op = j["op"].get<std::string>();
+  if (op == "subscribe") handleSubscribe(c, j);
+  else if (op == "unsubscribe") handleUnsubscribe(c, j);
+  else if (op == "advertise") handleClientAdvertise(c, j);
+  else if (op == "unadvertise") handleClientUnadvertise(c, j);
+  else if (op == "getParameters" || op == "setParameters" || op == "subscribeParameterUpdates" ||
+           op == "unsubscribeParameterUpdates" || op == "subscribeConnectionGraph" ||
+           op == "unsubscribeConnectionGraph" || op == "fetchAsset") {
+    count("ws_rejected_unsupported_op");
+    status(c, 2, "rejected: op \"" + op + "\" is not supported by hoist-dash (capability not announced)");
+  } else {
+    count("ws_rejected_unknown_op");
+    status(c, 2, "rejected: unknown op \"" + op.substr(0, 64) + "\"");
+  }
+}
+
+void Hub::handleSubscribe(Client& c, const Json& j) {
+  const auto subs = j.find("subscriptions");
+  if (subs == j.end() || !subs->is_array()) {
+    count("ws_rejected_bad_request");
+    status(c, 2, "rejected subscribe: \"subscriptions\" must be an array");
+    return;
+  }
+  for (const auto& s : *subs) {
+    if (!s.is_object() || !s.contains("id") || !s.contains("channelId") || !isUint32(s["id"]) ||
+        !isUint32(s["channelId"])) {
+      count("ws_rejected_bad_request");
+      status(c, 2, "rejected subscribe: each subscription needs uint32 \"id\" and \"channelId\"");
+      continue;
+    }
+    const auto id = s["id"].get<std::uint32_t>();
+    const auto chan = s["channelId"].get<std::uint32_t>();
+    const auto ch = by_id_.find(chan);
+    if (ch == by_id_.end()) {
+      count("ws_rejected_bad_request");
+      status(c, 2, "rejected subscribe: unknown channel id " + std::to_string(chan));
+      continue;
+    }
+    if (c.subs_.count(id) || c.by_chan_.count(chan)) {
+      count("ws_rejected_bad_request");
+      status(c, 2, "rejected subscribe: subscription id " + std::to_string(id) +
+                       " or channel " + std::to_string(chan) + " already in use");
+      continue;
+    }
+    if (c.subs_.size() >= 1024) {
+      count("ws_rejected_bad_request");
+      status(c, 2, "rejected subscribe: too many subscriptions");
+      continue;
+    }
+    c.subs_[id] = chan;
+    c.by_chan_[chan] = id;
+    count("ws_subscriptions");
+    // Low-rate state is sent at once: the latest health/shape, the alarm table.
+    if (ch->second->latest) sendTo(c, id, *ch->second->latest);
+    for (const auto& [key, p] : ch->second->table) sendTo(c, id, *p);
+  }
+}
+
+void Hub::handleUnsubscribe(Client& c, const Json& j) {
+  const auto ids = j.find("subscriptionIds");
+  if (ids == j.end() || !ids->is_array()) {
+    count("ws_rejected_bad_request");
+    status(c, 2, "rejected unsubscribe: \"subscriptionIds\" must be an array");
+    return;
+  }
+  for (const auto& v : *ids) {
+    if (!isUint32(v) || !c.subs_.count(v.get<std::uint32_t>())) {
+      count("ws_rejected_bad_request");
+      status(c, 1, "unsubscribe: no such subscription " + v.dump().substr(0, 32));
+      continue;
+    }
+    const auto id = v.get<std::uint32_t>();
+    c.by_chan_.erase(c.subs_[id]);
+    c.subs_.erase(id);
+  }
+}
+
+void Hub::handleClientAdvertise(Client& c, const Json& j) {
+  if (opt_.read_only) {
+    count("commands_rejected_read_only");
+    status(c, 2, "rejected: hoist-dash runs --read-only; operator commands are disabled");
+    return;
+  }
+  const auto chans = j.find("channels");
+  if (chans == j.end() || !chans->is_array()) {
+    count("ws_rejected_bad_request");
+    status(c, 2, "rejected advertise: \"channels\" must be an array");
+    return;
+  }
+  for (const auto& ch : *chans) {
+    if (!ch.is_object() || !ch.contains("id") || !isUint32(ch["id"]) || !ch.contains("topic") ||
+        !ch["topic"].is_string() || ch.value("encoding", std::string()) != "json") {
+      count("ws_rejected_bad_request");
+      status(c, 2, "rejected advertise: each channel needs uint32 \"id\", \"topic\" and encoding \"json\"");
+      continue;
+    }
+    const std::string topic = ch["topic"].get<std::string>();
+    const Channel* target = channelFor(topic);
+    if (target == nullptr || target->suffix != "HOIST_ALARM_ACK") {
+      count("commands_rejected_topic");
+      status(c, 2, "rejected advertise: clients may publish only on <prefix>HOIST_ALARM_ACK of a known shaft, not \"" +
+                       topic.substr(0, 128) + "\"");
+      continue;
+    }
+    if (c.published_.size() >= 64) {
+      count("ws_rejected_bad_request");
+      status(c, 2, "rejected advertise: too many client channels");
+      continue;
+    }
+    c.published_[ch["id"].get<std::uint32_t>()] = topic;
+  }
+}
+
+void Hub::handleClientUnadvertise(Client& c, const Json& j) {
+  const auto ids = j.find("channelIds");
+  if (ids == j.end() || !ids->is_array()) {
+    count("ws_rejected_bad_request");
+    status(c, 2, "rejected unadvertise: \"channelIds\" must be an array");
+    return;
+  }
+  for (const auto& v : *ids)
+    if (isUint32(v)) c.published_.erase(v.get<std::uint32_t>());
+}
+
+void Hub::onClientBinary(Client& c, std::string_view bytes) {
+  if (bytes.empty() || static_cast<std::uint8_t>(bytes[0]) != 0x01) {
+    count("ws_rejected_unknown_binary_op");
+    status(c, 2, "rejected: unknown binary opcode (hoist-dash accepts only 0x01 client message data)");
+    return;
+  }
+  if (bytes.size() < 5) {
+    count("ws_rejected_bad_request");
+    status(c, 2, "rejected: client message data shorter than its 5-byte header");
+    return;
+  }
+  std::uint32_t chan = 0;
+  for (int i = 0; i < 4; ++i) chan |= std::uint32_t(static_cast<std::uint8_t>(bytes[1 + i])) << (8 * i);
+  handleClientMessage(c, chan, bytes.substr(5));
+}
+
+void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view payload) {
+  if (opt_.read_only) {
+    count("commands_rejected_read_only");
+    status(c, 2, "rejected: hoist-dash runs --read-only; operator commands are disabled");
+    return;
+  }
+  const auto it = c.published_.find(chan);
+  if (it == c.published_.end()) {
+    count("commands_rejected_unadvertised");
+    status(c, 2, "rejected: client channel " + std::to_string(chan) + " was not advertised");
+    return;
+  }
+  const Json j = Json::parse(payload.begin(), payload.end(), nullptr, false);
+  alarm_ack_t ack{};
+  std::string err;
+  if (j.is_discarded() || !j.is_object()) {
+    count("commands_rejected_invalid");
+    status(c, 2, "rejected command: payload is not a JSON object");
+    return;
+  }
+  bool parsed = false;
+  try {
+    parsed = msg::fromJson(j, ack, err);
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
+  if (!parsed) {
+    count("commands_rejected_invalid");
+    status(c, 2, "rejected command: " + err);
+    return;
+  }
+  if (const std::string why = validateAckFields(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.user);
+      !why.empty()) {
+    count("commands_rejected_invalid");
+    status(c, 2, "rejected command: " + why);
+    return;
+  }
+  ack.utime = static_cast<std::int64_t>(clock_() / 1000);  // the command's time is the server's
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(ack.getEncodedSize()));
+  if (ack.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0 || !publish_(it->second, buf)) {
+    count("commands_publish_failed");
+    status(c, 2, "command not sent: LCM publish failed");
+    return;
+  }
+  count("commands_published");
+  static const char* actions[] = {"", "acknowledge", "shelve", "unshelve"};
+  status(c, 0, std::string("sent ") + actions[ack.action] + " " + ack.kind + " (level " +
+                   std::to_string(ack.level) + ") by " + ack.user + " on " + it->second);
+}
+
+}  // namespace hoist::dash

@@ -1,0 +1,148 @@
+// hoist/dash hub.hpp -- the Foxglove WebSocket protocol (subprotocol
+// foxglove.websocket.v1) between the hoist LCM channels and any number of
+// clients, without any networking: the Beast server (server.hpp) feeds it the
+// clients' frames, main.cpp the LCM messages, and it answers through the
+// Client interface.  Single-threaded: every call comes from one Asio loop.
+//
+// What it implements (docs/dashboard.md): serverInfo, status, advertise
+// (one channel per hoist LCM channel and shaft prefix, JSON encoding, JSON
+// Schema from the message codec, plus one decimated cage channel per shaft),
+// subscribe / unsubscribe with client-chosen ids, binary messageData, and
+// (unless read-only) clientPublish of HOIST_ALARM_ACK in JSON.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace hoist::dash {
+
+using Json = nlohmann::json;
+
+/// The channel suffix (LCM channel name without the shaft prefix) of each
+/// hoist message type ("hoist.cage_state_t" -> "HOIST_CAGE"); "" if none.
+std::string channelSuffixOfType(const std::string& type_name);
+/// The suffix `channel` ends with (longest match), "" if it is no hoist channel.
+std::string hoistSuffixOf(const std::string& channel);
+
+/// Min/max decimation of a stream of JSON messages: every numeric leaf (also
+/// inside arrays) keeps its smallest and largest value over the interval, so
+/// that no peak is lost at the display rate; booleans keep their OR in "max"
+/// and AND in "min"; the interval's last message is kept whole.
+class MinMaxDecimator {
+ public:
+  void add(const Json& sample);
+  bool empty() const { return count_ == 0; }
+  /// {"count", "first": {"t", "utime"}, "last": <message>, "min": {...}, "max": {...}}; resets.
+  Json take();
+
+ private:
+  static void foldMin(Json& acc, const Json& v);
+  static void foldMax(Json& acc, const Json& v);
+  std::size_t count_ = 0;
+  Json first_, last_, min_, max_;
+};
+
+/// One connected protocol client (a WebSocket session, or a test double).
+class Client {
+ public:
+  virtual ~Client() = default;
+  /// A JSON text frame (control: serverInfo, advertise, status).
+  virtual void sendText(std::shared_ptr<const std::string> frame) = 0;
+  /// A binary messageData frame; the client may drop it when it is behind.
+  virtual void sendData(std::shared_ptr<const std::string> frame) = 0;
+
+ private:
+  friend class Hub;
+  std::map<std::uint32_t, std::uint32_t> subs_;     // subscription id -> channel id
+  std::map<std::uint32_t, std::uint32_t> by_chan_;  // channel id -> subscription id
+  std::map<std::uint32_t, std::string> published_;  // client channel id -> LCM channel
+};
+
+class Hub {
+ public:
+  struct Options {
+    bool read_only = false;
+    std::vector<std::string> prefixes;  ///< fixed prefixes (--channel-prefix); empty: discover
+    bool discover = true;               ///< add prefixes seen on *HOIST_HEALTH
+    std::size_t max_prefixes = 16;
+    std::size_t max_lcm_bytes = 1 << 20;  ///< larger LCM messages are dropped (counted)
+    Json shaft_meta = Json::object();     ///< prefix -> {warning_fraction, ...} (serverInfo metadata)
+  };
+  /// Publishes encoded bytes on an LCM channel; false on failure.
+  using Publisher = std::function<bool(const std::string& channel, const std::vector<std::uint8_t>& bytes)>;
+  using Clock = std::function<std::uint64_t()>;  ///< wall time in ns since the epoch
+
+  Hub(Options opt, Publisher publish, Clock clock);
+
+  void addClient(Client& c);     ///< sends serverInfo and advertise
+  void removeClient(Client& c);
+  std::size_t clientCount() const { return clients_.size(); }
+
+  /// A raw LCM message: validated and decoded by the codec (failures
+  /// counted, never thrown), then sent to the subscribers.
+  void onLcm(const std::string& channel, const void* data, std::size_t size);
+  /// Flush the decimated channels (call at the display rate, ~25 Hz).
+  void flushDecimated();
+
+  void onClientText(Client& c, std::string_view text);
+  void onClientBinary(Client& c, std::string_view bytes);
+
+  /// Counted events (rejections, drops, ...), by name.
+  void count(const std::string& what, std::uint64_t n = 1) { counters_[what] += n; }
+  std::uint64_t counter(const std::string& what) const;
+  Json stats() const;
+  const std::vector<std::string>& prefixes() const { return prefix_list_; }
+  bool readOnly() const { return opt_.read_only; }
+
+  static constexpr const char* kDecimatedSuffix = "HOIST_CAGE/decimated";
+
+ private:
+  struct Channel {
+    std::uint32_t id = 0;
+    std::string topic, prefix, suffix, schema_name, schema;
+    std::shared_ptr<const std::string> latest;                   // replayed on subscribe (health, shape)
+    std::map<std::string, std::shared_ptr<const std::string>> table;  // alarms: kind/level -> latest
+  };
+  void addPrefix(const std::string& prefix);
+  Channel* channelFor(const std::string& topic);
+  Json advertiseOf(const std::vector<const Channel*>& chans) const;
+  void broadcast(Channel& ch, const std::shared_ptr<const std::string>& payload);
+  void sendTo(Client& c, std::uint32_t sub_id, const std::string& payload);
+  void status(Client& c, int level, const std::string& msg);
+  void handleSubscribe(Client& c, const Json& j);
+  void handleUnsubscribe(Client& c, const Json& j);
+  void handleClientAdvertise(Client& c, const Json& j);
+  void handleClientUnadvertise(Client& c, const Json& j);
+  void handleClientMessage(Client& c, std::uint32_t chan, std::string_view payload);
+
+  Options opt_;
+  Publisher publish_;
+  Clock clock_;
+  std::set<Client*> clients_;
+  std::vector<std::string> prefix_list_;
+  std::map<std::string, Channel> channels_;             // by topic
+  std::map<std::uint32_t, Channel*> by_id_;
+  std::map<std::string, MinMaxDecimator> decimators_;   // by prefix
+  std::map<std::string, std::map<std::string, std::shared_ptr<const std::string>>> pending_alarms_;
+  std::uint32_t next_id_ = 1;
+  std::map<std::string, std::uint64_t> counters_;
+  std::string session_id_;
+};
+
+/// Checks an operator command before it is published: kind is 1..64
+/// characters of [A-Z0-9_*], level 0..2, action ACK/SHELVE/UNSHELVE,
+/// shelve_duration finite in (0, 1e6] for SHELVE, user 1..64 printable
+/// characters.  Returns "" when valid, else the reason.
+std::string validateAckFields(const std::string& kind, int level, int action, double shelve_duration,
+                              const std::string& user);
+
+}  // namespace hoist::dash

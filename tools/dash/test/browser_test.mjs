@@ -1,0 +1,134 @@
+// Browser test of hoist-dash (CTest label `browser`): the real daemon,
+// replay, lcm-logger and hoist-dash on a private LCM URL and a free port, the
+// page in headless Chromium (Debian's, driven by puppeteer-core).
+//
+//   node browser_test.mjs [LCM_PORT] [--screenshot FILE]
+//
+// Asserts: within 5 s the displayed depth and sway equal the latest
+// HOIST_CAGE (as lcm-logger recorded it) to display rounding; the daemon's
+// alarm appears in the list; Acknowledge publishes HOIST_ALARM_ACK (seen in
+// lcm-logger's log) and the alarm turns acknowledged; a --read-only server's
+// page shows no command buttons; STALE within 3 s after the daemon stops.
+import fs from "node:fs";
+import path from "node:path";
+import puppeteer from "puppeteer-core";
+import { binDir, check, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
+
+const args = process.argv.slice(2);
+const lcmPort = Number(args.find((a) => /^\d+$/.test(a)) || 7871);
+const shotIdx = args.indexOf("--screenshot");
+const dir = workDir("browser");
+const shot = shotIdx >= 0 ? path.resolve(args[shotIdx + 1]) : path.join(dir, "dashboard.png");
+const chromium = process.env.CHROMIUM || ["/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"].find((p) => fs.existsSync(p));
+if (!chromium) fail("no Chromium found (scripts/setup.sh installs Debian's chromium)");
+console.log(`work dir ${dir}, LCM ${lcmUrl(lcmPort)}`);
+
+const lcm = lcmUrl(lcmPort);
+// The dashboards first (the daemon announces an alarm once, then every 30 s).
+const dash = await startDash(dir, lcm, []);
+const ro = await startDash(dir, lcm, ["--read-only"], "hoist-dash-ro");
+const twin = await startTwin(dir, lcm, { replay: false });  // at rest at 50 m: the +y WARNING is on
+
+const browser = await puppeteer.launch({
+  executablePath: chromium, headless: true,
+  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1180"],
+  defaultViewport: { width: 1500, height: 1180 },
+});
+const page = await browser.newPage();
+const errors = [];
+page.on("pageerror", (e) => errors.push(String(e)));
+page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
+const t0 = Date.now();
+await page.goto(dash.url, { waitUntil: "load" });
+process.on("uncaughtException", async (e) => {
+  console.error(`FAIL: ${e.message}`);
+  try {
+    console.error(await page.evaluate(() => document.body.innerText.slice(0, 3000)));
+    await page.screenshot({ path: path.join(dir, "failure.png") });
+    console.error(`page at failure: ${path.join(dir, "failure.png")}`);
+  } catch { /* browser gone */ }
+  process.exit(1);
+});
+
+// 2. The daemon's alarm (demo config: CAGE_POS_Y WARNING at the top of the shaft).
+await page.waitForSelector('tr.alarm[data-kind="CAGE_POS_Y"][data-active="true"]', { timeout: 10000 });
+check(true, "CAGE_POS_Y alarm raised by the daemon appears in the alarm list");
+
+// 3. Acknowledge with an operator name.
+await page.type("#user", "test-operator");
+await page.click('tr.alarm[data-kind="CAGE_POS_Y"][data-active="true"] button[data-action="acknowledge"]');
+const tAck = Date.now();
+await page.waitForSelector('tr.alarm[data-kind="CAGE_POS_Y"][data-acked="true"]', { timeout: 5000 });
+check(true, `alarm turned acknowledged ${Date.now() - tAck} ms after pressing Acknowledge`);
+// 5. The read-only server's page: the alarm, but no command buttons.
+const page2 = await browser.newPage();
+await page2.goto(ro.url, { waitUntil: "load" });
+await page2.waitForSelector('tr.alarm[data-kind="CAGE_POS_Y"]', { timeout: 5000 });
+const roButtons = await page2.evaluate(() => ({
+  buttons: document.querySelectorAll("button[data-action]").length,
+  readOnly: document.body.dataset.readOnly,
+  userVisible: getComputedStyle(document.querySelector("#user").closest("label")).display !== "none",
+}));
+check(roButtons.readOnly === "true" && roButtons.buttons === 0 && !roButtons.userVisible,
+      `--read-only page shows no command buttons (${JSON.stringify(roButtons)})`);
+const rwButtons = await page.evaluate(() => document.querySelectorAll("button[data-action]").length);
+check(rwButtons > 0, `the operator page does show command buttons (${rwButtons})`);
+await page2.close();
+
+twin.replay = start("hoist-replay", path.join(binDir, "hoist-replay"), ["--lcm-url", lcm, "--profile", "paper", "-q"], dir);
+const tReplay = Date.now();
+// 1. The cage state within 5 s of the first input.
+await page.waitForFunction(() => {
+  const r = document.querySelector('[data-shaft=""] [data-role=readouts]');
+  return r && r.dataset.utime;
+}, { timeout: 5000 });
+check(true, `page shows the cage state ${Date.now() - tReplay} ms after the replay started`);
+await sleep(3000);  // the cage on its way down
+// 4. Depth and sway while the cage moves.
+const shown = await page.evaluate(() => {
+  const r = document.querySelector('[data-shaft=""] [data-role=readouts]');
+  const f = (k) => r.querySelector(`[data-field="${k}"]`).textContent;
+  return { utime: Number(r.dataset.utime), l: f("l"), y_c: f("y_c"), now_us: Date.now() * 1000 };
+});
+console.log(`page shows after ${Date.now() - t0} ms:`, shown);
+// ~0.1 s on an idle machine; the bound allows for a loaded CI machine.
+check(shown.now_us - shown.utime < 2000e3, `displayed cage state is current (${((shown.now_us - shown.utime) / 1e3).toFixed(0)} ms old)`);
+
+await page.select("#window", "10");  // the 10-s trend window for the screenshot
+await sleep(2500);
+await page.screenshot({ path: shot });
+console.log(`screenshot: ${shot}`);
+
+// 6. STALE within 3 s of the daemon stopping.
+await stop(twin.replay);
+const tStop = Date.now();
+await stop(twin.twind);
+await page.waitForFunction(() => document.querySelector('[data-shaft=""] [data-role=stale]').dataset.state === "stale",
+                           { timeout: 3000 });
+const staleMs = Date.now() - tStop;
+const bannerText = await page.$eval('[data-shaft=""] [data-role=stale]', (e) => e.textContent);
+check(staleMs <= 3000 && /STALE/.test(bannerText), `STALE shown ${staleMs} ms after the daemon stopped ("${bannerText}")`);
+await page.screenshot({ path: path.join(dir, "dashboard-stale.png") });
+
+await browser.close();
+await stop(twin.logger, "SIGINT");
+const dashStats = await (await fetch(new URL("/api/stats", dash.url))).json();
+await stop(dash.proc);
+await stop(ro.proc);
+check(errors.length === 0, `no errors in the page's console (${errors.join(" | ")})`);
+check(dashStats.counters.commands_published === 1, `hoist-dash published exactly one command (${dashStats.counters.commands_published})`);
+
+// 7. Against what lcm-logger recorded.
+const log = readLog(path.join(dir, "run.lcm"), dir);
+const cage = log.HOIST_CAGE || [];
+const row = cage.find((r) => Number(r.utime) === shown.utime);
+if (!row) fail(`no HOIST_CAGE with utime ${shown.utime} in lcm-logger's log (${cage.length} rows)`);
+const l2 = Number(row.l).toFixed(2), y2 = (Number(row.y_c) * 1e3).toFixed(2);
+check(l2 === shown.l && y2 === shown.y_c, `displayed depth ${shown.l} m and sway ${shown.y_c} mm equal HOIST_CAGE (l=${row.l}, y_c=${row.y_c}) to display rounding`);
+const acks = log.HOIST_ALARM_ACK || [];
+check(acks.some((a) => a.kind === "CAGE_POS_Y" && Number(a.action) === 1 && a.user === "test-operator"),
+      `HOIST_ALARM_ACK {CAGE_POS_Y, ACK, test-operator} seen on LCM (${JSON.stringify(acks)})`);
+const alarms = log.HOIST_ALARM || [];
+check(alarms.some((a) => a.kind === "CAGE_POS_Y" && a.acked === "1"), "the daemon announced the alarm acknowledged");
+console.log("PASS");
+process.exit(0);

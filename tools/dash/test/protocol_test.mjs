@@ -1,0 +1,112 @@
+// Protocol test of hoist-dash (CTest label `browser`): the official
+// @foxglove/ws-protocol client in Node against the real twin.
+//
+//   node protocol_test.mjs [LCM_PORT]
+//
+// Connects, receives serverInfo and advertise (every hoist channel with a
+// parseable JSON Schema naming the msgs/*.lcm fields), subscribes to
+// HOIST_CAGE, decodes >= 50 messages, and checks that their fields equal what
+// lcm-logger recorded in the same run (through hoist-log2csv, round-trip
+// exact doubles).  Also publishes one HOIST_ALARM_ACK as a client channel.
+import foxglove from "@foxglove/ws-protocol";
+import path from "node:path";
+import WebSocket from "ws";
+import { check, fail, lcmUrl, readLog, sleep, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
+
+const { FoxgloveClient } = foxglove;
+const lcmPort = Number(process.argv[2] || 7872);
+const dir = workDir("protocol");
+const lcm = lcmUrl(lcmPort);
+console.log(`work dir ${dir}, LCM ${lcm}`);
+const dash = await startDash(dir, lcm, []);
+const twin = await startTwin(dir, lcm);
+
+const ws = new WebSocket(dash.url.replace("http", "ws"), [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+const client = new FoxgloveClient({ ws });
+let info = null;
+const channels = new Map();
+const decoded = [];
+const statuses = [];
+let cageSub = null;
+client.on("serverInfo", (i) => { info = i; });
+client.on("status", (s) => statuses.push(s));
+client.on("error", (e) => fail(`client error: ${e}`));
+client.on("advertise", (chs) => {
+  for (const ch of chs) channels.set(ch.topic, ch);
+  const cage = channels.get("HOIST_CAGE");
+  if (cage && cageSub === null) cageSub = client.subscribe(cage.id);
+});
+client.on("message", ({ subscriptionId, data }) => {
+  if (subscriptionId !== cageSub) return;
+  decoded.push(JSON.parse(new TextDecoder().decode(data)));
+});
+
+await waitFor(() => info, 5000, "serverInfo");
+check(info.name === "hoist-dash" && info.capabilities.includes("clientPublish"), `serverInfo ${JSON.stringify(info.capabilities)}`);
+await waitFor(() => channels.has("HOIST_CAGE"), 5000, "advertise of HOIST_CAGE (discovered from HOIST_HEALTH)");
+const expect = {
+  HOIST_WINDER: ["utime", "seq", "v", "a", "has_length", "length"],
+  HOIST_CAGE: ["utime", "t", "l", "v", "a", "x_c", "y_c", "theta", "lambdas", "y_top", "y_bottom", "min_clearance", "alarm_level", "degraded"],
+  HOIST_GUIDE_SHAPE: ["utime", "t", "l", "h", "n", "x", "y1", "y2"],
+  HOIST_ALARM: ["utime", "kind", "level", "event_type", "active", "acked", "shelved", "latched", "value", "threshold", "message", "user"],
+  HOIST_ALARM_ACK: ["utime", "kind", "level", "action", "shelve_duration", "user"],
+  HOIST_HEALTH: ["utime", "step_p50_us", "deadline_misses", "input_age", "rejected_total", "reject_reason", "rejected", "degraded"],
+};
+for (const [topic, fields] of Object.entries(expect)) {
+  const ch = channels.get(topic);
+  if (!ch) fail(`channel ${topic} not advertised (have ${[...channels.keys()].join(", ")})`);
+  const schema = JSON.parse(ch.schema);
+  const props = Object.keys(schema.properties || {});
+  const missing = fields.filter((f) => !props.includes(f));
+  check(ch.encoding === "json" && missing.length === 0,
+        `${topic}: encoding json, schema ${ch.schemaName} names the msgs/*.lcm fields (missing: ${missing.join(",") || "none"})`);
+}
+
+await waitFor(() => decoded.length >= 60, 10000, "60 HOIST_CAGE messages");
+client.unsubscribe(cageSub);
+const n = decoded.length;
+await sleep(300);
+const after = decoded.length;
+check(after - n <= 2, `unsubscribe stops the stream (${after - n} more after 300 ms)`);
+
+// A command through clientPublish, as Foxglove's Publish panel would send it.
+const cid = client.advertise({ topic: "HOIST_ALARM_ACK", encoding: "json", schemaName: "hoist.alarm_ack_t" });
+client.sendMessage(cid, new TextEncoder().encode(JSON.stringify({ utime: 0, kind: "CAGE_NEG_Y", level: 0, action: 1, shelve_duration: 0, user: "protocol-test" })));
+await waitFor(() => statuses.some((s) => /sent acknowledge CAGE_NEG_Y/.test(s.message)), 3000, "the server's confirmation");
+client.sendMessage(cid, new TextEncoder().encode(JSON.stringify({ utime: 0, kind: "../etc", level: 9, action: 7, shelve_duration: 0, user: "" })));
+await waitFor(() => statuses.some((s) => s.level === 2 && /rejected command/.test(s.message)), 3000, "rejection of a bad command");
+check(true, "client publish: a valid HOIST_ALARM_ACK is confirmed, an invalid one rejected");
+await sleep(300);
+client.close();
+
+await stop(twin.replay);
+await stop(twin.twind);
+await sleep(300);
+await stop(twin.logger, "SIGINT");
+await stop(dash.proc);
+
+// Every decoded message equals the one lcm-logger recorded (same utime).
+const log = readLog(path.join(dir, "run.lcm"), dir);
+const rows = new Map((log.HOIST_CAGE || []).map((r) => [r.utime, r]));
+let compared = 0;
+for (const m of decoded) {
+  const r = rows.get(String(m.utime));
+  if (!r) fail(`HOIST_CAGE utime ${m.utime} not in lcm-logger's log`);
+  const want = {
+    t: m.t, l: m.l, v: m.v, a: m.a, x_c: m.x_c, y_c: m.y_c, theta: m.theta,
+    lambda_0: m.lambdas[0], lambda_1: m.lambdas[1], lambda_2: m.lambdas[2], lambda_3: m.lambdas[3], lambda_4: m.lambdas[4],
+    seq: m.seq, input_seq: m.input_seq, y_top: m.y_top, y_bottom: m.y_bottom, guide_deflection: m.guide_deflection,
+    clearance_pos_y: m.clearance_pos_y, clearance_neg_y: m.clearance_neg_y, clearance_guide: m.clearance_guide,
+    min_clearance: m.min_clearance, alarm_level: m.alarm_level, degraded: m.degraded ? 1 : 0,
+  };
+  for (const [k, v] of Object.entries(want)) {
+    if (r[k] === undefined) fail(`log2csv has no column ${k}`);
+    if (Number(r[k]) !== Number(v)) fail(`utime ${m.utime}: ${k} = ${v} over WebSocket, ${r[k]} in the log`);
+  }
+  compared++;
+}
+check(compared >= 50, `${compared} HOIST_CAGE messages decoded from the WebSocket equal lcm-logger's record field by field`);
+const acks = log.HOIST_ALARM_ACK || [];
+check(acks.length === 1 && acks[0].user === "protocol-test", `exactly the valid command reached LCM (${acks.length})`);
+console.log("PASS");
+process.exit(0);

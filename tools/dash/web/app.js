@@ -1,0 +1,506 @@
+// hoist-dash page: a Foxglove WebSocket protocol client (foxglove.websocket.v1)
+// of the hoist-dash server it was loaded from.  Per shaft (channel prefix): the
+// shaft view, the trends (uPlot), the ISA-18.2 alarm list with operator
+// commands, the health panel and the STALE / NO DATA state.
+"use strict";
+
+(() => {
+  const SUBPROTOCOL = "foxglove.websocket.v1";
+  const SUFFIXES = ["HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM_ACK", "HOIST_ALARM", "HOIST_HEALTH",
+                    "HOIST_FORECAST", "HOIST_TRIP_PLAN", "HOIST_WINDER", "HOIST_CAGE"];
+  const SUBSCRIBE = new Set(["HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM", "HOIST_HEALTH", "HOIST_FORECAST"]);
+  const STALE_AFTER_MS = 1500;     // STALE shown within 2 s of silence
+  const KEEP_S = 300;              // longest trend window
+  const LEVELS = ["NONE", "WARNING", "CRITICAL"];
+
+  const $ = (sel, root = document) => root.querySelector(sel);
+  const el = (tag, attrs = {}, ...kids) => {
+    const e = document.createElement(tag);
+    for (const [k, v] of Object.entries(attrs)) {
+      if (k === "class") e.className = v;
+      else if (k.startsWith("on")) e.addEventListener(k.slice(2), v);
+      else e.setAttribute(k, v);
+    }
+    for (const k of kids) e.append(k);
+    return e;
+  };
+  const toast = (msg, err = false) => {
+    const d = el("div", { class: err ? "err" : "" }, msg);
+    $("#toast").append(d);
+    setTimeout(() => d.remove(), err ? 8000 : 4000);
+    while ($("#toast").children.length > 5) $("#toast").firstChild.remove();
+  };
+
+  const state = {
+    ws: null, readOnly: true, meta: {}, channels: new Map(), subs: new Map(), nextSub: 1,
+    shafts: new Map(), selected: null, ackChannels: new Map(), nextClientChan: 1,
+    windowS: 60,
+  };
+  const userInput = $("#user");
+  userInput.value = localStorage.getItem("hoist-dash-user") || "";
+  userInput.addEventListener("change", () => localStorage.setItem("hoist-dash-user", userInput.value.trim()));
+  $("#window").addEventListener("change", (e) => {
+    state.windowS = Number(e.target.value);
+    for (const s of state.shafts.values()) s.dirty = true;
+  });
+
+  function splitTopic(topic) {
+    for (const suf of SUFFIXES) if (topic.endsWith(suf)) return [topic.slice(0, topic.length - suf.length), suf];
+    return [null, null];
+  }
+
+  // ---- connection -------------------------------------------------------------
+  function setConn(text, cls, st) {
+    const c = $("#conn");
+    c.textContent = text;
+    c.className = "conn " + cls;
+    c.dataset.state = st;
+  }
+
+  function connect() {
+    const ws = new WebSocket(`ws://${location.host}/`, [SUBPROTOCOL]);
+    ws.binaryType = "arraybuffer";
+    state.ws = ws;
+    state.channels.clear(); state.subs.clear(); state.ackChannels.clear();
+    setConn("connecting…", "conn-wait", "connecting");
+    ws.onopen = () => setConn("connected", "conn-ok", "connected");
+    ws.onclose = () => {
+      setConn("DISCONNECTED: retrying", "conn-bad", "disconnected");
+      for (const s of state.shafts.values()) s.lastMsg = -1e12;
+      setTimeout(connect, 2000);
+    };
+    ws.onmessage = (ev) => {
+      if (typeof ev.data === "string") onJson(JSON.parse(ev.data));
+      else onBinary(ev.data);
+    };
+  }
+
+  function send(obj) { if (state.ws && state.ws.readyState === 1) state.ws.send(JSON.stringify(obj)); }
+
+  function onJson(m) {
+    switch (m.op) {
+      case "serverInfo": {
+        state.readOnly = !(m.capabilities || []).includes("clientPublish");
+        document.body.classList.toggle("read-only", state.readOnly);
+        document.body.dataset.readOnly = String(state.readOnly);
+        $("#mode").textContent = state.readOnly ? "read-only: operator commands disabled" : "";
+        try { state.meta = JSON.parse((m.metadata || {}).shafts || "{}"); } catch { state.meta = {}; }
+        for (const s of state.shafts.values()) renderAlarms(s);
+        break;
+      }
+      case "advertise": {
+        const subs = [];
+        for (const ch of m.channels) {
+          state.channels.set(ch.id, ch);
+          const [prefix, suffix] = splitTopic(ch.topic);
+          if (prefix === null) continue;
+          const shaft = getShaft(prefix);
+          if (SUBSCRIBE.has(suffix)) {
+            const id = state.nextSub++;
+            state.subs.set(id, { shaft, suffix });
+            subs.push({ id, channelId: ch.id });
+          }
+          if (suffix === "HOIST_ALARM_ACK" && !state.readOnly) {
+            const cid = state.nextClientChan++;
+            state.ackChannels.set(prefix, cid);
+            send({ op: "advertise", channels: [{ id: cid, topic: ch.topic, encoding: "json", schemaName: "hoist.alarm_ack_t" }] });
+          }
+        }
+        if (subs.length) send({ op: "subscribe", subscriptions: subs });
+        break;
+      }
+      case "unadvertise": break;
+      case "status":
+        toast(m.message, m.level >= 2);
+        break;
+      default: break;
+    }
+  }
+
+  const decoder = new TextDecoder();
+  function onBinary(buf) {
+    const dv = new DataView(buf);
+    if (dv.byteLength < 13 || dv.getUint8(0) !== 1) return;
+    const sub = state.subs.get(dv.getUint32(1, true));
+    if (!sub) return;
+    const msg = JSON.parse(decoder.decode(new Uint8Array(buf, 13)));
+    const s = sub.shaft;
+    s.lastMsg = performance.now();
+    switch (sub.suffix) {
+      case "HOIST_CAGE/decimated": onCage(s, msg); break;
+      case "HOIST_GUIDE_SHAPE": s.shape = msg; s.dirty = true; break;
+      case "HOIST_ALARM": onAlarm(s, msg); break;
+      case "HOIST_HEALTH": s.health = msg; renderHealth(s); break;
+      case "HOIST_FORECAST": s.forecast = msg; renderForecast(s); break;
+    }
+  }
+
+  // ---- shafts -------------------------------------------------------------------
+  function getShaft(prefix) {
+    let s = state.shafts.get(prefix);
+    if (s) return s;
+    $("#noshaft")?.remove();
+    const label = prefix === "" ? "default shaft" : prefix;
+    const root = el("section", { class: "shaft", "data-shaft": prefix });
+    const banner = el("div", { class: "banner", "data-role": "stale", "data-state": "nodata" }, "NO DATA");
+    const canvas = el("canvas", { class: "shaftview", width: "560", height: "1280" });
+    const ro = el("div", { class: "readouts", "data-role": "readouts" });
+    const fields = [["t", "model time", "s"], ["l", "depth l", "m"], ["y_c", "sway y_c", "mm"], ["theta", "tilt θ", "mrad"],
+                    ["v", "speed v", "m/s"], ["min_clearance", "min clearance", "mm"], ["alarm_level", "alarm level", ""],
+                    ["degraded", "degraded", ""]];
+    for (const [f, k, u] of fields) {
+      ro.append(el("span", { class: "k" }, `${k}${u ? " [" + u + "]" : ""}`), el("span", { class: "v", "data-field": f }, "–"));
+    }
+    const left = el("div", { class: "card" }, el("h2", {}, "Shaft view"), canvas,
+                    el("div", { class: "scale-note", "data-role": "scale" }, ""), ro);
+    const trends = el("div", { class: "card trends" }, el("h2", {}, "Trends"));
+    const alarmsBody = el("tbody");
+    const alarms = el("div", { class: "card alarms" }, el("h2", {}, "Alarms"),
+      el("table", {}, el("thead", {}, el("tr", {}, ...["Level", "Alarm", "State", "Time", "Value / threshold", "By", ""].map((h) => el("th", {}, h)))), alarmsBody),
+      el("p", { class: "empty", "data-role": "no-alarms" }, "no alarms"),
+      el("label", { class: "cmd" }, "Shelve for ", el("select", { "data-role": "shelve-s" },
+        el("option", { value: "600" }, "10 min"), el("option", { value: "1800" }, "30 min"), el("option", { value: "3600" }, "60 min"))));
+    const health = el("div", { class: "card health" }, el("h2", {}, "Health"), el("dl", { "data-role": "health" }, el("dt", {}, "–"), el("dd", {}, "no HOIST_HEALTH yet")));
+    const forecast = el("div", { class: "card forecast", "data-role": "forecast", hidden: "" }, el("h2", {}, "Forecasts"), el("div", { "data-role": "forecast-body" }));
+    const right = el("div", { class: "side" }, alarms, health, forecast);
+    root.append(banner, left, trends, right);
+    $("#shafts").append(root);
+    const tab = el("button", { "data-shaft": prefix, onclick: () => select(prefix) }, el("span", { class: "dot" }), label);
+    $("#tabs").append(tab);
+    s = { prefix, root, banner, canvas, ro, alarmsBody, tab, lastMsg: -1e12, everData: false, cage: null, shape: null,
+          health: null, alarms: new Map(), thr: {}, dirty: true, charts: [], data: null, gap: null };
+    s.data = { x: [], y_c: [], theta: [], l1: [], l2: [], l3: [], l4: [], l0: [], clr: [], warn: [], crit: [], v: [], l: [] };
+    makeCharts(s, trends);
+    state.shafts.set(prefix, s);
+    if (state.selected === null) select(prefix);
+    else root.hidden = true;
+    return s;
+  }
+
+  function select(prefix) {
+    state.selected = prefix;
+    for (const s of state.shafts.values()) {
+      s.root.hidden = s.prefix !== prefix;
+      s.tab.classList.toggle("sel", s.prefix === prefix);
+      if (s.prefix === prefix) { s.dirty = true; for (const c of s.charts) c.u.setSize(chartSize(c.el)); }
+    }
+  }
+
+  // ---- trends -------------------------------------------------------------------
+  function chartSize(host) { return { width: Math.max(300, host.clientWidth || 600), height: 112 }; }
+
+  function makeCharts(s, host) {
+    const D = s.data;
+    const defs = [
+      ["sway y_c [mm]", [["y_c", "#60a5fa"]]],
+      ["tilt θ [mrad]", [["theta", "#a78bfa"]]],
+      ["guide-sleeve forces λ1..λ4 [N]", [["l1", "#f87171", "λ1"], ["l2", "#fbbf24", "λ2"], ["l3", "#34d399", "λ3"], ["l4", "#60a5fa", "λ4"]]],
+      ["hoisting-rope force λ0 [kN]", [["l0", "#e5e7eb", "λ0"]]],
+      ["min clearance [mm]", [["clr", "#2fbf71", "min clearance"], ["warn", "#f0b429", "WARNING", [6, 4]], ["crit", "#ef4444", "CRITICAL", [6, 4]]]],
+      ["speed v [m/s] and depth l [m]", [["v", "#93c5fd", "v"], ["l", "#fca5a5", "l", null, "l"]]],
+    ];
+    for (const [title, series] of defs) {
+      const box = el("div", { class: "trend" }, el("h3", {}, title));
+      const plotEl = el("div");
+      box.append(plotEl);
+      host.append(box);
+      const scales = { x: { time: true } };
+      const hms = (u, vals) => vals.map((v) => new Date(v * 1000).toLocaleTimeString([], { hour12: false }));
+      const axes = [{ stroke: "#8a96a3", grid: { stroke: "#252c34" }, values: hms, size: 24, space: 90 },
+                    { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60 }];
+      if (series.some((sr) => sr[4] === "l")) {
+        scales.l = {};
+        axes.push({ scale: "l", side: 1, stroke: "#fca5a5", grid: { show: false }, size: 50 });
+      }
+      const opts = {
+        ...chartSize(plotEl), scales, axes, legend: { show: true },
+        cursor: { drag: { x: false, y: false } },
+        series: [{}, ...series.map(([k, c, label, dash, scale]) => ({ label: label || k, stroke: c, width: 1.2, dash: dash || undefined, scale: scale || "y", points: { show: false } }))],
+      };
+      const u = new uPlot(opts, [D.x, ...series.map(([k]) => D[k])], plotEl);
+      s.charts.push({ u, keys: series.map(([k]) => k), el: plotEl });
+    }
+  }
+
+  function pushPoint(s, x, vals) {
+    const D = s.data;
+    D.x.push(x);
+    for (const k of Object.keys(vals)) D[k].push(vals[k]);
+  }
+
+  function cageVals(m, s) {
+    const lam = m.lambdas || [NaN, NaN, NaN, NaN, NaN];
+    const [w, c] = thresholds(s);
+    return { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
+             clr: m.min_clearance * 1e3, warn: w, crit: c, v: m.v, l: m.l };
+  }
+
+  function onCage(s, d) {
+    const last = d.last;
+    s.cage = last;
+    s.everData = true;
+    // Gaps from the message itself: clearance + excursion = gap (per side).
+    const gp = last.clearance_pos_y + Math.max(last.y_top, last.y_bottom);
+    const gn = last.clearance_neg_y + Math.max(-last.y_top, -last.y_bottom);
+    if (isFinite(gp) && isFinite(gn)) s.gap = { pos: gp, neg: gn, guide: last.clearance_guide + last.guide_deflection };
+    // Min/max decimation: the interval's minimum and maximum both enter the
+    // trend (at its first and last time), so no peak is lost.
+    const t0 = d.first.utime / 1e6, t1 = last.utime / 1e6;
+    if (d.count > 1 && t1 > t0) {
+      pushPoint(s, t0, cageVals(d.min, s));
+      pushPoint(s, t1, cageVals(d.max, s));
+    } else {
+      pushPoint(s, t1, cageVals(last, s));
+    }
+    // Keep order (a restarted daemon) and length bounded.
+    const D = s.data;
+    const n = D.x.length;
+    if (n > 1 && D.x[n - 1] < D.x[n - 2]) for (const k of Object.keys(D)) D[k].splice(0, n - 1);
+    const tmin = D.x[D.x.length - 1] - KEEP_S;
+    let cut = 0;
+    while (cut < D.x.length && D.x[cut] < tmin) cut++;
+    if (cut > 0) for (const k of Object.keys(D)) D[k].splice(0, cut);
+    renderReadouts(s, last);
+    s.dirty = true;
+  }
+
+  // Excursion threshold [m] of a cage side at a level: from the daemon's own
+  // alarms once one was announced (alarm_t.threshold), else the fraction of
+  // the gap given to hoist-dash (--warning-fraction, --critical-fraction).
+  function sideThr(s, side, level) {
+    const t = s.thr[`${side === "pos" ? "CAGE_POS_Y" : "CAGE_NEG_Y"}/${level}`];
+    if (t > 0) return t;
+    const m = state.meta[s.prefix] || state.meta["*"] || {};
+    return (level === 1 ? (m.warning_fraction ?? 0.5) : (m.critical_fraction ?? 0.8)) * s.gap[side];
+  }
+
+  // WARNING / CRITICAL on the min-clearance trend: clearance = gap - excursion.
+  function thresholds(s) {
+    if (!s.gap) return [NaN, NaN];
+    const clr = (level) => 1e3 * Math.min(s.gap.pos - sideThr(s, "pos", level), s.gap.neg - sideThr(s, "neg", level));
+    return [clr(1), clr(2)];
+  }
+
+  function renderReadouts(s, m) {
+    const set = (f, text, cls) => {
+      const e = $(`[data-field="${f}"]`, s.ro);
+      e.textContent = text;
+      if (cls !== undefined) e.className = "v " + cls;
+    };
+    s.ro.dataset.utime = String(m.utime);
+    set("t", m.t.toFixed(2));
+    set("l", m.l.toFixed(2));
+    set("y_c", (m.y_c * 1e3).toFixed(2));
+    set("theta", (m.theta * 1e3).toFixed(3));
+    set("v", m.v.toFixed(2));
+    set("min_clearance", (m.min_clearance * 1e3).toFixed(1));
+    set("alarm_level", LEVELS[m.alarm_level] || String(m.alarm_level), "lvl" + m.alarm_level);
+    set("degraded", m.degraded ? "DEGRADED" : "no", m.degraded ? "lvl2" : "");
+    s.tab.querySelector(".dot").style.background = ["#2fbf71", "#f0b429", "#ef4444"][m.alarm_level] || "#8a96a3";
+  }
+
+  // ---- alarms (ISA-18.2 states) ---------------------------------------------------
+  function onAlarm(s, a) {
+    for (const k of ["active", "acked", "shelved", "latched"]) a[k] = Boolean(a[k]);
+    if ((a.kind === "CAGE_POS_Y" || a.kind === "CAGE_NEG_Y") && a.threshold > 0) s.thr[`${a.kind}/${a.level}`] = a.threshold;
+    s.alarms.set(`${a.kind}/${a.level}`, a);
+    renderAlarms(s);
+  }
+
+  function stateText(a) {
+    if (a.shelved) return "SHELVED";
+    if (a.active && !a.acked) return a.latched ? "UNACK · LATCHED" : "UNACK";
+    if (a.active && a.acked) return a.latched ? "ACKED · LATCHED" : "ACKED";
+    if (!a.active && !a.acked) return "RTN UNACK";
+    return "NORMAL";
+  }
+
+  function fmtVal(a) {
+    if (a.kind === "INPUT_STALE" || a.kind === "MODEL_FAULT") return a.value >= 0.5 ? "on" : "off";
+    return `${(a.value * 1e3).toFixed(1)} mm / ${(a.threshold * 1e3).toFixed(1)} mm`;
+  }
+
+  function renderAlarms(s) {
+    const body = s.alarmsBody;
+    body.textContent = "";
+    const rows = [...s.alarms.values()]
+      .filter((a) => a.active || !a.acked || a.shelved)
+      .sort((a, b) => (b.level - a.level) || (b.utime - a.utime));
+    $("[data-role=no-alarms]", s.root).hidden = rows.length > 0;
+    for (const a of rows) {
+      const tr = el("tr", {
+        class: `alarm lvl-${a.level} ${a.active ? "active" : ""} ${a.acked ? "acked" : "unacked"} ${a.shelved ? "shelved" : ""}`,
+        "data-kind": a.kind, "data-level": String(a.level), "data-active": String(a.active), "data-acked": String(a.acked),
+        "data-shelved": String(a.shelved), "data-latched": String(a.latched),
+      });
+      const when = new Date(a.utime / 1000);
+      tr.append(el("td", { class: "lv" }, LEVELS[a.level] || String(a.level)),
+        el("td", { title: a.message }, a.kind),
+        el("td", { class: "state" }, stateText(a)),
+        el("td", {}, `${when.toLocaleTimeString()} (t=${a.t.toFixed(1)} s)`),
+        el("td", {}, fmtVal(a)),
+        el("td", {}, a.user || ""));
+      const btns = el("td", { class: "btns cmd" });
+      if (!state.readOnly) {
+        const mk = (label, action, enabled) => el("button", { "data-action": label.toLowerCase(), ...(enabled ? {} : { disabled: "" }),
+          onclick: () => command(s, a, action) }, label);
+        btns.append(mk("Acknowledge", 1, !a.acked && !a.shelved), mk("Shelve", 2, !a.shelved), mk("Unshelve", 3, a.shelved));
+      }
+      tr.append(btns);
+      body.append(tr);
+    }
+  }
+
+  function command(s, a, action) {
+    const user = userInput.value.trim();
+    if (!user) { toast("Enter your name (Operator) before acknowledging or shelving.", true); userInput.focus(); return; }
+    const cid = state.ackChannels.get(s.prefix);
+    if (cid === undefined) { toast("No command channel for this shaft (read-only server?)", true); return; }
+    const shelve = Number($("[data-role=shelve-s]", s.root).value);
+    const payload = new TextEncoder().encode(JSON.stringify({
+      utime: 0, kind: a.kind, level: a.level, action, shelve_duration: action === 2 ? shelve : 0, user }));
+    const buf = new Uint8Array(5 + payload.length);
+    buf[0] = 1;
+    new DataView(buf.buffer).setUint32(1, cid, true);
+    buf.set(payload, 5);
+    state.ws.send(buf);
+  }
+
+  // ---- health ---------------------------------------------------------------------
+  function renderHealth(s) {
+    const h = s.health;
+    const dl = $("[data-role=health]", s.root);
+    dl.textContent = "";
+    const rows = [
+      ["clock / rate", `${h.clock} / ${h.rate} Hz`],
+      ["step time p50 / p99 / max", `${h.step_p50_us.toFixed(1)} / ${h.step_p99_us.toFixed(1)} / ${h.step_max_us.toFixed(1)} µs`],
+      ["tick lateness p50 / p99 / max", `${h.late_p50_us.toFixed(1)} / ${h.late_p99_us.toFixed(1)} / ${h.late_max_us.toFixed(1)} µs`],
+      ["deadline misses", String(h.deadline_misses)],
+      ["input age", h.input_age < 0 ? "no input yet" : `${h.input_age.toFixed(2)} s`],
+      ["inputs accepted / lost (seq gaps)", `${h.accepted} / ${h.seq_gaps}`],
+      ["rejected inputs", String(h.rejected_total)],
+    ];
+    (h.reject_reason || []).forEach((r, i) => { if (h.rejected[i] > 0) rows.push([`  rejected: ${r}`, String(h.rejected[i])]); });
+    rows.push(["alarms active / unacked / shelved", `${h.alarms_active} / ${h.alarms_unacked} / ${h.alarms_shelved}`],
+              ["model faults / resets", `${h.model_faults} / ${h.model_resets}`],
+              ["publish failures", String(h.publish_failures)],
+              ["uptime", `${h.uptime.toFixed(0)} s`]);
+    for (const [k, v] of rows) dl.append(el("dt", {}, k), el("dd", {}, v));
+    dl.append(el("dt", {}, "degraded"), el("dd", { "data-field": "health-degraded" },
+      el("span", { class: h.degraded ? "degraded-yes" : "" }, h.degraded ? "DEGRADED" : "no")));
+  }
+
+  // ---- forecasts (only when HOIST_FORECAST publishes) -------------------------------
+  function renderForecast(s) {
+    const box = $("[data-role=forecast]", s.root);
+    box.hidden = false;
+    const body = $("[data-role=forecast-body]", s.root);
+    body.textContent = "";
+    const f = s.forecast;
+    const tbl = el("table");
+    for (const [k, v] of Object.entries(f)) {
+      if (k === "utime") continue;
+      tbl.append(el("tr", {}, el("th", {}, k), el("td", {}, Array.isArray(v) ? v.map((x) => typeof x === "number" ? x.toPrecision(4) : String(x)).join(", ") : String(v))));
+    }
+    body.append(tbl);
+  }
+
+  // ---- shaft view -----------------------------------------------------------------
+  function drawShaft(s) {
+    const cv = s.canvas, g = cv.getContext("2d");
+    const W = cv.width, H = cv.height;
+    g.setTransform(1, 0, 0, 1, 0, 0);
+    g.clearRect(0, 0, W, H);
+    g.scale(2, 2);  // canvas at 2x for crisp lines
+    const w = W / 2, h = H / 2, top = 14, bot = h - 14;
+    const L = s.shape && s.shape.x && s.shape.x.length ? s.shape.x[s.shape.x.length - 1] : 400;
+    const vs = (bot - top) / L;                       // px per metre, vertical
+    const gap = s.gap ? Math.max(s.gap.pos, s.gap.neg) : 0.3;
+    const ls = 40 / Math.max(gap, 1e-3);              // px per metre, lateral: the gap is 40 px
+    const mag = ls / vs;
+    const cx = w / 2, half = 40;                      // guide ropes drawn 80 px apart
+    const Y = (x) => top + x * vs;
+    $("[data-role=scale]", s.root).textContent =
+      `depth to scale 0…${L.toFixed(0)} m; lateral ×${mag.toFixed(0)} (gap ${(gap * 1e3).toFixed(1)} mm = 40 px)`;
+    g.font = "10px system-ui"; g.fillStyle = "#8a96a3"; g.strokeStyle = "#222a33"; g.lineWidth = 1;
+    for (let d = 0; d <= L + 1e-9; d += L > 200 ? 50 : 20) {
+      g.beginPath(); g.moveTo(18, Y(d)); g.lineTo(w, Y(d)); g.stroke();
+      g.fillText(`${d.toFixed(0)}`, 0, Y(d) + 3);
+    }
+    // Clearance limits (cage sides): the gap (CRITICAL at the wall), WARNING dashed.
+    if (s.gap) {
+      const lines = [[s.gap.pos, "#ef4444", []], [-s.gap.neg, "#ef4444", []],
+                     [sideThr(s, "pos", 1), "#f0b429", [5, 4]], [-sideThr(s, "neg", 1), "#f0b429", [5, 4]]];
+      for (const [y, col, dash] of lines) {
+        const px = cx + (y > 0 ? half : -half) + y * ls;
+        g.strokeStyle = col; g.setLineDash(dash); g.beginPath(); g.moveTo(px, top); g.lineTo(px, bot); g.stroke();
+      }
+      g.setLineDash([]);
+    }
+    // Guide ropes, live shape.
+    if (s.shape && s.shape.x) {
+      const { x, y1, y2 } = s.shape;
+      for (const [ys, off, col] of [[y1, -half, "#cbd5e1"], [y2, half, "#cbd5e1"]]) {
+        g.strokeStyle = col; g.lineWidth = 1.5; g.beginPath();
+        for (let i = 0; i < x.length; i++) { const px = cx + off + ys[i] * ls, py = Y(x[i]); i ? g.lineTo(px, py) : g.moveTo(px, py); }
+        g.stroke();
+      }
+    }
+    // The cage: top sleeves at depth l with excursion y_top, bottom sleeves at l + 2h with y_bottom.
+    const c = s.cage;
+    if (c) {
+      const hh = s.shape ? s.shape.h : 8;
+      const yt = cx + c.y_top * ls, yb = cx + c.y_bottom * ls;
+      const stale = s.root.classList.contains("stale");
+      const col = stale ? "#6b7280" : ["#2fbf71", "#f0b429", "#ef4444"][c.alarm_level] || "#6b7280";
+      g.fillStyle = col; g.globalAlpha = 0.85;
+      g.beginPath();
+      g.moveTo(yt - half + 3, Y(c.l)); g.lineTo(yt + half - 3, Y(c.l));
+      g.lineTo(yb + half - 3, Y(c.l + 2 * hh)); g.lineTo(yb - half + 3, Y(c.l + 2 * hh)); g.closePath();
+      g.fill(); g.globalAlpha = 1;
+      g.strokeStyle = "#fff"; g.lineWidth = 1; g.stroke();
+      // Hoisting rope from the head sheave.
+      g.strokeStyle = "#9ca3af"; g.beginPath(); g.moveTo(cx, top - 10); g.lineTo(yt, Y(c.l)); g.stroke();
+      g.fillStyle = "#fff";
+      g.fillText(`${c.l.toFixed(1)} m`, yt + half + 4, Y(c.l) + 10);
+    }
+  }
+
+  // ---- loop ---------------------------------------------------------------------
+  function updateStale() {
+    const now = performance.now();
+    for (const s of state.shafts.values()) {
+      const age = now - s.lastMsg;
+      const st = !s.everData ? "nodata" : age > STALE_AFTER_MS ? "stale" : "ok";
+      s.banner.dataset.state = st;
+      s.banner.textContent = st === "nodata"
+        ? `NO DATA: no cage state from ${s.prefix || "the default shaft"}${s.health && age <= STALE_AFTER_MS ? " (the daemon is up, waiting for winder input)" : ""}`
+        : st === "stale" ? `STALE: no data for ${s.lastMsg < 0 ? "—" : (age / 1000).toFixed(1) + " s"}; values below are old` : "";
+      const was = s.root.classList.contains("stale");
+      s.root.classList.toggle("stale", st !== "ok");
+      if (was !== (st !== "ok")) s.dirty = true;
+      if (st !== "ok") s.tab.querySelector(".dot").style.background = "#6b7280";
+    }
+  }
+
+  function frame() {
+    updateStale();
+    for (const s of state.shafts.values()) {
+      if (!s.dirty || s.root.hidden) continue;
+      s.dirty = false;
+      drawShaft(s);
+      const D = s.data;
+      const xmax = D.x.length ? D.x[D.x.length - 1] : Date.now() / 1000;
+      for (const c of s.charts) {
+        c.u.setData([D.x, ...c.keys.map((k) => D[k])], false);
+        c.u.setScale("x", { min: xmax - state.windowS, max: xmax });
+      }
+    }
+    requestAnimationFrame(frame);
+  }
+  setInterval(updateStale, 250);  // also when the tab is in the background
+  window.addEventListener("resize", () => { for (const s of state.shafts.values()) for (const c of s.charts) c.u.setSize(chartSize(c.el)); });
+  window.hoistDash = state;  // for tests and debugging
+  connect();
+  requestAnimationFrame(frame);
+})();
