@@ -45,6 +45,7 @@ class FastSolver final : public Solver {
   const CageResponse& response() const override { return resp_; }
   void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override;
   void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override;
+  void residualSleeveLoads(SleeveLoads& out) const override;
   bool finite() const override;
   Method method() const override { return Method::Fast; }
 
@@ -58,11 +59,17 @@ class FastSolver final : public Solver {
   /// Longitudinal state: hoisting-rope modal coordinates q0 and rates.
   const VectorXd& hoistingRopeCoordinates() const { return y_; }
   const VectorXd& hoistingRopeRates() const { return yd_; }
+  /// Static correction active, and the sleeves' residual flexibility R(l) at
+  /// the current position (zero without the correction) [m/N].
+  bool staticCorrection() const { return corr_; }
+  const Eigen::Matrix4d& residualFlexibility() const { return R_; }
 
  private:
   void fillConstraintRows(double l);                 // G_ (4 x N) at l
   void fillConstraintRowDerivatives(double l);       // Gl_, Gll_ (init only)
-  void solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d);
+  void fillResidualFlexibility(double l);            // R_ at l (after fillConstraintRows)
+  // KKT solve  S qdd - G^T lam = r,  G qdd + c R lam = d  (c = 0: rigid sleeves).
+  void solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d, double c);
   void longitudinalOperators(const Kinematics& k);  // Ek_ and scalars at k
   void updateResponse(double t, const Kinematics& k);
 
@@ -84,6 +91,10 @@ class FastSolver final : public Solver {
   Eigen::Matrix<double, Eigen::Dynamic, 4> Y_;  // S^-1 G^T
   VectorXd sa_, sb_, xhat_, vhat_, r_, tmp_;
   Eigen::Vector4d lam_;
+  bool corr_ = false;                 // static correction
+  Eigen::Matrix4d R_ = Eigen::Matrix4d::Zero();  // residual flexibility at the sleeves
+  VectorXd kinv_;                     // 1 / kappa (rope entries)
+  mutable VectorXd zs_;               // guideRopeCoordinates workspace (2n)
 
   // longitudinal
   VectorXd u_;                        // U0_i(1)
