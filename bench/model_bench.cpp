@@ -19,9 +19,12 @@ namespace {
 
 using namespace hoist;
 
-void stepBench(benchmark::State& state, Method m) {
+void stepBench(benchmark::State& state, Method m, int corr = -1) {
   ShaftParams p;
   p.n = static_cast<int>(state.range(0));
+  // The paper's method has no static correction; -1 = the default (on).
+  if (m == Method::Paper) p.static_correction = false;
+  if (corr >= 0) p.static_correction = corr != 0;
   auto model = std::make_shared<const ShaftModel>(p);
   auto s = makeSolver(m, model);
   const HoistProfile prof = HoistProfile::trapezoid();
@@ -45,6 +48,12 @@ void stepBench(benchmark::State& state, Method m) {
 
 void BM_FastStep(benchmark::State& state) { stepBench(state, Method::Fast); }
 void BM_PaperStep(benchmark::State& state) { stepBench(state, Method::Paper); }
+/// The fast step without (0) and with (1) the static correction, side by side.
+void BM_FastStepCorrection(benchmark::State& state) {
+  stepBench(state, Method::Fast, static_cast<int>(state.range(1)));
+  state.counters["static_correction"] = static_cast<double>(state.range(1));
+}
+BENCHMARK(BM_FastStepCorrection)->ArgsProduct({{20, 50}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(BM_FastStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Arg(400)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PaperStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
