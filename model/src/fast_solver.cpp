@@ -107,6 +107,11 @@ void FastSolver::fillResidualFlexibility(double l) {
     return Eigen::Vector3d(Sa * (SL - Sa) / SL, Sa * (SL - Sb) / SL, Sb * (SL - Sb) / SL);
   };
   const Eigen::Vector3d G1 = rope(1, a, b), G2 = rope(2, a, b);
+  // Wave impedance of the rope at each sleeve (both directions): 2 sqrt(T rho2).
+  const double Ta1 = model_->guideTension(1, a), Tb1 = model_->guideTension(1, b);
+  const double Ta2 = model_->guideTension(2, a), Tb2 = model_->guideTension(2, b);
+  Zd_ << 2.0 * std::sqrt(Ta1 * p.rho2), 2.0 * std::sqrt(Ta2 * p.rho2), 2.0 * std::sqrt(Tb2 * p.rho2),
+      2.0 * std::sqrt(Tb1 * p.rho2);
   R_.setZero();
   R_(0, 0) = G1(0) - g1.cwiseProduct(k1).dot(g1);
   R_(0, 3) = R_(3, 0) = G1(1) - g1.cwiseProduct(k1).dot(g4);
@@ -148,7 +153,7 @@ void FastSolver::solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen
   Y_ = Gt_.array().colwise() / Sd.array();
   Eigen::Matrix4d W;
   W.noalias() = Gt_.transpose() * Y_;
-  if (c != 0.0) W += c * R_;
+  if (c != 0.0) W += c * Rc_;
   tmp_ = r.array() / Sd.array();
   Eigen::Vector4d rhs = d;
   rhs.noalias() -= Gt_.transpose() * tmp_;
@@ -248,6 +253,8 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   } else {
     x_.setZero();
   }
+  delta_.noalias() = -(Gt_.transpose() * x_);
+  lamS_ = lam_;
   fillConstraintRowDerivatives(k0.l);
   consistentInitialVelocity(k0.v);
   r_ = F_ - Cd_.cwiseProduct(xd_) - Kd_.cwiseProduct(x_);
@@ -320,9 +327,28 @@ void FastSolver::step(double t1, const Kinematics& k1) {
   Eigen::Vector4d d;
   d.noalias() = Gt_.transpose() * xhat_;
   d *= -1.0 / hb;
+  if (corr_) {
+    // Compliant sleeves with the high modes' spring R^-1 and dashpot Z in
+    // parallel: lam = R^-1 delta + Z (delta - delta_n)/h, delta = -G x, i.e.
+    //   A R^-1 ... :  (I + R Z/h)^-1 R lam = delta - (I + R Z/h)^-1 (R Z/h) delta_n.
+    // With delta = -G (xhat + hb qdd):  G qdd + Rc lam / hb = d - e / hb,
+    // Rc = (I + R Z/h)^-1 R = (R^-1 + Z/h)^-1 (symmetric positive definite).
+    Eigen::Matrix4d A = R_ * (Zd_ / h).asDiagonal();
+    const Eigen::Vector4d rz = A * delta_;
+    A.diagonal().array() += 1.0;
+    const Eigen::PartialPivLU<Eigen::Matrix4d> lu(A);
+    Rc_ = lu.solve(R_);
+    d -= lu.solve(rz) / hb;
+  }
   solveLateral(Sd_, r_, d, corr_ ? 1.0 / hb : 0.0);
   xa_ += g.ca * xdd_;
   x_ = xhat_ + hb * xdd_;
+  if (corr_) {
+    Eigen::Vector4d dn;
+    dn.noalias() = -(Gt_.transpose() * x_);
+    lamS_ = lam_ - Zd_.cwiseProduct(dn - delta_) / h;  // spring part: R lamS = delta
+    delta_ = dn;
+  }
   xd_ = vhat_ + hg * xdd_;
 
   // ---- longitudinal -----------------------------------------------------------
@@ -388,7 +414,7 @@ void FastSolver::guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const {
     // tmp: modal coordinates shifted by the modal part of the sleeve loads
     VectorXd& z = zs_;  // preallocated workspace (keeps GuideRopeEnvelope::evaluate allocation-free)
     z = x_.head(2 * n_);
-    for (int k = 0; k < 4; ++k) z -= lam_(k) * kinv_.cwiseProduct(Gt_.col(k).head(2 * n_));
+    for (int k = 0; k < 4; ++k) z -= lamS_(k) * kinv_.cwiseProduct(Gt_.col(k).head(2 * n_));
     q1.noalias() = model_->guideModalVectors(1) * z.head(n_);
     q2.noalias() = model_->guideModalVectors(2) * z.segment(n_, n_);
     return;
@@ -406,7 +432,8 @@ void FastSolver::residualSleeveLoads(SleeveLoads& out) const {
   out.count = 4;
   out.rope = {1, 2, 2, 1};  // g1..g4
   out.x = {l, l, b, b};
-  out.f = {lam_(0), lam_(1), lam_(2), lam_(3)};
+  // The quasi-static (spring) part of the sleeve forces deflects the high modes.
+  out.f = {lamS_(0), lamS_(1), lamS_(2), lamS_(3)};
 }
 
 void FastSolver::guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const {

@@ -63,6 +63,10 @@ class FastSolver final : public Solver {
   /// the current position (zero without the correction) [m/N].
   bool staticCorrection() const { return corr_; }
   const Eigen::Matrix4d& residualFlexibility() const { return R_; }
+  /// The high modes' wave impedance at each sleeve, 2 sqrt(T rho2) [N s/m],
+  /// and the spring (quasi-static) part of the sleeve forces, R^-1 (-G q).
+  const Eigen::Vector4d& residualDamping() const { return Zd_; }
+  const Eigen::Vector4d& residualSpringForces() const { return lamS_; }
 
  private:
   void fillConstraintRows(double l);                 // G_ (4 x N) at l
@@ -93,6 +97,10 @@ class FastSolver final : public Solver {
   Eigen::Vector4d lam_;
   bool corr_ = false;                 // static correction
   Eigen::Matrix4d R_ = Eigen::Matrix4d::Zero();  // residual flexibility at the sleeves
+  Eigen::Matrix4d Rc_ = Eigen::Matrix4d::Zero(); // step compliance (R^-1 + Z/h)^-1
+  Eigen::Vector4d Zd_ = Eigen::Vector4d::Zero(); // wave impedance 2 sqrt(T rho2) at each sleeve
+  Eigen::Vector4d delta_ = Eigen::Vector4d::Zero();  // residual displacement -G x at the last step
+  Eigen::Vector4d lamS_ = Eigen::Vector4d::Zero();   // spring part of lam: R lamS = delta
   VectorXd kinv_;                     // 1 / kappa (rope entries)
   mutable VectorXd zs_;               // guideRopeCoordinates workspace (2n)
 
