@@ -167,9 +167,15 @@ void FastSolver::longitudinalOperators(const Kinematics& k) {
   const auto& H = model_->hoistingRope();
   const double rho1 = p.rho1;
   Ek_ = (rho1 * k.a) * H.A_acc - (p.u1 * k.v) * H.A_vel - (rho1 * k.v * k.v / k.l) * H.A_cent;
+  longitudinalLoads(k);
+}
+
+void FastSolver::longitudinalLoads(const Kinematics& k) {
+  const ShaftParams& p = model_->params();
+  const auto& H = model_->hoistingRope();
   // F0 + u * F(x_c): hoisting-rope load plus the cage load carried through x_c = u.q0
   const double Fxc = p.Fa + p.m * (p.g - k.a);
-  F0_ = (-rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
+  F0_ = (-p.rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
 }
 
 void FastSolver::updateResponse(double t, const Kinematics& k) {
@@ -261,7 +267,7 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   if (corr_) {
     // Compliant sleeves: lam is fixed by the positions (G x + R lam = 0: the
     // static solution's lam, or 0 at rest), the accelerations follow from it.
-    tmp_ = Gt_ * lam_;
+    tmp_.noalias() = Gt_ * lam_;
     xdd_ = (r_ + tmp_).cwiseQuotient(Md_);
   } else {
     // Consistent accelerations: G qdd = -2 Gdot qd - Gddot q, Gdot = v G_l, Gddot = a G_l + v^2 G_ll.
@@ -353,7 +359,8 @@ void FastSolver::step(double t1, const Kinematics& k1) {
 
   // ---- longitudinal -----------------------------------------------------------
   const auto& H = model_->hoistingRope();
-  longitudinalOperators(k1);
+  if (fused_) longitudinalLoads(k1);
+  else longitudinalOperators(k1);
   r0_ = (g.alpha_f * ydd_ - g.alpha_m * ya_) / (1.0 - g.alpha_m);  // abar (r0_ reused below)
   yhat_ = y_ + h * yd_ + (h * h * (0.5 - g.beta)) * ya_ + (h * h * g.beta) * r0_;
   yvhat_ = yd_ + (h * (1.0 - g.gamma)) * ya_ + (h * g.gamma) * r0_;
@@ -362,11 +369,23 @@ void FastSolver::step(double t1, const Kinematics& k1) {
   const double kscale = p.EA / k1.l;
   // r0 = F0 - C vhat - K yhat
   r0_ = F0_ - cdiag * yvhat_ - kscale * k2_.cwiseProduct(yhat_);
-  r0_.noalias() -= (p.rho1 * k1.v) * (H.A_gyro * yvhat_);
-  r0_.noalias() -= Ek_ * yhat_;
   // S = M + hg C + hb K = P + E,  P = diag(Pd) + m u u^T,  E = hg rho1 v A_gyro + hb Ek.
-  Ek_ *= hb;
-  Ek_.noalias() += (hg * p.rho1 * k1.v) * H.A_gyro;  // Ek_ now holds E
+  const double c4 = p.rho1 * k1.v;
+  if (fused_) {
+    // E is linear in four scalars of (l, v, a, h): one pass over the four
+    // constant matrices builds it (Ek itself is never formed), and
+    //   Ek yhat + c4 A_gyro vhat = E yhat / hb + c4 A_gyro (vhat - (hg/hb) yhat).
+    const double c1 = p.rho1 * k1.a, c2 = -p.u1 * k1.v, c3 = -p.rho1 * k1.v * k1.v / k1.l;
+    Ek_ = (hb * c1) * H.A_acc + (hb * c2) * H.A_vel + (hb * c3) * H.A_cent + (hg * c4) * H.A_gyro;  // E
+    r0_.noalias() -= (1.0 / hb) * (Ek_ * yhat_);
+    dy_ = yvhat_ - (hg / hb) * yhat_;  // workspace (dy_ is overwritten by the sweeps)
+    r0_.noalias() -= c4 * (H.A_gyro * dy_);
+  } else {
+    r0_.noalias() -= c4 * (H.A_gyro * yvhat_);
+    r0_.noalias() -= Ek_ * yhat_;
+    Ek_ *= hb;
+    Ek_.noalias() += (hg * c4) * H.A_gyro;  // Ek_ now holds E
+  }
   Pd_ = (p.rho1 * k1.l + hg * cdiag) + (hb * kscale) * k2_.array();
   w_ = u_.cwiseQuotient(Pd_);
   const double sm = p.m / (1.0 + p.m * u_.dot(w_));  // Sherman-Morrison
