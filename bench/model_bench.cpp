@@ -13,15 +13,19 @@
 #include <memory>
 #include <vector>
 
+#include "hoist/fast_solver.hpp"
 #include "hoist/simulator.hpp"
 
 namespace {
 
 using namespace hoist;
 
-void stepBench(benchmark::State& state, Method m) {
+void stepBench(benchmark::State& state, Method m, int corr = -1) {
   ShaftParams p;
   p.n = static_cast<int>(state.range(0));
+  // The paper's method has no static correction; -1 = the default (on).
+  if (m == Method::Paper) p.static_correction = false;
+  if (corr >= 0) p.static_correction = corr != 0;
   auto model = std::make_shared<const ShaftModel>(p);
   auto s = makeSolver(m, model);
   const HoistProfile prof = HoistProfile::trapezoid();
@@ -45,6 +49,40 @@ void stepBench(benchmark::State& state, Method m) {
 
 void BM_FastStep(benchmark::State& state) { stepBench(state, Method::Fast); }
 void BM_PaperStep(benchmark::State& state) { stepBench(state, Method::Paper); }
+/// The fast step without (0) and with (1) the static correction, side by side.
+void BM_FastStepCorrection(benchmark::State& state) {
+  stepBench(state, Method::Fast, static_cast<int>(state.range(1)));
+  state.counters["static_correction"] = static_cast<double>(state.range(1));
+}
+BENCHMARK(BM_FastStepCorrection)->ArgsProduct({{20, 50}, {0, 1}})->Unit(benchmark::kMicrosecond);
+
+/// The longitudinal step: E built in one pass from the four constant matrices
+/// (1, the default) against the previous Ek build-apply-scale-add (0), side
+/// by side (correction on).
+void BM_FastStepLongitudinalFused(benchmark::State& state) {
+  ShaftParams p;
+  p.n = static_cast<int>(state.range(0));
+  auto model = std::make_shared<const ShaftModel>(p);
+  FastSolver s(model);
+  s.setFusedLongitudinal(state.range(1) != 0);
+  const HoistProfile prof = HoistProfile::trapezoid();
+  const double dt = 0.01;
+  s.initialize(0.0, prof.at(0.0));
+  long k = 0;
+  for (auto _ : state) {
+    if (++k * dt > 55.0) {
+      state.PauseTiming();
+      k = 1;
+      s.initialize(0.0, prof.at(0.0));
+      state.ResumeTiming();
+    }
+    const double t = k * dt;
+    s.step(t, prof.at(t));
+    benchmark::DoNotOptimize(s.response().lambda[0]);
+  }
+  state.counters["fused"] = static_cast<double>(state.range(1));
+}
+BENCHMARK(BM_FastStepLongitudinalFused)->ArgsProduct({{20, 50, 200}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(BM_FastStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Arg(400)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PaperStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kMicrosecond)->MinTime(0.5);

@@ -96,6 +96,13 @@ const std::vector<Field>& fields() {
          else throw ConfigError(src, lineOf(n), key, "expected \"static\" or \"rest\", got \"" + s->get() + "\"");
        }},
       {"model", "rho_inf", number(&ShaftParams::rho_inf)},
+      {"model", "static_correction",
+       [](const toml::node& n, ShaftParams& p, const std::string& src, const std::string& key) {
+         const auto* b = n.as_boolean();
+         if (!b)
+           throw ConfigError(src, lineOf(n), key, std::string("expected true or false, got ") + typeName(n));
+         p.static_correction = b->get();
+       }},
   };
   return f;
 }
@@ -231,7 +238,9 @@ std::string toToml(const ShaftParams& p) {
      << "modes = " << p.n << "\n"
      << "gravity = " << num(p.g) << "\n"
      << "initial = \"" << toString(p.initial) << "\"\n"
-     << "rho_inf = " << num(p.rho_inf) << "   # generalized-alpha high-frequency damping\n";
+     << "rho_inf = " << num(p.rho_inf) << "   # generalized-alpha high-frequency damping\n"
+     << "static_correction = " << (p.static_correction ? "true" : "false")
+     << "   # residual flexibility of the guide ropes (false: the paper's truncation)\n";
   return os.str();
 }
 

@@ -41,6 +41,10 @@ FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model)
   Gt_(N - 1, 2) = -p.h;
   Gt_(N - 1, 3) = -p.h;
   lam_.setZero();
+  corr_ = p.static_correction;
+  kinv_ = Kd_.head(2 * n).cwiseInverse();
+  zs_ = VectorXd::Zero(2 * n);
+  R_.setZero();
 
   u_ = model_->hoistingRope().U1;
   y_ = yd_ = ydd_ = ya_ = yhat_ = yvhat_ = r0_ = F0_ = VectorXd::Zero(n);
@@ -83,6 +87,40 @@ void FastSolver::fillConstraintRows(double l) {
   Gt_.col(3).head(n).noalias() = V1.transpose() * sb_;
 }
 
+// Residual flexibility of the sleeves (static correction, docs/model.md):
+//   R_r(a_i, a_j) = G_r(a_i, a_j) - Phi_r(a_i) K_r^-1 Phi_r(a_j)^T
+// for the two sleeves of each rope (rope 1: g1 at l, g4 at l + 2h; rope 2:
+// g2 at l, g3 at l + 2h); the ropes do not couple.  Phi_r(a)^T are the rope
+// columns of G^T (modal coordinates), so the modal part is O(n) per pair.
+void FastSolver::fillResidualFlexibility(double l) {
+  if (!corr_) return;
+  const ShaftParams& p = model_->params();
+  const int n = n_;
+  const double a = l, b = l + 2.0 * p.h;
+  const auto k1 = kinv_.head(n), k2 = kinv_.segment(n, n);
+  const auto g1 = Gt_.col(0).head(n), g4 = Gt_.col(3).head(n);
+  const auto g2 = Gt_.col(1).segment(n, n), g3 = Gt_.col(2).segment(n, n);
+  auto rope = [&](int r, double xa, double xb) {
+    const double SL = model_->guideFlexibilityTotal(r);
+    const double Sa = model_->guideFlexibilityIntegral(r, xa), Sb = model_->guideFlexibilityIntegral(r, xb);
+    // xa < xb: G(a,a) = Sa (SL - Sa)/SL, G(a,b) = Sa (SL - Sb)/SL, G(b,b) = Sb (SL - Sb)/SL
+    return Eigen::Vector3d(Sa * (SL - Sa) / SL, Sa * (SL - Sb) / SL, Sb * (SL - Sb) / SL);
+  };
+  const Eigen::Vector3d G1 = rope(1, a, b), G2 = rope(2, a, b);
+  // Wave impedance of the rope at each sleeve (both directions): 2 sqrt(T rho2).
+  const double Ta1 = model_->guideTension(1, a), Tb1 = model_->guideTension(1, b);
+  const double Ta2 = model_->guideTension(2, a), Tb2 = model_->guideTension(2, b);
+  Zd_ << 2.0 * std::sqrt(Ta1 * p.rho2), 2.0 * std::sqrt(Ta2 * p.rho2), 2.0 * std::sqrt(Tb2 * p.rho2),
+      2.0 * std::sqrt(Tb1 * p.rho2);
+  R_.setZero();
+  R_(0, 0) = G1(0) - g1.cwiseProduct(k1).dot(g1);
+  R_(0, 3) = R_(3, 0) = G1(1) - g1.cwiseProduct(k1).dot(g4);
+  R_(3, 3) = G1(2) - g4.cwiseProduct(k1).dot(g4);
+  R_(1, 1) = G2(0) - g2.cwiseProduct(k2).dot(g2);
+  R_(1, 2) = R_(2, 1) = G2(1) - g2.cwiseProduct(k2).dot(g3);
+  R_(2, 2) = G2(2) - g3.cwiseProduct(k2).dot(g3);
+}
+
 void FastSolver::fillConstraintRowDerivatives(double l) {
   const ShaftParams& p = model_->params();
   const int n = n_;
@@ -110,11 +148,12 @@ void FastSolver::fillConstraintRowDerivatives(double l) {
   Gllt_.col(3).head(n).noalias() = V1.transpose() * sb_;
 }
 
-// KKT solve with diagonal S:  S qdd = r + G^T lam,  G qdd = d.
-void FastSolver::solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d) {
+// KKT solve with diagonal S:  S qdd = r + G^T lam,  G qdd + c R lam = d.
+void FastSolver::solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d, double c) {
   Y_ = Gt_.array().colwise() / Sd.array();
   Eigen::Matrix4d W;
   W.noalias() = Gt_.transpose() * Y_;
+  if (c != 0.0) W += c * Rc_;
   tmp_ = r.array() / Sd.array();
   Eigen::Vector4d rhs = d;
   rhs.noalias() -= Gt_.transpose() * tmp_;
@@ -128,9 +167,15 @@ void FastSolver::longitudinalOperators(const Kinematics& k) {
   const auto& H = model_->hoistingRope();
   const double rho1 = p.rho1;
   Ek_ = (rho1 * k.a) * H.A_acc - (p.u1 * k.v) * H.A_vel - (rho1 * k.v * k.v / k.l) * H.A_cent;
+  longitudinalLoads(k);
+}
+
+void FastSolver::longitudinalLoads(const Kinematics& k) {
+  const ShaftParams& p = model_->params();
+  const auto& H = model_->hoistingRope();
   // F0 + u * F(x_c): hoisting-rope load plus the cage load carried through x_c = u.q0
   const double Fxc = p.Fa + p.m * (p.g - k.a);
-  F0_ = (-rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
+  F0_ = (-p.rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
 }
 
 void FastSolver::updateResponse(double t, const Kinematics& k) {
@@ -192,31 +237,44 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   fallbacks_ = 0;
   last_iters_ = 0;
   fillConstraintRows(k0.l);
+  fillResidualFlexibility(k0.l);
 
   // ---- lateral ------------------------------------------------------------
   xd_.setZero();
+  lam_.setZero();
   if (init == InitialState::Static) {
-    // K x - G^T lam = F,  G x = 0
+    // K x - G^T lam = F,  G x + R lam = 0  (R = 0 without the static correction)
     MatrixXd& A = initA_;
     A.setZero();
     A.topLeftCorner(N, N).diagonal() = Kd_;
     A.topRightCorner(N, 4) = -Gt_;
     A.bottomLeftCorner(4, N) = Gt_.transpose();
+    A.bottomRightCorner(4, 4) = R_;
     initRhs_.setZero();
     initRhs_.head(N) = F_;
     initLu_.compute(A);
     initSol_ = initLu_.solve(initRhs_);
     x_ = initSol_.head(N);
+    lam_ = initSol_.tail(4);
   } else {
     x_.setZero();
   }
+  delta_.noalias() = -(Gt_.transpose() * x_);
+  lamS_ = lam_;
   fillConstraintRowDerivatives(k0.l);
   consistentInitialVelocity(k0.v);
-  // Consistent accelerations: G qdd = -2 Gdot qd - Gddot q, Gdot = v G_l, Gddot = a G_l + v^2 G_ll.
-  Eigen::Vector4d d = -2.0 * k0.v * (Glt_.transpose() * xd_) -
-                      (k0.a * (Glt_.transpose() * x_) + k0.v * k0.v * (Gllt_.transpose() * x_));
   r_ = F_ - Cd_.cwiseProduct(xd_) - Kd_.cwiseProduct(x_);
-  solveLateral(Md_, r_, d);
+  if (corr_) {
+    // Compliant sleeves: lam is fixed by the positions (G x + R lam = 0: the
+    // static solution's lam, or 0 at rest), the accelerations follow from it.
+    tmp_.noalias() = Gt_ * lam_;
+    xdd_ = (r_ + tmp_).cwiseQuotient(Md_);
+  } else {
+    // Consistent accelerations: G qdd = -2 Gdot qd - Gddot q, Gdot = v G_l, Gddot = a G_l + v^2 G_ll.
+    Eigen::Vector4d d = -2.0 * k0.v * (Glt_.transpose() * xd_) -
+                        (k0.a * (Glt_.transpose() * x_) + k0.v * k0.v * (Gllt_.transpose() * x_));
+    solveLateral(Md_, r_, d, 0.0);
+  }
   xa_ = xdd_;
 
   // ---- longitudinal ---------------------------------------------------------
@@ -270,17 +328,39 @@ void FastSolver::step(double t1, const Kinematics& k1) {
   xa_ = tmp_;  // holds abar until the new accelerations are known
   r_ = F_ - Cd_.cwiseProduct(vhat_) - Kd_.cwiseProduct(xhat_);
   fillConstraintRows(k1.l);
+  fillResidualFlexibility(k1.l);
+  // Position level at t_{n+1}: G (xhat + hb qdd) + R lam = 0.
   Eigen::Vector4d d;
   d.noalias() = Gt_.transpose() * xhat_;
   d *= -1.0 / hb;
-  solveLateral(Sd_, r_, d);
+  if (corr_) {
+    // Compliant sleeves with the high modes' spring R^-1 and dashpot Z in
+    // parallel: lam = R^-1 delta + Z (delta - delta_n)/h, delta = -G x, i.e.
+    //   A R^-1 ... :  (I + R Z/h)^-1 R lam = delta - (I + R Z/h)^-1 (R Z/h) delta_n.
+    // With delta = -G (xhat + hb qdd):  G qdd + Rc lam / hb = d - e / hb,
+    // Rc = (I + R Z/h)^-1 R = (R^-1 + Z/h)^-1 (symmetric positive definite).
+    Eigen::Matrix4d A = R_ * (Zd_ / h).asDiagonal();
+    const Eigen::Vector4d rz = A * delta_;
+    A.diagonal().array() += 1.0;
+    const Eigen::PartialPivLU<Eigen::Matrix4d> lu(A);
+    Rc_ = lu.solve(R_);
+    d -= lu.solve(rz) / hb;
+  }
+  solveLateral(Sd_, r_, d, corr_ ? 1.0 / hb : 0.0);
   xa_ += g.ca * xdd_;
   x_ = xhat_ + hb * xdd_;
+  if (corr_) {
+    Eigen::Vector4d dn;
+    dn.noalias() = -(Gt_.transpose() * x_);
+    lamS_ = lam_ - Zd_.cwiseProduct(dn - delta_) / h;  // spring part: R lamS = delta
+    delta_ = dn;
+  }
   xd_ = vhat_ + hg * xdd_;
 
   // ---- longitudinal -----------------------------------------------------------
   const auto& H = model_->hoistingRope();
-  longitudinalOperators(k1);
+  if (fused_) longitudinalLoads(k1);
+  else longitudinalOperators(k1);
   r0_ = (g.alpha_f * ydd_ - g.alpha_m * ya_) / (1.0 - g.alpha_m);  // abar (r0_ reused below)
   yhat_ = y_ + h * yd_ + (h * h * (0.5 - g.beta)) * ya_ + (h * h * g.beta) * r0_;
   yvhat_ = yd_ + (h * (1.0 - g.gamma)) * ya_ + (h * g.gamma) * r0_;
@@ -289,11 +369,23 @@ void FastSolver::step(double t1, const Kinematics& k1) {
   const double kscale = p.EA / k1.l;
   // r0 = F0 - C vhat - K yhat
   r0_ = F0_ - cdiag * yvhat_ - kscale * k2_.cwiseProduct(yhat_);
-  r0_.noalias() -= (p.rho1 * k1.v) * (H.A_gyro * yvhat_);
-  r0_.noalias() -= Ek_ * yhat_;
   // S = M + hg C + hb K = P + E,  P = diag(Pd) + m u u^T,  E = hg rho1 v A_gyro + hb Ek.
-  Ek_ *= hb;
-  Ek_.noalias() += (hg * p.rho1 * k1.v) * H.A_gyro;  // Ek_ now holds E
+  const double c4 = p.rho1 * k1.v;
+  if (fused_) {
+    // E is linear in four scalars of (l, v, a, h): one pass over the four
+    // constant matrices builds it (Ek itself is never formed), and
+    //   Ek yhat + c4 A_gyro vhat = E yhat / hb + c4 A_gyro (vhat - (hg/hb) yhat).
+    const double c1 = p.rho1 * k1.a, c2 = -p.u1 * k1.v, c3 = -p.rho1 * k1.v * k1.v / k1.l;
+    Ek_ = (hb * c1) * H.A_acc + (hb * c2) * H.A_vel + (hb * c3) * H.A_cent + (hg * c4) * H.A_gyro;  // E
+    r0_.noalias() -= (1.0 / hb) * (Ek_ * yhat_);
+    dy_ = yvhat_ - (hg / hb) * yhat_;  // workspace (dy_ is overwritten by the sweeps)
+    r0_.noalias() -= c4 * (H.A_gyro * dy_);
+  } else {
+    r0_.noalias() -= c4 * (H.A_gyro * yvhat_);
+    r0_.noalias() -= Ek_ * yhat_;
+    Ek_ *= hb;
+    Ek_.noalias() += (hg * c4) * H.A_gyro;  // Ek_ now holds E
+  }
   Pd_ = (p.rho1 * k1.l + hg * cdiag) + (hb * kscale) * k2_.array();
   w_ = u_.cwiseQuotient(Pd_);
   const double sm = p.m / (1.0 + p.m * u_.dot(w_));  // Sherman-Morrison
@@ -329,22 +421,53 @@ void FastSolver::step(double t1, const Kinematics& k1) {
   updateResponse(t1, k1);
 }
 
+// With the static correction the shape is y = U.(V z) + sum R(x, a_k) lam_k,
+// R(x, a) = G(x, a) - U(x)^T K^-1 U(a): the modal part is shifted by
+// -K^-1 sum U(a_k) lam_k (in modal coordinates -kappa^-1 .* G^T lam) and the
+// exact Green's function of the sleeve loads is added (residualSleeveLoads).
+// At the sleeves this is exactly G q + R lam, i.e. the cage position.
 void FastSolver::guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const {
   q1.resize(n_);
   q2.resize(n_);
+  if (corr_) {
+    // tmp: modal coordinates shifted by the modal part of the sleeve loads
+    VectorXd& z = zs_;  // preallocated workspace (keeps GuideRopeEnvelope::evaluate allocation-free)
+    z = x_.head(2 * n_);
+    for (int k = 0; k < 4; ++k) z -= lamS_(k) * kinv_.cwiseProduct(Gt_.col(k).head(2 * n_));
+    q1.noalias() = model_->guideModalVectors(1) * z.head(n_);
+    q2.noalias() = model_->guideModalVectors(2) * z.segment(n_, n_);
+    return;
+  }
   q1.noalias() = model_->guideModalVectors(1) * x_.head(n_);
   q2.noalias() = model_->guideModalVectors(2) * x_.segment(n_, n_);
+}
+
+void FastSolver::residualSleeveLoads(SleeveLoads& out) const {
+  if (!corr_) {
+    out.count = 0;
+    return;
+  }
+  const double l = kin_.l, b = l + 2.0 * model_->params().h;
+  out.count = 4;
+  out.rope = {1, 2, 2, 1};  // g1..g4
+  out.x = {l, l, b, b};
+  // The quasi-static (spring) part of the sleeve forces deflects the high modes.
+  out.f = {lamS_(0), lamS_(1), lamS_(2), lamS_(3)};
 }
 
 void FastSolver::guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const {
   VectorXd q1, q2, U(n_);
   guideRopeCoordinates(q1, q2);
+  SleeveLoads loads;
+  residualSleeveLoads(loads);
   y1.resize(x.size());
   y2.resize(x.size());
   for (Eigen::Index i = 0; i < x.size(); ++i) {
     model_->guideModes(x(i) / model_->params().L, U);
     y1(i) = U.dot(q1);
     y2(i) = U.dot(q2);
+    for (int k = 0; k < loads.count; ++k)
+      (loads.rope[k] == 1 ? y1(i) : y2(i)) += model_->guideGreen(loads.rope[k], x(i), loads.x[k]) * loads.f[k];
   }
 }
 

@@ -11,6 +11,10 @@ PaperSolver::PaperSolver(std::shared_ptr<const ShaftModel> model)
     : Solver(std::move(model)), ga_(model_->params().rho_inf) {
   n_ = model_->n();
   if (n_ < 2) throw std::invalid_argument("the paper's method needs model.modes >= 2");
+  if (model_->params().static_correction)
+    throw std::invalid_argument(
+        "the paper's method has no static correction: set model.static_correction = false "
+        "(--static-correction off) with --method paper");
   nq_ = 3 * n_ + 3;
   n1_ = 3 * n_ - 2;
   // Block order p: [q0_1..q0_n, q1_1..q1_n, q2_1..q2_n, x_c, y_c, theta].

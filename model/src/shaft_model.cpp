@@ -1,6 +1,7 @@
 #include "hoist/shaft_model.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -76,6 +77,22 @@ ShaftModel::ShaftModel(const ShaftParams& p) : p_(p) {
   };
   decompose(K1_, V1_, kappa1_);
   decompose(K2_, V2_, kappa2_);
+  SL1_ = guideFlexibilityIntegral(1, p_.L);
+  SL2_ = guideFlexibilityIntegral(2, p_.L);
+}
+
+double ShaftModel::guideFlexibilityIntegral(int r, double x) const {
+  const double Tb = r == 1 ? p_.Tb1 : p_.Tb2;
+  const double rg = p_.rho2 * p_.g;
+  if (rg == 0.0) return x / Tb;
+  // ln(T(0)/T(x)) with T(0)/T(x) = 1 + rg x / T(x): log1p keeps full accuracy near x = 0.
+  return std::log1p(rg * x / (Tb + rg * (p_.L - x))) / rg;
+}
+
+double ShaftModel::guideGreen(int r, double x, double s) const {
+  const double lo = std::min(x, s), hi = std::max(x, s);
+  const double SL = r == 1 ? SL1_ : SL2_;
+  return guideFlexibilityIntegral(r, lo) * (SL - guideFlexibilityIntegral(r, hi)) / SL;
 }
 
 void ShaftModel::guideModes(double eta, Eigen::Ref<VectorXd> out) const {

@@ -25,6 +25,14 @@ GuideRopeEnvelope::GuideRopeEnvelope(const ShaftModel& model, int samples) {
     model.guideModes(x_(i) / model.params().L, U);
     table_.row(i) = U.transpose();
   }
+  S1_.resize(samples);
+  S2_.resize(samples);
+  for (int i = 0; i < samples; ++i) {
+    S1_(i) = model.guideFlexibilityIntegral(1, x_(i));
+    S2_(i) = model.guideFlexibilityIntegral(2, x_(i));
+  }
+  SL1_ = model.guideFlexibilityTotal(1);
+  SL2_ = model.guideFlexibilityTotal(2);
   q1_ = q2_ = VectorXd::Zero(n);
   y1_ = y2_ = VectorXd::Zero(samples);
 }
@@ -33,6 +41,20 @@ double GuideRopeEnvelope::evaluate(const Solver& s) {
   s.guideRopeCoordinates(q1_, q2_);
   y1_.noalias() = table_ * q1_;
   y2_.noalias() = table_ * q2_;
+  SleeveLoads loads;
+  s.residualSleeveLoads(loads);
+  for (int k = 0; k < loads.count; ++k) {
+    // G(x, a) f = S(min)(S(L) - S(max)) / S(L) f on the grid.
+    const bool r1 = loads.rope[k] == 1;
+    const VectorXd& S = r1 ? S1_ : S2_;
+    const double SL = r1 ? SL1_ : SL2_;
+    const double Sa = s.model().guideFlexibilityIntegral(r1 ? 1 : 2, loads.x[k]);
+    const double f = loads.f[k] / SL;
+    VectorXd& y = r1 ? y1_ : y2_;
+    const Eigen::Index m = x_.size();
+    for (Eigen::Index i = 0; i < m; ++i)
+      y(i) += x_(i) <= loads.x[k] ? S(i) * (SL - Sa) * f : Sa * (SL - S(i)) * f;
+  }
   return std::max(y1_.cwiseAbs().maxCoeff(), y2_.cwiseAbs().maxCoeff());
 }
 

@@ -95,7 +95,8 @@ std::string toToml(const TwinConfig& c) {
      << "[cage]\nmass = " << Num{p.m} << "\ninertia = " << Num{p.J} << "\nhalf_height = " << Num{p.h} << "\n\n"
      << "[load]\neccentric_force = " << Num{p.Fa} << "\noffset = " << Num{p.b} << "\n\n"
      << "[model]\nmodes = " << p.n << "\ngravity = " << Num{p.g} << "\ninitial = \""
-     << toString(p.initial) << "\"\nrho_inf = " << Num{p.rho_inf} << "\n\n";
+     << toString(p.initial) << "\"\nrho_inf = " << Num{p.rho_inf}
+     << "\nstatic_correction = " << (p.static_correction ? "true" : "false") << "\n\n";
   const ServiceConfig& s = c.service;
   os << "[service]\nrate = " << Num{s.rate} << "\ncage_rate = " << Num{s.cage_rate}
      << "\nshape_rate = " << Num{s.shape_rate} << "\nhealth_rate = " << Num{s.health_rate}

@@ -68,6 +68,7 @@ const std::vector<ConfigCase>& configCases() {
       {"modes_negative", "[model]\nmodes = -5\n", "model.modes", 2},
       {"initial_unknown", "[model]\ninitial = \"dynamic\"\n", "model.initial", 2},
       {"rho_inf_out_of_range", "[model]\nrho_inf = 1.5\n", "model.rho_inf", 2},
+      {"static_correction_not_boolean", "[model]\nstatic_correction = \"yes\"\n", "model.static_correction", 2},
       {"negative_gravity", "[model]\ngravity = -9.81\n", "model.gravity", 2},
       {"offset_beyond_shaft", "[load]\noffset = 1e6\n", "load.offset", 2},
       {"toml_syntax_error", "[cage]\nmass = = 800\n", "", 2},

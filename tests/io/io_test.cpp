@@ -82,6 +82,7 @@ modes = 20
 gravity = 9.8
 initial = "rest"
 rho_inf = 0.8
+static_correction = false
 )");
   EXPECT_EQ(p.rho1, 3.5);
   EXPECT_EQ(p.EA, 4e7);
@@ -101,6 +102,7 @@ rho_inf = 0.8
   EXPECT_EQ(p.g, 9.8);
   EXPECT_EQ(p.initial, InitialState::Rest);
   EXPECT_EQ(p.rho_inf, 0.8);
+  EXPECT_FALSE(p.static_correction);
 }
 
 TEST(Config, ReferenceCaseFileLoads) {
@@ -157,6 +159,15 @@ TEST(Config, ImpossibleValuesNameKeyAndLine) {
   EXPECT_EQ(e.line(), 4);
   EXPECT_EQ(configError("[hoisting_rope]\ninitial_length = 390.0\n").key(), "hoisting_rope.initial_length");
   EXPECT_EQ(configError("[model]\nrho_inf = 1.5\n").key(), "model.rho_inf");
+  // static_correction is a boolean: 1, "on", "true" are errors naming the key.
+  for (const char* v : {"1", "\"on\"", "\"true\"", "0.0"}) {
+    const ConfigError b = configError(std::string("[model]\nstatic_correction = ") + v + "\n");
+    EXPECT_EQ(b.key(), "model.static_correction") << v;
+    EXPECT_EQ(b.line(), 2) << v;
+    EXPECT_NE(std::string(b.what()).find("true or false"), std::string::npos) << b.what();
+  }
+  EXPECT_TRUE(parse("[model]\nmodes = 10\n").static_correction) << "default on";
+  EXPECT_FALSE(parse("[model]\nstatic_correction = false\n").static_correction);
 }
 
 TEST(Config, SyntaxErrorsGiveTheLine) {
@@ -187,6 +198,7 @@ TEST(Config, ToTomlReadsBackExactly) {
     p.n = 10 + trial;
     p.rho_inf = u(rng) / 2.0;
     p.initial = trial % 2 ? InitialState::Rest : InitialState::Static;
+    p.static_correction = trial % 3 != 0;
     const ShaftParams q = parse(toToml(p));
     EXPECT_EQ(q.rho1, p.rho1);
     EXPECT_EQ(q.EA, p.EA);
@@ -204,6 +216,7 @@ TEST(Config, ToTomlReadsBackExactly) {
     EXPECT_EQ(q.n, p.n);
     EXPECT_EQ(q.rho_inf, p.rho_inf);
     EXPECT_EQ(q.initial, p.initial);
+    EXPECT_EQ(q.static_correction, p.static_correction);
   }
 }
 

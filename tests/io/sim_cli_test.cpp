@@ -89,8 +89,9 @@ TEST_F(SimCli, HeaderIsTheContract) {
 }
 
 TEST_F(SimCli, PaperCaseStaticStartMatchesReference) {
+  // The reference is the paper's truncation: static correction off.
   const SimRun r = sim({"--config", kData + "/c1-paper/shaft.toml", "--profile", kData + "/c1-paper/profile.csv", "--out",
-                     path("o.csv"), "--shape-out", path("s.csv")});
+                     path("o.csv"), "--shape-out", path("s.csv"), "--static-correction", "off"});
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("peak |y_c|"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("steps/s"), std::string::npos) << r.output;
@@ -118,13 +119,14 @@ TEST_F(SimCli, PaperCaseStaticStartMatchesReference) {
 
 TEST_F(SimCli, PaperCaseRestStartMatchesReference) {
   const SimRun r = sim({"--config", kData + "/c1-paper-rest/shaft.toml", "--profile", "paper", "--out", path("o.csv"),
-                     "-q"});
+                     "-q", "--static-correction", "off"});
   ASSERT_EQ(r.status, 0) << r.output;
   expectMatchesReference(readCsv(path("o.csv")), readCsv(kData + "/c1-paper-rest/reference.csv"), 1e-2);
 }
 
 TEST_F(SimCli, PaperMethodAgreesWithFastMethod) {
-  const SimRun a = sim({"--profile", "paper", "--t-end", "3", "--out", path("fast.csv"), "-q", "--modes", "20"});
+  const SimRun a = sim({"--profile", "paper", "--t-end", "3", "--out", path("fast.csv"), "-q", "--modes", "20",
+                     "--static-correction", "off"});
   const SimRun b = sim({"--profile", "paper", "--t-end", "3", "--out", path("paper.csv"), "-q", "--modes", "20",
                      "--method", "paper"});
   ASSERT_EQ(a.status, 0) << a.output;
@@ -133,6 +135,34 @@ TEST_F(SimCli, PaperMethodAgreesWithFastMethod) {
   ASSERT_EQ(f.rows.size(), 301u);
   for (const char* c : {"x_c", "y_c", "theta", "lambda_0", "lambda_1", "lambda_3"})
     EXPECT_LT(nrms(p.column(c), f.column(c)), 1e-3) << c;
+}
+
+TEST_F(SimCli, StaticCorrectionOption) {
+  // Default on; --static-correction overrides the config; the paper method refuses it.
+  const std::string off = write("off.toml", "[model]\nstatic_correction = false\n");
+  SimRun r = sim({"--print-config"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("static_correction = true"), std::string::npos) << r.output;
+  r = sim({"--config", off, "--print-config"});
+  EXPECT_NE(r.output.find("static_correction = false"), std::string::npos) << r.output;
+  r = sim({"--config", off, "--static-correction", "on", "--print-config"});
+  EXPECT_NE(r.output.find("static_correction = true"), std::string::npos) << r.output;
+  r = sim({"--method", "paper", "--print-config"});
+  EXPECT_NE(r.output.find("static_correction = false"), std::string::npos) << "paper implies off:\n" << r.output;
+  r = sim({"--method", "paper", "--static-correction", "on", "--out", path("o.csv")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--method paper has no static correction"), std::string::npos) << r.output;
+  r = sim({"--static-correction", "maybe", "--out", path("o.csv")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--static-correction"), std::string::npos) << r.output;
+  const std::string bad = write("b.toml", "[model]\nstatic_correction = \"yes\"\n");
+  r = sim({"--config", bad, "--out", path("o.csv")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("b.toml:2: model.static_correction"), std::string::npos) << r.output;
+  // At n = 20 the corrected static tilt at l = 50 m is the exact continuum value 8.055e-4 rad.
+  r = sim({"--modes", "20", "--t-end", "0.01", "--out", path("o.csv"), "-q"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NEAR(readCsv(path("o.csv")).column("theta").front(), 8.055e-4, 0.01 * 8.055e-4);
 }
 
 TEST_F(SimCli, CommandLineOverridesTheConfig) {
@@ -186,7 +216,8 @@ TEST_F(SimCli, BadInputExitsWithStatus2AndNamesTheProblem) {
 TEST_F(SimCli, HelpDescribesTheOptions) {
   const SimRun r = sim({"--help"});
   EXPECT_EQ(r.status, 0);
-  for (const char* opt : {"--config", "--profile", "--out", "--dt", "--modes", "--initial", "--method", "--shape-out",
+  for (const char* opt : {"--config", "--profile", "--out", "--dt", "--modes", "--initial", "--method",
+                          "--static-correction", "--shape-out",
                           "--shape-times", "trapezoid:"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
 }

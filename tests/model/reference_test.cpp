@@ -29,7 +29,10 @@ const char* kCols[8] = {"x_c", "y_c", "theta", "lambda_0", "lambda_1", "lambda_2
 Errors compare(const std::string& cs, InitialState init, double dt, double max_step, Method m = Method::Fast,
                double t_end = -1) {
   const Table ref = readCsv(dataDir() + "/" + cs + "/reference.csv");
-  const ShaftParams p;  // the reference is the paper baseline (shaft.toml = defaults)
+  // The reference is the paper baseline (shaft.toml = defaults) with the
+  // paper's truncation: static correction off.
+  ShaftParams p;
+  p.static_correction = false;
   auto solver = makeSolver(m, std::make_shared<const ShaftModel>(p));
   SimulationOptions o;
   o.dt = dt;
@@ -102,7 +105,8 @@ TEST(Reference, PaperMethodFirstSeconds) {
 
 TEST(Reference, GuideRopeShapes) {
   const Table shape = readCsv(dataDir() + "/c1-paper/shape.csv");
-  const ShaftParams p;
+  ShaftParams p;
+  p.static_correction = false;
   auto model = std::make_shared<const ShaftModel>(p);
   auto solver = makeSolver(Method::Fast, model);
   const HoistProfile prof = loadProfile("c1-paper");

@@ -1,6 +1,8 @@
 // [service] and [alarms] parsing: defaults, errors naming file:line and key.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "hoist/bus/channels.hpp"
 #include "hoist/service/config_file.hpp"
 
@@ -127,4 +129,20 @@ TEST(Channels, Prefix) {
   EXPECT_EQ(ch.health, "A_HOIST_HEALTH");
   EXPECT_EQ(hoist::bus::channel("north/", hoist::bus::kChannelCage), "north/HOIST_CAGE");
   EXPECT_EQ(hoist::bus::Channels().winder, "HOIST_WINDER");
+}
+
+TEST(ServiceConfig, DaemonReadsTheStaticCorrection) {
+  // [model] static_correction reaches the daemon's model through the shaft
+  // parameters (default on); the printed configuration keeps it.
+  const std::string path = ::testing::TempDir() + "/static_correction.toml";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs("[model]\nmodes = 12\nstatic_correction = false\n[service]\nrate = 50\n", f);
+    std::fclose(f);
+  }
+  const TwinConfig c = loadTwinConfig(path);
+  EXPECT_FALSE(c.shaft.static_correction);
+  EXPECT_NE(toToml(c).find("static_correction = false"), std::string::npos);
+  EXPECT_TRUE(TwinConfig{}.shaft.static_correction);
 }

@@ -105,6 +105,11 @@ TEST(Parameters, KeysApplyAndRoundTrip) {
   EXPECT_DOUBLE_EQ(p.J, 1740);
   applyParameter(p, "model.modes", 20);
   EXPECT_EQ(p.n, 20);
+  applyParameter(p, "model.static_correction", 0);
+  EXPECT_FALSE(p.static_correction);
+  EXPECT_EQ(parameterValue(p, "model.static_correction"), 0.0);
+  applyParameter(p, "model.static_correction", 1);
+  EXPECT_TRUE(p.static_correction);
   for (const auto& k : sweepableKeys()) {
     ShaftParams q;
     const double v = parameterValue(q, k);
@@ -124,6 +129,7 @@ TEST(Parameters, ErrorsNameTheKey) {
     EXPECT_NE(std::string(e.what()).find("cage.mass"), std::string::npos);  // lists valid keys
   }
   EXPECT_THROW(applyParameter(p, "model.modes", 2.5), ParamError);
+  EXPECT_THROW(applyParameter(p, "model.static_correction", 0.5), ParamError);
   try {
     sweepStudy("cage.mass", {800, -5}, p);
     FAIL();

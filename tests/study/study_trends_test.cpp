@@ -38,6 +38,7 @@ ShaftParams base() {
   ShaftParams p;
   p.n = 50;
   p.initial = InitialState::Rest;
+  p.static_correction = false;  // the paper's truncation: its figures (hoist-study's default for them)
   return p;
 }
 

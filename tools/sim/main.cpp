@@ -3,6 +3,7 @@
 //
 //   hoist-sim [--config FILE] --profile FILE|SPEC --out FILE.csv [--dt 0.01]
 //             [--modes N] [--initial static|rest] [--method fast|paper]
+//             [--static-correction on|off]
 //             [--shape-out FILE.csv --shape-times 18,36,60]
 //   hoist-sim study ...        (runs hoist-study: the paper's parameter studies)
 //
@@ -37,7 +38,7 @@ struct Options {
   std::string config, profile = "paper", out, shape_out, shape_times = "18,36,60", write_profile;
   double dt = 0.01, max_step = 0.0025, t_end = -1.0, rho_inf = -1.0;
   int modes = 0, shape_points = 401;
-  std::string initial, method = "fast";
+  std::string initial, method = "fast", static_correction;
   bool quiet = false, print_config = false;
 };
 
@@ -125,6 +126,14 @@ int run(const Options& o) {
   if (o.modes != 0) p.n = o.modes;
   if (!o.initial.empty()) p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
   if (o.rho_inf >= 0.0) p.rho_inf = o.rho_inf;
+  if (o.method == "paper") {
+    // The paper's method is the paper's literal truncation.
+    if (o.static_correction == "on")
+      throw UsageError("--method paper has no static correction: use --static-correction off (or --method fast)");
+    p.static_correction = false;
+  } else if (!o.static_correction.empty()) {
+    p.static_correction = o.static_correction == "on";
+  }
   try {
     p.validate();
   } catch (const hoist::ParamError& e) {
@@ -194,7 +203,8 @@ int run(const Options& o) {
   const long steps = std::lround((t_end - t0) / o.dt);
   if (!o.quiet)
     std::cerr << "hoist-sim: " << hoist::toString(sim.method) << " path, n = " << p.n << ", initial = "
-              << hoist::toString(p.initial) << ", t = " << t0 << " .. " << t_end << " s, dt = " << o.dt << " s ("
+              << hoist::toString(p.initial) << ", static correction "
+              << (p.static_correction ? "on" : "off") << ", t = " << t0 << " .. " << t_end << " s, dt = " << o.dt << " s ("
               << sub << " substep" << (sub > 1 ? "s" : "") << " of " << o.dt / sub << " s), " << steps
               << " output steps\n";
 
@@ -312,6 +322,10 @@ int main(int argc, char** argv) {
                  "fast: structured KKT solver (default); paper: the paper's literal partition, Eqs. (18)-(24)")
       ->capture_default_str()
       ->check(CLI::IsMember({"fast", "paper"}));
+  app.add_option("--static-correction", o.static_correction,
+                 "residual flexibility of the guide ropes at the sleeves (overrides model.static_correction, "
+                 "default on; off = the paper's truncation, required by --method paper)")
+      ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--rho-inf", o.rho_inf, "generalized-alpha spectral radius (overrides model.rho_inf)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--shape-out", o.shape_out, "guide-rope shape CSV (t,x,y1,y2) at --shape-times");

@@ -4,7 +4,7 @@
 //
 //   hoist-study NAME [--out-dir DIR] [--config FILE] [--profile FILE|SPEC]
 //                    [--modes N] [--dt S] [--max-step S] [--initial rest|static|config]
-//                    [--jobs N] [--no-plots]
+//                    [--static-correction on|off] [--jobs N] [--no-plots]
 //   NAME: response | preload | tension-difference | eccentric-load | mass | all
 //         | sweep --param KEY --values V1,V2,... | advise --clearance M ...
 //
@@ -54,6 +54,7 @@ struct Common {
   double dt = 0.01;
   double max_step = 0.0025;
   std::string initial;  // "" -> rest for the studies, config for advise
+  std::string static_correction;  // "" -> off for the paper's studies, config (default on) for sweep/advise
   int jobs = 0;
   bool no_plots = false;
 };
@@ -78,7 +79,7 @@ CLI::Validator numberAbove(double lo, bool inclusive) {
       inclusive ? "NUMBER >= 0" : "NUMBER > 0");
 }
 
-void addCommon(CLI::App* sub, Common& c, bool advisor) {
+void addCommon(CLI::App* sub, Common& c, bool advisor, bool paper) {
   sub->add_option("--out-dir", c.out_dir, "Directory for CSVs, scripts and PNGs (created)")
       ->capture_default_str();
   sub->add_option("--config", c.config,
@@ -96,6 +97,12 @@ void addCommon(CLI::App* sub, Common& c, bool advisor) {
                               "of the paper's figures), static (equilibrium), config (model.initial); default: ") +
                       (advisor ? "config" : "rest"))
       ->check(CLI::IsMember({"rest", "static", "config"}));
+  sub->add_option("--static-correction", c.static_correction,
+                  std::string("Residual flexibility of the guide ropes (overrides model.static_correction); "
+                              "default: ") +
+                      (paper ? "off: the paper's truncation, which its figures show"
+                             : "model.static_correction (on unless the config says false)"))
+      ->check(CLI::IsMember({"on", "off"}));
   sub->add_option("--jobs,-j", c.jobs, "Parallel runs (default: hardware concurrency)")
       ->check(numberAbove(0, true));
   sub->add_flag("--no-plots", c.no_plots, "Write CSVs and gnuplot scripts but do not run gnuplot");
@@ -179,6 +186,8 @@ ShaftParams loadParams(const Common& c) {
   if (c.modes > 0) p.n = c.modes;
   if (c.initial == "rest") p.initial = InitialState::Rest;
   else if (c.initial == "static") p.initial = InitialState::Static;
+  if (c.static_correction == "on") p.static_correction = true;
+  else if (c.static_correction == "off") p.static_correction = false;
   try {
     p.validate();
   } catch (const ParamError& e) {
@@ -404,6 +413,9 @@ int runStudy(const Study& s, const Common& c, const ShaftParams& base, const Hoi
   if (!res.empty() && !res.front().shapes.empty())
     out::writeShapesCsv((dir / "shapes.csv").string(), res.front().shapes);
   printSummary(s, res, ms);
+  const bool corr = s.runs.front().params.static_correction;
+  std::printf("  static correction %s%s\n", corr ? "on" : "off",
+              corr ? "" : " (the paper's truncation: reproduces its figures; --static-correction on for the converged model)");
   if (failed == 0) renderFigures(dir.string(), figuresFor(s), ps);
   std::printf("  -> %s/ (summary.csv, runs/*.csv, *.gp%s)\n", dir.string().c_str(),
               ps.enabled && !ps.gnuplot.empty() ? ", *.png" : "");
@@ -437,8 +449,11 @@ int runAdvisor(const AdviseArgs& a, const Common& c, const ShaftParams& base, co
   const RunOptions ro = runOptions(c, base);
   const fs::path dir = fs::path(c.out_dir) / "advise";
   fs::create_directories(dir);
-  std::fprintf(stderr, "hoist-study advise: searching Tb1 + Tb2 in [%g, %g] N, split in [%g, %g] (n = %d, initial = %s)\n",
-               o.total_min, o.total_max, o.split_min, o.split_max, base.n, toString(base.initial));
+  std::fprintf(stderr,
+               "hoist-study advise: searching Tb1 + Tb2 in [%g, %g] N, split in [%g, %g] (n = %d, initial = %s, "
+               "static correction %s)\n",
+               o.total_min, o.total_max, o.split_min, o.split_max, base.n, toString(base.initial),
+               base.static_correction ? "on" : "off");
   AdvisorResult r = advisePreload(simulationEvaluator(base, profile, ro.sim), o);
   out::writeAdvisorCsv((dir / "advise_curve.csv").string(), r.curve);
   out::writeAdvisorCsv((dir / "advise_split.csv").string(), r.split_scan);
@@ -508,14 +523,14 @@ int main(int argc, char** argv) {
            {"mass", "(m, J) = (800, 870), (1200, 1305), (1600, 1740): Figs. 12-13"},
            {"all", "all of the paper's studies (response, preload, tension-difference, eccentric-load, mass)"}}) {
     auto* sub = app.add_subcommand(name, help);
-    addCommon(sub, c, false);
+    addCommon(sub, c, false, true);
     studies.emplace_back(sub, name);
   }
   std::string key, values;
   auto* sweep = app.add_subcommand("sweep", "sweep one config key over values (same outputs as a paper study)");
   sweep->add_option("--param", key, "Dotted config key, one of:\n" + parameterHelp())->required();
   sweep->add_option("--values", values, "Comma-separated values, or START:STOP:COUNT")->required();
-  addCommon(sweep, c, false);
+  addCommon(sweep, c, false, false);
   AdviseArgs aa;
   auto* advise = app.add_subcommand(
       "advise",
@@ -531,7 +546,7 @@ int main(int argc, char** argv) {
   advise->add_option("--samples", aa.samples, "Log-spaced totals sampled (curve, monotonicity check)")
       ->capture_default_str()
       ->check(CLI::Range(2, 200));
-  addCommon(advise, c, true);
+  addCommon(advise, c, true, false);
 
   try {
     app.parse(argc, argv);
@@ -541,6 +556,8 @@ int main(int argc, char** argv) {
   }
 
   if (c.initial.empty()) c.initial = advise->parsed() ? "config" : "rest";
+  // The paper's studies reproduce its figures: the paper's truncation unless asked otherwise.
+  if (c.static_correction.empty() && !advise->parsed() && !sweep->parsed()) c.static_correction = "off";
   PlotState ps;
   ps.enabled = !c.no_plots;
   ps.gnuplot = ps.enabled ? out::findGnuplot() : "";

@@ -45,6 +45,7 @@ class FastSolver final : public Solver {
   const CageResponse& response() const override { return resp_; }
   void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override;
   void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override;
+  void residualSleeveLoads(SleeveLoads& out) const override;
   bool finite() const override;
   Method method() const override { return Method::Fast; }
 
@@ -58,12 +59,28 @@ class FastSolver final : public Solver {
   /// Longitudinal state: hoisting-rope modal coordinates q0 and rates.
   const VectorXd& hoistingRopeCoordinates() const { return y_; }
   const VectorXd& hoistingRopeRates() const { return yd_; }
+  /// The longitudinal step matrix E built in one pass from the constant
+  /// matrices (default), or, false, the previous form (Ek built, applied, scaled
+  /// and added to): kept to benchmark the two side by side and to test that
+  /// they agree.
+  void setFusedLongitudinal(bool on) { fused_ = on; }
+  /// Static correction active, and the sleeves' residual flexibility R(l) at
+  /// the current position (zero without the correction) [m/N].
+  bool staticCorrection() const { return corr_; }
+  const Eigen::Matrix4d& residualFlexibility() const { return R_; }
+  /// The high modes' wave impedance at each sleeve, 2 sqrt(T rho2) [N s/m],
+  /// and the spring (quasi-static) part of the sleeve forces, R^-1 (-G q).
+  const Eigen::Vector4d& residualDamping() const { return Zd_; }
+  const Eigen::Vector4d& residualSpringForces() const { return lamS_; }
 
  private:
   void fillConstraintRows(double l);                 // G_ (4 x N) at l
   void fillConstraintRowDerivatives(double l);       // Gl_, Gll_ (init only)
-  void solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d);
-  void longitudinalOperators(const Kinematics& k);  // Ek_ and scalars at k
+  void fillResidualFlexibility(double l);            // R_ at l (after fillConstraintRows)
+  // KKT solve  S qdd - G^T lam = r,  G qdd + c R lam = d  (c = 0: rigid sleeves).
+  void solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d, double c);
+  void longitudinalOperators(const Kinematics& k);  // Ek_ and F0_ at k
+  void longitudinalLoads(const Kinematics& k);      // F0_ at k
   void updateResponse(double t, const Kinematics& k);
 
   GeneralizedAlpha ga_;
@@ -84,6 +101,14 @@ class FastSolver final : public Solver {
   Eigen::Matrix<double, Eigen::Dynamic, 4> Y_;  // S^-1 G^T
   VectorXd sa_, sb_, xhat_, vhat_, r_, tmp_;
   Eigen::Vector4d lam_;
+  bool corr_ = false;                 // static correction
+  Eigen::Matrix4d R_ = Eigen::Matrix4d::Zero();  // residual flexibility at the sleeves
+  Eigen::Matrix4d Rc_ = Eigen::Matrix4d::Zero(); // step compliance (R^-1 + Z/h)^-1
+  Eigen::Vector4d Zd_ = Eigen::Vector4d::Zero(); // wave impedance 2 sqrt(T rho2) at each sleeve
+  Eigen::Vector4d delta_ = Eigen::Vector4d::Zero();  // residual displacement -G x at the last step
+  Eigen::Vector4d lamS_ = Eigen::Vector4d::Zero();   // spring part of lam: R lamS = delta
+  VectorXd kinv_;                     // 1 / kappa (rope entries)
+  mutable VectorXd zs_;               // guideRopeCoordinates workspace (2n)
 
   // longitudinal
   VectorXd u_;                        // U0_i(1)
@@ -94,6 +119,7 @@ class FastSolver final : public Solver {
   VectorXd k2_, Pd_, w_, res_, dy_;  // k_i^2, diagonal of P, P^-1 u, residual, update
   int last_iters_ = 0;
   long fallbacks_ = 0;
+  bool fused_ = true;
   double lambda0_ = 0.0;
 
   CageResponse resp_;

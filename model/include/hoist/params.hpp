@@ -16,6 +16,7 @@
 //   Fa, b             eccentric load [N] and its offset        [m]
 //   n                 assumed modes per rope
 //   g                 gravity                                  [m/s^2]
+//   static_correction residual flexibility of the guide ropes (not in the paper)
 #pragma once
 
 #include <stdexcept>
@@ -74,6 +75,13 @@ struct ShaftParams {
   /// multipliers grow without bound, see tests); 0.9 damps the spurious
   /// constraint oscillation while keeping second-order accuracy.
   double rho_inf = 0.9;
+  /// model.static_correction: add the guide ropes' residual flexibility at the
+  /// sleeves (the quasi-static compliance of the modes above n, from the exact
+  /// static Green's function) to the sleeve constraints of the fast path, so
+  /// that statics are exact for every n and the tilt converges at n ~ 10-20
+  /// (docs/model.md).  false = the paper's literal truncation (reproduces the
+  /// reference data); the paper path (Method::Paper) requires false.
+  bool static_correction = true;
 
   /// Throws ParamError naming the key of the first invalid value.
   void validate() const;

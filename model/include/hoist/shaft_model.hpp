@@ -75,11 +75,22 @@ class ShaftModel {
   /// Static tension of guide rope r at depth x: T_br + rho2 g (L - x).
   double guideTension(int r, double x) const;
 
+  // ---- exact statics of a guide rope (static correction) ------------------
+  /// S_r(x) = Int_0^x ds / T_r(s) = ln(T_r(0)/T_r(x)) / (rho2 g)  (x / T_br if g = 0).
+  double guideFlexibilityIntegral(int r, double x) const;
+  /// Exact static Green's function of guide rope r, the lateral deflection at x
+  /// under a unit point load at s of  -(T_r y')' = delta(x - s), y(0) = y(L) = 0:
+  ///   G_r(x, s) = S_r(min) (S_r(L) - S_r(max)) / S_r(L)   [m/N].
+  double guideGreen(int r, double x, double s) const;
+  /// S_r(L), precomputed.
+  double guideFlexibilityTotal(int r) const { return r == 1 ? SL1_ : SL2_; }
+
  private:
   ShaftParams p_;
   HoistingRopeIntegrals hr_;
   MatrixXd K1_, K2_, V1_, V2_;
   VectorXd kappa1_, kappa2_;
+  double SL1_ = 0.0, SL2_ = 0.0;
 };
 
 }  // namespace hoist

@@ -38,6 +38,18 @@ struct CageResponse {
   std::array<double, 5> lambda{};  ///< lambda_0 (hoisting rope) .. lambda_4 (sleeves) [N]
 };
 
+/// Point loads whose exact static deflection (the Green's function of each
+/// guide rope, ShaftModel::guideGreen) is part of the guide-rope shape: with
+/// the static correction the shape is
+///   y_r(x) = U(x/L) . q_r + sum_{k: rope_k = r} G_r(x, x_k) f_k
+/// (q_r from guideRopeCoordinates); without it there are none (count = 0).
+struct SleeveLoads {
+  int count = 0;
+  std::array<int, 4> rope{};    ///< 1 or 2
+  std::array<double, 4> x{};    ///< depth of the load [m]
+  std::array<double, 4> f{};    ///< force on the rope, +y [N]
+};
+
 enum class Method { Fast, Paper };
 const char* toString(Method m);
 
@@ -59,8 +71,12 @@ class Solver {
   /// Lateral displacement of both guide ropes at depths x (same size outputs).
   virtual void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const = 0;
 
-  /// Guide-rope modal coordinates in the sine basis of Eq. (13) (q_1,i and q_2,i).
+  /// Guide-rope modal coordinates in the sine basis of Eq. (13) (q_1,i and q_2,i):
+  /// the modal part of the shape (see SleeveLoads for the rest).
   virtual void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const = 0;
+
+  /// The point loads that complete the shape (static correction); none by default.
+  virtual void residualSleeveLoads(SleeveLoads& out) const { out.count = 0; }
 
   /// All state values finite.
   virtual bool finite() const = 0;
@@ -82,8 +98,8 @@ std::unique_ptr<Solver> makeSolver(Method method, std::shared_ptr<const ShaftMod
 /// given solver is NOT guaranteed -- use GuideRopeEnvelope for real time).
 double maxGuideRopeDeflection(const Solver& s, int samples = 401);
 
-/// Real-time helper: precomputed sine table on a fixed depth grid; evaluate()
-/// allocates nothing.
+/// Real-time helper: precomputed sine table (and, for the static correction,
+/// S_r(x) of both ropes) on a fixed depth grid; evaluate() allocates nothing.
 class GuideRopeEnvelope {
  public:
   GuideRopeEnvelope(const ShaftModel& model, int samples = 401);
@@ -96,6 +112,8 @@ class GuideRopeEnvelope {
  private:
   VectorXd x_;
   MatrixXd table_;  // samples x n
+  VectorXd S1_, S2_;  // S_r(x) on the grid (Green's function of the sleeve loads)
+  double SL1_ = 0.0, SL2_ = 0.0;
   VectorXd q1_, q2_, y1_, y2_;
 };
 

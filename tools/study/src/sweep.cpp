@@ -43,6 +43,7 @@ const std::vector<KeyInfo>& keyTable() {
       {"model.modes", "n, assumed modes per rope (integer)"},
       {"model.gravity", "g [m/s^2]"},
       {"model.rho_inf", "integrator spectral radius in [0, 1)"},
+      {"model.static_correction", "residual flexibility of the guide ropes: 1 on, 0 off"},
   };
   return k;
 }
@@ -110,7 +111,10 @@ void applyParameter(ShaftParams& p, const std::string& key, double value) {
     p.n = static_cast<int>(value);
   } else if (key == "model.gravity") p.g = value;
   else if (key == "model.rho_inf") p.rho_inf = value;
-  else {
+  else if (key == "model.static_correction") {
+    if (value != 0.0 && value != 1.0) throw ParamError(key, "must be 1 (on) or 0 (off), got " + fmt(value));
+    p.static_correction = value == 1.0;
+  } else {
     std::string list;
     for (const auto& k : sweepableKeys()) list += (list.empty() ? "" : ", ") + k;
     throw ParamError(key, "unknown or unsweepable key; valid keys: " + list);
@@ -137,6 +141,7 @@ double parameterValue(const ShaftParams& p, const std::string& key) {
   if (key == "model.modes") return p.n;
   if (key == "model.gravity") return p.g;
   if (key == "model.rho_inf") return p.rho_inf;
+  if (key == "model.static_correction") return p.static_correction ? 1.0 : 0.0;
   throw ParamError(key, "unknown key");
 }
 
