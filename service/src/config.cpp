@@ -8,30 +8,11 @@
 #include <sstream>
 
 #include "hoist/io/config.hpp"
+#include "hoist/io/toml_section.hpp"
 
 namespace hoist::svc {
 
 const char* toString(ClockMode c) { return c == ClockMode::Wall ? "wall" : "input"; }
-
-namespace {
-std::string configMessage(const std::string& source, int line, const std::string& key,
-                          const std::string& msg) {
-  std::string s = source;
-  if (line > 0) {
-    s += ':';
-    s += std::to_string(line);
-  }
-  s += ": ";
-  s += key;
-  s += ": ";
-  s += msg;
-  return s;
-}
-}  // namespace
-
-ConfigError::ConfigError(const std::string& source, int line, const std::string& key,
-                         const std::string& msg)
-    : std::runtime_error(configMessage(source, line, key, msg)), key_(key) {}
 
 namespace {
 
@@ -74,91 +55,12 @@ void ServiceConfig::validate() const {
 
 namespace {
 
-int lineOf(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
-
-/// Reads one section with a fixed set of keys; unknown keys are errors.
-class SectionReader {
- public:
-  SectionReader(const toml::table& root, const char* section, const std::string& source)
-      : section_(section), source_(source) {
-    const toml::node* n = root.get(section);
-    if (!n) return;
-    tbl_ = n->as_table();
-    if (!tbl_) throw ConfigError(source, lineOf(*n), section, "must be a table ([" + std::string(section) + "])");
-  }
-
-  void number(const char* key, double& out) {
-    handlers_[key] = [this, key, &out](const toml::node& n) {
-      if (auto i = n.as_integer()) out = static_cast<double>(i->get());
-      else if (auto f = n.as_floating_point()) out = f->get();
-      else fail(n, key, "must be a number");
-      if (!std::isfinite(out)) fail(n, key, "must be finite");
-    };
-  }
-  void integer(const char* key, int& out) {
-    handlers_[key] = [this, key, &out](const toml::node& n) {
-      auto i = n.as_integer();
-      if (!i) fail(n, key, "must be an integer");
-      if (i->get() < -1000000000 || i->get() > 1000000000) fail(n, key, "out of range");
-      out = static_cast<int>(i->get());
-    };
-  }
-  void boolean(const char* key, bool& out) {
-    handlers_[key] = [this, key, &out](const toml::node& n) {
-      auto b = n.as_boolean();
-      if (!b) fail(n, key, "must be true or false");
-      out = b->get();
-    };
-  }
-  void string(const char* key, std::function<void(const toml::node&, const std::string&)> set) {
-    handlers_[key] = [this, key, set](const toml::node& n) {
-      auto s = n.as_string();
-      if (!s) fail(n, key, "must be a string");
-      set(n, s->get());
-    };
-  }
-
-  /// Apply all handlers; returns the line of the section (for validate errors).
-  void run() {
-    if (!tbl_) return;
-    for (auto&& [k, node] : *tbl_) {
-      auto it = handlers_.find(std::string(k.str()));
-      if (it == handlers_.end()) {
-        std::string known;
-        for (auto& h : handlers_) known += (known.empty() ? "" : ", ") + h.first;
-        fail(node, std::string(k.str()), "unknown key (known: " + known + ")");
-      }
-      it->second(node);
-      lines_[it->first] = lineOf(node);
-    }
-  }
-  int lineOfKey(const std::string& key) const {
-    auto it = lines_.find(key);
-    if (it != lines_.end()) return it->second;
-    return tbl_ ? lineOf(*tbl_) : 0;
-  }
-  [[noreturn]] void fail(const toml::node& n, const std::string& key, const std::string& why) const {
-    throw ConfigError(source_, lineOf(n), std::string(section_) + "." + key, why);
-  }
-
- private:
-  const char* section_;
-  std::string source_;
-  const toml::table* tbl_ = nullptr;
-  std::map<std::string, std::function<void(const toml::node&)>> handlers_;
-  std::map<std::string, int> lines_;
-};
+using hoist::io::SectionReader;
 
 /// Rethrow a validate() error ("section.key: why") with the file and line.
 [[noreturn]] void rethrowWithPosition(const std::invalid_argument& e, const std::string& source,
-                                      const SectionReader& r, const std::string& section) {
-  std::string what = e.what();
-  const auto colon = what.find(": ");
-  std::string key = colon == std::string::npos ? section : what.substr(0, colon);
-  std::string why = colon == std::string::npos ? what : what.substr(colon + 2);
-  const auto dot = key.find('.');
-  const int line = r.lineOfKey(dot == std::string::npos ? key : key.substr(dot + 1));
-  throw ConfigError(source, line, key, why);
+                                      const SectionReader& r) {
+  hoist::io::rethrowWithLine(e.what(), source, {&r}, true);
 }
 
 }  // namespace
@@ -193,7 +95,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   try {
     s.validate();
   } catch (const std::invalid_argument& e) {
-    rethrowWithPosition(e, source, sr, "service");
+    rethrowWithPosition(e, source, sr);
   }
 
   AlarmConfig& a = cfg.alarms;
@@ -213,7 +115,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   try {
     a.validate();
   } catch (const std::invalid_argument& e) {
-    rethrowWithPosition(e, source, ar, "alarms");
+    rethrowWithPosition(e, source, ar);
   }
 }
 
@@ -241,16 +143,7 @@ std::ostream& operator<<(std::ostream& os, Num n) {
 
 std::string toToml(const TwinConfig& c) {
   std::ostringstream os;
-  const ShaftParams& p = c.shaft;
-  os << "# hoist-twind effective configuration\n"
-     << "[hoisting_rope]\nmass_per_length = " << Num{p.rho1} << "\naxial_stiffness = " << Num{p.EA}
-     << "\ndamping = " << Num{p.u1} << "\ninitial_length = " << Num{p.l0} << "\n\n"
-     << "[guide_ropes]\nlength = " << Num{p.L} << "\nmass_per_length = " << Num{p.rho2}
-     << "\ndamping = " << Num{p.u2} << "\npreload = [" << Num{p.Tb1} << ", " << Num{p.Tb2} << "]\n\n"
-     << "[cage]\nmass = " << Num{p.m} << "\ninertia = " << Num{p.J} << "\nhalf_height = " << Num{p.h} << "\n\n"
-     << "[load]\neccentric_force = " << Num{p.Fa} << "\noffset = " << Num{p.b} << "\n\n"
-     << "[model]\nmodes = " << p.n << "\ngravity = " << Num{p.g} << "\ninitial = \""
-     << toString(p.initial) << "\"\nrho_inf = " << Num{p.rho_inf} << "\n\n";
+  os << "# hoist-twind effective configuration\n" << hoist::io::toToml(c.shaft) << "\n";
   const ServiceConfig& s = c.service;
   os << "[service]\nrate = " << Num{s.rate} << "\ncage_rate = " << Num{s.cage_rate}
      << "\nshape_rate = " << Num{s.shape_rate} << "\nhealth_rate = " << Num{s.health_rate}

@@ -1,5 +1,5 @@
 // hoist/service/config.hpp -- the daemon's configuration: the shaft TOML
-// (sections of INTERFACES.md, parsed by hoist_io) plus [service] and [alarms].
+// (sections of hoist::kParamFields, parsed by hoist_io) plus [service] and [alarms].
 // Every key is optional; a missing key takes the default below (the shaft's
 // defaults are the paper's values).  Unknown keys, wrong types, non-finite or
 // out-of-range values are errors naming the file, line and dotted key.
@@ -10,6 +10,7 @@
 
 #include <toml++/toml.h>
 
+#include "hoist/io/error.hpp"
 #include "hoist/params.hpp"
 #include "hoist/service/alarms.hpp"
 
@@ -54,22 +55,15 @@ struct TwinConfig {
 };
 
 /// A configuration error; what() is "<file>:<line>: <key>: <message>" (the
-/// line is omitted when unknown).
-class ConfigError : public std::runtime_error {
- public:
-  ConfigError(const std::string& source, int line, const std::string& key, const std::string& msg);
-  const std::string& key() const { return key_; }
-
- private:
-  std::string key_;
-};
+/// line is omitted when unknown).  The one type of hoist_io.
+using ConfigError = hoist::io::ConfigError;
 
 /// Parse [service] and [alarms] from `tbl` into `cfg` (other sections are
 /// ignored here).  Throws ConfigError.
 void parseServiceSections(const toml::table& tbl, const std::string& source, TwinConfig& cfg);
 
 /// The whole configuration from a TOML file (shaft sections through hoist_io,
-/// plus [service] and [alarms]).  Throws (ConfigError or hoist_io's error).
+/// plus [service] and [alarms]).  Throws ConfigError.
 TwinConfig loadTwinConfig(const std::string& path);
 
 /// The effective configuration as TOML (for --print-config).
