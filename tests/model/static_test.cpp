@@ -1,5 +1,5 @@
 // Static equilibrium: the solver's static start against an exact (n -> inf)
-// solution of the continuous problem, MODEL.md's static check, the hoisting
+// solution of the continuous problem, docs/model.md's static check, the hoisting
 // rope's stretch, and convergence in the number of modes.
 #include <gtest/gtest.h>
 
@@ -9,62 +9,13 @@
 #include "hoist/fast_solver.hpp"
 #include "hoist/paper_solver.hpp"
 #include "hoist/solver.hpp"
+#include "exact_static.hpp"
 
 using namespace hoist;
+using hoist::test::ExactStatic;
+using hoist::test::exactStatic;
 
 namespace {
-
-/// Exact static solution of the continuous model (strings with tension
-/// T_r(x) = Tb_r + rho2 g (L - x), rigid cage on four sleeves).  Green's
-/// function of -(T y')' = delta(x - s), y(0) = y(L) = 0:
-///   y(x) = phi(min) (phi(L) - phi(max)) / phi(L),  phi(x) = Int_0^x ds / T(s).
-struct ExactStatic {
-  double y_c, theta;
-  double lambda[4];
-};
-
-ExactStatic exactStatic(const ShaftParams& p, double l) {
-  auto phi = [&](double Tb, double x) {
-    if (p.g == 0.0) return x / Tb;
-    const double rg = p.rho2 * p.g;
-    return std::log((Tb + rg * p.L) / (Tb + rg * (p.L - x))) / rg;
-  };
-  auto green = [&](double Tb, double x, double s) {
-    const double lo = std::min(x, s), hi = std::max(x, s);
-    return phi(Tb, lo) * (phi(Tb, p.L) - phi(Tb, hi)) / phi(Tb, p.L);
-  };
-  const double xt = l, xb = l + 2 * p.h;
-  // unknowns: lambda1..4, y_c, theta
-  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
-  // g1: y1(l) + h th - y_c = 0, rope 1 carries lambda1 at l, lambda4 at l+2h.
-  A(0, 0) = green(p.Tb1, xt, xt);
-  A(0, 3) = green(p.Tb1, xt, xb);
-  A(0, 4) = -1;
-  A(0, 5) = p.h;
-  // g2: y2(l) + h th - y_c, rope 2 carries lambda2 at l, lambda3 at l+2h.
-  A(1, 1) = green(p.Tb2, xt, xt);
-  A(1, 2) = green(p.Tb2, xt, xb);
-  A(1, 4) = -1;
-  A(1, 5) = p.h;
-  // g3: y2(l+2h) - h th - y_c
-  A(2, 1) = green(p.Tb2, xb, xt);
-  A(2, 2) = green(p.Tb2, xb, xb);
-  A(2, 4) = -1;
-  A(2, 5) = -p.h;
-  // g4: y1(l+2h) - h th - y_c
-  A(3, 0) = green(p.Tb1, xb, xt);
-  A(3, 3) = green(p.Tb1, xb, xb);
-  A(3, 4) = -1;
-  A(3, 5) = -p.h;
-  // cage: sum lambda = 0 (no lateral load); Fa b + h(l1 + l2) - h(l3 + l4) = 0
-  A(4, 0) = A(4, 1) = A(4, 2) = A(4, 3) = 1;
-  A(5, 0) = A(5, 1) = p.h;
-  A(5, 2) = A(5, 3) = -p.h;
-  rhs(5) = -p.Fa * p.b;
-  const Eigen::Matrix<double, 6, 1> s = A.fullPivLu().solve(rhs);
-  return {s(4), s(5), {s(0), s(1), s(2), s(3)}};
-}
 
 CageResponse staticAt(ShaftParams p, double l, Method m = Method::Fast) {
   auto model = std::make_shared<const ShaftModel>(p);
@@ -74,7 +25,7 @@ CageResponse staticAt(ShaftParams p, double l, Method m = Method::Fast) {
 }
 
 TEST(Static, ModelCheckOfModelMd) {
-  // MODEL.md: n = 50 baseline, lambda = (-31.25, -31.25, +31.25, +31.25) N
+  // docs/model.md: n = 50 baseline, lambda = (-31.25, -31.25, +31.25, +31.25) N
   // = Fa b / (4 h), theta_static about 7-8e-4 rad for l = 50..300 m.
   const ShaftParams p;
   for (double l : {50.0, 100.0, 150.0, 200.0, 250.0, 300.0}) {
@@ -122,7 +73,7 @@ TEST(Static, LateralConvergesToExactContinuumSolution) {
   ShaftParams base;
   const double l = 50.0;
   const ExactStatic ex = exactStatic(base, l);
-  // MODEL.md / case README: converged theta at l = 50 m is about 8.05e-4 rad.
+  // docs/model.md / case README: converged theta at l = 50 m is about 8.05e-4 rad.
   EXPECT_NEAR(ex.theta, 8.05e-4, 0.01e-4);
   std::cout << "exact (continuum) at l = 50 m: theta = " << ex.theta << " rad, y_c = " << ex.y_c << " m\n";
   std::cout << "    n      theta_static   theta/exact     y_c_static   y_c/exact\n";
@@ -187,7 +138,7 @@ TEST(Static, FastAndPaperPathsAgreeAcrossTheShaft) {
 }
 
 TEST(Static, PaperPartitionConditionMatchesModelMd) {
-  // MODEL.md: cond(G0) is 78 at l = 50 m, 8 at 192 m, 512 at 370 m, 1.6e4 at 383 m.
+  // docs/model.md: cond(G0) is 78 at l = 50 m, 8 at 192 m, 512 at 370 m, 1.6e4 at 383 m.
   ShaftParams p;
   p.n = 5;
   PaperSolver s(std::make_shared<const ShaftModel>(p));
