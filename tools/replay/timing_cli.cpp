@@ -9,7 +9,8 @@
 
 #include "cli_util.hpp"
 #include "hoist/io/config.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/channels.hpp"
+#include "hoist/bus/lcm_util.hpp"
 #include "timing_test.hpp"
 
 namespace hoist::replay {
@@ -90,7 +91,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  url = hoist::svc::resolveLcmUrl(url);
+  url = hoist::bus::resolveLcmUrl(url);
 
   TimingTestOptions o;
   if (!(rate >= 1.0 && rate <= 1000.0)) {

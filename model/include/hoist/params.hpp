@@ -1,6 +1,6 @@
 // hoist/params.hpp -- every symbol of Wang et al. (2016), Section 2-3, as one
 // validated value type.  SI units throughout.  No I/O here: loading from TOML
-// lives in tools/io (hoist_io); this header only states and checks values.
+// lives in io/ (hoist_io); this header only states and checks values.
 //
 // Frame (x down from the shaft top, y lateral, theta): model/include/hoist/solver.hpp
 // and docs/model.md "Frame and signs".
