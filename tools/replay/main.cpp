@@ -141,12 +141,7 @@ int main(int argc, char** argv) {
   app.add_flag("--with-length", with_length, "include the encoder rope length l in every message");
   app.add_flag("--restamp", restamp, "--lcm-log: rewrite utime to the replay's wall clock");
   app.add_flag("-q,--quiet", quiet, "no progress display");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::replay::parseCommandLine(app, argc, argv)) return *rc;
 
   url = hoist::bus::resolveLcmUrl(url);
   if (prefixes.size() > 1) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -85,12 +86,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   budget("--max-e2e-p99-us", b_e2e_p99, "budget: end-to-end latency p99, input publish -> cage output received [us]");
   budget("--max-rejected", budgets.max_rejected, "budget: inputs rejected by the daemon (default 0)");
   app.add_option("--report", report_path, "also write the Markdown report to FILE");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = parseCommandLine(app, argc, argv)) return *rc;
   url = hoist::bus::resolveLcmUrl(url);
 
   TimingTestOptions o;
