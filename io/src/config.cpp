@@ -184,9 +184,10 @@ std::string toToml(const ShaftParams& p) {
       }
       value += "]";
     }
+    // "rho1, kg/m"; without a unit, the meaning: "n: assumed modes per rope (integer)".
     std::string comment = symbols;
     if (!f.unit.empty()) comment += (comment.empty() ? "" : ", ") + std::string(f.unit);
-    if (comment.empty()) comment = f.doc;
+    else comment += (comment.empty() ? "" : ": ") + std::string(f.doc);
     out += std::string(f.name) + " = " + value + "   # " + comment + "\n";
   }
   return out;

@@ -131,12 +131,6 @@ inline CapturedRun runCaptured(const std::string& exe, const std::vector<std::st
   return r;
 }
 
-inline std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 #ifdef HOIST_TEST_WORK_DIR
 /// A fresh directory for one test's files.
