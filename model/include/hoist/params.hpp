@@ -195,7 +195,7 @@ inline constexpr std::array<ParamField, 19> kParamFields = {{
                  "generalized-alpha spectral radius at infinite frequency", -1, 0.0, 1.0),
     ParamField{"model", "static_correction", -1, ParamType::Boolean, nullptr, nullptr,
                &ShaftParams::static_correction, nullptr, "", "", ParamBound::None, 0.0, 0.0, true,
-               "add the quasi-static correction: true or false (1 or 0 as a --param value)"},
+               "add the quasi-static correction (true or false)"},
 }};
 
 /// The sections of kParamFields in file order.
