@@ -104,7 +104,7 @@ void PaperSolver::assemble(const Kinematics& k, PaperSystem& s) const {
     s.G(row, q_of_p_[3 * n + 1]) = -1.0;
     s.G(row, q_of_p_[3 * n + 2]) = t ? p.h : -p.h;
   }
-  // ---- Eqs. (19)-(20) and the l-derivatives of Phi (MODEL.md) ------------------
+  // ---- Eqs. (19)-(20) and the l-derivatives of Phi (docs/model.md) ------------------
   s.G0 = s.G.leftCols(5);
   const Eigen::PartialPivLU<Eigen::Matrix<double, 5, 5>> G0lu(s.G0);
   const int n1 = n1_;

@@ -16,50 +16,82 @@ std::string fmt(double v) {
   return os.str();
 }
 
-void requireFinite(const char* key, double v) {
-  if (!std::isfinite(v)) throw ParamError(key, "must be a finite number (got " + fmt(v) + ")");
-}
-void requirePositive(const char* key, double v) {
-  requireFinite(key, v);
-  if (!(v > 0.0)) throw ParamError(key, "must be > 0 (got " + fmt(v) + ")");
-}
-void requireNonNegative(const char* key, double v) {
-  requireFinite(key, v);
-  if (!(v >= 0.0)) throw ParamError(key, "must be >= 0 (got " + fmt(v) + ")");
-}
-
 }  // namespace
 
+std::string ParamField::key() const { return std::string(section) + "." + std::string(name); }
+
+std::string ParamField::element() const {
+  return index < 0 ? key() : key() + "[" + std::to_string(index) + "]";
+}
+
+double ParamField::get(const ShaftParams& p) const {
+  switch (type) {
+    case ParamType::Real: return p.*real;
+    case ParamType::Integer: return p.*integer;
+    case ParamType::Boolean: return p.*boolean ? 1.0 : 0.0;
+    case ParamType::Initial: return p.*initial == InitialState::Static ? 0.0 : 1.0;
+  }
+  return 0.0;
+}
+
+void ParamField::set(ShaftParams& p, double v) const {
+  switch (type) {
+    case ParamType::Real: p.*real = v; break;
+    case ParamType::Integer: p.*integer = static_cast<int>(v); break;
+    case ParamType::Boolean: p.*boolean = v != 0.0; break;
+    case ParamType::Initial: p.*initial = v == 0.0 ? InitialState::Static : InitialState::Rest; break;
+  }
+}
+
+std::string ParamField::check(double v) const {
+  if (type == ParamType::Integer) {
+    if (bound == ParamBound::Closed && !(v >= lo && v <= hi))
+      return "must be between " + fmt(lo) + " and " + fmt(hi) + " (got " + fmt(v) + ")";
+    return {};
+  }
+  if (bound == ParamBound::None) return {};
+  if (!std::isfinite(v)) return "must be a finite number (got " + fmt(v) + ")";
+  switch (bound) {
+    case ParamBound::Positive:
+      if (!(v > 0.0)) return "must be > 0 (got " + fmt(v) + ")";
+      break;
+    case ParamBound::NonNegative:
+      if (!(v >= 0.0)) return "must be >= 0 (got " + fmt(v) + ")";
+      break;
+    case ParamBound::Closed:
+      if (!(v >= lo && v <= hi)) return "must be in [" + fmt(lo) + ", " + fmt(hi) + "] (got " + fmt(v) + ")";
+      break;
+    default: break;
+  }
+  return {};
+}
+
+const ParamField* findParam(std::string_view key) {
+  for (const auto& f : kParamFields)
+    if (f.element() == key || (f.index < 0 && f.key() == key)) return &f;
+  return nullptr;
+}
+
+std::vector<const ParamField*> paramFieldsOf(std::string_view section, std::string_view name) {
+  std::vector<const ParamField*> out;
+  for (const auto& f : kParamFields)
+    if (f.section == section && f.name == name) out.push_back(&f);
+  return out;
+}
+
 void ShaftParams::validate() const {
-  requirePositive("hoisting_rope.mass_per_length", rho1);
-  requirePositive("hoisting_rope.axial_stiffness", EA);
-  requireNonNegative("hoisting_rope.damping", u1);
-  requirePositive("guide_ropes.length", L);
-  requirePositive("guide_ropes.mass_per_length", rho2);
-  requireNonNegative("guide_ropes.damping", u2);
-  requirePositive("guide_ropes.preload", Tb1);
-  requirePositive("guide_ropes.preload", Tb2);
-  requirePositive("cage.mass", m);
-  requirePositive("cage.inertia", J);
-  requirePositive("cage.half_height", h);
+  // Each value on its own, in table order.
+  for (const auto& f : kParamFields)
+    if (std::string why = f.check(f.get(*this)); !why.empty()) throw ParamError(f.key(), why);
+  // Relations between values.
   if (!(2.0 * h < L))
     throw ParamError("cage.half_height", "cage height 2h = " + fmt(2.0 * h) +
                                              " m must be shorter than the guide ropes (guide_ropes.length = " +
                                              fmt(L) + " m)");
-  requireFinite("load.eccentric_force", Fa);
-  requireFinite("load.offset", b);
-  requireNonNegative("model.gravity", g);
-  if (n < 1 || n > kMaxModes)
-    throw ParamError("model.modes", "must be between 1 and " + std::to_string(kMaxModes) + " (got " +
-                                        std::to_string(n) + ")");
-  requirePositive("hoisting_rope.initial_length", l0);
   if (!(l0 < maxRopeLength()))
     throw ParamError("hoisting_rope.initial_length",
                      "must be < L - 2h = " + fmt(maxRopeLength()) + " m so the cage is inside the guide ropes (got " +
                          fmt(l0) + ")");
-  requireFinite("model.rho_inf", rho_inf);
-  if (!(rho_inf >= 0.0 && rho_inf <= 1.0))
-    throw ParamError("model.rho_inf", "must be in [0, 1] (got " + fmt(rho_inf) + ")");
   // Physical sanity: the cage rotation must be small for the linearized
   // constraints (Eq. 8) to hold.  A static tilt estimate is Fa b / (torsional
   // stiffness); we cannot bound it cheaply here, so only reject absurd offsets.

@@ -134,7 +134,7 @@ void ShaftModel::hoistingRopeMatrices(double l, double v, double a, HoistingRope
   out.C = MatrixXd::Identity(n, n) * (rho1 * v + p_.u1 * l);
   out.K = ((p_.EA / l) * H.k.array().square()).matrix().asDiagonal();
   if (!printed) {
-    // MODEL.md (corrected): i = equation row, j = coordinate column.
+    // docs/model.md (corrected): i = equation row, j = coordinate column.
     out.C += rho1 * v * H.A_gyro;
     out.K += rho1 * a * H.A_acc - p_.u1 * v * H.A_vel - (rho1 * v * v / l) * H.A_cent;
   } else {

@@ -1,35 +1,15 @@
-// Daemon configuration (plain structs, validation, TOML output): see
-// hoist/service/config.hpp.  Reading TOML lives in config_file.cpp.
+// Daemon configuration (plain structs and their validation): see
+// hoist/service/config.hpp.  Reading and writing TOML
+// lives in config_file.cpp.
 #include "hoist/service/config.hpp"
 
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <sstream>
 
 namespace hoist::svc {
 
 const char* toString(ClockMode c) { return c == ClockMode::Wall ? "wall" : "input"; }
-
-namespace {
-std::string configMessage(const std::string& source, int line, const std::string& key,
-                          const std::string& msg) {
-  std::string s = source;
-  if (line > 0) {
-    s += ':';
-    s += std::to_string(line);
-  }
-  s += ": ";
-  s += key;
-  s += ": ";
-  s += msg;
-  return s;
-}
-}  // namespace
-
-ConfigError::ConfigError(const std::string& source, int line, const std::string& key,
-                         const std::string& msg)
-    : std::runtime_error(configMessage(source, line, key, msg)), key_(key) {}
 
 namespace {
 
@@ -68,54 +48,6 @@ void ServiceConfig::validate() const {
   for (char c : channel_prefix)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '/'))
       bad("service.channel_prefix", "may contain only letters, digits and _ - . /");
-}
-
-namespace {
-/// A double as a TOML float: shortest round-trip form, always with '.' or 'e'.
-struct Num {
-  double v;
-};
-std::ostream& operator<<(std::ostream& os, Num n) {
-  char buf[64];
-  auto r = std::to_chars(buf, buf + sizeof buf, n.v);
-  std::string s(buf, r.ptr);
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";
-  return os << s;
-}
-}  // namespace
-
-std::string toToml(const TwinConfig& c) {
-  std::ostringstream os;
-  const ShaftParams& p = c.shaft;
-  os << "# hoist-twind effective configuration\n"
-     << "[hoisting_rope]\nmass_per_length = " << Num{p.rho1} << "\naxial_stiffness = " << Num{p.EA}
-     << "\ndamping = " << Num{p.u1} << "\ninitial_length = " << Num{p.l0} << "\n\n"
-     << "[guide_ropes]\nlength = " << Num{p.L} << "\nmass_per_length = " << Num{p.rho2}
-     << "\ndamping = " << Num{p.u2} << "\npreload = [" << Num{p.Tb1} << ", " << Num{p.Tb2} << "]\n\n"
-     << "[cage]\nmass = " << Num{p.m} << "\ninertia = " << Num{p.J} << "\nhalf_height = " << Num{p.h} << "\n\n"
-     << "[load]\neccentric_force = " << Num{p.Fa} << "\noffset = " << Num{p.b} << "\n\n"
-     << "[model]\nmodes = " << p.n << "\ngravity = " << Num{p.g} << "\ninitial = \""
-     << toString(p.initial) << "\"\nrho_inf = " << Num{p.rho_inf}
-     << "\nstatic_correction = " << (p.static_correction ? "true" : "false") << "\n\n";
-  const ServiceConfig& s = c.service;
-  os << "[service]\nrate = " << Num{s.rate} << "\ncage_rate = " << Num{s.cage_rate}
-     << "\nshape_rate = " << Num{s.shape_rate} << "\nhealth_rate = " << Num{s.health_rate}
-     << "\nchannel_prefix = \"" << s.channel_prefix << "\"\nlcm_url = \"" << s.lcm_url
-     << "\"\nclock = \"" << toString(s.clock) << "\"\nmax_speed = " << Num{s.max_speed}
-     << "\nmax_accel = " << Num{s.max_accel} << "\nmax_length_jump = " << Num{s.max_length_jump}
-     << "\nmax_time_step = " << Num{s.max_time_step} << "\nstale_timeout = " << Num{s.stale_timeout}
-     << "\nstale_periods = " << Num{s.stale_periods} << "\nstale_min = " << Num{s.stale_min}
-     << "\nmax_step = " << Num{s.max_step} << "\nshape_points = " << s.shape_points
-     << "\nenvelope_points = " << s.envelope_points << "\nlog_rate_limit = " << s.log_rate_limit
-     << "\nfault_hold = " << Num{s.fault_hold} << "\n\n";
-  const AlarmConfig& a = c.alarms;
-  os << "[alarms]\ngap_pos_y = " << Num{a.gap_pos_y} << "\ngap_neg_y = " << Num{a.gap_neg_y}
-     << "\nguide_rope_gap = " << Num{a.guide_rope_gap} << "\nwarning_fraction = " << Num{a.warning_fraction}
-     << "\ncritical_fraction = " << Num{a.critical_fraction} << "\ndeadband = " << Num{a.deadband}
-     << "\non_delay = " << Num{a.on_delay} << "\noff_delay = " << Num{a.off_delay}
-     << "\nreannounce = " << Num{a.reannounce} << "\nlatch_critical = "
-     << (a.latch_critical ? "true" : "false") << "\nmax_shelve = " << Num{a.max_shelve} << "\n";
-  return os.str();
 }
 
 }  // namespace hoist::svc

@@ -1,101 +1,25 @@
 // Reading the daemon's configuration from TOML: see hoist/service/config_file.hpp.
 #include "hoist/service/config_file.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <functional>
-#include <map>
+#include <ostream>
+#include <sstream>
 
 #include "hoist/io/config.hpp"
+#include "hoist/io/toml_section.hpp"
 
 namespace hoist::svc {
 
 namespace {
 
-int lineOf(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
-
-/// Reads one section with a fixed set of keys; unknown keys are errors.
-class SectionReader {
- public:
-  SectionReader(const toml::table& root, const char* section, const std::string& source)
-      : section_(section), source_(source) {
-    const toml::node* n = root.get(section);
-    if (!n) return;
-    tbl_ = n->as_table();
-    if (!tbl_) throw ConfigError(source, lineOf(*n), section, "must be a table ([" + std::string(section) + "])");
-  }
-
-  void number(const char* key, double& out) {
-    handlers_[key] = [this, key, &out](const toml::node& n) {
-      if (auto i = n.as_integer()) out = static_cast<double>(i->get());
-      else if (auto f = n.as_floating_point()) out = f->get();
-      else fail(n, key, "must be a number");
-      if (!std::isfinite(out)) fail(n, key, "must be finite");
-    };
-  }
-  void integer(const char* key, int& out) {
-    handlers_[key] = [this, key, &out](const toml::node& n) {
-      auto i = n.as_integer();
-      if (!i) fail(n, key, "must be an integer");
-      if (i->get() < -1000000000 || i->get() > 1000000000) fail(n, key, "out of range");
-      out = static_cast<int>(i->get());
-    };
-  }
-  void boolean(const char* key, bool& out) {
-    handlers_[key] = [this, key, &out](const toml::node& n) {
-      auto b = n.as_boolean();
-      if (!b) fail(n, key, "must be true or false");
-      out = b->get();
-    };
-  }
-  void string(const char* key, std::function<void(const toml::node&, const std::string&)> set) {
-    handlers_[key] = [this, key, set](const toml::node& n) {
-      auto s = n.as_string();
-      if (!s) fail(n, key, "must be a string");
-      set(n, s->get());
-    };
-  }
-
-  /// Apply all handlers; returns the line of the section (for validate errors).
-  void run() {
-    if (!tbl_) return;
-    for (auto&& [k, node] : *tbl_) {
-      auto it = handlers_.find(std::string(k.str()));
-      if (it == handlers_.end()) {
-        std::string known;
-        for (auto& h : handlers_) known += (known.empty() ? "" : ", ") + h.first;
-        fail(node, std::string(k.str()), "unknown key (known: " + known + ")");
-      }
-      it->second(node);
-      lines_[it->first] = lineOf(node);
-    }
-  }
-  int lineOfKey(const std::string& key) const {
-    auto it = lines_.find(key);
-    if (it != lines_.end()) return it->second;
-    return tbl_ ? lineOf(*tbl_) : 0;
-  }
-  [[noreturn]] void fail(const toml::node& n, const std::string& key, const std::string& why) const {
-    throw ConfigError(source_, lineOf(n), std::string(section_) + "." + key, why);
-  }
-
- private:
-  const char* section_;
-  std::string source_;
-  const toml::table* tbl_ = nullptr;
-  std::map<std::string, std::function<void(const toml::node&)>> handlers_;
-  std::map<std::string, int> lines_;
-};
+using hoist::io::SectionReader;
 
 /// Rethrow a validate() error ("section.key: why") with the file and line.
 [[noreturn]] void rethrowWithPosition(const std::invalid_argument& e, const std::string& source,
-                                      const SectionReader& r, const std::string& section) {
-  std::string what = e.what();
-  const auto colon = what.find(": ");
-  std::string key = colon == std::string::npos ? section : what.substr(0, colon);
-  std::string why = colon == std::string::npos ? what : what.substr(colon + 2);
-  const auto dot = key.find('.');
-  const int line = r.lineOfKey(dot == std::string::npos ? key : key.substr(dot + 1));
-  throw ConfigError(source, line, key, why);
+                                      const SectionReader& r) {
+  hoist::io::rethrowWithLine(e.what(), source, {&r}, true);
 }
 
 }  // namespace
@@ -130,7 +54,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   try {
     s.validate();
   } catch (const std::invalid_argument& e) {
-    rethrowWithPosition(e, source, sr, "service");
+    rethrowWithPosition(e, source, sr);
   }
 
   AlarmConfig& a = cfg.alarms;
@@ -150,7 +74,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   try {
     a.validate();
   } catch (const std::invalid_argument& e) {
-    rethrowWithPosition(e, source, ar, "alarms");
+    rethrowWithPosition(e, source, ar);
   }
 }
 
@@ -160,6 +84,44 @@ TwinConfig loadTwinConfig(const std::string& path) {
   cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, {"service", "alarms"});
   parseServiceSections(tbl, path, cfg);
   return cfg;
+}
+
+namespace {
+/// A double as a TOML float: shortest round-trip form, always with '.' or 'e'.
+struct Num {
+  double v;
+};
+std::ostream& operator<<(std::ostream& os, Num n) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, n.v);
+  std::string s(buf, r.ptr);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return os << s;
+}
+}  // namespace
+
+std::string toToml(const TwinConfig& c) {
+  std::ostringstream os;
+  os << "# hoist-twind effective configuration\n" << hoist::io::toToml(c.shaft) << "\n";
+  const ServiceConfig& s = c.service;
+  os << "[service]\nrate = " << Num{s.rate} << "\ncage_rate = " << Num{s.cage_rate}
+     << "\nshape_rate = " << Num{s.shape_rate} << "\nhealth_rate = " << Num{s.health_rate}
+     << "\nchannel_prefix = \"" << s.channel_prefix << "\"\nlcm_url = \"" << s.lcm_url
+     << "\"\nclock = \"" << toString(s.clock) << "\"\nmax_speed = " << Num{s.max_speed}
+     << "\nmax_accel = " << Num{s.max_accel} << "\nmax_length_jump = " << Num{s.max_length_jump}
+     << "\nmax_time_step = " << Num{s.max_time_step} << "\nstale_timeout = " << Num{s.stale_timeout}
+     << "\nstale_periods = " << Num{s.stale_periods} << "\nstale_min = " << Num{s.stale_min}
+     << "\nmax_step = " << Num{s.max_step} << "\nshape_points = " << s.shape_points
+     << "\nenvelope_points = " << s.envelope_points << "\nlog_rate_limit = " << s.log_rate_limit
+     << "\nfault_hold = " << Num{s.fault_hold} << "\n\n";
+  const AlarmConfig& a = c.alarms;
+  os << "[alarms]\ngap_pos_y = " << Num{a.gap_pos_y} << "\ngap_neg_y = " << Num{a.gap_neg_y}
+     << "\nguide_rope_gap = " << Num{a.guide_rope_gap} << "\nwarning_fraction = " << Num{a.warning_fraction}
+     << "\ncritical_fraction = " << Num{a.critical_fraction} << "\ndeadband = " << Num{a.deadband}
+     << "\non_delay = " << Num{a.on_delay} << "\noff_delay = " << Num{a.off_delay}
+     << "\nreannounce = " << Num{a.reannounce} << "\nlatch_critical = "
+     << (a.latch_critical ? "true" : "false") << "\nmax_shelve = " << Num{a.max_shelve} << "\n";
+  return os.str();
 }
 
 }  // namespace hoist::svc

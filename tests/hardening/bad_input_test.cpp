@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "hoist/io/config.hpp"
+#include "process.hpp"
 #include "hoist/io/profile.hpp"
 
 namespace fs = std::filesystem;
@@ -207,33 +208,10 @@ TEST(ProfileCsv, CrlfAndBomAreAccepted) {
 // ---------------------------------------------------------------------------
 // The same classes through the tools: exit status 2 and a message naming the key.
 
-struct ToolRun {
-  int status = -1;
-  std::string output;
-};
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char ch : s) {
-    if (ch == '\'') q.append("'\\''");
-    else q.push_back(ch);
-  }
-  return q + "'";
-}
+using ToolRun = hoist::test::CapturedRun;
 
 ToolRun run(const std::string& exe, const std::vector<std::string>& args) {
-  std::string cmd = quote(exe);
-  for (const auto& a : args) cmd += " " + quote(a);
-  cmd += " 2>&1 </dev/null";
-  ToolRun r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
+  return hoist::test::runCaptured(exe, args);
 }
 
 fs::path workDir(const std::string& name) {

@@ -13,7 +13,7 @@
 
 #include <map>
 
-#include "../tools/lcm_test_util.hpp"
+#include "lcm_fixtures.hpp"
 #include "attack_bytes.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"

@@ -16,9 +16,12 @@
 #include "hoist/health_t.hpp"
 #include "hoist/service/twin_core.hpp"
 #include "hoist/service/winder_decode.hpp"
+#include "lcm_messages.hpp"
 
 using namespace hoist;
 using namespace hoist::svc;
+using hoist::test::encode;
+using hoist::test::winder;
 
 namespace {
 
@@ -30,24 +33,6 @@ TwinConfig smallConfig() {
   c.service.envelope_points = 51;
   c.service.shape_points = 11;
   return c;
-}
-
-template <class Msg>
-std::vector<std::uint8_t> encode(const Msg& m) {
-  std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(b.data(), 0, static_cast<int>(b.size()));
-  return b;
-}
-
-hoist::winder_t winder(std::int64_t seq, std::int64_t utime, double v = 0.0, double length = 100.0) {
-  hoist::winder_t m{};
-  m.utime = utime;
-  m.seq = seq;
-  m.v = v;
-  m.a = 0.0;
-  m.has_length = true;
-  m.length = length;
-  return m;
 }
 
 bool finiteOutput(const CageOutput& o) {

@@ -1,4 +1,4 @@
-// hoist_io: every rule of INTERFACES.md's file formats, accepted and rejected.
+// hoist_io: every rule of the file formats (docs/model.md, README), accepted and rejected.
 #include <gtest/gtest.h>
 
 #include <cmath>

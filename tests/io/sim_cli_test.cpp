@@ -1,4 +1,4 @@
-// hoist-sim as a program: INTERFACES.md's contract (columns, exit status 2 on
+// hoist-sim as a program: the documented contract (README, docs/model.md) (columns, exit status 2 on
 // bad input with a message naming the key/line), and agreement with the
 // independent reference solutions in tests/data at the default settings.
 #include <gtest/gtest.h>
@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "process.hpp"
 #include "test_util.hpp"
 
 namespace fs = std::filesystem;
@@ -18,35 +19,9 @@ using hoist::test::Table;
 
 namespace {
 
-struct SimRun {
-  int status = -1;
-  std::string output;  // stdout + stderr
-};
+using SimRun = hoist::test::CapturedRun;
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) {
-    if (c == '\'') q.append("'\\''");
-    else q.push_back(c);
-  }
-  q.push_back('\'');
-  return q;
-}
-
-SimRun sim(const std::vector<std::string>& args) {
-  std::string cmd = quote(HOIST_SIM);
-  for (const auto& a : args) cmd += " " + quote(a);
-  cmd += " 2>&1";
-  SimRun r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+SimRun sim(const std::vector<std::string>& args) { return hoist::test::runCaptured(HOIST_SIM, args); }
 
 class SimCli : public ::testing::Test {
  protected:

@@ -48,7 +48,7 @@ TEST_P(HoistingRopeIntegrals, ClosedFormsMatchQuadrature) {
                         std::abs(H.A_gyro(i - 1, j - 1) - gyro) / scale, std::abs(H.A_vel(i - 1, j - 1) - vel) / scale,
                         std::abs(H.A_cent(i - 1, j - 1) - cent) / scale,
                         std::abs(H.B_printed(i - 1, j - 1) - pr) / scale});
-      // MODEL.md closed forms: Int U_i U_j = delta_ij, Int U_i' U_j' = k_i^2 delta_ij.
+      // docs/model.md closed forms: Int U_i U_j = delta_ij, Int U_i' U_j' = k_i^2 delta_ij.
       EXPECT_NEAR(mass, i == j ? 1.0 : 0.0, 1e-11);
       const double k = (2.0 * i - 1) * kPi / 2;
       EXPECT_NEAR(stiff, i == j ? k * k : 0.0, 1e-9 * k * k);
@@ -173,7 +173,7 @@ TEST(HoistingRope, PrintedBlockDiffersFromCorrectedOnlyInTransposedAndSpuriousTe
   const auto& H = model.hoistingRope();
   const MatrixXd spurious = (p.rho1 * 25.0 / 120.0) * H.B_printed;
   EXPECT_LT((pr.K.transpose() - spurious.transpose() - c.K).cwiseAbs().maxCoeff(), 1e-6);
-  // ... and the difference is tiny against the elastic stiffness (MODEL.md).
+  // ... and the difference is tiny against the elastic stiffness (docs/model.md).
   EXPECT_LT((pr.K - c.K).norm() / c.K.norm(), 1e-4);
   EXPECT_GT((pr.K - c.K).norm(), 0.0);
 }

@@ -1,61 +1,19 @@
 // The fast path's step() and initialize() allocate nothing after start-up.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <cerrno>
 #include <new>
 
 #include "hoist/fast_solver.hpp"
 #include "hoist/simulator.hpp"
 
-// malloc and friends are interposed for the whole process (this executable's
-// definitions take precedence over libc's), so Eigen's aligned allocations
-// and operator new (which calls malloc) are both counted, whichever library
-// they come from.  Eigen's own guard (EIGEN_RUNTIME_NO_MALLOC) only covers
-// code compiled in this file, not the model library.
-extern "C" {
-void* __libc_malloc(size_t);
-void* __libc_calloc(size_t, size_t);
-void* __libc_realloc(void*, size_t);
-void* __libc_memalign(size_t, size_t);
-void __libc_free(void*);
-}
+// malloc and friends are interposed for the whole process (tests/support
+// limit_malloc.hpp), so Eigen's aligned allocations and operator new (which
+// calls malloc) are both counted, whichever library they come from.  Eigen's
+// own guard (EIGEN_RUNTIME_NO_MALLOC) only covers code compiled in this file,
+// not the model library.
+#include "limit_malloc.hpp"
 
-namespace {
-std::atomic<long> g_allocs{0};
-}
-
-extern "C" {
-void* malloc(size_t n) {
-  g_allocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(n);
-}
-void* calloc(size_t a, size_t b) {
-  g_allocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(a, b);
-}
-void* realloc(void* p, size_t n) {
-  g_allocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, n);
-}
-void* memalign(size_t al, size_t n) {
-  g_allocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(al, n);
-}
-void* aligned_alloc(size_t al, size_t n) {
-  g_allocs.fetch_add(1, std::memory_order_relaxed);
-  return __libc_memalign(al, n);
-}
-int posix_memalign(void** out, size_t al, size_t n) {
-  g_allocs.fetch_add(1, std::memory_order_relaxed);
-  void* p = __libc_memalign(al, n);
-  if (!p) return ENOMEM;
-  *out = p;
-  return 0;
-}
-void free(void* p) { __libc_free(p); }
-}
+using hoist::test::allocationCount;
 
 using namespace hoist;
 
@@ -70,7 +28,7 @@ TEST(NoAlloc, FastStepAndEnvelopeAllocateNothing) {
     const HoistProfile prof = HoistProfile::trapezoid();
     s.initialize(0.0, prof.at(0.0));
     s.step(0.01, prof.at(0.01));  // first step may size nothing new, but allow it
-    const long before = g_allocs.load();
+    const long before = allocationCount();
     Eigen::internal::set_is_malloc_allowed(false);
     double acc = 0;
     for (int k = 2; k <= 3000; ++k) {
@@ -79,7 +37,7 @@ TEST(NoAlloc, FastStepAndEnvelopeAllocateNothing) {
       acc += env.evaluate(s);
     }
     Eigen::internal::set_is_malloc_allowed(true);
-    EXPECT_EQ(g_allocs.load() - before, 0) << "n = " << n;
+    EXPECT_EQ(allocationCount() - before, 0) << "n = " << n;
     EXPECT_TRUE(std::isfinite(acc));
   }
 }
@@ -96,7 +54,7 @@ TEST(NoAlloc, ReinitializeAllocatesNothing) {
     FastSolver s(model);
     const HoistProfile prof = HoistProfile::trapezoid();
     s.initialize(0.0, prof.at(0.0));
-    const long before = g_allocs.load();
+    const long before = allocationCount();
     Eigen::internal::set_is_malloc_allowed(false);
     double acc = 0;
     for (double t : {0.0, 3.0, 10.0, 30.0, 55.0}) {
@@ -107,7 +65,7 @@ TEST(NoAlloc, ReinitializeAllocatesNothing) {
       acc += s.response().y_c;
     }
     Eigen::internal::set_is_malloc_allowed(true);
-    EXPECT_EQ(g_allocs.load() - before, 0) << "n = " << n;
+    EXPECT_EQ(allocationCount() - before, 0) << "n = " << n;
     EXPECT_TRUE(std::isfinite(acc));
   }
 }
@@ -115,14 +73,14 @@ TEST(NoAlloc, ReinitializeAllocatesNothing) {
 TEST(NoAlloc, CounterSeesAllocations) {
   // The guard itself works (a test that cannot fail is a defect): operator
   // new, and an Eigen allocation made inside the model library.
-  const long before = g_allocs.load();
+  const long before = allocationCount();
   auto* v = new std::vector<double>(100);
   delete v;
-  EXPECT_GE(g_allocs.load() - before, 1);
+  EXPECT_GE(allocationCount() - before, 1);
   ShaftParams p;
   p.n = 10;
   auto model = std::make_shared<const ShaftModel>(p);
-  const long mid = g_allocs.load();
+  const long mid = allocationCount();
   FastSolver s(model);  // sizes its workspace in the library
-  EXPECT_GT(g_allocs.load() - mid, 10);
+  EXPECT_GT(allocationCount() - mid, 10);
 }

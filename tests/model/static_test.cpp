@@ -1,5 +1,5 @@
 // Static equilibrium: the solver's static start against an exact (n -> inf)
-// solution of the continuous problem, MODEL.md's static check, the hoisting
+// solution of the continuous problem, docs/model.md's static check, the hoisting
 // rope's stretch, and convergence in the number of modes.
 #include <gtest/gtest.h>
 
@@ -25,7 +25,7 @@ CageResponse staticAt(ShaftParams p, double l, Method m = Method::Fast) {
 }
 
 TEST(Static, ModelCheckOfModelMd) {
-  // MODEL.md: n = 50 baseline, lambda = (-31.25, -31.25, +31.25, +31.25) N
+  // docs/model.md: n = 50 baseline, lambda = (-31.25, -31.25, +31.25, +31.25) N
   // = Fa b / (4 h), theta_static about 7-8e-4 rad for l = 50..300 m.
   // The paper's truncation: static correction off (with it theta is exact).
   ShaftParams p;
@@ -77,7 +77,7 @@ TEST(Static, LateralConvergesToExactContinuumSolution) {
   base.static_correction = false;
   const double l = 50.0;
   const ExactStatic ex = exactStatic(base, l);
-  // MODEL.md / case README: converged theta at l = 50 m is about 8.05e-4 rad.
+  // docs/model.md / case README: converged theta at l = 50 m is about 8.05e-4 rad.
   EXPECT_NEAR(ex.theta, 8.05e-4, 0.01e-4);
   std::cout << "exact (continuum) at l = 50 m: theta = " << ex.theta << " rad, y_c = " << ex.y_c << " m\n";
   std::cout << "    n      theta_static   theta/exact     y_c_static   y_c/exact\n";
@@ -144,7 +144,7 @@ TEST(Static, FastAndPaperPathsAgreeAcrossTheShaft) {
 }
 
 TEST(Static, PaperPartitionConditionMatchesModelMd) {
-  // MODEL.md: cond(G0) is 78 at l = 50 m, 8 at 192 m, 512 at 370 m, 1.6e4 at 383 m.
+  // docs/model.md: cond(G0) is 78 at l = 50 m, 8 at 192 m, 512 at 370 m, 1.6e4 at 383 m.
   ShaftParams p;
   p.n = 5;
   p.static_correction = false;

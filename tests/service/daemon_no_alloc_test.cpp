@@ -11,10 +11,6 @@
 // clears), so every event path runs inside the watched window.
 #include <gtest/gtest.h>
 
-#include <execinfo.h>
-#include <malloc.h>
-#include <unistd.h>
-
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
@@ -27,64 +23,10 @@
 #include "hoist/profile.hpp"
 #include "hoist/winder_t.hpp"
 
-extern "C" {
-void* __libc_malloc(size_t);
-void* __libc_calloc(size_t, size_t);
-void* __libc_realloc(void*, size_t);
-void* __libc_memalign(size_t, size_t);
-void __libc_free(void*);
-}
+#include "limit_malloc.hpp"
 
-namespace {
-thread_local bool t_watch = false;  // initial-exec TLS in the executable: no allocation
-std::atomic<long> g_watched_allocs{0};
-bool g_trace = std::getenv("HOIST_ALLOC_TRACE") != nullptr;
-/// HOIST_ALLOC_TRACE=1: print the call stack of each counted allocation
-/// (symbolize with addr2line -Cfe; the build has no -rdynamic).
-inline void count() {
-  if (!t_watch) return;
-  g_watched_allocs.fetch_add(1, std::memory_order_relaxed);
-  if (g_trace) {
-    t_watch = false;
-    void* frames[24];
-    const int n = backtrace(frames, 24);
-    (void)!write(2, "---- allocation\n", 16);
-    backtrace_symbols_fd(frames, n, 2);
-    t_watch = true;
-  }
-}
-}  // namespace
-
-extern "C" {
-void* malloc(size_t n) {
-  count();
-  return __libc_malloc(n);
-}
-void* calloc(size_t a, size_t b) {
-  count();
-  return __libc_calloc(a, b);
-}
-void* realloc(void* p, size_t n) {
-  count();
-  return __libc_realloc(p, n);
-}
-void* memalign(size_t al, size_t n) {
-  count();
-  return __libc_memalign(al, n);
-}
-void* aligned_alloc(size_t al, size_t n) {
-  count();
-  return __libc_memalign(al, n);
-}
-int posix_memalign(void** out, size_t al, size_t n) {
-  count();
-  void* p = __libc_memalign(al, n);
-  if (!p) return ENOMEM;
-  *out = p;
-  return 0;
-}
-void free(void* p) { __libc_free(p); }
-}
+using hoist::test::AllocationWatch;
+using hoist::test::watchedAllocationCount;
 
 using namespace hoist;
 using namespace hoist::svc;
@@ -165,18 +107,22 @@ bool multicastWorks() {
 
 TEST(DaemonNoAlloc, CounterSeesMallocOnTheWatchedThreadOnly) {
   // The interposer works (a test that cannot fail is a defect) ...
-  const long before = g_watched_allocs.load();
-  t_watch = true;
-  void* volatile p = std::malloc(100);
-  auto* v = new std::vector<double>(10);
-  t_watch = false;
+  void* volatile p = nullptr;
+  std::vector<double>* v = nullptr;
+  long seen = 0;
+  {
+    AllocationWatch watch;
+    p = std::malloc(100);
+    v = new std::vector<double>(10);
+    seen = watch.count();
+  }
   std::free(p);
   delete v;
-  EXPECT_GE(g_watched_allocs.load() - before, 2);
+  EXPECT_GE(seen, 2);
   // ... and ignores other threads.
-  const long mid = g_watched_allocs.load();
+  const long mid = watchedAllocationCount();
   std::thread([] { std::free(std::malloc(64)); }).join();
-  EXPECT_EQ(g_watched_allocs.load(), mid);
+  EXPECT_EQ(watchedAllocationCount(), mid);
 }
 
 TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
@@ -205,11 +151,12 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   };
   loopFor(1.0s);  // warm-up: first input, re-initialization, first events, first health
   const ShaftRunStats a0 = d.shaft(0).runStats(), b0 = d.shaft(1).runStats();
-  const long before = g_watched_allocs.load();
-  t_watch = true;
-  loopFor(3.3s);
-  t_watch = false;
-  const long allocs = g_watched_allocs.load() - before;
+  long allocs = 0;
+  {
+    AllocationWatch watch;
+    loopFor(3.3s);
+    allocs = watch.count();
+  }
   const ShaftRunStats a1 = d.shaft(0).runStats(), b1 = d.shaft(1).runStats();
   feed.join();
   d.requestStop("test over");

@@ -1,6 +1,7 @@
 // Frequency estimators, peaks/RMS and the sweep parameter keys.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -166,4 +167,28 @@ TEST(Parallel, ParallelForRunsAllAndRethrows) {
   for (int h : hit) EXPECT_EQ(h, 1);
   EXPECT_THROW(parallelFor(10, 3, [](int i) { if (i == 7) throw std::runtime_error("x"); }),
                std::runtime_error);
+}
+
+TEST(Parameters, EverySweepableTableFieldIsAParam) {
+  // hoist-study --param follows hoist::kParamFields: each sweepable field is
+  // a key that sets exactly that member; the others are refused by name.
+  for (const auto& f : kParamFields) {
+    ShaftParams p;
+    const std::string key = f.element();
+    if (!f.sweepable) {
+      EXPECT_THROW(applyParameter(p, key, f.get(p)), ParamError) << key;
+      continue;
+    }
+    EXPECT_NE(std::find(sweepableKeys().begin(), sweepableKeys().end(), key), sweepableKeys().end()) << key;
+    EXPECT_NE(parameterHelp().find(key), std::string::npos) << key;
+    const double v = f.type == ParamType::Boolean ? 1.0 - f.get(p)
+                     : f.type == ParamType::Integer ? 17.0
+                                                    : f.get(p) * 1.25;
+    applyParameter(p, key, v);
+    EXPECT_EQ(f.get(p), v) << key;
+    EXPECT_EQ(parameterValue(p, key), v) << key;
+    ShaftParams q = p;
+    f.set(q, f.get(ShaftParams{}));
+    EXPECT_TRUE(q == ShaftParams{}) << key << ": set more than its own member";
+  }
 }

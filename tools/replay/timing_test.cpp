@@ -359,17 +359,17 @@ int runTimingTest(const TimingTestOptions& o) {
   if (!o.report_path.empty()) {
     report.open(o.report_path, std::ios::out | std::ios::trunc);
     if (!report) {
-      std::cerr << "hoist-replay: --report: cannot write " << o.report_path << "\n";
+      std::cerr << "hoist-timing-test: --report: cannot write " << o.report_path << "\n";
       return 2;
     }
   }
   auto say = [&](const std::string& s) {
-    if (o.progress) std::cerr << "hoist-replay: " << s << "\n";
+    if (o.progress) std::cerr << "hoist-timing-test: " << s << "\n";
   };
 
   lcm::LCM rx(o.lcm_url), tx(o.lcm_url);
   if (!rx.good() || !tx.good()) {
-    std::cerr << "hoist-replay: cannot open LCM at " << hoist::bus::describeLcmUrl(o.lcm_url) << "\n";
+    std::cerr << "hoist-timing-test: cannot open LCM at " << hoist::bus::describeLcmUrl(o.lcm_url) << "\n";
     return 1;
   }
   const RoundTrip trip(o.l0, o.travel, o.vmax, o.amax);
@@ -408,7 +408,7 @@ int runTimingTest(const TimingTestOptions& o) {
     if (report.is_open()) {
       report << text;
       report.close();
-      if (!report) std::cerr << "hoist-replay: --report: writing " << o.report_path << " failed\n";
+      if (!report) std::cerr << "hoist-timing-test: --report: writing " << o.report_path << " failed\n";
     }
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
@@ -430,7 +430,7 @@ int runTimingTest(const TimingTestOptions& o) {
     while (!allHeard() && monotonicNs() < end && !g_signal.load()) rx.handleTimeout(50);
   }
   if (g_signal.load()) {
-    std::cerr << "hoist-replay: stopped before the timing test started\n";
+    std::cerr << "hoist-timing-test: stopped before the timing test started\n";
     if (report.is_open()) report << "VERDICT: INCONCLUSIVE (shortened run: stopped before the test started)\n";
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
@@ -441,7 +441,7 @@ int runTimingTest(const TimingTestOptions& o) {
     for (auto& s : run.shafts) {
       result.shafts.push_back(s->res);
       if (!s->have_base)
-        std::cerr << "hoist-replay: no HOIST_HEALTH on " << s->res.prefix << "HOIST_HEALTH within " << o.health_timeout
+        std::cerr << "hoist-timing-test: no HOIST_HEALTH on " << s->res.prefix << "HOIST_HEALTH within " << o.health_timeout
                   << " s: is hoist-twind running with the same --lcm-url and channel prefix?\n";
     }
     return finish(result);
@@ -483,7 +483,7 @@ int runTimingTest(const TimingTestOptions& o) {
         misses += s.carry.misses + (s.have_last ? s.last.misses - s.base.misses : 0);
         late = std::max(late, s.res.late_p99_worst);
       }
-      std::fprintf(stderr, "hoist-replay: timing test %4.0f/%g s  sent %lld  misses %lld  worst late p99 %.1f us\n",
+      std::fprintf(stderr, "hoist-timing-test: timing test %4.0f/%g s  sent %lld  misses %lld  worst late p99 %.1f us\n",
                    static_cast<double>(monotonicNs() - t0) * 1e-9, o.duration, static_cast<long long>(sent),
                    static_cast<long long>(misses), late);
     }

@@ -302,7 +302,7 @@ int main(int argc, char** argv) {
       "Writes t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4 per output step.\n"
       "Also: 'hoist-sim study NAME ...' runs the paper's parameter studies (hoist-study --help).",
       "hoist-sim"};
-  app.add_option("--config", o.config, "shaft TOML (INTERFACES.md); missing keys take the paper's values")
+  app.add_option("--config", o.config, "shaft TOML (README / docs/model.md); missing keys take the paper's values")
       ->check(CLI::ExistingFile);
   app.add_option("--profile", o.profile, std::string("hoist profile CSV or SPEC (default: paper)\n") +
                                              hoist::io::profileSpecHelp());

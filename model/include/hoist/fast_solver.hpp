@@ -1,6 +1,6 @@
 // hoist/fast_solver.hpp -- the production path ("fast").
 //
-// Solves Eq. (15) in multiplier form, exploiting MODEL.md's structure:
+// Solves Eq. (15) in multiplier form, exploiting the structure of docs/model.md:
 //
 // Longitudinal (hoisting rope q0 + x_c, constraint g0 = U0(1).q0 - x_c = 0):
 //   the constraint row is constant, so x_c = u.q0 (u = U0(1)) is eliminated

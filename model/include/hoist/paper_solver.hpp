@@ -1,6 +1,6 @@
 // hoist/paper_solver.hpp -- the paper's method, literally (verification path).
 //
-// Wang et al. (2016), Section 2.2, with MODEL.md's corrected hoisting-rope
+// Wang et al. (2016), Section 2.2, with docs/model.md's corrected hoisting-rope
 // block of Eq. (17):
 //   * generalized coordinates in the paper's order (Eq. 15)
 //       q = (q0_1, q1_1, q1_2, q2_1, q2_2, q0_2, q0_3, q1_3, q2_3, ...,
@@ -11,7 +11,7 @@
 //     q0 = the first five coordinates (Eq. 19);
 //   * Phi = [-G0^-1 G1; I] (Eq. 20), Phi-dot = v Phi', Phi-ddot = a Phi' + v^2 Phi''
 //     with Phi' = [-G0^-1 G' Phi; 0], Phi'' = [-G0^-1 (G'' Phi + 2 G' Phi'); 0]
-//     (' = d/dl, MODEL.md);
+//     (' = d/dl, docs/model.md);
 //   * the reduced ODE  M_G q1'' + C_G q1' + K_G q1 = F_G  (Eqs. 22-23),
 //     integrated with the same generalized-alpha scheme as the fast path;
 //   * q assembled by Eq. (24) and lambda recovered from Eq. (15):

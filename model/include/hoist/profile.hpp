@@ -33,7 +33,7 @@ class HoistProfile {
   static HoistProfile fromVelocity(const std::vector<double>& t, const std::vector<double>& v,
                                    const std::vector<double>& a, double l0);
 
-  /// The paper's Fig. 2 trapezoid (MODEL.md): l(0) = l0, a = +amax until v = vmax,
+  /// The paper's Fig. 2 trapezoid (docs/model.md): l(0) = l0, a = +amax until v = vmax,
   /// cruise, a = -amax, rest; sampled every dt up to t_end.  Defaults give the
   /// paper run: 50 m -> 300 m in 55 s, 60 s in all.
   static HoistProfile trapezoid(double l0 = 50.0, double vmax = 5.0, double amax = 1.0,

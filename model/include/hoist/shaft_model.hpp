@@ -1,6 +1,6 @@
 // hoist/shaft_model.hpp -- the immutable, precomputed shaft model.
 //
-// Wang et al. (2016), Eqs. (12)-(17) with the corrections of MODEL.md.
+// Wang et al. (2016), Eqs. (12)-(17) with the corrections of docs/model.md.
 // Assumed modes (Eq. 13), xi = x/l(t), eta = x/L:
 //   U0_i(xi)  = sqrt(2) sin(k_i xi),  k_i = (2i-1) pi/2      (hoisting rope)
 //   U1_i(eta) = U2_i(eta) = sqrt(2) sin(i pi eta)              (guide ropes)
@@ -32,10 +32,10 @@ struct HoistingRopeIntegrals {
   MatrixXd A_acc;  ///< Int (1-xi) U_i U_j'
   MatrixXd A_vel;  ///< Int xi U_i U_j'
   MatrixXd A_cent; ///< Int (1-xi)^2 U_i' U_j'
-  MatrixXd B_printed; ///< Int xi U_i' U_j (the term of the printed Eq. 17 that MODEL.md deletes)
+  MatrixXd B_printed; ///< Int xi U_i' U_j (the term of the printed Eq. 17 that docs/model.md deletes)
 };
 
-/// The paper's system matrices for one subsystem at one instant (MODEL.md, Eq. 17).
+/// The paper's system matrices for one subsystem at one instant (docs/model.md, Eq. 17).
 struct HoistingRopeMatrices {
   MatrixXd M, C, K;
   VectorXd F;
@@ -65,7 +65,7 @@ class ShaftModel {
   const MatrixXd& guideModalVectors(int r) const { return r == 1 ? V1_ : V2_; }
   const VectorXd& guideModalStiffness(int r) const { return r == 1 ? kappa1_ : kappa2_; }
 
-  /// Hoisting-rope block of Eq. (17) at (l, v, a) as corrected by MODEL.md
+  /// Hoisting-rope block of Eq. (17) at (l, v, a) as corrected in docs/model.md
   /// (`printed = true`: the printed, transposed form with its spurious term,
   /// kept only to measure the difference).  F includes the cage-free rope
   /// terms: F_i = -rho1 l a sqrt(2)/k_i - sqrt(2) (-1)^(i+1) m g (+ excitation terms: none).

@@ -9,15 +9,37 @@
 //   * PaperSolver (the verification path, paper_solver.hpp): the paper's literal
 //     coordinate partition G = (G0 G1), q = Phi q1 (Eqs. 18-24), reduced ODE
 //     Eq. (22), lambda recovered from Eq. (15).  Ill-conditioned near the shaft
-//     ends (MODEL.md) and O(n^3) per step: for checking, not for production.
-// Both use the same implicit, fixed-step generalized-alpha integrator
-// (rho_inf = 1: trapezoidal / Newmark average acceleration) with the equations
-// of motion enforced at t_{n+1}.
+//     ends (docs/model.md) and O(n^3) per step: for checking, not for production.
+// Both use the same implicit, fixed-step generalized-alpha integrator with
+// spectral radius ShaftParams::rho_inf (default 0.9; 1 would be the
+// trapezoidal rule) and the equations of motion enforced at t_{n+1}.
 //
-// Sign conventions (MODEL.md): lambda_k is the force the cage exerts on the
-// rope at constraint g_k, positive in +y (+x for lambda_0); the cage feels
-// -lambda_k.  Cage lateral displacement at the top sleeves is y_c - h theta,
-// at the bottom sleeves y_c + h theta.
+// Frame (the one every part of the project uses; docs/model.md "Frame"):
+//   x      depth, origin at the top of the shaft (head sheave / derrick, where
+//          both guide ropes are fixed), positive DOWNWARD.  The hoisting rope
+//          occupies [0, l]; the cage's top sleeves are at x = l, its bottom
+//          sleeves at x = l + 2h; the guide ropes span [0, L].  v = dl/dt > 0
+//          when the cage descends, a = dv/dt.  x_c: cage displacement along
+//          +x about the static (gravity-loaded) state.
+//   y      the one lateral direction of the model (paper Fig. 1b).  Guide
+//          rope 1 stands on one side of the cage and rope 2 on the other, and
+//          y_1, y_2 and y_c are all measured along the SAME +y: each sleeve
+//          makes its rope move with the cage there (g1..g4 below), so the
+//          linear model does not depend on which side a rope stands.
+//   theta  cage rotation in the x-y plane, positive when it turns the cage's
+//          downward axis toward +y: the bottom sleeves move by +h theta, the
+//          top sleeves by -h theta.  The eccentric load's moment +Fa b drives
+//          +theta (b > 0 tilts the cage bottom toward +y).
+// Constraints (Eqs. 6, 8, linearized; lambda_k goes with g_k):
+//   g0 = u(l) - x_c                 hoisting rope / cage
+//   g1 = y1(l)    + h theta - y_c   top sleeve, rope 1
+//   g2 = y2(l)    + h theta - y_c   top sleeve, rope 2
+//   g3 = y2(l+2h) - h theta - y_c   bottom sleeve, rope 2
+//   g4 = y1(l+2h) - h theta - y_c   bottom sleeve, rope 1
+// lambda_k is the force the cage exerts on the rope at constraint g_k,
+// positive in +y (+x for lambda_0); the cage feels -lambda_k.  Cage lateral
+// displacement at the top sleeves is y_c - h theta, at the bottom sleeves
+// y_c + h theta.
 #pragma once
 
 #include <array>

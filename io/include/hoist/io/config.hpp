@@ -1,12 +1,8 @@
-// hoist/io/config.hpp -- the shaft configuration file (INTERFACES.md).
+// hoist/io/config.hpp -- the shaft configuration file (docs/model.md).
 //
-//   [hoisting_rope] mass_per_length, axial_stiffness, damping, initial_length
-//   [guide_ropes]   length, mass_per_length, damping, preload = [Tb1, Tb2]
-//   [cage]          mass, inertia, half_height
-//   [load]          eccentric_force, offset
-//   [model]         modes, gravity, initial = "static"|"rest", rho_inf
-//
-// Every key is optional and defaults to the paper's Section 3 value
+// The sections and keys are those of hoist::kParamFields (hoist/params.hpp):
+// [hoisting_rope], [guide_ropes] (preload = [Tb1, Tb2]), [cage], [load],
+// [model].  Every key is optional and defaults to the paper's Section 3 value
 // (ShaftParams{}).  Rejected, with ConfigError naming file, line and key:
 // TOML syntax errors, unknown sections or keys (with a "did you mean"),
 // wrong types (a string for a number, a float for `modes`, ...), and every

@@ -1,6 +1,6 @@
 // hoist/io/profile.hpp -- hoist profiles from CSV files and SPEC strings.
 //
-// CSV (INTERFACES.md): a header row naming the columns; `t` [s], `v` [m/s] and
+// CSV (docs/model.md): a header row naming the columns; `t` [s], `v` [m/s] and
 // `a` [m/s^2] required, `l` [m] optional (absent: l is integrated from v
 // starting at l0).  Other columns are ignored, so a hoist-sim result file is
 // also a valid profile.  Lines starting with '#' and blank lines are skipped;

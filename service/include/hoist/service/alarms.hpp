@@ -1,7 +1,7 @@
 // hoist/service/alarms.hpp -- clearance alarms of the twin (pure: no I/O, no
 // clock, no allocation after construction).
 //
-// What is measured (MODEL.md conventions; y lateral, theta cage rotation, h
+// What is measured (docs/model.md conventions; y lateral, theta cage rotation, h
 // cage half height):
 //   top-sleeve excursion      y_top    = y_c - h theta
 //   bottom-sleeve excursion   y_bottom = y_c + h theta

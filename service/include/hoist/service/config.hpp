@@ -44,7 +44,7 @@ struct ServiceConfig {
   int log_rate_limit = 5;       ///< log lines per second per rejection reason, [1, 1000]
   double fault_hold = 1.0;      ///< outputs flagged degraded after a model re-init [s]
 
-  void validate() const;  ///< throws ConfigError naming service.<key>
+  void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
 };
 
 struct TwinConfig {
@@ -52,19 +52,5 @@ struct TwinConfig {
   ServiceConfig service;
   AlarmConfig alarms;
 };
-
-/// A configuration error; what() is "<file>:<line>: <key>: <message>" (the
-/// line is omitted when unknown).
-class ConfigError : public std::runtime_error {
- public:
-  ConfigError(const std::string& source, int line, const std::string& key, const std::string& msg);
-  const std::string& key() const { return key_; }
-
- private:
-  std::string key_;
-};
-
-/// The effective configuration as TOML (for --print-config).
-std::string toToml(const TwinConfig& cfg);
 
 }  // namespace hoist::svc

@@ -2,7 +2,7 @@
 // can reach the model (pure: no I/O, no clock, no allocation).
 //
 // A winder sample (winder_t) carries utime [us], seq, v [m/s], a [m/s^2] and
-// optionally the encoder rope length [m] (MODEL.md: depth down, v > 0
+// optionally the encoder rope length [m] (docs/model.md: depth down, v > 0
 // descending).  check() classifies one sample against the configured limits
 // and the last ACCEPTED sample of the current stream; accept() makes it the
 // reference.  A stream is restarted with resync() (after the input went

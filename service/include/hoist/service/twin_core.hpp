@@ -3,7 +3,7 @@
 // clearance alarms.  hoist-twind wraps it with LCM and timers; tests drive
 // it directly.
 //
-// Kinematics (MODEL.md: l = hoisting-rope length = depth of the cage's top
+// Kinematics (docs/model.md: l = hoisting-rope length = depth of the cage's top
 // sleeves, v = dl/dt > 0 descending, a = dv/dt):
 //   * when a winder sample carries the encoder length the twin follows it;
 //   * otherwise l is integrated from v, starting at the shaft config's

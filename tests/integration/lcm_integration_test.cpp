@@ -21,7 +21,7 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/winder_t.hpp"
-#include "lcm_test_util.hpp"
+#include "lcm_fixtures.hpp"
 
 using namespace hoist::test;
 namespace fs = std::filesystem;
@@ -47,16 +47,10 @@ std::string writeProfile(const fs::path& dir) {
   return path;
 }
 
-class LcmIntegration : public ::testing::Test {
+class LcmIntegration : public LcmProcessTest {
  protected:
   void start(int port, const std::string& name) {
-    url_ = urlFor(port);
-    dir_ = testDir(name);
-    std::string why;
-    if (!loopbackMulticastWorks(url_, why)) FAIL() << why << ".\n" << kMulticastHelp;
-    listener_ = std::make_unique<Listener>(url_);
-    ASSERT_TRUE(listener_->good()) << kMulticastHelp;
-    listener_->subscribe("HOIST_HEALTH");  // readiness and statistics
+    LcmProcessTest::start(port, name, {"HOIST_HEALTH"});  // readiness and statistics
   }
 
   std::unique_ptr<Process> startDaemon(std::vector<std::string> extra, const std::string& log_name) {
@@ -76,9 +70,6 @@ class LcmIntegration : public ::testing::Test {
     return p.wait(1s);
   }
 
-  std::string url_;
-  fs::path dir_;
-  std::unique_ptr<Listener> listener_;
 };
 
 std::vector<std::string> splitCsv(const std::string& line) {

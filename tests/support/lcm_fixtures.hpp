@@ -1,107 +1,23 @@
-// Helpers for the LCM integration tests: child processes with timeouts, an
-// LCM listener that records raw messages, and the loopback-multicast check.
+// tests/support/lcm_fixtures.hpp -- LCM fixtures for the tests that talk to
+// the programs over real UDP multicast on loopback: a Listener that records
+// raw messages (optionally into an LCM log), the loopback-multicast check,
+// the tests' URLs, and starting and stopping hoist-twind.
 #pragma once
-
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdint>
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <memory>
-#include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
-extern char** environ;
+#include "process.hpp"
 
 namespace hoist::test {
-
-using namespace std::chrono_literals;
-
-/// A child process; killed (SIGKILL) if still running when destroyed.
-class Process {
- public:
-  Process(std::vector<std::string> argv, const std::string& log_path) : argv_(std::move(argv)) {
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
-    posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-    std::vector<char*> args;
-    for (auto& a : argv_) args.push_back(a.data());
-    args.push_back(nullptr);
-    if (posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
-  }
-  ~Process() {
-    if (running()) {
-      ::kill(pid_, SIGKILL);
-      int st;
-      ::waitpid(pid_, &st, 0);
-    }
-  }
-  Process(const Process&) = delete;
-  Process& operator=(const Process&) = delete;
-
-  bool started() const { return pid_ > 0; }
-  bool running() {
-    if (pid_ <= 0 || done_) return false;
-    int st;
-    const pid_t r = ::waitpid(pid_, &st, WNOHANG);
-    if (r == pid_) {
-      done_ = true;
-      status_ = st;
-      return false;
-    }
-    return true;
-  }
-  void signal(int sig) {
-    if (running()) ::kill(pid_, sig);
-  }
-  /// Exit status (0..255, 128+signal if killed), or -1 on timeout.
-  int wait(std::chrono::milliseconds timeout) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    while (running()) {
-      if (std::chrono::steady_clock::now() > end) return -1;
-      std::this_thread::sleep_for(5ms);
-    }
-    if (pid_ <= 0) return -1;
-    return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
-  }
-
- private:
-  std::vector<std::string> argv_;
-  pid_t pid_ = -1;
-  bool done_ = false;
-  int status_ = 0;
-};
-
-/// Run to completion (with timeout); returns the exit status or -1.
-inline int runProcess(std::vector<std::string> argv, const std::string& log_path,
-                      std::chrono::milliseconds timeout) {
-  Process p(std::move(argv), log_path);
-  if (!p.started()) return -1;
-  return p.wait(timeout);
-}
-
-inline std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 /// Records every message on the subscribed channels (raw bytes), optionally
 /// into an LCM log file.
@@ -210,14 +126,6 @@ inline bool loopbackMulticastWorks(const std::string& url, std::string& why) {
   return got;
 }
 
-/// A fresh directory for one test's files.
-inline std::filesystem::path testDir(const std::string& name) {
-  const auto dir = std::filesystem::path(HOIST_TEST_WORK_DIR) / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
-
 /// The tests' LCM URL on `port`: UDP multicast on loopback, host-local.
 inline std::string urlFor(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
 
@@ -243,5 +151,27 @@ inline void stopDaemonCleanly(Process& p, const std::string& log) {
   p.signal(SIGTERM);
   EXPECT_EQ(p.wait(10s), 0) << readFile(log);
 }
+
+#ifdef HOIST_TEST_WORK_DIR
+/// Base fixture of the process-level tests: the LCM URL of one port, a fresh
+/// directory for the test's files, and a Listener on that URL.
+class LcmProcessTest : public ::testing::Test {
+ protected:
+  /// Fails the test (with instructions) when loopback multicast is off.
+  void start(int port, const std::string& name, const std::vector<std::string>& channels = {}) {
+    url_ = urlFor(port);
+    dir_ = testDir(name);
+    std::string why;
+    if (!loopbackMulticastWorks(url_, why)) FAIL() << why << ".\n" << kMulticastHelp;
+    listener_ = std::make_unique<Listener>(url_);
+    ASSERT_TRUE(listener_->good()) << kMulticastHelp;
+    for (const auto& c : channels) listener_->subscribe(c);
+  }
+
+  std::string url_;
+  std::filesystem::path dir_;
+  std::unique_ptr<Listener> listener_;
+};
+#endif
 
 }  // namespace hoist::test

@@ -10,7 +10,8 @@
 
 #include <cmath>
 
-#include "../tools/lcm_test_util.hpp"
+#include "lcm_fixtures.hpp"
+#include "lcm_messages.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
@@ -32,17 +33,6 @@ int runTwind(const std::vector<std::string>& args, const fs::path& log) {
   argv.insert(argv.end(), args.begin(), args.end());
   Process p(argv, log.string());
   return p.wait(10s);
-}
-
-hoist::winder_t winder(std::int64_t seq, std::int64_t utime, double v, double l) {
-  hoist::winder_t m{};
-  m.utime = utime;
-  m.seq = seq;
-  m.v = v;
-  m.a = 0.0;
-  m.has_length = true;
-  m.length = l;
-  return m;
 }
 
 std::int64_t nowUs() {

@@ -1,4 +1,4 @@
-// hoist-replay --timing-test against a real hoist-twind through real LCM (UDP
+// hoist-timing-test (and its alias hoist-replay --timing-test) against a real hoist-twind through real LCM (UDP
 // multicast on loopback, ttl=0, one port per test, 7790-7795):
 //
 //   * generous budgets: PASS (exit 0), the report shows deadline misses and
@@ -13,7 +13,7 @@
 
 #include <regex>
 
-#include "lcm_test_util.hpp"
+#include "lcm_fixtures.hpp"
 
 using namespace hoist::test;
 namespace fs = std::filesystem;
@@ -22,16 +22,8 @@ namespace {
 
 std::string firstLine(const std::string& s) { return s.substr(0, s.find('\n')); }
 
-class TimingTest : public ::testing::Test {
+class TimingTest : public LcmProcessTest {
  protected:
-  void start(int port, const std::string& name) {
-    url_ = urlFor(port);
-    dir_ = testDir(name);
-    std::string why;
-    if (!loopbackMulticastWorks(url_, why)) FAIL() << why << ".\n" << kMulticastHelp;
-    listener_ = std::make_unique<Listener>(url_);
-    ASSERT_TRUE(listener_->good()) << kMulticastHelp;
-  }
 
   /// A daemon on prefix `prefix`, up (its first HOIST_HEALTH heard).
   std::unique_ptr<Process> startDaemon(const std::string& prefix, const std::string& log_name) {
@@ -49,11 +41,13 @@ class TimingTest : public ::testing::Test {
     stopDaemonCleanly(p, (dir_ / log_name).string());
   }
 
-  /// hoist-replay --timing-test with `extra`; returns the exit status, the
-  /// combined output in `out` and the wall time in `secs`.
+  /// hoist-timing-test with `extra` (`alias`: as hoist-replay --timing-test);
+  /// returns the exit status, the combined output in `out` and the wall time
+  /// in `secs`.
   int timingTest(std::vector<std::string> extra, std::string& out, double& secs,
-                 std::chrono::milliseconds timeout = 30s) {
-    std::vector<std::string> argv{HOIST_REPLAY, "--timing-test", "--lcm-url", url_, "-q"};
+                 std::chrono::milliseconds timeout = 30s, bool alias = false) {
+    std::vector<std::string> argv{HOIST_TIMING_TEST, "--lcm-url", url_, "-q"};
+    if (alias) argv = {HOIST_REPLAY, "--timing-test", "--lcm-url", url_, "-q"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     const auto log = (dir_ / "replay.log").string();
     std::filesystem::remove(log);
@@ -64,9 +58,6 @@ class TimingTest : public ::testing::Test {
     return rc;
   }
 
-  std::string url_;
-  fs::path dir_;
-  std::unique_ptr<Listener> listener_;
 };
 
 }  // namespace
@@ -96,7 +87,7 @@ TEST_F(TimingTest, GenerousBudgetsPass) {
   EXPECT_NE(r.find("| host | "), std::string::npos);
   EXPECT_NE(r.find("| rate | 100 Hz"), std::string::npos);
   EXPECT_NE(r.find("| duration | 4 s"), std::string::npos);
-  EXPECT_NE(r.find("--timing-test"), std::string::npos) << "the command is in the report";
+  EXPECT_NE(r.find("hoist-timing-test --lcm-url"), std::string::npos) << "the command is in the report";
   EXPECT_NE(r.find("## Violated budgets\n\nnone"), std::string::npos) << r;
   // About 400 inputs sent (the feeder may skip a period under load), nearly all accepted.
   ASSERT_TRUE(std::regex_search(r, m, std::regex(R"(\| inputs sent / accepted / lost \| (\d+) / (\d+) / (-?\d+) \|)")))
@@ -132,11 +123,12 @@ TEST_F(TimingTest, ImpossibleBudgetFails) {
 }
 
 TEST_F(TimingTest, NoDaemonFailsWithinSevenSeconds) {
+  // Through the alias hoist-replay --timing-test: the same run, the same report.
   start(7792, "timing_nodaemon");
   const auto report = (dir_ / "timing.md").string();
   std::string out;
   double secs = 0;
-  const int rc = timingTest({"--duration", "4", "--report", report}, out, secs, 15s);
+  const int rc = timingTest({"--duration", "4", "--report", report}, out, secs, 15s, true);
   EXPECT_EQ(rc, 1) << out;
   EXPECT_LT(secs, 7.0);
   EXPECT_GE(secs, 4.5);
@@ -147,6 +139,7 @@ TEST_F(TimingTest, NoDaemonFailsWithinSevenSeconds) {
   const std::string r = readFile(report);
   EXPECT_EQ(firstLine(r), "VERDICT: FAIL") << r;
   EXPECT_NE(r.find("no HOIST_HEALTH on HOIST_HEALTH within 5 s"), std::string::npos) << r;
+  EXPECT_NE(r.find("hoist-replay --timing-test --lcm-url"), std::string::npos) << r;
 }
 
 TEST_F(TimingTest, BadOptionsExitTwoNamingTheOption) {
@@ -176,6 +169,9 @@ TEST_F(TimingTest, BadOptionsExitTwoNamingTheOption) {
     EXPECT_EQ(timingTest(c.args, out, secs, 10s), 2) << c.args[0] << ": " << out;
     EXPECT_NE(out.find(c.option), std::string::npos) << c.args[0] << ": " << out;
     EXPECT_LT(secs, 3.0) << c.args[0];
+    // The alias hoist-replay --timing-test takes the same options.
+    EXPECT_EQ(timingTest(c.args, out, secs, 10s, true), 2) << "alias " << c.args[0] << ": " << out;
+    EXPECT_NE(out.find(c.option), std::string::npos) << "alias " << c.args[0] << ": " << out;
   }
   // Budgets belong to the timing test.
   const auto log = (dir_ / "plain.log").string();

@@ -21,7 +21,8 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/winder_t.hpp"
-#include "../tools/lcm_test_util.hpp"
+#include "lcm_fixtures.hpp"
+#include "lcm_messages.hpp"
 
 using namespace hoist::test;
 namespace fs = std::filesystem;
@@ -31,23 +32,6 @@ namespace {
 std::int64_t nowUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-template <class Msg>
-std::vector<std::uint8_t> encode(const Msg& m) {
-  std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(b.data(), 0, static_cast<int>(b.size()));
-  return b;
-}
-
-hoist::winder_t winder(std::int64_t seq, std::int64_t utime, double v, double length) {
-  hoist::winder_t m{};
-  m.utime = utime;
-  m.seq = seq;
-  m.v = v;
-  m.has_length = true;
-  m.length = length;
-  return m;
 }
 
 std::map<std::string, std::int64_t> reasons(const hoist::health_t& h) {
@@ -65,18 +49,10 @@ bool finiteCage(const hoist::cage_state_t& c) {
   return ok;
 }
 
-class DaemonHardening : public ::testing::Test {
+class DaemonHardening : public LcmProcessTest {
  protected:
   void start(int port, const std::string& name) {
-    url_ = urlFor(port);
-    dir_ = testDir(name);
-    std::string why;
-    if (!loopbackMulticastWorks(url_, why)) FAIL() << why << ".\n" << kMulticastHelp;
-    listener_ = std::make_unique<Listener>(url_);
-    ASSERT_TRUE(listener_->good()) << kMulticastHelp;
-    listener_->subscribe("HOIST_HEALTH");
-    listener_->subscribe("HOIST_CAGE");
-    listener_->subscribe("HOIST_ALARM");
+    LcmProcessTest::start(port, name, {"HOIST_HEALTH", "HOIST_CAGE", "HOIST_ALARM"});
   }
   /// A config whose staleness does not depend on the input period (the
   /// rejection-count tests send bursts and must not see a stream resync).
@@ -111,9 +87,6 @@ class DaemonHardening : public ::testing::Test {
       ASSERT_TRUE(std::isfinite(a.value) && std::isfinite(a.threshold) && std::isfinite(a.t));
   }
 
-  std::string url_;
-  fs::path dir_;
-  std::unique_ptr<Listener> listener_;
 };
 
 TEST_F(DaemonHardening, GarbageLcmLogPlayedWithLogplayer) {

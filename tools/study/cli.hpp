@@ -1,0 +1,56 @@
+// cli.hpp -- hoist-study's command line: the options every subcommand shares,
+// value parsing, and the configuration and profile they name.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hoist/params.hpp"
+#include "hoist/profile.hpp"
+#include "hoist/study/runner.hpp"
+
+namespace hoist::study::cli {
+
+/// A usage or configuration error: exit status 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Common {
+  std::string out_dir = "study-out";
+  std::string config;
+  std::string profile;
+  int modes = 0;
+  double dt = 0.01;
+  double max_step = 0.0025;
+  std::string initial;  // "" -> rest for the studies, config for advise
+  std::string static_correction;  // "" -> off for the paper's studies, config (default on) for sweep/advise
+  int jobs = 0;
+  bool no_plots = false;
+};
+
+/// "%g" (or `f`) of v.
+std::string fmtg(double v, const char* f = "%g");
+
+/// Readable replacements for CLI::PositiveNumber / NonNegativeNumber (whose
+/// messages print DBL_MAX).
+CLI::Validator numberAbove(double lo, bool inclusive);
+/// The options of Common on a subcommand (`advisor`: its --initial default is "config";
+/// `paper`: one of the paper's studies, whose --static-correction default is off).
+void addCommon(CLI::App* sub, Common& c, bool advisor, bool paper);
+/// "1,2,3" or "start:stop:count" (evenly spaced, count >= 2).  Throws UsageError.
+std::vector<double> parseValues(const std::string& s);
+/// "MIN:MAX" for option `opt`.  Throws UsageError.
+std::pair<double, double> parseRange(const std::string& opt, const std::string& s);
+
+/// The shaft of --config (the paper's by default) with --modes/--initial applied.
+ShaftParams loadParams(const Common& c);
+/// The profile of --profile (the paper's trapezoid by default).
+HoistProfile loadProfile(const Common& c, const ShaftParams& p);
+/// Simulation options of --dt/--max-step for `p`.
+RunOptions runOptions(const Common& c, const ShaftParams& p);
+
+}  // namespace hoist::study::cli
