@@ -318,7 +318,6 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
       [](const json& j, bool) { return j["warning"].is_object() && j["warning"]["acked"].get<bool>(); }, 5s);
   ASSERT_TRUE(acked) << readFile(log("twind.log"));
   EXPECT_EQ((*acked)["last_event"], "ACK");
-  EXPECT_EQ((*acked)["warning"]["user"], "scada-op");
   EXPECT_FALSE((*acked)["unacked"].get<bool>());
   EXPECT_TRUE((*acked)["active"].get<bool>());
   EXPECT_NE(readFile(log("twind.log")).find("operator 'scada-op': acknowledge"), std::string::npos);
@@ -389,6 +388,7 @@ TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
   while (countOf(readFile(log("bridge.log")), "connected to the broker") < 2 && std::chrono::steady_clock::now() < end)
     std::this_thread::sleep_for(50ms);
   ASSERT_EQ(countOf(readFile(log("bridge.log")), "connected to the broker"), 2u) << readFile(log("bridge.log"));
+  std::this_thread::sleep_for(1s);  // the republication follows the log line
   c2.subscribe("hoist/#");
   auto again = c2.waitJson("hoist/default/alarm/CAGE_POS_Y", [](const json& j, bool r) { return r && isWarningActive(j); }, 5s);
   EXPECT_TRUE(again) << "the retained alarm state was not republished after the broker restart";

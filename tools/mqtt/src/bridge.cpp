@@ -240,10 +240,11 @@ struct Bridge::Impl {
     return &it->second;
   }
 
-  /// The shaft of `prefix`, discovering it from a health message if allowed.
-  Shaft* shaftFor(const std::string& prefix, bool is_health) {
+  /// The shaft of `prefix`, discovering it if allowed (from any of its
+  /// channels: an alarm may come before the first health message is heard).
+  Shaft* shaftFor(const std::string& prefix) {
     if (auto it = shafts.find(prefix); it != shafts.end()) return &it->second;
-    if (!discover || !is_health) return nullptr;
+    if (!discover) return nullptr;
     std::string why;
     if (!validChannelPrefix(prefix, &why)) return nullptr;
     const std::string name = shaftName(prefix);
@@ -276,7 +277,7 @@ struct Bridge::Impl {
         return channel.size() >= n && channel.compare(channel.size() - n, n, suffix) == 0;
       };
       if (ends(kCage)) {
-        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kCage)), false);
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kCage)));
         if (!s) return void(++ignored_channels);
         hoist::cage_state_t m;
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
@@ -285,7 +286,7 @@ struct Bridge::Impl {
         s->cage_new = true;
         ++s->cage_in;
       } else if (ends(kHealth)) {
-        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kHealth)), true);
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kHealth)));
         if (!s) return void(++ignored_channels);
         hoist::health_t m;
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
@@ -296,7 +297,7 @@ struct Bridge::Impl {
         s->instance_id = m.instance_id;
         publish({s->t_health, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
       } else if (ends(kAlarm)) {
-        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kAlarm)), false);
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kAlarm)));
         if (!s) return void(++ignored_channels);
         hoist::alarm_t m;
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
@@ -625,7 +626,7 @@ struct Bridge::Impl {
     spdlog::info("hoist-mqtt: LCM {}; broker {}; cage states at {} Hz; commands {}; shafts: {}",
                  hoist::svc::describeLcmUrl(lcm_url), brokerText(), cfg.cage_rate,
                  cfg.commands ? "accepted on hoist/<shaft>/cmd/ack" : "disabled (--no-commands)",
-                 discover ? "discovered from *HOIST_HEALTH channels" : std::to_string(shafts.size()) + " configured");
+                 discover ? "discovered from their *HOIST_{HEALTH,CAGE,ALARM} channels" : std::to_string(shafts.size()) + " configured");
     const int lcm_fd = lcm.getFileno();
     while (!stop) {
       auto now = Clock::now();

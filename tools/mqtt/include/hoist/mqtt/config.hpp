@@ -51,7 +51,7 @@ struct BridgeConfig {
 
   // [bridge]
   std::string lcm_url;                     ///< "" = $LCM_DEFAULT_URL, else LCM's default
-  std::vector<std::string> channel_prefixes;  ///< empty = discover from *HOIST_HEALTH channels
+  std::vector<std::string> channel_prefixes;  ///< empty = discover from *HOIST_{HEALTH,CAGE,ALARM} channels
   bool commands = true;                    ///< accept hoist/<shaft>/cmd/ack
   double cage_rate = 10.0;                 ///< cage states per second per shaft [Hz], (0, 1000]
   double health_period = 5.0;              ///< the bridge's own health topic period [s]
