@@ -133,11 +133,13 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
   shape_msg_.h = cfg_.shaft.h;
   health_msg_.clock = toString(s.clock);
   health_msg_.rate = s.rate;
-  health_msg_.n_reasons = kRejectReasons;
-  health_msg_.reject_reason.resize(kRejectReasons);
-  health_msg_.rejected.assign(kRejectReasons, 0);
+  health_msg_.n_reasons = kRejectReasons + kExtraReasons;
+  health_msg_.reject_reason.resize(kRejectReasons + kExtraReasons);
+  health_msg_.rejected.assign(kRejectReasons + kExtraReasons, 0);
   for (int i = 0; i < kRejectReasons; ++i)
     health_msg_.reject_reason[i] = toString(static_cast<RejectReason>(i));
+  health_msg_.reject_reason[kRejectReasons] = "command_decode";
+  health_msg_.reject_reason[kRejectReasons + 1] = "handler_exception";
   alarm_msg_.kind.reserve(64);
   alarm_msg_.message.reserve(sizeof text_);
   cage_buf_.resize(static_cast<std::size_t>(cage_msg_.getEncodedSize()) + 64);
@@ -172,7 +174,35 @@ void ShaftTwin::logReject(RejectReason r, const char* detail) {
     log_.warn("{}rejected winder input ({}): {}", tag_, toString(r), detail);
 }
 
+void ShaftTwin::handlerFailed(const char* what, const char* channel) {
+  ++handler_exceptions_;
+  std::int64_t suppressed = 0;
+  if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
+    log_.error("{}exception in the {} handler caught (message dropped): {} [{} similar suppressed]", tag_, channel,
+               what, suppressed);
+}
+
 void ShaftTwin::onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  try {
+    handleWinder(rbuf);
+  } catch (const std::exception& e) {
+    handlerFailed(e.what(), "HOIST_WINDER");
+  } catch (...) {
+    handlerFailed("unknown exception", "HOIST_WINDER");
+  }
+}
+
+void ShaftTwin::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  try {
+    handleAck(rbuf);
+  } catch (const std::exception& e) {
+    handlerFailed(e.what(), "HOIST_ALARM_ACK");
+  } catch (...) {
+    handlerFailed("unknown exception", "HOIST_ALARM_ACK");
+  }
+}
+
+void ShaftTwin::handleWinder(const lcm::ReceiveBuffer* rbuf) {
   const double wall = wallNow();
   WinderSample s;
   const WinderDecode dec = decodeWinder(rbuf->data, rbuf->data_size, winder_in_, s);
@@ -209,19 +239,24 @@ void ShaftTwin::onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& /*ch
   drainAlarmEvents();
 }
 
-void ShaftTwin::onAck(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+void ShaftTwin::handleAck(const lcm::ReceiveBuffer* rbuf) {
   // Operator commands are rare and outside the tick: decoding them into the
-  // message's std::strings may allocate.
+  // message's std::strings may allocate -- but only after checkedDecode has
+  // validated every length (a 37-byte command with a string length of 0 or
+  // 0x80000000 used to kill the daemon, issue 12).
   hoist::alarm_ack_t ack;
-  const auto size = static_cast<int>(rbuf->data_size);
+  const auto size = static_cast<std::size_t>(rbuf->data_size);
   // Anyone on the group can send commands (docs/security.md): their log lines
   // are rate-limited, and the sender's strings are shortened and made
   // printable before they reach the log.
   std::int64_t suppressed = 0;
   const bool may_log = reject_log_.allow(kRejectReasons + 2, wallNow(), suppressed);
   if (may_log && suppressed > 0) log_.warn("{}{} alarm-command log lines suppressed", tag_, suppressed);
-  if (ack.decode(rbuf->data, 0, size) != size) {
-    if (may_log) log_.warn("{}ignored undecodable alarm command ({} bytes) on {}", tag_, size, ch_.ack);
+  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, ack); st != hoist::msg::DecodeStatus::ok) {
+    ++command_decode_rejects_;
+    if (may_log)
+      log_.warn("{}ignored undecodable alarm command ({} bytes, {}) on {}", tag_, size, hoist::msg::toString(st),
+                ch_.ack);
     return;
   }
   ack.user = printable(ack.user);
@@ -434,6 +469,8 @@ void ShaftTwin::publishHealth(bool final_report) {
   health_msg_.seq_gaps = c.seq_gaps;
   health_msg_.rejected_total = c.rejectedTotal();
   for (int i = 0; i < kRejectReasons; ++i) health_msg_.rejected[i] = c.rejected[i];
+  health_msg_.rejected[kRejectReasons] = command_decode_rejects_;
+  health_msg_.rejected[kRejectReasons + 1] = handler_exceptions_;
   health_msg_.alarms_active = al.activeCount();
   health_msg_.alarms_unacked = al.unackedCount();
   health_msg_.alarms_shelved = al.shelvedCount();
@@ -473,6 +510,8 @@ void ShaftTwin::logFinal() {
             publish_failures_, nonfinite_blocked_, core_.degraded() ? " DEGRADED" : "");
   for (int i = 0; i < kRejectReasons; ++i)
     if (c.rejected[i] > 0) log_.info("{}  rejected {}: {}", tag_, toString(static_cast<RejectReason>(i)), c.rejected[i]);
+  if (command_decode_rejects_ > 0) log_.info("{}  rejected alarm commands (command_decode): {}", tag_, command_decode_rejects_);
+  if (handler_exceptions_ > 0) log_.info("{}  exceptions caught in LCM handlers: {}", tag_, handler_exceptions_);
 }
 
 ShaftRunStats ShaftTwin::runStats() const {

@@ -80,8 +80,13 @@ class ShaftTwin {
   ShaftRunStats runStats() const;
 
  private:
+  // LCM callbacks: no exception escapes them (a throw is counted as
+  // "handler_exception" in HOIST_HEALTH and logged, rate-limited).
   void onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void onAck(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void handleWinder(const lcm::ReceiveBuffer* rbuf);
+  void handleAck(const lcm::ReceiveBuffer* rbuf);
+  void handlerFailed(const char* what, const char* channel);
   double wallNow() const;
   void publishCage(std::int64_t utime);
   void publishShape(std::int64_t utime);
@@ -110,6 +115,11 @@ class ShaftTwin {
   LatencyHistogram step_hist_, late_hist_;    // this health window
   LatencyHistogram step_total_, late_total_;  // whole run (final report)
   std::int64_t publish_failures_ = 0, nonfinite_blocked_ = 0, alarm_events_ = 0;
+  // Extra HOIST_HEALTH reasons after the winder reasons (not in rejected_total,
+  // which counts winder inputs): undecodable alarm commands, and exceptions
+  // caught in an LCM callback.
+  static constexpr int kExtraReasons = 2;
+  std::int64_t command_decode_rejects_ = 0, handler_exceptions_ = 0;
   std::int64_t publish_attempts_ = 0;
   bool fault_injected_ = false;
   std::int64_t cage_seq_ = 0, alarm_id_ = 0;

@@ -1,7 +1,12 @@
 // hoist-log2csv -- an LCM log file (as written by lcm-logger) to CSV, one file
 // per channel: DIR/<CHANNEL>.csv.
 //
-//   hoist-log2csv LOGFILE --out-dir DIR
+//   hoist-log2csv LOGFILE --out-dir DIR [--lenient]
+//
+// The log is read with hoist::io::LcmLogReader (not liblcm's reader): every
+// event header is validated against the file before anything is allocated,
+// and a corrupted event is skipped by resynchronising on the next sync word.
+// Every payload is validated by hoist::msg::checkedDecode before decoding.
 //
 // Messages are recognized by their LCM type fingerprint (the first 8 bytes),
 // not by channel name, so prefixed or renamed channels decode too.  Events of
@@ -23,15 +28,18 @@
 //   hoist.alarm_ack_t   utime,kind,level,action,shelve_duration,user
 //   hoist.health_t      utime,uptime,t,clock,rate,window,ticks,steps,deadline_misses,
 //                       step_p50_us,...,degraded, then rejected_<reason> per reason
-// Exit status: 0 on success, 1 if the log cannot be read or a file cannot be
-// written, 2 for a bad command line.
+// Exit status: 0 on success; 1 if the log cannot be read, a file cannot be
+// written to its last byte (the path and the errno text are printed), or --
+// unless --lenient -- the log had corrupt regions (bytes skipped, events
+// lost) or events that carry a hoist fingerprint but fail the checked decode;
+// 2 for a bad command line.
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <cerrno>
+#include <cstring>
 #include <iostream>
-#include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -42,6 +50,8 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/io/lcm_log.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
 
 namespace {
@@ -63,18 +73,31 @@ std::string csvQuote(const std::string& s) {
   return out + "\"";
 }
 
-std::int64_t fingerprintOf(const void* data, std::size_t size) {
-  if (size < 8) return 0;
-  const auto* b = static_cast<const std::uint8_t*>(data);
-  std::uint64_t h = 0;
-  for (int i = 0; i < 8; ++i) h = (h << 8) | b[i];
-  return static_cast<std::int64_t>(h);
-}
+using Event = hoist::io::LcmLogEvent;
 
+/// One output file, written through stdio so that every error -- on a write,
+/// the final fflush or fclose -- is seen with its errno.
 struct Writer {
-  std::ofstream out;
+  std::FILE* f = nullptr;
+  std::string path;
   std::string type;
   long rows = 0;
+  int err = 0;  ///< first errno seen (0: none)
+  void write(const std::string& line) {
+    if (f == nullptr || err != 0) return;
+    if (std::fwrite(line.data(), 1, line.size(), f) != line.size() || std::fputc('\n', f) == EOF)
+      err = errno ? errno : EIO;
+  }
+  /// Flush and close; false (err set) if any byte did not reach the file.
+  bool close() {
+    if (f == nullptr) return err == 0;
+    errno = 0;
+    if (std::fflush(f) != 0 && err == 0) err = errno ? errno : EIO;
+    if (std::ferror(f) && err == 0) err = EIO;
+    if (std::fclose(f) != 0 && err == 0) err = errno ? errno : EIO;
+    f = nullptr;
+    return err == 0;
+  }
 };
 
 class Converter {
@@ -82,30 +105,44 @@ class Converter {
   explicit Converter(std::filesystem::path dir) : dir_(std::move(dir)) {}
 
   /// Returns false if the event is of no known type or does not decode.
-  bool handle(const lcm::LogEvent& ev) {
-    const std::int64_t fp = fingerprintOf(ev.data, static_cast<std::size_t>(ev.datalen));
-    const int len = ev.datalen;
-    if (fp == hoist::cage_state_t::getHash()) return cage(ev, len);
-    if (fp == hoist::winder_t::getHash()) return winder(ev, len);
-    if (fp == hoist::guide_shape_t::getHash()) return shape(ev, len);
-    if (fp == hoist::alarm_t::getHash()) return alarm(ev, len);
-    if (fp == hoist::alarm_ack_t::getHash()) return ack(ev, len);
-    if (fp == hoist::health_t::getHash()) return health(ev, len);
+  bool handle(const Event& ev) {
+    const hoist::msg::TypeInfo* t = hoist::msg::findByFingerprint(ev.data.data(), ev.data.size());
+    const std::string name = t ? t->name : "";
+    if (name == "hoist.cage_state_t") return cage(ev);
+    if (name == "hoist.winder_t") return winder(ev);
+    if (name == "hoist.guide_shape_t") return shape(ev);
+    if (name == "hoist.alarm_t") return alarm(ev);
+    if (name == "hoist.alarm_ack_t") return ack(ev);
+    if (name == "hoist.health_t") return health(ev);
     ++unknown_[ev.channel];
     return false;
   }
 
-  void report(std::ostream& os) const {
-    for (const auto& [key, w] : writers_)
-      os << "hoist-log2csv: " << w->rows << " rows of hoist." << w->type << " -> "
-         << (dir_ / fileName(key)).string() << "\n";
+  /// Closes every file (checked to the last byte), then prints the summary.
+  /// False if any file failed.
+  bool finish(std::ostream& os) {
+    for (auto& [key, w] : writers_) {
+      if (!w->close()) {
+        os << "hoist-log2csv: error: writing " << w->path << " failed: " << std::strerror(w->err) << "\n";
+        failed_ = true;
+      } else {
+        os << "hoist-log2csv: " << w->rows << " rows of hoist." << w->type << " -> " << w->path << "\n";
+      }
+    }
     for (const auto& [ch, n] : unknown_)
-      os << "hoist-log2csv: note: skipped " << n << " event(s) of an unknown type on channel " << ch << "\n";
-    for (const auto& [ch, n] : bad_)
-      os << "hoist-log2csv: note: skipped " << n << " event(s) on channel " << ch
-         << " that carry a hoist fingerprint but do not decode (truncated?)\n";
+      os << "hoist-log2csv: note: skipped " << n << " event(s) of an unknown type on channel "
+         << hoist::msg::terminalSafe(ch) << "\n";
+    for (const auto& [key, n] : bad_)
+      os << "hoist-log2csv: skipped " << n << " event(s) on channel " << hoist::msg::terminalSafe(key.first)
+         << " that carry a hoist fingerprint but fail the checked decode (" << key.second << ")\n";
+    return !failed_;
   }
   bool failed() const { return failed_; }
+  long badCount() const {
+    long n = 0;
+    for (auto& [c, k] : bad_) n += k;
+    return n;
+  }
   long unknownCount() const {
     long n = 0;
     for (auto& [c, k] : unknown_) n += k;
@@ -132,13 +169,10 @@ class Converter {
     if (it == writers_.end()) {
       auto w = std::make_unique<Writer>();
       w->type = type;
-      const auto path = dir_ / fileName(key);
-      w->out.open(path);
-      if (!w->out) {
-        std::cerr << "hoist-log2csv: cannot write " << path.string() << "\n";
-        failed_ = true;
-      }
-      w->out << header << "\n";
+      w->path = (dir_ / fileName(key)).string();
+      w->f = std::fopen(w->path.c_str(), "w");
+      if (w->f == nullptr) w->err = errno ? errno : EIO;
+      w->write(header);
       it = writers_.emplace(key, std::move(w)).first;
     }
     ++it->second->rows;
@@ -146,17 +180,18 @@ class Converter {
   }
 
   template <class Msg>
-  bool decode(const lcm::LogEvent& ev, int len, Msg& m) {
-    if (m.decode(ev.data, 0, len) != len) {
-      ++bad_[ev.channel];
+  bool decode(const Event& ev, Msg& m) {
+    const auto st = hoist::msg::checkedDecode(ev.data.data(), ev.data.size(), m);
+    if (st != hoist::msg::DecodeStatus::ok) {
+      ++bad_[{ev.channel, hoist::msg::toString(st)}];
       return false;
     }
     return true;
   }
 
-  bool cage(const lcm::LogEvent& ev, int len) {
+  bool cage(const Event& ev) {
     hoist::cage_state_t m{};
-    if (!decode(ev, len, m)) return false;
+    if (!decode(ev, m)) return false;
     Writer* w = writer(ev.channel, "cage_state_t",
                        "t,l,v,a,x_c,y_c,theta,lambda_0,lambda_1,lambda_2,lambda_3,lambda_4,utime,seq,"
                        "input_seq,y_top,y_bottom,guide_deflection,clearance_pos_y,clearance_neg_y,"
@@ -169,32 +204,40 @@ class Converter {
        << num(m.y_bottom) << ',' << num(m.guide_deflection) << ',' << num(m.clearance_pos_y) << ','
        << num(m.clearance_neg_y) << ',' << num(m.clearance_guide) << ',' << num(m.min_clearance)
        << ',' << int(m.alarm_level) << ',' << int(m.degraded);
-    w->out << os.str() << '\n';
+    w->write(os.str());
     return true;
   }
 
-  bool winder(const lcm::LogEvent& ev, int len) {
+  bool winder(const Event& ev) {
     hoist::winder_t m{};
-    if (!decode(ev, len, m)) return false;
+    if (!decode(ev, m)) return false;
     Writer* w = writer(ev.channel, "winder_t", "utime,seq,v,a,has_length,length,log_utime");
-    w->out << m.utime << ',' << m.seq << ',' << num(m.v) << ',' << num(m.a) << ',' << int(m.has_length)
-           << ',' << num(m.length) << ',' << ev.timestamp << '\n';
+    {
+      std::ostringstream os;
+      os << m.utime << ',' << m.seq << ',' << num(m.v) << ',' << num(m.a) << ',' << int(m.has_length)
+           << ',' << num(m.length) << ',' << ev.timestamp;
+      w->write(os.str());
+    }
     return true;
   }
 
-  bool shape(const lcm::LogEvent& ev, int len) {
+  bool shape(const Event& ev) {
     hoist::guide_shape_t m{};
-    if (!decode(ev, len, m)) return false;
+    if (!decode(ev, m)) return false;
     Writer* w = writer(ev.channel, "guide_shape_t", "t,x,y1,y2,l,utime");
     for (int i = 0; i < m.n; ++i)
-      w->out << num(m.t) << ',' << num(m.x[i]) << ',' << num(m.y1[i]) << ',' << num(m.y2[i]) << ','
-             << num(m.l) << ',' << m.utime << '\n';
+      {
+      std::ostringstream os;
+      os << num(m.t) << ',' << num(m.x[i]) << ',' << num(m.y1[i]) << ',' << num(m.y2[i]) << ','
+             << num(m.l) << ',' << m.utime;
+      w->write(os.str());
+    }
     return true;
   }
 
-  bool alarm(const lcm::LogEvent& ev, int len) {
+  bool alarm(const Event& ev) {
     hoist::alarm_t m{};
-    if (!decode(ev, len, m)) return false;
+    if (!decode(ev, m)) return false;
     Writer* w = writer(ev.channel, "alarm_t",
                        "utime,id,t,kind,level,event,active,acked,shelved,latched,value,threshold,"
                        "shelved_for,message");
@@ -202,25 +245,33 @@ class Converter {
     static const char* events[] = {"?", "RAISE", "CLEAR", "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE"};
     const char* lvl = (m.level >= 0 && m.level <= 2) ? levels[m.level] : "?";
     const char* evn = (m.event_type >= 1 && m.event_type <= 6) ? events[m.event_type] : "?";
-    w->out << m.utime << ',' << m.id << ',' << num(m.t) << ',' << csvQuote(m.kind) << ',' << lvl << ','
+    {
+      std::ostringstream os;
+      os << m.utime << ',' << m.id << ',' << num(m.t) << ',' << csvQuote(m.kind) << ',' << lvl << ','
            << evn << ',' << int(m.active) << ',' << int(m.acked) << ',' << int(m.shelved) << ','
            << int(m.latched) << ',' << num(m.value) << ',' << num(m.threshold) << ','
-           << num(m.shelved_for) << ',' << csvQuote(m.message) << '\n';
+           << num(m.shelved_for) << ',' << csvQuote(m.message);
+      w->write(os.str());
+    }
     return true;
   }
 
-  bool ack(const lcm::LogEvent& ev, int len) {
+  bool ack(const Event& ev) {
     hoist::alarm_ack_t m{};
-    if (!decode(ev, len, m)) return false;
+    if (!decode(ev, m)) return false;
     Writer* w = writer(ev.channel, "alarm_ack_t", "utime,kind,level,action,shelve_duration,user");
-    w->out << m.utime << ',' << csvQuote(m.kind) << ',' << int(m.level) << ',' << int(m.action) << ','
-           << num(m.shelve_duration) << ',' << csvQuote(m.user) << '\n';
+    {
+      std::ostringstream os;
+      os << m.utime << ',' << csvQuote(m.kind) << ',' << int(m.level) << ',' << int(m.action) << ','
+           << num(m.shelve_duration) << ',' << csvQuote(m.user);
+      w->write(os.str());
+    }
     return true;
   }
 
-  bool health(const lcm::LogEvent& ev, int len) {
+  bool health(const Event& ev) {
     hoist::health_t m{};
-    if (!decode(ev, len, m)) return false;
+    if (!decode(ev, m)) return false;
     std::string header =
         "utime,uptime,t,clock,rate,window,ticks,steps,deadline_misses,step_p50_us,step_p99_us,"
         "step_max_us,late_p50_us,late_p99_us,late_max_us,input_age,accepted,seq_gaps,rejected_total,"
@@ -238,13 +289,14 @@ class Converter {
        << m.alarm_events << ',' << m.model_faults << ',' << m.model_resets << ','
        << m.publish_failures << ',' << m.nonfinite_blocked << ',' << int(m.degraded);
     for (auto v : m.rejected) os << ',' << v;
-    w->out << os.str() << '\n';
+    w->write(os.str());
     return true;
   }
 
   std::filesystem::path dir_;
   std::map<std::string, std::unique_ptr<Writer>> writers_;
-  std::map<std::string, long> unknown_, bad_;
+  std::map<std::string, long> unknown_;
+  std::map<std::pair<std::string, std::string>, long> bad_;  // (channel, status)
   bool failed_ = false;
 };
 
@@ -255,10 +307,15 @@ int main(int argc, char** argv) {
       "hoist-log2csv: convert an LCM log (lcm-logger) of the hoist channels to CSV,\n"
       "one file per channel (DIR/<CHANNEL>.csv).  Types are recognized by fingerprint;\n"
       "for HOIST_CAGE the first columns are t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4\n"
-      "(as hoist-sim writes them)."};
+      "(as hoist-sim writes them).  Corrupted events are skipped (resynchronising on\n"
+      "the next event) and reported; the exit status is then 1 unless --lenient.\n"
+      "Exit status: 0 ok, 1 unreadable log / unwritable file / data lost, 2 bad usage."};
   std::string log_path, out_dir;
+  bool lenient = false;
   app.add_option("LOGFILE", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
   app.add_option("--out-dir", out_dir, "output directory (created if missing)")->required();
+  app.add_flag("--lenient", lenient,
+               "exit 0 even when corrupt events were skipped or events failed to decode");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -271,18 +328,28 @@ int main(int argc, char** argv) {
     std::cerr << "hoist-log2csv: cannot create " << out_dir << ": " << ec.message() << "\n";
     return 1;
   }
-  lcm::LogFile log(log_path, "r");
-  if (!log.good()) {
-    std::cerr << "hoist-log2csv: cannot open " << log_path << " as an LCM log\n";
+  hoist::io::LcmLogReader log(log_path);
+  if (!log.ok()) {
+    std::cerr << "hoist-log2csv: " << log.error() << "\n";
     return 1;
   }
   Converter conv(out_dir);
-  long events = 0;
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
-    ++events;
-    conv.handle(*ev);
+  hoist::io::LcmLogEvent ev;
+  while (log.next(ev)) conv.handle(ev);
+  const bool files_ok = conv.finish(std::cerr);
+  if (!log.ok()) {
+    std::cerr << "hoist-log2csv: error: " << log.error() << "\n";
+    return 1;
   }
-  std::cerr << "hoist-log2csv: " << events << " events read from " << log_path << "\n";
-  conv.report(std::cerr);
-  return conv.failed() ? 1 : 0;
+  std::cerr << "hoist-log2csv: " << log_path << ": " << log.summary() << "\n";
+  if (!files_ok) return 1;
+  const bool lost = log.stats().lost() || conv.badCount() > 0;
+  if (lost) {
+    std::cerr << "hoist-log2csv: " << (lenient ? "warning" : "error") << ": data lost ("
+              << log.stats().bytes_skipped << " bytes skipped, about " << log.stats().events_lost
+              << " event(s) lost, " << conv.badCount() << " undecodable)"
+              << (lenient ? " -- ignored (--lenient)" : "; use --lenient to accept") << "\n";
+    if (!lenient) return 1;
+  }
+  return 0;
 }

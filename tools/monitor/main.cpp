@@ -8,6 +8,14 @@
 // (theta), the largest guide-sleeve force max|lambda_1..4|, the minimum
 // remaining clearance and the active alarms.  Alarm events are printed as
 // they arrive.  Stops on SIGINT/SIGTERM or after --duration.
+//
+// Hostile input (issue 12): every payload passes hoist::msg::checkedDecode
+// before it is decoded (undecodable ones are counted and shown), no exception
+// leaves an LCM callback, every string from the network is printed through
+// hoist::msg::terminalSafe (no control characters or escape sequences reach
+// the terminal), at most 64 active alarms are tracked, and when no HOIST_CAGE
+// or no HOIST_HEALTH arrived for more than --stale seconds (default 2) the
+// line says STALE with the age of the data.
 #include <CLI/CLI.hpp>
 #include <poll.h>
 #include <unistd.h>
@@ -24,6 +32,7 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/service/lcm_util.hpp"
 
 namespace {
@@ -31,36 +40,77 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void onSignal(int) { g_stop = 1; }
 
+using Clock = std::chrono::steady_clock;
+
 class Monitor {
  public:
-  void onCage(const lcm::ReceiveBuffer*, const std::string&, const hoist::cage_state_t* m) {
-    cage_ = *m;
-    have_cage_ = true;
-    ++cages_;
+  static constexpr std::size_t kMaxActive = 64;
+
+  void onCage(const lcm::ReceiveBuffer* rb, const std::string&) {
+    guarded([&] {
+      hoist::cage_state_t m;
+      if (!decode(rb, m)) return;
+      cage_ = m;
+      have_cage_ = true;
+      last_cage_ = Clock::now();
+      ++cages_;
+    });
   }
-  void onAlarm(const lcm::ReceiveBuffer*, const std::string&, const hoist::alarm_t* m) {
-    static const char* lv[] = {"", "WARNING", "CRITICAL"};
-    const std::string key = m->kind + "/" + ((m->level >= 0 && m->level <= 2) ? lv[m->level] : "?");
-    if (m->active && !m->shelved) active_[key] = true;
-    else active_.erase(key);
-    if (m->event_type != hoist::alarm_t::EVENT_REANNOUNCE) {
-      std::printf("  >> [t=%7.2f s] %s\n", m->t, m->message.c_str());
-      std::fflush(stdout);
-    }
+  void onAlarm(const lcm::ReceiveBuffer* rb, const std::string&) {
+    guarded([&] {
+      hoist::alarm_t m;
+      if (!decode(rb, m)) return;
+      static const char* lv[] = {"", "WARNING", "CRITICAL"};
+      const std::string key = hoist::msg::terminalSafe(m.kind, 40) + "/" +
+                              ((m.level >= 0 && m.level <= 2) ? lv[m.level] : "?");
+      if (m.active && !m.shelved) {
+        if (active_.size() < kMaxActive || active_.count(key)) active_[key] = true;
+        else ++active_overflow_;
+      } else {
+        active_.erase(key);
+      }
+      if (m.event_type != hoist::alarm_t::EVENT_REANNOUNCE) {
+        std::printf("  >> [t=%7.2f s] %s\n", m.t, hoist::msg::terminalSafe(m.message).c_str());
+        std::fflush(stdout);
+      }
+    });
   }
-  void onHealth(const lcm::ReceiveBuffer*, const std::string&, const hoist::health_t* m) {
-    health_ = *m;
-    have_health_ = true;
+  void onHealth(const lcm::ReceiveBuffer* rb, const std::string&) {
+    guarded([&] {
+      hoist::health_t m;
+      if (!decode(rb, m)) return;
+      health_ = std::move(m);
+      have_health_ = true;
+      last_health_ = Clock::now();
+    });
+  }
+
+  /// " STALE: no HOIST_CAGE for 3.2 s, no HOIST_HEALTH for 3.1 s" or "".
+  std::string staleness(Clock::time_point now) const {
+    std::string out;
+    auto add = [&](bool have, Clock::time_point last, const char* what) {
+      const double age = std::chrono::duration<double>(now - (have ? last : start_)).count();
+      if (age <= stale_s_) return;
+      char b[96];
+      std::snprintf(b, sizeof b, "%s no %s for %.1f s", out.empty() ? "" : ",", what, age);
+      out += b;
+    };
+    add(have_cage_, last_cage_, "HOIST_CAGE");
+    add(have_health_, last_health_, "HOIST_HEALTH");
+    return out.empty() ? out : "  ** STALE:" + out + " **";
   }
 
   void printLine() {
+    const std::string stale = staleness(Clock::now());
+    std::string bad;
+    if (undecodable_ > 0) bad = "  [undecodable messages: " + std::to_string(undecodable_) + "]";
     if (lines_ % 20 == 0)
       std::printf("%9s %9s %9s %10s %11s %10s %11s  %s\n", "time[s]", "depth[m]", "v[m/s]",
                   "sway[mm]", "tilt[mrad]", "Fmax[N]", "clear[mm]", "alarms");
     ++lines_;
     if (!have_cage_) {
-      std::printf("%9s  waiting for %s ...%s\n", "-", cage_channel_.c_str(),
-                  have_health_ ? " (daemon is up, no model output yet)" : "");
+      std::printf("%9s  waiting for %s ...%s%s%s\n", "-", hoist::msg::terminalSafe(cage_channel_).c_str(),
+                  have_health_ ? " (daemon is up, no model output yet)" : "", stale.c_str(), bad.c_str());
       std::fflush(stdout);
       return;
     }
@@ -69,18 +119,40 @@ class Monitor {
     std::string alarms;
     for (const auto& [k, on] : active_) alarms += (alarms.empty() ? "" : " ") + k;
     if (alarms.empty()) alarms = "none";
+    if (active_overflow_ > 0) alarms += " (+more)";
     if (cage_.degraded) alarms += "  (DEGRADED)";
     if (have_health_ && health_.rejected_total > 0)
       alarms += "  [rejected inputs: " + std::to_string(health_.rejected_total) + "]";
-    std::printf("%9.2f %9.2f %9.2f %+10.3f %+11.4f %10.1f %11.1f  %s\n", cage_.t, cage_.l, cage_.v,
-                cage_.y_c * 1e3, cage_.theta * 1e3, fmax, cage_.min_clearance * 1e3, alarms.c_str());
+    std::printf("%9.2f %9.2f %9.2f %+10.3f %+11.4f %10.1f %11.1f  %s%s%s\n", cage_.t, cage_.l, cage_.v,
+                cage_.y_c * 1e3, cage_.theta * 1e3, fmax, cage_.min_clearance * 1e3, alarms.c_str(),
+                stale.c_str(), bad.c_str());
     std::fflush(stdout);
   }
 
   std::string cage_channel_;
   long cages_ = 0;
+  double stale_s_ = 2.0;
+  Clock::time_point start_ = Clock::now();
 
  private:
+  template <class M>
+  bool decode(const lcm::ReceiveBuffer* rb, M& m) {
+    if (hoist::msg::checkedDecode(rb->data, rb->data_size, m) == hoist::msg::DecodeStatus::ok) return true;
+    ++undecodable_;
+    return false;
+  }
+  /// No exception leaves an LCM callback: a failure drops the message.
+  template <class F>
+  void guarded(F&& f) {
+    try {
+      f();
+    } catch (...) {
+      ++undecodable_;
+    }
+  }
+  Clock::time_point last_cage_{}, last_health_{};
+  long undecodable_ = 0;
+  std::size_t active_overflow_ = 0;
   hoist::cage_state_t cage_{};
   hoist::health_t health_{};
   bool have_cage_ = false, have_health_ = false;
@@ -101,6 +173,9 @@ int main(int argc, char** argv) {
   app.add_option("--period", period, "seconds between lines (default 1)")->check(CLI::PositiveNumber);
   app.add_option("--duration", duration, "stop after this many seconds (default: until Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
+  double stale = 2.0;
+  app.add_option("--stale", stale, "flag the data STALE after this many seconds without HOIST_CAGE/HEALTH (default 2)")
+      ->check(CLI::PositiveNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -115,6 +190,7 @@ int main(int argc, char** argv) {
   }
   Monitor mon;
   mon.cage_channel_ = prefix + "HOIST_CAGE";
+  mon.stale_s_ = stale;
   lcm.subscribe(prefix + "HOIST_CAGE", &Monitor::onCage, &mon);
   lcm.subscribe(prefix + "HOIST_ALARM", &Monitor::onAlarm, &mon);
   lcm.subscribe(prefix + "HOIST_HEALTH", &Monitor::onHealth, &mon);
@@ -123,7 +199,6 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 
-  using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   auto next = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period));
   const int fd = lcm.getFileno();

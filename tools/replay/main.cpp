@@ -13,7 +13,12 @@
 //   * an LCM log (lcm-logger): every event whose channel ends in HOIST_WINDER
 //     is re-published with its recorded timing, payload unchanged (so
 //     `hoist-twind --clock input` reproduces the recorded run), unless
-//     --restamp rewrites utime to the replay's wall clock.
+//     --restamp rewrites utime to the replay's wall clock.  The log is read
+//     with hoist::io::LcmLogReader (validated headers, resynchronisation on
+//     the next event after a corrupted one) and each payload must pass
+//     hoist::msg::checkedDecode as a winder_t; skipped bytes, lost events and
+//     undecodable payloads are reported and make the exit status 1 unless
+//     --lenient.
 // Message k carries seq = k and utime = (wall time at start, us) + round((t_k -
 // t0) * 1e6): utime follows PROFILE time whatever the speed, so that
 // `hoist-twind --clock input` steps the model exactly by the profile's dt.
@@ -40,7 +45,9 @@
 #include <string>
 #include <vector>
 
+#include "hoist/io/lcm_log.hpp"
 #include "hoist/io/profile.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/service/lcm_util.hpp"
 #include "hoist/winder_t.hpp"
 #include "hoist/io/config.hpp"
@@ -195,6 +202,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_flag("--with-length", with_length, "include the encoder rope length l in every message");
   app.add_flag("--restamp", restamp, "--lcm-log: rewrite utime to the replay's wall clock");
+  bool lenient = false;
+  app.add_flag("--lenient", lenient,
+               "--lcm-log: exit 0 even when corrupt events were skipped or payloads failed to decode");
   app.add_flag("-q,--quiet", quiet, "no progress display");
   auto* t_opt = app.add_flag("--timing-test", timing,
                              "check a running hoist-twind's timing against budgets (see below)")
@@ -298,30 +308,38 @@ int main(int argc, char** argv) {
   std::vector<std::uint8_t> buf(256);
   hoist::winder_t msg{};
 
+  long log_bad = 0;
+  bool log_lost = false;
   if (!log_path.empty()) {
-    lcm::LogFile log(log_path, "r");
-    if (!log.good()) {
-      std::cerr << "hoist-replay: cannot open " << log_path << " as an LCM log\n";
+    hoist::io::LcmLogReader log(log_path);
+    if (!log.ok()) {
+      std::cerr << "hoist-replay: " << log.error() << "\n";
       return 1;
     }
     std::int64_t first_ts = 0, first_utime = 0;
     bool first = true;
-    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    hoist::io::LcmLogEvent ev;
+    while (log.next(ev)) {
       if (g_signal) break;
-      if (!endsWith(ev->channel, "HOIST_WINDER")) continue;
+      if (!endsWith(ev.channel, "HOIST_WINDER")) continue;
+      // Validate before anything is sent: the daemon would reject it anyway.
+      if (const auto st = hoist::msg::checkedDecode(ev.data.data(), ev.data.size(), msg);
+          st != hoist::msg::DecodeStatus::ok) {
+        if (log_bad++ < 5)
+          std::cerr << "hoist-replay: " << log_path << ": event " << ev.eventnum << " at byte " << ev.offset
+                    << " on " << hoist::msg::terminalSafe(ev.channel) << " is not a valid hoist.winder_t ("
+                    << hoist::msg::toString(st) << "); skipped\n";
+        continue;
+      }
       if (first) {
-        first_ts = ev->timestamp;
+        first_ts = ev.timestamp;
         first = false;
       }
-      const double t_rel = static_cast<double>(ev->timestamp - first_ts) * 1e-6;
+      const double t_rel = static_cast<double>(ev.timestamp - first_ts) * 1e-6;
       if (speed > 0.0 && !sleepUntil(start_ns + static_cast<std::int64_t>(t_rel / speed * 1e9))) break;
-      const void* data = ev->data;
-      int len = ev->datalen;
+      const void* data = ev.data.data();
+      int len = static_cast<int>(ev.data.size());
       if (restamp) {
-        if (msg.decode(ev->data, 0, ev->datalen) != ev->datalen) {
-          ++failed;
-          continue;
-        }
         if (sent == 0) first_utime = msg.utime;
         msg.utime = start_utime + (msg.utime - first_utime);
         len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
@@ -331,6 +349,17 @@ int main(int argc, char** argv) {
       else ++sent;
       progress.update(t_rel, 0.0, t_rel, sent);
     }
+    if (!log.ok()) {
+      progress.done();
+      std::cerr << "hoist-replay: error: " << log.error() << "\n";
+      return 1;
+    }
+    log_lost = log.stats().lost() || log_bad > 0;
+    if (!g_signal && (log_lost || !quiet))
+      std::cerr << "hoist-replay: " << log_path << ": " << log.summary()
+                << (log_bad ? "; " + std::to_string(log_bad) + " undecodable HOIST_WINDER payload(s) skipped"
+                            : std::string())
+                << "\n";
   } else {
     double l0 = 50.0;
     try {
@@ -375,5 +404,10 @@ int main(int argc, char** argv) {
   if (!quiet)
     std::cerr << "hoist-replay: published " << sent << " messages on " << channel
               << (failed ? " (" + std::to_string(failed) + " failed)" : std::string()) << "\n";
+  if (log_lost) {
+    std::cerr << "hoist-replay: " << (lenient ? "warning" : "error") << ": data lost in " << log_path
+              << (lenient ? " -- ignored (--lenient)" : "; use --lenient to accept") << "\n";
+    if (!lenient) return 1;
+  }
   return failed ? 1 : 0;
 }

@@ -26,6 +26,7 @@
 
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/profile.hpp"
 #include "hoist/service/lcm_util.hpp"
 #include "hoist/winder_t.hpp"
@@ -262,9 +263,11 @@ struct Run {
   explicit Run(const TimingTestOptions& opt) : o(opt) {}
 };
 
-void Shaft::onHealth(const lcm::ReceiveBuffer* rb, const std::string& /*channel*/) {
+// LCM callbacks: bytes checked before decoding, and no exception escapes
+// (function-try-blocks; a failure drops the message).
+void Shaft::onHealth(const lcm::ReceiveBuffer* rb, const std::string& /*channel*/) try {
   hoist::health_t h;
-  if (h.decode(rb->data, 0, static_cast<int>(rb->data_size)) != static_cast<int>(rb->data_size)) return;
+  if (hoist::msg::checkedDecode(rb->data, rb->data_size, h) != hoist::msg::DecodeStatus::ok) return;
   const Run& r = *run;
   if (r.phase == Phase::Done || res.final_report) return;
   res.heard = true;
@@ -299,13 +302,14 @@ void Shaft::onHealth(const lcm::ReceiveBuffer* rb, const std::string& /*channel*
   have_last = true;
   // The first report after the last input (with a margin for its processing).
   if (r.phase == Phase::Post && h.utime >= r.feed_end_utime + 20000) res.final_report = true;
+} catch (...) {
 }
 
-void Shaft::onCage(const lcm::ReceiveBuffer* rb, const std::string& /*channel*/) {
+void Shaft::onCage(const lcm::ReceiveBuffer* rb, const std::string& /*channel*/) try {
   const Run& r = *run;
   if (r.phase != Phase::Feeding && r.phase != Phase::Post) return;
   hoist::cage_state_t c;
-  if (c.decode(rb->data, 0, static_cast<int>(rb->data_size)) != static_cast<int>(rb->data_size)) return;
+  if (hoist::msg::checkedDecode(rb->data, rb->data_size, c) != hoist::msg::DecodeStatus::ok) return;
   std::int64_t t_pub = 0;
   if (!ring->get(c.input_seq, t_pub)) {
     // Ours but already overwritten in the ring (a very late answer)?
@@ -321,6 +325,7 @@ void Shaft::onCage(const lcm::ReceiveBuffer* rb, const std::string& /*channel*/)
     answered = c.input_seq;
     res.e2e.add(static_cast<double>(rb->recv_utime - t_pub));
   }
+} catch (...) {
 }
 
 std::string hostName() {

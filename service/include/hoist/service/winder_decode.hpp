@@ -2,15 +2,17 @@
 // exactly as hoist-twind decodes them (header-only: needs the lcm-gen'd
 // hoist/winder_t.hpp, i.e. link hoist_msgs).
 //
-// Bounded work: winder_t has a fixed size (8-byte fingerprint + 41 bytes), so
-// decoding reads at most that many bytes whatever `size` is; a payload of
-// another size is rejected before or after decoding without touching the
-// rest.  Used by the daemon, the hardening tests and the LCM-input fuzzer.
+// Bounded work: the bytes are validated by hoist::msg::checkedDecode (the
+// generated walker of hoist_msgs_codec: fingerprint, exact size 8 + 41 bytes)
+// before lcm-gen's decode sees them; winder_t has no strings or arrays, so
+// nothing is allocated.  Link hoist_msgs_codec.  Used by the daemon, the
+// hardening tests and the LCM-input fuzzer.
 #pragma once
 
 #include <cstdint>
 
 #include "hoist/service/input_validator.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
 
 namespace hoist::svc {
@@ -36,12 +38,11 @@ inline const char* describe(WinderDecode d) {
 inline WinderDecode decodeWinder(const void* data, std::int64_t size, hoist::winder_t& scratch,
                                  WinderSample& out) {
   if (size <= 0 || data == nullptr) return WinderDecode::Empty;
-  // winder_t is fixed-size: anything longer than INT32_MAX cannot be one, and
-  // LCM's int-sized decode must not see a truncated length.
-  const int n = size > 0x7fffffff ? 0x7fffffff : static_cast<int>(size);
-  const int used = scratch.decode(data, 0, n);
-  if (used < 0) return WinderDecode::Malformed;
-  if (used != size) return WinderDecode::Trailing;
+  switch (hoist::msg::checkedDecode(data, static_cast<std::size_t>(size), scratch)) {
+    case hoist::msg::DecodeStatus::ok: break;
+    case hoist::msg::DecodeStatus::too_large: return WinderDecode::Trailing;
+    default: return WinderDecode::Malformed;
+  }
   out.utime = scratch.utime;
   out.seq = scratch.seq;
   out.v = scratch.v;
