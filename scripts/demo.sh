@@ -20,6 +20,7 @@
 #                  the paper's shaft with tight clearances so alarms show)
 #   --port N       UDP port of the private LCM URL (default 7690)
 #   --with-length  send the encoder rope length too
+#   --mqtt [...]   the same twin seen through MQTT: scripts/demo-mqtt.sh [...]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 setup=1
@@ -36,7 +37,8 @@ while [[ $# -gt 0 ]]; do
     --config) config="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
     --with-length) replay_extra+=(--with-length); shift ;;
-    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --mqtt) shift; [[ $setup -eq 0 ]] && set -- --no-setup "$@"; exec "$here/scripts/demo-mqtt.sh" "$@" ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -266,9 +266,11 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
   auto retained = late.waitJson("hoist/north/alarm/CAGE_POS_Y", [](const json& j, bool r) { return r && isWarningActive(j); }, 3s);
   EXPECT_TRUE(retained) << "a late subscriber must see the active alarm as a retained message";
   std::this_thread::sleep_for(500ms);
-  for (const auto& m : late.messages())
-    if (m.retain)
+  for (const auto& m : late.messages()) {
+    if (m.retain) {
       EXPECT_TRUE(m.topic.rfind("hoist/north/alarm/", 0) == 0 || m.topic == "hoist/_bridge/bridge-a/status") << m.topic;
+    }
+  }
   EXPECT_FALSE(late.on("hoist/north/cage").empty());
 
   // Malformed commands: rejected, counted, never forwarded, never echoed.
