@@ -77,7 +77,7 @@ echo "   mosquitto_pub -t hoist/default/cmd/ack -m '{\"kind\":\"*\",\"level\":0,
 mosquitto_pub -h 127.0.0.1 -p "$bport" -q 1 -t hoist/default/cmd/ack -m '{"kind":"*","level":0,"action":1,"user":"demo"}'
 sleep 1.5
 echo "== what a SCADA client connecting now gets at once (retained): mosquitto_sub --retained-only -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status'"
-mosquitto_sub -h 127.0.0.1 -p "$bport" -v --retained-only -W 2 -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status' | cut -c1-200 || true
+mosquitto_sub -h 127.0.0.1 -p "$bport" -v --retained-only -W 2 -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status' 2>/dev/null | cut -c1-200 || true
 cleanup
 echo "== bridge log:"
 cat "$logdir/hoist-mqtt.log"

@@ -14,6 +14,7 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "hoist/io/error.hpp"
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
+  spdlog::set_default_logger(spdlog::stderr_color_mt("hoist-mqtt"));  // logs on stderr (journal under systemd)
   spdlog::set_pattern("%Y-%m-%d %H:%M:%S.%e [%l] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);
 
