@@ -11,7 +11,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
 
 namespace hoist::svc {
 
@@ -56,7 +56,7 @@ bool Daemon::start() {
   if (!lcm_.good()) {
     out_->error("cannot open LCM at {}; for multicast on one machine see docs/service.md "
                 "(ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo)",
-                describeLcmUrl(opt_.lcm_url));
+                bus::describeLcmUrl(opt_.lcm_url));
     return false;
   }
   rt_ = applyRealtime(opt_.realtime);
@@ -91,7 +91,7 @@ bool Daemon::start() {
     out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}, input {}, outputs {} {} {} {}, "
                "n={} modes, L={} m, h={} m, l0={} m",
                s.tag(), n == 1 ? "started" : "shaft",
-               toString(c.service.clock), c.service.rate, describeLcmUrl(opt_.lcm_url), s.channels().winder,
+               toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url), s.channels().winder,
                s.channels().cage, s.channels().shape, s.channels().alarm, s.channels().health, c.shaft.n,
                c.shaft.L, c.shaft.h, c.shaft.l0);
   }

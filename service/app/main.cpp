@@ -20,7 +20,8 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/service/config_file.hpp"
+#include "hoist/bus/lcm_util.hpp"
 
 int main(int argc, char** argv) {
   using namespace hoist::svc;
@@ -133,7 +134,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  opt.lcm_url = resolveLcmUrl(lcm_url, shaft_url);
+  opt.lcm_url = hoist::bus::resolveLcmUrl(lcm_url, shaft_url);
   opt.duration = duration;
   opt.hooks.inject_fault_at = inject_fault_at;
   opt.hooks.fail_publish_every = fail_publish_every;

@@ -25,7 +25,8 @@
 #include "hoist/msg/codec.hpp"
 #include "hoist/mqtt/command.hpp"
 #include "hoist/mqtt/outbox.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/channels.hpp"
+#include "hoist/bus/lcm_util.hpp"
 
 namespace hoist::mqtt {
 
@@ -34,10 +35,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using json = nlohmann::json;
 
-constexpr const char* kCage = "HOIST_CAGE";
-constexpr const char* kHealth = "HOIST_HEALTH";
-constexpr const char* kAlarm = "HOIST_ALARM";
-constexpr const char* kAck = "HOIST_ALARM_ACK";
+using hoist::bus::kChannelAlarm;
+using hoist::bus::kChannelAlarmAck;
+using hoist::bus::kChannelCage;
+using hoist::bus::kChannelHealth;
 constexpr int kMaxKindsPerShaft = 32;
 
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
@@ -140,7 +141,7 @@ struct Bridge::Impl {
 
   // ---- counters ----------------------------------------------------------------
   Clock::time_point started = Clock::now();
-  std::int64_t started_utime = hoist::svc::wallUtime();
+  std::int64_t started_utime = hoist::bus::wallUtime();
   std::uint64_t connects = 0, disconnects = 0, connect_failures = 0;
   std::uint64_t lcm_messages = 0, ignored_channels = 0, alarm_rejected = 0;
   std::map<std::string, std::uint64_t> decode_errors;  // "cage/truncated" -> n
@@ -153,11 +154,11 @@ struct Bridge::Impl {
   Impl(const BridgeConfig& c, const std::string& password)
       : cfg(c),
         broker(parseBrokerUrl(c.url)),
-        lcm_url(hoist::svc::resolveLcmUrl(c.lcm_url)),
+        lcm_url(hoist::bus::resolveLcmUrl(c.lcm_url)),
         lcm(lcm_url),
         outbox(static_cast<std::size_t>(c.max_messages), static_cast<std::size_t>(c.max_alarm_events)) {
     if (!lcm.good())
-      throw std::runtime_error("cannot open LCM (" + hoist::svc::describeLcmUrl(lcm_url) +
+      throw std::runtime_error("cannot open LCM (" + hoist::bus::describeLcmUrl(lcm_url) +
                                "); is loopback multicast enabled? (scripts/setup.sh)");
     client_id = cfg.client_id;
     if (client_id.empty()) {
@@ -172,7 +173,10 @@ struct Bridge::Impl {
 
     discover = cfg.channel_prefixes.empty();
     for (const auto& p : cfg.channel_prefixes) addShaft(p);
-    lcm.subscribe(".*HOIST_(CAGE|HEALTH|ALARM)", &Impl::onLcm, this);
+    // One subscription for every shaft: ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM)" (LCM anchors it).
+    lcm.subscribe(".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" +
+                      std::string(kChannelAlarm) + ")",
+                  &Impl::onLcm, this);
 
     mosq = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
     if (!mosq) throw std::runtime_error("mosquitto_new failed: " + std::string(std::strerror(errno)));
@@ -234,8 +238,9 @@ struct Bridge::Impl {
     s.t_cmd = base + "cmd/ack";
     auto [it, fresh] = shafts.emplace(prefix, std::move(s));
     cmd_topics[it->second.t_cmd] = prefix;
-    spdlog::info("shaft '{}': LCM {}{{CAGE,HEALTH,ALARM}} -> {}{{cage,health,alarm/<KIND>}}{}", it->second.name,
-                 prefix + "HOIST_", base, cfg.commands ? ", " + it->second.t_cmd + " -> " + prefix + kAck : "");
+    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM}} -> {}{{cage,health,alarm/<KIND>}}{}", it->second.name,
+                 prefix, base,
+                 cfg.commands ? ", " + it->second.t_cmd + " -> " + hoist::bus::channel(prefix, kChannelAlarmAck) : "");
     if (conn == Conn::Connected) subscribeCommands(it->second);
     return &it->second;
   }
@@ -272,12 +277,12 @@ struct Bridge::Impl {
   void onLcm(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     try {
       ++lcm_messages;
-      auto ends = [&](const char* suffix) {
-        const std::size_t n = std::strlen(suffix);
-        return channel.size() >= n && channel.compare(channel.size() - n, n, suffix) == 0;
+      auto ends = [&](std::string_view suffix) {
+        return channel.size() >= suffix.size() &&
+               std::string_view(channel).substr(channel.size() - suffix.size()) == suffix;
       };
-      if (ends(kCage)) {
-        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kCage)));
+      if (ends(kChannelCage)) {
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelCage.size()));
         if (!s) return void(++ignored_channels);
         hoist::cage_state_t m;
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
@@ -285,8 +290,8 @@ struct Bridge::Impl {
         s->cage = m;
         s->cage_new = true;
         ++s->cage_in;
-      } else if (ends(kHealth)) {
-        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kHealth)));
+      } else if (ends(kChannelHealth)) {
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelHealth.size()));
         if (!s) return void(++ignored_channels);
         hoist::health_t m;
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
@@ -296,8 +301,8 @@ struct Bridge::Impl {
         if (s->instance_id != 0 && m.instance_id != s->instance_id) daemonRestarted(*s, m);
         s->instance_id = m.instance_id;
         publish({s->t_health, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
-      } else if (ends(kAlarm)) {
-        Shaft* s = shaftFor(channel.substr(0, channel.size() - std::strlen(kAlarm)));
+      } else if (ends(kChannelAlarm)) {
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelAlarm.size()));
         if (!s) return void(++ignored_channels);
         hoist::alarm_t m;
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
@@ -422,7 +427,7 @@ struct Bridge::Impl {
   json bridgeHealth() const {
     const auto now = Clock::now();
     json j = json::object();
-    j["utime"] = hoist::svc::wallUtime();
+    j["utime"] = hoist::bus::wallUtime();
     j["client_id"] = client_id;
     j["uptime"] = seconds(now - started);
     j["broker"] = brokerText();
@@ -438,7 +443,7 @@ struct Bridge::Impl {
       dec[k] = n;
       dec_total += n;
     }
-    j["lcm"] = {{"url", hoist::svc::describeLcmUrl(lcm_url)},
+    j["lcm"] = {{"url", hoist::bus::describeLcmUrl(lcm_url)},
                 {"messages", lcm_messages},
                 {"decode_errors", dec_total},
                 {"decode_errors_by_reason", dec},
@@ -541,7 +546,7 @@ struct Bridge::Impl {
     last_error.clear();
     delay = cfg.reconnect_min;
     connected_since_steady = Clock::now();
-    connected_since_utime = hoist::svc::wallUtime();
+    connected_since_utime = hoist::bus::wallUtime();
     spdlog::info("connected to the broker at {} as '{}'{}", brokerText(), client_id,
                  outbox.empty() ? std::string() : fmt::format("; sending {} buffered messages", outbox.size()));
     const std::string online =
@@ -586,7 +591,7 @@ struct Bridge::Impl {
       const bool may_log = cmd_log.allow(now, suppressed);
       if (may_log && suppressed) spdlog::warn("{} command log lines suppressed", suppressed);
       CommandResult r = parseAckCommand(m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
-                                        static_cast<std::size_t>(cfg.max_command_bytes), hoist::svc::wallUtime());
+                                        static_cast<std::size_t>(cfg.max_command_bytes), hoist::bus::wallUtime());
       if (r.reject != CommandReject::None) {
         ++cmd_rejected;
         ++cmd_by_reason[static_cast<int>(r.reject)];
@@ -595,7 +600,7 @@ struct Bridge::Impl {
                        r.detail);
         return;
       }
-      const std::string channel = s.prefix + kAck;
+      const std::string channel = s.hoist::bus::channel(prefix, kChannelAlarmAck);
       if (lcm.publish(channel, &r.ack) != 0) {
         ++cmd_lcm_failures;
         if (may_log) spdlog::error("command on {}: LCM publish on {} failed", s.t_cmd, channel);
@@ -624,7 +629,7 @@ struct Bridge::Impl {
     auto next_health = Clock::now() + health_period;
     next_attempt = Clock::now();
     spdlog::info("hoist-mqtt: LCM {}; broker {}; cage states at {} Hz; commands {}; shafts: {}",
-                 hoist::svc::describeLcmUrl(lcm_url), brokerText(), cfg.cage_rate,
+                 hoist::bus::describeLcmUrl(lcm_url), brokerText(), cfg.cage_rate,
                  cfg.commands ? "accepted on hoist/<shaft>/cmd/ack" : "disabled (--no-commands)",
                  discover ? "discovered from their *HOIST_{HEALTH,CAGE,ALARM} channels" : std::to_string(shafts.size()) + " configured");
     const int lcm_fd = lcm.getFileno();
