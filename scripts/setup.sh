@@ -30,8 +30,8 @@ say() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
 required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev liblcm-bin
           libglib2.0-dev libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libtomlplusplus-dev
           libcli11-dev nlohmann-json3-dev gnuplot-nox python3 iproute2)
-# MQTT bridge (hoist-mqtt): the client library, and the broker + clients its tests and demo start.
-required+=(libmosquitto-dev mosquitto mosquitto-clients)
+# MQTT bridge (hoist-mqtt): the client library, and the broker, clients and openssl (TLS test) its tests and demo use.
+required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
 # Java bindings let lcm-spy decode the hoist channels; clang gives the fuzzers.
 optional=(liblcm-java default-jdk-headless clang libclang-rt-14-dev)
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }

@@ -460,3 +460,69 @@ TEST_F(MqttBridge, BadConfigurationExits2) {
   EXPECT_NE(readFile(log("out2.log")).find("broker.url"), std::string::npos) << readFile(log("out2.log"));
   EXPECT_EQ(runProcess({HOIST_MQTT, "--help"}, log("out3.log"), 10s), 0);
 }
+
+// TLS with a CA file and username/password (password from a file): the
+// bridge connects to a TLS listener that requires both; with a wrong
+// password it is refused, says so once, keeps retrying and never exits.
+TEST_F(MqttBridge, TlsWithPasswordFile) {
+  dir_ = testDir("mqtt_tls");
+  auto path = [&](const char* f) { return (dir_ / f).string(); };
+  auto run = [&](std::vector<std::string> argv) {
+    const int rc = runProcess(std::move(argv), path("openssl.log"), 60s);
+    ASSERT_EQ(rc, 0) << readFile(path("openssl.log"));
+  };
+  // A private CA and a server certificate for localhost / 127.0.0.1.
+  std::ofstream(path("ext.cnf")) << "subjectAltName=DNS:localhost,IP:127.0.0.1\n";
+  run({HOIST_OPENSSL, "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", path("ca.key"), "-out",
+       path("ca.crt"), "-days", "2", "-subj", "/CN=hoist-test-ca"});
+  run({HOIST_OPENSSL, "req", "-newkey", "rsa:2048", "-nodes", "-keyout", path("server.key"), "-out",
+       path("server.csr"), "-subj", "/CN=localhost"});
+  run({HOIST_OPENSSL, "x509", "-req", "-in", path("server.csr"), "-CA", path("ca.crt"), "-CAkey", path("ca.key"),
+       "-CAcreateserial", "-out", path("server.crt"), "-days", "2", "-extfile", path("ext.cnf")});
+  run({HOIST_MOSQUITTO_PASSWD, "-b", "-c", path("passwd"), "hoist", "s3cret"});
+  std::filesystem::permissions(path("server.key"), std::filesystem::perms::owner_read | std::filesystem::perms::group_read |
+                                                       std::filesystem::perms::others_read);
+  // Listener 1: plain, anonymous (the test's client); listener 2: TLS + password (the bridge).
+  const int plain = freePort(), tls = freePort();
+  std::ofstream(path("mosquitto.conf")) << "per_listener_settings true\npersistence false\nlog_dest stdout\n"
+                                        << "listener " << plain << " 127.0.0.1\nallow_anonymous true\n"
+                                        << "listener " << tls << " 127.0.0.1\nallow_anonymous false\n"
+                                        << "password_file " << path("passwd") << "\ncafile " << path("ca.crt")
+                                        << "\ncertfile " << path("server.crt") << "\nkeyfile " << path("server.key")
+                                        << "\n";
+  Process broker({HOIST_MOSQUITTO, "-c", path("mosquitto.conf")}, path("mosquitto.log"));
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (!(tcpOpen(plain) && tcpOpen(tls)) && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(tcpOpen(tls)) << readFile(path("mosquitto.log"));
+  Client c(plain, "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/_bridge/#");
+
+  std::ofstream(path("pw")) << "s3cret\n";
+  std::ofstream(path("badpw")) << "Wr0ngPw-xyz\n";
+  auto config = [&](const char* name, const char* pwfile) {
+    std::ofstream(path(name)) << "[broker]\nurl = \"mqtts://localhost:" << tls << "\"\nusername = \"hoist\"\n"
+                              << "password_file = \"" << path(pwfile) << "\"\nreconnect_min = 0.1\nreconnect_max = 0.3\n"
+                              << "[tls]\nca_file = \"" << path("ca.crt") << "\"\n[bridge]\nhealth_period = 0.5\n";
+  };
+  config("good.toml", "pw");
+  config("bad.toml", "badpw");
+  Process good({HOIST_MQTT, "--config", path("good.toml"), "--lcm-url", urlFor(7934), "--client-id", "tls-good"},
+               path("good.log"));
+  Process bad({HOIST_MQTT, "--config", path("bad.toml"), "--lcm-url", urlFor(7934), "--client-id", "tls-bad"},
+              path("bad.log"));
+  auto st = c.waitJson("hoist/_bridge/tls-good/status", [](const json& j, bool) { return j.value("online", false); }, 15s);
+  ASSERT_TRUE(st) << readFile(path("good.log")) << readFile(path("mosquitto.log"));
+  std::this_thread::sleep_for(1500ms);
+  EXPECT_TRUE(bad.running());
+  EXPECT_TRUE(c.on("hoist/_bridge/tls-bad/status").empty());
+  const std::string blog = readFile(path("bad.log"));
+  EXPECT_EQ(countOf(blog, "cannot connect to the broker"), 1u) << blog;
+  EXPECT_NE(blog.find("not authorised"), std::string::npos) << blog;
+  EXPECT_EQ(blog.find("s3cret"), std::string::npos);
+  EXPECT_EQ(blog.find("Wr0ngPw-xyz"), std::string::npos) << "the password must never be logged";
+  good.signal(SIGTERM);
+  bad.signal(SIGTERM);
+  EXPECT_EQ(good.wait(5s), 0);
+  EXPECT_EQ(bad.wait(5s), 0);
+}
