@@ -16,17 +16,18 @@
 #include <optional>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
+#include <string_view>
 #include <vector>
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
-#include "hoist/cage_state_t.hpp"
-#include "hoist/health_t.hpp"
-#include "hoist/msg/codec.hpp"
-#include "hoist/mqtt/command.hpp"
-#include "hoist/mqtt/outbox.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/health_t.hpp"
+#include "hoist/mqtt/command.hpp"
+#include "hoist/mqtt/outbox.hpp"
+#include "hoist/msg/codec.hpp"
 
 namespace hoist::mqtt {
 
@@ -600,7 +601,7 @@ struct Bridge::Impl {
                        r.detail);
         return;
       }
-      const std::string channel = s.hoist::bus::channel(prefix, kChannelAlarmAck);
+      const std::string channel = hoist::bus::channel(s.prefix, kChannelAlarmAck);
       if (lcm.publish(channel, &r.ack) != 0) {
         ++cmd_lcm_failures;
         if (may_log) spdlog::error("command on {}: LCM publish on {} failed", s.t_cmd, channel);
