@@ -5,7 +5,9 @@
 #   scripts/fuzz.sh [--time S] [--build-dir DIR] [--no-build] [TARGET...]
 #
 # Targets: config (TOML loader), csv (profile CSV reader), winder (LCM input
-# decoder + validator + TwinCore).  Default: all three, 600 s each.  The seed
+# decoder + validator + TwinCore), msgs (every LCM type of msgs/ through the
+# generated checked decoders and JSON), lcmlog (the safe LCM log reader).
+# Default: all five, 600 s each.  The seed
 # corpus is fuzz/corpus/<target>/ (committed); new inputs go to
 # BUILD/corpus/<target>/, crashes to BUILD/artifacts/<target>/, logs to
 # BUILD/logs/<target>.log.  Prints executions and coverage per target; exit
@@ -18,19 +20,19 @@ while [[ $# -gt 0 ]]; do
     --time) time_s="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
     --no-build) build=0; shift ;;
-    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-    config|csv|winder) targets+=("$1"); shift ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    config|csv|winder|msgs|lcmlog) targets+=("$1"); shift ;;
     *) echo "fuzz.sh: unknown option or target $1 (see --help)" >&2; exit 2 ;;
   esac
 done
-[[ ${#targets[@]} -gt 0 ]] || targets=(config csv winder)
+[[ ${#targets[@]} -gt 0 ]] || targets=(config csv winder msgs lcmlog)
 if [[ $build -eq 1 ]]; then
   command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found" >&2; exit 2; }
   CC=clang CXX=clang++ cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHOIST_FUZZ=ON \
     -DHOIST_BUILD_TESTS=OFF -DHOIST_BUILD_BENCH=OFF >/dev/null
   cmake --build "$build_dir" -j"$(nproc)" --target $(printf 'fuzz_%s ' "${targets[@]}")
 fi
-declare -A max_len=([config]=4096 [csv]=8192 [winder]=2048)
+declare -A max_len=([config]=4096 [csv]=8192 [winder]=2048 [msgs]=4096 [lcmlog]=8192)
 rc=0
 summary=""
 for t in "${targets[@]}"; do

@@ -327,8 +327,11 @@ def scalar_schema(m):
 
 def schema(st):
     props = {}
+    maxima = {m.dims[0][1]: m.max_count for m in st.members if m.dims and m.dims[0][0] == 1}
     for m in st.members:
         s = scalar_schema(m)
+        if m.name in maxima:  # an array count: what checkedDecode accepts
+            s["minimum"], s["maximum"] = 0, maxima[m.name]
         if m.dims:
             mode, size = m.dims[0]
             s = {"type": "array", "items": s}

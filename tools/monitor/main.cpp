@@ -32,9 +32,9 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
-#include "hoist/msg/codec.hpp"
-#include "hoist/bus/lcm_util.hpp"
 #include "hoist/bus/channels.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/msg/codec.hpp"
 
 namespace {
 

@@ -47,9 +47,9 @@
 
 #include "hoist/io/lcm_log.hpp"
 #include "hoist/io/profile.hpp"
-#include "hoist/msg/codec.hpp"
-#include "hoist/bus/lcm_util.hpp"
 #include "hoist/bus/channels.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
 #include "hoist/io/config.hpp"
 #include "timing_test.hpp"

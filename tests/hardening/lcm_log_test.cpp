@@ -1,0 +1,300 @@
+// Issue 12 s.1 and s.6: hostile and damaged LCM log files.
+//   * hoist::io::LcmLogReader: a header claiming datalen 0x7fffffff (or any
+//     length beyond the file) allocates nothing and is skipped; a corrupted
+//     event in the middle is skipped by resynchronising on the next sync
+//     word, with the bytes skipped and events lost counted; a truncated tail;
+//     garbage before the first event; sync words inside payloads.
+//   * hoist-log2csv and hoist-replay --lcm-log on those files: alive, bounded
+//     memory, exit 1 when anything was lost (0 with --lenient); the 70-byte
+//     guide_shape_t event with a huge count (780 MB before); every output
+//     file checked to the last byte (/dev/full -> exit 1, path, errno text).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "attack_bytes.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/io/lcm_log.hpp"
+#include "hoist/msg/codec.hpp"
+#include "hoist/winder_t.hpp"
+#include "run_util.hpp"
+
+namespace fs = std::filesystem;
+namespace atk = hoist::test::attack;
+using Bytes = std::vector<std::uint8_t>;
+using hoist::test::runMeasured;
+
+namespace {
+
+fs::path workDir(const std::string& name) {
+  const auto d = fs::path(HOIST_TEST_WORK_DIR) / "lcm_log" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void writeBytes(const fs::path& p, const Bytes& b) {
+  std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+}
+
+template <class M>
+Bytes encode(const M& m) {
+  Bytes b(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(b.data(), 0, static_cast<int>(b.size()));
+  return b;
+}
+
+Bytes winderBytes(std::int64_t seq) {
+  hoist::winder_t w{};
+  w.utime = 1700000000000000 + seq * 10000;
+  w.seq = seq;
+  w.v = 1.0;
+  w.has_length = 1;
+  w.length = 100.0 + 0.01 * static_cast<double>(seq);
+  return encode(w);
+}
+
+/// `n` winder events on HOIST_WINDER; offsets[i] = start of event i.
+Bytes winderLog(int n, std::vector<std::size_t>* offsets = nullptr) {
+  Bytes log;
+  for (int i = 0; i < n; ++i) {
+    if (offsets) offsets->push_back(log.size());
+    const Bytes ev = atk::logEvent(i, 1000000 + i * 10000, "HOIST_WINDER", winderBytes(i));
+    log.insert(log.end(), ev.begin(), ev.end());
+  }
+  return log;
+}
+
+struct ReadAll {
+  std::vector<hoist::io::LcmLogEvent> events;
+  hoist::io::LcmLogStats stats;
+  bool ok = false;
+};
+
+ReadAll readAll(const fs::path& p) {
+  hoist::io::LcmLogReader r(p.string());
+  ReadAll out;
+  hoist::io::LcmLogEvent ev;
+  while (r.next(ev)) out.events.push_back(ev);
+  out.stats = r.stats();
+  out.ok = r.ok();
+  return out;
+}
+
+int csvRows(const fs::path& p) {
+  std::ifstream in(p);
+  std::string line;
+  int n = -1;  // header
+  while (std::getline(in, line)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST(LcmLogReader, CleanLogReadsEverything) {
+  const auto d = workDir("clean");
+  writeBytes(d / "a.lcmlog", winderLog(50));
+  const auto r = readAll(d / "a.lcmlog");
+  ASSERT_TRUE(r.ok);
+  ASSERT_EQ(r.events.size(), 50u);
+  EXPECT_FALSE(r.stats.lost());
+  EXPECT_EQ(r.events[7].eventnum, 7);
+  EXPECT_EQ(r.events[7].channel, "HOIST_WINDER");
+  EXPECT_EQ(r.events[7].data, winderBytes(7));
+  // An empty file: no events, nothing lost.
+  writeBytes(d / "empty.lcmlog", {});
+  const auto e = readAll(d / "empty.lcmlog");
+  EXPECT_TRUE(e.ok);
+  EXPECT_TRUE(e.events.empty());
+  EXPECT_FALSE(e.stats.lost());
+  // A missing file: an error naming it.
+  hoist::io::LcmLogReader missing((d / "nope.lcmlog").string());
+  EXPECT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("nope.lcmlog"), std::string::npos);
+  EXPECT_NE(missing.error().find("No such file"), std::string::npos) << missing.error();
+}
+
+// The issue's event: datalen = 0x7fffffff (liblcm mallocs it and segfaults).
+TEST(LcmLogReader, HugeDataLengthAllocatesNothingAndIsSkipped) {
+  const auto d = workDir("huge");
+  Bytes log = winderLog(10);
+  const Bytes bad = atk::logEvent(10, 2000000, "HOIST_WINDER", winderBytes(10), 0x7fffffff);
+  log.insert(log.end(), bad.begin(), bad.end());
+  // then event 11 (event 10 is the bad one)
+  for (int i = 11; i < 12; ++i) {
+    const Bytes ev = atk::logEvent(i, 1000000 + i * 10000, "HOIST_WINDER", winderBytes(i));
+    log.insert(log.end(), ev.begin(), ev.end());
+  }
+  writeBytes(d / "huge.lcmlog", log);
+  const auto r = readAll(d / "huge.lcmlog");
+  ASSERT_TRUE(r.ok);
+  EXPECT_EQ(r.events.size(), 11u);
+  EXPECT_EQ(r.stats.regions, 1u);
+  EXPECT_EQ(r.stats.events_lost, 1u);
+  EXPECT_EQ(r.stats.bytes_skipped, bad.size());
+  // Every length from the header variants: negative, past the end, over the cap.
+  for (std::int64_t len : {0x80000000LL, 0xFFFFFFFFLL, 100000000LL, 1000LL}) {
+    Bytes l2 = winderLog(3);
+    const Bytes b2 = atk::logEvent(3, 0, "HOIST_WINDER", winderBytes(3), len);
+    l2.insert(l2.end(), b2.begin(), b2.end());
+    writeBytes(d / "len.lcmlog", l2);
+    const auto r2 = readAll(d / "len.lcmlog");
+    EXPECT_TRUE(r2.ok);
+    EXPECT_EQ(r2.events.size(), 3u) << len;
+    EXPECT_TRUE(r2.stats.lost()) << len;
+  }
+}
+
+// A corrupted event in the middle: the rest of the log is still read.
+TEST(LcmLogReader, CorruptedEventInTheMiddleResynchronises) {
+  const auto d = workDir("middle");
+  std::vector<std::size_t> off;
+  Bytes log = winderLog(100, &off);
+  const std::size_t ev_size = off[1] - off[0];
+  // Event 50: channel length 0x7fff0000 (garbage header).
+  log[off[50] + 20] = 0x7f;
+  log[off[50] + 21] = 0xff;
+  writeBytes(d / "mid.lcmlog", log);
+  auto r = readAll(d / "mid.lcmlog");
+  ASSERT_TRUE(r.ok);
+  EXPECT_EQ(r.events.size(), 99u);
+  EXPECT_EQ(r.stats.events_lost, 1u);
+  EXPECT_EQ(r.stats.bytes_skipped, ev_size);
+  EXPECT_EQ(r.stats.first_bad_offset, off[50]);
+  EXPECT_EQ(r.events[50].eventnum, 51);
+  // Event 30's data length one byte short (it does not end at a sync word)
+  // and 10 garbage bytes (with a false sync word) before event 70.
+  log = winderLog(100, &off);
+  log[off[30] + 27] -= 1;
+  Bytes junk = {0xED, 0xA1, 0xDA, 0x01, 1, 2, 3, 4, 5, 6};
+  log.insert(log.begin() + static_cast<long>(off[70]), junk.begin(), junk.end());
+  writeBytes(d / "mid2.lcmlog", log);
+  r = readAll(d / "mid2.lcmlog");
+  EXPECT_EQ(r.events.size(), 99u);
+  EXPECT_EQ(r.stats.regions, 2u);
+  EXPECT_EQ(r.stats.bytes_skipped, ev_size + junk.size());
+  // Truncated tail (logger killed mid-write) and garbage before the first event.
+  log = winderLog(20, &off);
+  log.resize(log.size() - 7);
+  log.insert(log.begin(), {1, 2, 3});
+  writeBytes(d / "tail.lcmlog", log);
+  r = readAll(d / "tail.lcmlog");
+  EXPECT_EQ(r.events.size(), 19u);
+  EXPECT_EQ(r.stats.regions, 2u);
+  EXPECT_EQ(r.stats.bytes_skipped, 3 + ev_size - 7);
+}
+
+// A sync word inside a payload is not taken for an event.
+TEST(LcmLogReader, SyncWordInsidePayload) {
+  const auto d = workDir("syncdata");
+  Bytes log;
+  Bytes payload = {0xED, 0xA1, 0xDA, 0x01, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 'X', 'Y'};
+  for (int i = 0; i < 3; ++i) {
+    const Bytes ev = atk::logEvent(i, i, "RAW", payload);
+    log.insert(log.end(), ev.begin(), ev.end());
+  }
+  writeBytes(d / "s.lcmlog", log);
+  const auto r = readAll(d / "s.lcmlog");
+  EXPECT_EQ(r.events.size(), 3u);
+  EXPECT_FALSE(r.stats.lost());
+  EXPECT_EQ(r.events[2].data, payload);
+}
+
+// hoist-log2csv on the issue's files: alive, bounded memory, exit status.
+TEST(Log2Csv, HostileLogsExitNonZeroWithBoundedMemory) {
+  const auto d = workDir("log2csv");
+  // (a) datalen 0x7fffffff in the middle.
+  std::vector<std::size_t> off;
+  Bytes log = winderLog(40, &off);
+  const Bytes bad = atk::logEvent(40, 0, "HOIST_WINDER", winderBytes(40), 0x7fffffff);
+  log.insert(log.begin() + static_cast<long>(off[20]), bad.begin(), bad.end());
+  writeBytes(d / "huge.lcmlog", log);
+  auto res = runMeasured({HOIST_LOG2CSV, (d / "huge.lcmlog").string(), "--out-dir", (d / "out1").string()},
+                         (d / "huge.log").string());
+  EXPECT_EQ(res.status, 1) << slurp(d / "huge.log");
+  EXPECT_LT(res.max_rss_kb, 64 * 1024);
+  EXPECT_EQ(csvRows(d / "out1" / "HOIST_WINDER.csv"), 40);
+  EXPECT_NE(slurp(d / "huge.log").find("1 corrupt region"), std::string::npos) << slurp(d / "huge.log");
+  res = runMeasured({HOIST_LOG2CSV, (d / "huge.lcmlog").string(), "--out-dir", (d / "out1l").string(), "--lenient"},
+                    (d / "huge_l.log").string());
+  EXPECT_EQ(res.status, 0) << slurp(d / "huge_l.log");
+
+  // (b) the 70-byte guide_shape_t event with count 0x7fffffff (and -1).
+  Bytes shape_log;
+  for (std::int32_t n : {0x7fffffff, -1, 100001}) {
+    const Bytes ev = atk::logEvent(0, 0, "HOIST_GUIDE_SHAPE", atk::guideShapeCount(n));
+    ASSERT_EQ(ev.size(), 28u + 17u + 44u);  // header, "HOIST_GUIDE_SHAPE", the 44-byte payload
+    shape_log.insert(shape_log.end(), ev.begin(), ev.end());
+  }
+  const Bytes h = atk::logEvent(1, 0, "HOIST_HEALTH", atk::healthCount(0x7fffffff));
+  shape_log.insert(shape_log.end(), h.begin(), h.end());
+  writeBytes(d / "shape.lcmlog", shape_log);
+  res = runMeasured({HOIST_LOG2CSV, (d / "shape.lcmlog").string(), "--out-dir", (d / "out2").string()},
+                    (d / "shape.log").string());
+  EXPECT_EQ(res.status, 1) << slurp(d / "shape.log");
+  EXPECT_LT(res.max_rss_kb, 64 * 1024) << "was 780 MB before the checked decoder";
+  EXPECT_NE(slurp(d / "shape.log").find("bad_count"), std::string::npos) << slurp(d / "shape.log");
+
+  // (c) a clean log: exit 0.
+  writeBytes(d / "clean.lcmlog", winderLog(5));
+  res = runMeasured({HOIST_LOG2CSV, (d / "clean.lcmlog").string(), "--out-dir", (d / "out3").string()},
+                    (d / "clean.log").string());
+  EXPECT_EQ(res.status, 0) << slurp(d / "clean.log");
+  EXPECT_EQ(csvRows(d / "out3" / "HOIST_WINDER.csv"), 5);
+}
+
+// A full disk: every file is checked to its last byte.
+TEST(Log2Csv, FullDiskIsAnErrorNamingTheFile) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const auto d = workDir("full");
+  writeBytes(d / "a.lcmlog", winderLog(600));
+  fs::create_directories(d / "out");
+  fs::create_symlink("/dev/full", d / "out" / "HOIST_WINDER.csv");
+  const auto res = runMeasured({HOIST_LOG2CSV, (d / "a.lcmlog").string(), "--out-dir", (d / "out").string()},
+                               (d / "run.log").string());
+  const std::string out = slurp(d / "run.log");
+  EXPECT_EQ(res.status, 1) << out;
+  EXPECT_NE(out.find("HOIST_WINDER.csv"), std::string::npos) << out;
+  EXPECT_NE(out.find("No space left on device"), std::string::npos) << out;
+  EXPECT_EQ(out.find("600 rows"), std::string::npos) << out;
+}
+
+// hoist-replay --lcm-log: the same log classes (publishing to memq://).
+TEST(ReplayLcmLog, HostileLogsExitNonZeroWithBoundedMemory) {
+  const auto d = workDir("replay");
+  std::vector<std::size_t> off;
+  Bytes log = winderLog(30, &off);
+  const Bytes bad = atk::logEvent(30, 0, "HOIST_WINDER", winderBytes(30), 0x7fffffff);
+  log.insert(log.begin() + static_cast<long>(off[10]), bad.begin(), bad.end());
+  writeBytes(d / "huge.lcmlog", log);
+  auto res = runMeasured({HOIST_REPLAY, "--lcm-log", (d / "huge.lcmlog").string(), "--lcm-url", "memq://",
+                          "--speed", "0", "-q"},
+                         (d / "huge.log").string());
+  EXPECT_EQ(res.status, 1) << slurp(d / "huge.log");
+  EXPECT_LT(res.max_rss_kb, 64 * 1024);
+  EXPECT_NE(slurp(d / "huge.log").find("corrupt region"), std::string::npos) << slurp(d / "huge.log");
+  res = runMeasured({HOIST_REPLAY, "--lcm-log", (d / "huge.lcmlog").string(), "--lcm-url", "memq://", "--speed",
+                     "0", "-q", "--lenient"},
+                    (d / "huge_l.log").string());
+  EXPECT_EQ(res.status, 0) << slurp(d / "huge_l.log");
+  // An undecodable payload on HOIST_WINDER (a 37-byte alarm_ack_t) is not sent.
+  Bytes l2 = winderLog(3);
+  const Bytes ack = atk::logEvent(3, 0, "HOIST_WINDER", atk::alarmAckStringLen(0));
+  l2.insert(l2.end(), ack.begin(), ack.end());
+  writeBytes(d / "ack.lcmlog", l2);
+  res = runMeasured({HOIST_REPLAY, "--lcm-log", (d / "ack.lcmlog").string(), "--lcm-url", "memq://", "--speed",
+                     "0"},
+                    (d / "ack.log").string());
+  EXPECT_EQ(res.status, 1) << slurp(d / "ack.log");
+  EXPECT_NE(slurp(d / "ack.log").find("bad_fingerprint"), std::string::npos) << slurp(d / "ack.log");
+  EXPECT_NE(slurp(d / "ack.log").find("published 3 messages"), std::string::npos) << slurp(d / "ack.log");
+}
