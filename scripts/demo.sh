@@ -24,6 +24,7 @@
 #   --with-length  send the encoder rope length too
 #   --dash-port N  TCP port of the dashboard, http://127.0.0.1:N/ (default 8080)
 #   --no-dash      do not start the dashboard
+#   --mqtt [...]   the same twin seen through MQTT: scripts/demo-mqtt.sh [...]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 setup=1
@@ -44,7 +45,8 @@ while [[ $# -gt 0 ]]; do
     --with-length) replay_extra+=(--with-length); shift ;;
     --dash-port) dash_port="$2"; shift 2 ;;
     --no-dash) dash=0; shift ;;
-    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --mqtt) shift; [[ $setup -eq 0 ]] && set -- --no-setup "$@"; exec "$here/scripts/demo-mqtt.sh" "$@" ;;
+    -h|--help) sed -n '2,26p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done

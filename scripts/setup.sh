@@ -34,6 +34,8 @@ required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev
 # hoist-dash's page (uPlot from npm) and its browser tests (headless Chromium
 # driven by puppeteer-core, the @foxglove/ws-protocol client): Node, npm, Chromium.
 dashboard=(nodejs npm chromium fonts-dejavu-core)
+# MQTT bridge (hoist-mqtt): the client library, and the broker, clients and openssl (TLS test) its tests and demo use.
+required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
 # Java bindings let lcm-spy decode the hoist channels; clang gives the fuzzers.
 optional=(liblcm-java default-jdk-headless clang libclang-rt-14-dev)
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }

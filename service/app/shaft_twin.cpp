@@ -8,6 +8,7 @@
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/service/alarm_command.hpp"
 #include "hoist/service/winder_decode.hpp"
 
 namespace hoist::svc {
@@ -259,33 +260,27 @@ void ShaftTwin::handleAck(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   ack.user = printable(ack.user);
-  std::optional<AlarmKind> kind;
-  if (!ack.kind.empty() && ack.kind != "*") {
-    kind = parseAlarmKind(ack.kind);
-    if (!kind) {
+  // The same validation as hoist-mqtt's (hoist/service/alarm_command.hpp).
+  AlarmCommand cmd;
+  switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, cmd)) {
+    case CommandError::None: break;
+    case CommandError::UnknownKind:
       if (may_log)
         log_.warn("{}ignored alarm command from '{}': unknown alarm kind '{}'", tag_, ack.user, printable(ack.kind));
       return;
-    }
-  }
-  if (ack.level < 0 || ack.level > 2) {
-    if (may_log) log_.warn("{}ignored alarm command from '{}': bad level {}", tag_, ack.user, int(ack.level));
-    return;
-  }
-  const auto level = static_cast<AlarmLevel>(ack.level);
-  AlarmAction action;
-  switch (ack.action) {
-    case hoist::alarm_ack_t::ACTION_ACK: action = AlarmAction::Ack; break;
-    case hoist::alarm_ack_t::ACTION_SHELVE: action = AlarmAction::Shelve; break;
-    case hoist::alarm_ack_t::ACTION_UNSHELVE: action = AlarmAction::Unshelve; break;
-    default:
+    case CommandError::BadLevel:
+      if (may_log) log_.warn("{}ignored alarm command from '{}': bad level {}", tag_, ack.user, int(ack.level));
+      return;
+    case CommandError::BadAction:
       if (may_log) log_.warn("{}ignored alarm command from '{}': bad action {}", tag_, ack.user, int(ack.action));
       return;
+    case CommandError::BadShelveDuration:
+      if (may_log) log_.warn("{}ignored shelve from '{}': shelve_duration must be > 0 s", tag_, ack.user);
+      return;
   }
-  if (action == AlarmAction::Shelve && !(std::isfinite(ack.shelve_duration) && ack.shelve_duration > 0.0)) {
-    if (may_log) log_.warn("{}ignored shelve from '{}': shelve_duration must be > 0 s", tag_, ack.user);
-    return;
-  }
+  const std::optional<AlarmKind> kind = cmd.kind;
+  const AlarmLevel level = cmd.level;
+  const AlarmAction action = cmd.action;
   const int n = core_.command(action, kind, level, ack.shelve_duration);
   const char* what = action == AlarmAction::Ack ? "acknowledge" : action == AlarmAction::Shelve ? "shelve" : "unshelve";
   char for_s[48] = "";

@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "hoist/service/alarm_command.hpp"
 #include "hoist/service/alarms.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/input_validator.hpp"
@@ -66,8 +67,7 @@ struct TickResult {
   bool domain_error = false;   ///< the model refused the kinematics; state held
 };
 
-/// Operator command (alarm_ack_t).
-enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3 };
+// AlarmAction (operator command, alarm_ack_t): hoist/service/alarm_command.hpp.
 
 class TwinCore {
  public:

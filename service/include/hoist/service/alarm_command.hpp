@@ -1,0 +1,40 @@
+// hoist/service/alarm_command.hpp -- validation of an operator's alarm command
+// (the fields of alarm_ack_t), shared by hoist-twind (commands from LCM) and
+// hoist-mqtt (commands from an MQTT broker), so both accept exactly the same
+// commands.  Pure: no I/O, no LCM types, no allocation.
+#pragma once
+
+#include <optional>
+#include <string_view>
+
+#include "hoist/service/alarms.hpp"
+
+namespace hoist::svc {
+
+/// Operator command; values match alarm_ack_t.ACTION_*.
+enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3 };
+
+/// Why a command was refused.
+enum class CommandError { None, UnknownKind, BadLevel, BadAction, BadShelveDuration };
+inline constexpr int kCommandErrors = 5;
+
+const char* toString(AlarmAction a);   ///< "ACK", "SHELVE", "UNSHELVE"
+const char* toString(CommandError e);  ///< "ok", "unknown_kind", "bad_level", "bad_action", "bad_shelve_duration"
+
+/// A validated command.  kind empty = every kind; level None = both levels.
+struct AlarmCommand {
+  AlarmAction action = AlarmAction::Ack;
+  std::optional<AlarmKind> kind;
+  AlarmLevel level = AlarmLevel::None;
+  double shelve_duration = 0.0;  ///< [s], > 0 and finite for Shelve
+};
+
+/// Validates the fields of an alarm_ack_t: `kind` an alarm kind name
+/// (parseAlarmKind), "" or "*" (all kinds); `level` 0 (both), 1 (WARNING) or
+/// 2 (CRITICAL); `action` alarm_ack_t.ACTION_ACK/SHELVE/UNSHELVE; for SHELVE a
+/// finite `shelve_duration` > 0 (the daemon bounds it by [alarms].max_shelve).
+/// Fills `out` and returns CommandError::None when valid.
+CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
+                                  AlarmCommand& out);
+
+}  // namespace hoist::svc

@@ -1,0 +1,50 @@
+// Operator alarm commands: see hoist/service/alarm_command.hpp.
+#include "hoist/service/alarm_command.hpp"
+
+#include <cmath>
+
+namespace hoist::svc {
+
+const char* toString(AlarmAction a) {
+  switch (a) {
+    case AlarmAction::Ack: return "ACK";
+    case AlarmAction::Shelve: return "SHELVE";
+    case AlarmAction::Unshelve: return "UNSHELVE";
+  }
+  return "?";
+}
+
+const char* toString(CommandError e) {
+  switch (e) {
+    case CommandError::None: return "ok";
+    case CommandError::UnknownKind: return "unknown_kind";
+    case CommandError::BadLevel: return "bad_level";
+    case CommandError::BadAction: return "bad_action";
+    case CommandError::BadShelveDuration: return "bad_shelve_duration";
+  }
+  return "?";
+}
+
+CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
+                                  AlarmCommand& out) {
+  AlarmCommand c;
+  if (!kind.empty() && kind != "*") {
+    c.kind = parseAlarmKind(kind);
+    if (!c.kind) return CommandError::UnknownKind;
+  }
+  if (level < 0 || level > 2) return CommandError::BadLevel;
+  c.level = static_cast<AlarmLevel>(level);
+  switch (action) {
+    case static_cast<int>(AlarmAction::Ack): c.action = AlarmAction::Ack; break;
+    case static_cast<int>(AlarmAction::Shelve): c.action = AlarmAction::Shelve; break;
+    case static_cast<int>(AlarmAction::Unshelve): c.action = AlarmAction::Unshelve; break;
+    default: return CommandError::BadAction;
+  }
+  if (c.action == AlarmAction::Shelve && !(std::isfinite(shelve_duration) && shelve_duration > 0.0))
+    return CommandError::BadShelveDuration;
+  c.shelve_duration = c.action == AlarmAction::Shelve ? shelve_duration : 0.0;
+  out = c;
+  return CommandError::None;
+}
+
+}  // namespace hoist::svc

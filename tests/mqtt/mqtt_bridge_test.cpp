@@ -1,0 +1,528 @@
+// hoist-mqtt against a real mosquitto broker (started here on a free loopback
+// port with a generated configuration), a real hoist-twind (demo.toml's tight
+// gaps: the paper's cage at rest at the top raises CAGE_POS_Y WARNING) fed by
+// hoist-replay, over LCM on loopback multicast (ttl=0, ports 7931-7934).
+// The MQTT side is checked with libmosquitto as a client: payloads, retained
+// flags, a late subscriber, commands, broker restarts.
+#include <arpa/inet.h>
+#include <mosquitto.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+#include <atomic>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "lcm_fixtures.hpp"
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
+
+using namespace hoist::test;
+using json = nlohmann::json;
+
+namespace {
+
+/// A free TCP port on 127.0.0.1 (bound, read back, released).
+int freePort() {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = 0;
+  socklen_t len = sizeof a;
+  int port = -1;
+  if (::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
+      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) == 0)
+    port = ntohs(a.sin_port);
+  ::close(s);
+  return port;
+}
+
+bool tcpOpen(int port) {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  ::close(s);
+  return ok;
+}
+
+/// A mosquitto broker on 127.0.0.1:port, no persistence (a restart loses the
+/// retained messages, as a broker without a persistence file does).
+class Broker {
+ public:
+  Broker(const std::filesystem::path& dir, int port) : dir_(dir), port_(port) {}
+  void start() {
+    const auto conf = (dir_ / "mosquitto.conf").string();
+    std::ofstream(conf) << "listener " << port_ << " 127.0.0.1\nallow_anonymous true\npersistence false\n"
+                        << "log_dest stdout\n";
+    proc_ = std::make_unique<Process>(std::vector<std::string>{HOIST_MOSQUITTO, "-c", conf},
+                                      (dir_ / "mosquitto.log").string());
+    const auto end = std::chrono::steady_clock::now() + 10s;
+    while (!tcpOpen(port_) && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
+    ASSERT_TRUE(tcpOpen(port_)) << "mosquitto did not start:\n" << readFile((dir_ / "mosquitto.log").string());
+  }
+  void stop() {
+    if (!proc_) return;
+    proc_->signal(SIGTERM);
+    proc_->wait(5s);
+    proc_.reset();
+  }
+  std::string url() const { return "mqtt://127.0.0.1:" + std::to_string(port_); }
+  int port() const { return port_; }
+
+ private:
+  std::filesystem::path dir_;
+  int port_;
+  std::unique_ptr<Process> proc_;
+};
+
+/// An MQTT client (libmosquitto, its own network thread) recording every message.
+class Client {
+ public:
+  struct Msg {
+    std::string topic, payload;
+    bool retain = false;
+  };
+  Client(int port, const std::string& id) {
+    mosquitto_lib_init();
+    m_ = mosquitto_new(id.c_str(), true, this);
+    mosquitto_message_callback_set(m_, [](mosquitto*, void* obj, const mosquitto_message* msg) {
+      auto* self = static_cast<Client*>(obj);
+      std::lock_guard<std::mutex> lk(self->mu_);
+      self->msgs_.push_back({msg->topic, std::string(static_cast<const char*>(msg->payload), msg->payloadlen),
+                             msg->retain});
+    });
+    mosquitto_connect_callback_set(m_, [](mosquitto*, void* obj, int rc) {
+      if (rc == 0) static_cast<Client*>(obj)->connected_ = true;
+    });
+    connect_ok_ = mosquitto_connect(m_, "127.0.0.1", port, 30) == MOSQ_ERR_SUCCESS;
+    mosquitto_loop_start(m_);
+    const auto end = std::chrono::steady_clock::now() + 5s;
+    while (!connected_ && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(10ms);
+  }
+  ~Client() {
+    mosquitto_disconnect(m_);
+    mosquitto_loop_stop(m_, true);
+    mosquitto_destroy(m_);
+  }
+  bool connected() const { return connect_ok_ && connected_; }
+  void subscribe(const std::string& topic) { mosquitto_subscribe(m_, nullptr, topic.c_str(), 1); }
+  void publish(const std::string& topic, const std::string& payload) {
+    mosquitto_publish(m_, nullptr, topic.c_str(), static_cast<int>(payload.size()), payload.data(), 1, false);
+  }
+  std::vector<Msg> messages() {
+    std::lock_guard<std::mutex> lk(mu_);
+    return msgs_;
+  }
+  std::vector<Msg> on(const std::string& topic) {
+    std::vector<Msg> out;
+    for (auto& m : messages())
+      if (m.topic == topic) out.push_back(m);
+    return out;
+  }
+  /// Waits until pred(messages) holds.
+  bool waitFor(const std::function<bool(const std::vector<Msg>&)>& pred, std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < end) {
+      if (pred(messages())) return true;
+      std::this_thread::sleep_for(20ms);
+    }
+    return pred(messages());
+  }
+  /// The latest message on `topic` whose JSON satisfies pred.
+  std::optional<json> waitJson(const std::string& topic, const std::function<bool(const json&, bool)>& pred,
+                               std::chrono::milliseconds timeout) {
+    std::optional<json> found;
+    waitFor(
+        [&](const std::vector<Msg>& ms) {
+          for (auto it = ms.rbegin(); it != ms.rend(); ++it) {
+            if (it->topic != topic) continue;
+            json j = json::parse(it->payload, nullptr, false);
+            if (!j.is_discarded() && pred(j, it->retain)) {
+              found = j;
+              return true;
+            }
+          }
+          return false;
+        },
+        timeout);
+    return found;
+  }
+
+ private:
+  mosquitto* m_ = nullptr;
+  std::mutex mu_;
+  std::vector<Msg> msgs_;
+  std::atomic<bool> connected_{false};
+  bool connect_ok_ = false;
+};
+
+std::size_t countOf(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+/// demo.toml (tight gaps) with a channel prefix for the daemon.
+std::string daemonConfig(const std::filesystem::path& dir, const std::string& prefix) {
+  std::string text = readFile(HOIST_DEMO_CONFIG);
+  const auto pos = text.find("[service]\n");
+  EXPECT_NE(pos, std::string::npos);
+  text.insert(pos + 10, "channel_prefix = \"" + prefix + "\"\n");
+  const auto path = (dir / "twin.toml").string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+class MqttBridge : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (!loopbackMulticastWorks(urlFor(7930), why)) GTEST_FAIL() << kMulticastHelp << " (" << why << ")";
+  }
+  std::string log(const std::string& name) { return (dir_ / name).string(); }
+  std::filesystem::path dir_;
+};
+
+bool isWarningActive(const json& j) {
+  return j.value("active", false) && j.value("level", "") == "WARNING" && j.contains("warning") &&
+         j["warning"].is_object();
+}
+
+}  // namespace
+
+// State and alarms arrive with the right JSON and retained flags; a late
+// subscriber gets the active alarm at once; an ack command reaches the daemon
+// and the alarm turns acknowledged; malformed commands are rejected and counted.
+TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
+  dir_ = testDir("mqtt_state_alarms");
+  const std::string url = urlFor(7931);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client early(broker.port(), "early");
+  ASSERT_TRUE(early.connected());
+  early.subscribe("hoist/#");
+
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.5\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--channel-prefix",
+                  "north/", "--client-id", "bridge-a"},
+                 log("bridge.log"));
+  Listener lcm(url);
+  lcm.subscribe("north/HOIST_.*");
+  auto twind = startDaemonAndWait(lcm, {HOIST_TWIND, "--config", daemonConfig(dir_, "north/"), "--lcm-url", url},
+                                  log("twind.log"), "north/HOIST_HEALTH");
+  Process replay({HOIST_REPLAY, "--profile", "rest:t_end=60", "--lcm-url", url, "--channel-prefix", "north/"},
+                 log("replay.log"));
+
+  // The bridge's status is online (retained) and its LWT is set.
+  auto status = early.waitJson("hoist/_bridge/bridge-a/status", [](const json& j, bool) { return j.value("online", false); }, 10s);
+  ASSERT_TRUE(status) << readFile(log("bridge.log"));
+
+  // Cage state: the message's fields as JSON, not retained, decimated to ~10 Hz.
+  auto cage = early.waitJson("hoist/north/cage", [](const json& j, bool) { return j.value("input_seq", -1) >= 0; }, 10s);
+  ASSERT_TRUE(cage) << readFile(log("bridge.log")) << readFile(log("twind.log"));
+  for (const char* k : {"utime", "seq", "instance_id", "t", "l", "v", "a", "x_c", "y_c", "theta", "y_top", "y_bottom",
+                        "min_clearance", "alarm_level", "degraded"})
+    EXPECT_TRUE(cage->contains(k)) << k << " missing in " << cage->dump();
+  ASSERT_TRUE((*cage)["lambdas"].is_array());
+  EXPECT_EQ((*cage)["lambdas"].size(), 5u);
+  EXPECT_NEAR((*cage)["l"].get<double>(), 50.0, 1e-6);  // the paper's l0, at rest
+  EXPECT_GT(std::abs((*cage)["lambdas"][0].get<double>()), 7000.0);  // m g + Fa ~ 8848 N
+  for (const auto& m : early.on("hoist/north/cage")) EXPECT_FALSE(m.retain);
+  const auto n0 = early.on("hoist/north/cage").size();
+  std::this_thread::sleep_for(2s);
+  const auto n_cage = early.on("hoist/north/cage").size() - n0;
+  EXPECT_GE(n_cage, 12u) << "cage states in 2 s at 10 Hz";
+  EXPECT_LE(n_cage, 28u) << "cage states in 2 s at 10 Hz (the daemon publishes 100 Hz)";
+
+  // Health: the daemon's health_t as JSON.
+  auto health = early.waitJson("hoist/north/health", [](const json& j, bool) { return j.contains("instance_id"); }, 5s);
+  ASSERT_TRUE(health);
+  EXPECT_EQ((*health)["clock"], "wall");
+  EXPECT_TRUE((*health)["reject_reason"].is_array());
+
+  // The alarm: CAGE_POS_Y WARNING active (demo.toml's 16 mm gap, ~11 mm lean).
+  auto alarm = early.waitJson("hoist/north/alarm/CAGE_POS_Y", [](const json& j, bool) { return isWarningActive(j); }, 15s);
+  ASSERT_TRUE(alarm) << readFile(log("bridge.log")) << readFile(log("twind.log"));
+  EXPECT_EQ((*alarm)["shaft"], "north");
+  EXPECT_EQ((*alarm)["kind"], "CAGE_POS_Y");
+  EXPECT_TRUE((*alarm)["unacked"].get<bool>());
+  EXPECT_EQ((*alarm)["warning"]["kind"], "CAGE_POS_Y");
+  EXPECT_EQ((*alarm)["warning"]["level"], +hoist::alarm_t::LEVEL_WARNING);
+  EXPECT_TRUE((*alarm)["warning"]["active"].get<bool>());
+  EXPECT_GT((*alarm)["warning"]["value"].get<double>(), (*alarm)["warning"]["threshold"].get<double>());
+  EXPECT_TRUE((*alarm)["critical"].is_null());
+
+  // A late subscriber gets the active alarm at once, RETAINED; nothing else
+  // it receives at once is retained except alarm states and the bridge status.
+  Client late(broker.port(), "late");
+  ASSERT_TRUE(late.connected());
+  late.subscribe("hoist/#");
+  auto retained = late.waitJson("hoist/north/alarm/CAGE_POS_Y", [](const json& j, bool r) { return r && isWarningActive(j); }, 3s);
+  EXPECT_TRUE(retained) << "a late subscriber must see the active alarm as a retained message";
+  std::this_thread::sleep_for(500ms);
+  for (const auto& m : late.messages()) {
+    if (m.retain) {
+      EXPECT_TRUE(m.topic.rfind("hoist/north/alarm/", 0) == 0 || m.topic == "hoist/_bridge/bridge-a/status") << m.topic;
+    }
+  }
+  EXPECT_FALSE(late.on("hoist/north/cage").empty());
+
+  // Malformed commands: rejected, counted, never forwarded, never echoed.
+  const std::size_t acks_before = lcm.count("north/HOIST_ALARM_ACK");
+  const std::vector<std::string> bad = {
+      "garbage-PAYLOAD-123",                                          // not JSON
+      std::string(5000, '{'),                                         // oversized
+      "[1,2,3]",                                                      // not an object
+      std::string("\xff\xfe\x00\x01", 4),                            // binary
+      R"({"kind":"NO_SUCH_KIND","level":0,"action":1})",             // unknown kind
+      R"({"kind":"CAGE_POS_Y","level":0,"action":9})",               // unknown action
+      R"({"kind":"CAGE_POS_Y","level":0,"action":1,"evil":"x"})",    // unknown key
+  };
+  for (const auto& p : bad) early.publish("hoist/north/cmd/ack", p);
+  auto bh = early.waitJson("hoist/_bridge/bridge-a/health",
+                           [](const json& j, bool) { return j["commands"]["rejected"].get<int>() >= 7; }, 5s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  const json& c = (*bh)["commands"];
+  EXPECT_EQ(c["received"], 7);
+  EXPECT_EQ(c["rejected"], 7);
+  EXPECT_EQ(c["forwarded"], 0);
+  EXPECT_EQ(c["rejected_by_reason"]["not_json"], 2);
+  EXPECT_EQ(c["rejected_by_reason"]["oversized"], 1);
+  EXPECT_EQ(c["rejected_by_reason"]["not_object"], 1);
+  EXPECT_EQ(c["rejected_by_reason"]["unknown_kind"], 1);
+  EXPECT_EQ(c["rejected_by_reason"]["bad_action"], 1);
+  EXPECT_EQ(c["rejected_by_reason"]["bad_fields"], 1);
+  EXPECT_EQ((*bh)["connection"]["state"], "connected");
+  EXPECT_EQ((*bh)["lcm"]["decode_errors"], 0);
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("north/HOIST_ALARM_ACK"), acks_before) << "a rejected command reached LCM";
+  const std::string blog = readFile(log("bridge.log"));
+  EXPECT_EQ(blog.find("garbage-PAYLOAD-123"), std::string::npos) << "raw payload echoed in the log";
+  EXPECT_NE(blog.find("rejected command on hoist/north/cmd/ack"), std::string::npos) << blog;
+
+  // An ack command reaches the daemon, and the alarm turns acknowledged.
+  early.publish("hoist/north/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"user":"scada-op"})");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("north/HOIST_ALARM_ACK") > acks_before; }, 5s))
+      << "no HOIST_ALARM_ACK on LCM; bridge log:\n" << readFile(log("bridge.log"));
+  const auto acks = lcm.decoded<hoist::alarm_ack_t>("north/HOIST_ALARM_ACK");
+  ASSERT_FALSE(acks.empty());
+  EXPECT_EQ(acks.back().kind, "CAGE_POS_Y");
+  EXPECT_EQ(acks.back().action, +hoist::alarm_ack_t::ACTION_ACK);
+  EXPECT_EQ(acks.back().user, "scada-op");
+  auto acked = early.waitJson(
+      "hoist/north/alarm/CAGE_POS_Y",
+      [](const json& j, bool) { return j["warning"].is_object() && j["warning"]["acked"].get<bool>(); }, 5s);
+  ASSERT_TRUE(acked) << readFile(log("twind.log"));
+  EXPECT_EQ((*acked)["last_event"], "ACK");
+  EXPECT_FALSE((*acked)["unacked"].get<bool>());
+  EXPECT_TRUE((*acked)["active"].get<bool>());
+  EXPECT_NE(readFile(log("twind.log")).find("operator 'scada-op': acknowledge"), std::string::npos);
+
+  // Stop: the bridge says it is offline (retained) and exits 0.
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0) << readFile(log("bridge.log"));
+  auto off = early.waitJson("hoist/_bridge/bridge-a/status", [](const json& j, bool) { return !j.value("online", true); }, 3s);
+  ASSERT_TRUE(off);
+  EXPECT_EQ((*off)["reason"], "shutdown");
+  replay.signal(SIGTERM);
+  stopDaemonCleanly(*twind, log("twind.log"));
+}
+
+// The broker is down at start and restarts mid-run: the bridge retries with
+// backoff, logs once per state change, buffers a bounded number of messages
+// (dropping cage states, never alarm transitions), reconnects, re-subscribes
+// and republishes the retained alarm states; nothing crashes.  A killed
+// bridge leaves its last will (offline).
+TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
+  dir_ = testDir("mqtt_restart");
+  const std::string url = urlFor(7932);
+  Broker broker(dir_, freePort());
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[broker]\nreconnect_min = 0.1\nreconnect_max = 0.5\n[bridge]\nhealth_period = 0.5\n"
+                         "[buffer]\nmax_messages = 15\n";
+  // Shafts discovered (no --channel-prefix); the daemon has no prefix: "default".
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-b"},
+                 log("bridge.log"));
+  Listener lcm(url);
+  lcm.subscribe("HOIST_.*");
+  auto twind = startDaemonAndWait(lcm, {HOIST_TWIND, "--config", daemonConfig(dir_, ""), "--lcm-url", url},
+                                  log("twind.log"));
+  Process replay({HOIST_REPLAY, "--profile", "rest:t_end=60", "--lcm-url", url}, log("replay.log"));
+  // The alarm comes up while the broker is down.
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("HOIST_ALARM") > 0; }, 10s)) << readFile(log("twind.log"));
+  lcm.pump(2s);
+  ASSERT_TRUE(bridge.running()) << readFile(log("bridge.log"));
+  std::string blog = readFile(log("bridge.log"));
+  EXPECT_EQ(countOf(blog, "cannot connect to the broker"), 1u) << "log once per state change:\n" << blog;
+
+  broker.start();
+  Client c1(broker.port(), "c1");
+  ASSERT_TRUE(c1.connected());
+  c1.subscribe("hoist/#");
+  auto st = c1.waitJson("hoist/default/alarm/CAGE_POS_Y", [](const json& j, bool) { return isWarningActive(j); }, 10s);
+  ASSERT_TRUE(st) << readFile(log("bridge.log"));
+  auto h1 = c1.waitJson("hoist/_bridge/bridge-b/health",
+                        [](const json& j, bool) { return j["connection"]["state"] == "connected"; }, 5s);
+  ASSERT_TRUE(h1);
+  EXPECT_EQ((*h1)["connection"]["connects"], 1);
+  EXPECT_GE((*h1)["connection"]["connect_failures"].get<int>(), 2);
+  EXPECT_GT((*h1)["buffer"]["dropped_cage"].get<int>(), 0) << "15 messages of buffer over > 2 s at 10 Hz";
+  EXPECT_EQ((*h1)["buffer"]["dropped_alarm"], 0);
+  ASSERT_EQ((*h1)["shafts"].size(), 1u);
+  EXPECT_EQ((*h1)["shafts"][0]["name"], "default");
+  EXPECT_EQ((*h1)["shafts"][0]["channel_prefix"], "");
+
+  // Broker restart (it loses its retained messages: no persistence).
+  broker.stop();
+  std::this_thread::sleep_for(1500ms);
+  ASSERT_TRUE(bridge.running()) << readFile(log("bridge.log"));
+  broker.start();
+  Client c2(broker.port(), "c2");
+  ASSERT_TRUE(c2.connected());
+  // Subscribe once the bridge is back.
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (countOf(readFile(log("bridge.log")), "connected to the broker") < 2 && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(50ms);
+  ASSERT_EQ(countOf(readFile(log("bridge.log")), "connected to the broker"), 2u) << readFile(log("bridge.log"));
+  std::this_thread::sleep_for(1s);  // the republication follows the log line
+  c2.subscribe("hoist/#");
+  auto again = c2.waitJson("hoist/default/alarm/CAGE_POS_Y", [](const json& j, bool r) { return r && isWarningActive(j); }, 5s);
+  EXPECT_TRUE(again) << "the retained alarm state was not republished after the broker restart";
+  EXPECT_TRUE(c2.waitJson("hoist/default/cage", [](const json&, bool) { return true; }, 3s));
+  auto h2 = c2.waitJson("hoist/_bridge/bridge-b/health", [](const json& j, bool) { return j["connection"]["connects"] == 2; }, 5s);
+  ASSERT_TRUE(h2);
+  EXPECT_EQ((*h2)["connection"]["disconnects"], 1);
+  // Commands work on the new connection (re-subscribed).
+  const std::size_t acks_before = lcm.count("HOIST_ALARM_ACK");
+  c2.publish("hoist/default/cmd/ack", R"({"kind":"*","level":0,"action":1})");
+  EXPECT_TRUE(lcm.waitFor([&] { return lcm.count("HOIST_ALARM_ACK") > acks_before; }, 5s));
+  blog = readFile(log("bridge.log"));
+  EXPECT_EQ(countOf(blog, "lost:"), 1u) << blog;
+  EXPECT_EQ(countOf(blog, "connected to the broker"), 2u) << blog;
+
+  // A killed bridge: the broker publishes its last will (offline, retained).
+  bridge.signal(SIGKILL);
+  bridge.wait(5s);
+  Client c3(broker.port(), "c3");
+  ASSERT_TRUE(c3.connected());
+  c3.subscribe("hoist/_bridge/bridge-b/status");
+  auto will = c3.waitJson("hoist/_bridge/bridge-b/status", [](const json& j, bool) { return !j.value("online", true); }, 10s);
+  ASSERT_TRUE(will) << "no last will after the bridge was killed";
+  EXPECT_EQ((*will)["reason"], "connection lost (last will)");
+  replay.signal(SIGTERM);
+  stopDaemonCleanly(*twind, log("twind.log"));
+}
+
+// --no-commands: nothing on hoist/<shaft>/cmd/ack reaches LCM.
+TEST_F(MqttBridge, NoCommandsIgnoresCommands) {
+  dir_ = testDir("mqtt_no_commands");
+  const std::string url = urlFor(7933);
+  Broker broker(dir_, freePort());
+  broker.start();
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--channel-prefix",
+                  "south/", "--no-commands", "--client-id", "bridge-c"},
+                 log("bridge.log"));
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/_bridge/#");
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-c/health", [](const json&, bool) { return true; }, 5s))
+      << readFile(log("bridge.log"));
+  Listener lcm(url);
+  lcm.subscribe("south/HOIST_ALARM_ACK");
+  for (int i = 0; i < 3; ++i) c.publish("hoist/south/cmd/ack", R"({"kind":"*","level":0,"action":1})");
+  lcm.pump(1500ms);
+  EXPECT_EQ(lcm.count("south/HOIST_ALARM_ACK"), 0u);
+  auto h = c.waitJson("hoist/_bridge/bridge-c/health", [](const json&, bool) { return true; }, 2s);
+  ASSERT_TRUE(h);
+  EXPECT_FALSE((*h)["commands"]["enabled"].get<bool>());
+  EXPECT_EQ((*h)["commands"]["received"], 0);
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}
+
+// Bad configuration: exit status 2 and a message naming file, line and key.
+TEST_F(MqttBridge, BadConfigurationExits2) {
+  dir_ = testDir("mqtt_bad_config");
+  const auto bcfg = (dir_ / "bad.toml").string();
+  std::ofstream(bcfg) << "[bridge]\ncage_rate = -1\n";
+  EXPECT_EQ(runProcess({HOIST_MQTT, "--config", bcfg}, log("out.log"), 10s), 2);
+  EXPECT_NE(readFile(log("out.log")).find("bad.toml:2: bridge.cage_rate: must be in (0, 1000]"), std::string::npos)
+      << readFile(log("out.log"));
+  EXPECT_EQ(runProcess({HOIST_MQTT, "--broker", "http://x"}, log("out2.log"), 10s), 2);
+  EXPECT_NE(readFile(log("out2.log")).find("broker.url"), std::string::npos) << readFile(log("out2.log"));
+  EXPECT_EQ(runProcess({HOIST_MQTT, "--help"}, log("out3.log"), 10s), 0);
+}
+
+// TLS with a CA file and username/password (password from a file): the
+// bridge connects to a TLS listener that requires both; with a wrong
+// password it is refused, says so once, keeps retrying and never exits.
+TEST_F(MqttBridge, TlsWithPasswordFile) {
+  dir_ = testDir("mqtt_tls");
+  auto path = [&](const char* f) { return (dir_ / f).string(); };
+  auto run = [&](std::vector<std::string> argv) {
+    const int rc = runProcess(std::move(argv), path("openssl.log"), 60s);
+    ASSERT_EQ(rc, 0) << readFile(path("openssl.log"));
+  };
+  // A private CA and a server certificate for localhost / 127.0.0.1.
+  std::ofstream(path("ext.cnf")) << "subjectAltName=DNS:localhost,IP:127.0.0.1\n";
+  run({HOIST_OPENSSL, "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", path("ca.key"), "-out",
+       path("ca.crt"), "-days", "2", "-subj", "/CN=hoist-test-ca"});
+  run({HOIST_OPENSSL, "req", "-newkey", "rsa:2048", "-nodes", "-keyout", path("server.key"), "-out",
+       path("server.csr"), "-subj", "/CN=localhost"});
+  run({HOIST_OPENSSL, "x509", "-req", "-in", path("server.csr"), "-CA", path("ca.crt"), "-CAkey", path("ca.key"),
+       "-CAcreateserial", "-out", path("server.crt"), "-days", "2", "-extfile", path("ext.cnf")});
+  run({HOIST_MOSQUITTO_PASSWD, "-b", "-c", path("passwd"), "hoist", "s3cret"});
+  std::filesystem::permissions(path("server.key"), std::filesystem::perms::owner_read | std::filesystem::perms::group_read |
+                                                       std::filesystem::perms::others_read);
+  // Listener 1: plain, anonymous (the test's client); listener 2: TLS + password (the bridge).
+  const int plain = freePort(), tls = freePort();
+  std::ofstream(path("mosquitto.conf")) << "per_listener_settings true\npersistence false\nlog_dest stdout\n"
+                                        << "listener " << plain << " 127.0.0.1\nallow_anonymous true\n"
+                                        << "listener " << tls << " 127.0.0.1\nallow_anonymous false\n"
+                                        << "password_file " << path("passwd") << "\ncafile " << path("ca.crt")
+                                        << "\ncertfile " << path("server.crt") << "\nkeyfile " << path("server.key")
+                                        << "\n";
+  Process broker({HOIST_MOSQUITTO, "-c", path("mosquitto.conf")}, path("mosquitto.log"));
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (!(tcpOpen(plain) && tcpOpen(tls)) && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(tcpOpen(tls)) << readFile(path("mosquitto.log"));
+  Client c(plain, "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/_bridge/#");
+
+  std::ofstream(path("pw")) << "s3cret\n";
+  std::ofstream(path("badpw")) << "Wr0ngPw-xyz\n";
+  auto config = [&](const char* name, const char* pwfile) {
+    std::ofstream(path(name)) << "[broker]\nurl = \"mqtts://localhost:" << tls << "\"\nusername = \"hoist\"\n"
+                              << "password_file = \"" << path(pwfile) << "\"\nreconnect_min = 0.1\nreconnect_max = 0.3\n"
+                              << "[tls]\nca_file = \"" << path("ca.crt") << "\"\n[bridge]\nhealth_period = 0.5\n";
+  };
+  config("good.toml", "pw");
+  config("bad.toml", "badpw");
+  Process good({HOIST_MQTT, "--config", path("good.toml"), "--lcm-url", urlFor(7934), "--client-id", "tls-good"},
+               path("good.log"));
+  Process bad({HOIST_MQTT, "--config", path("bad.toml"), "--lcm-url", urlFor(7934), "--client-id", "tls-bad"},
+              path("bad.log"));
+  auto st = c.waitJson("hoist/_bridge/tls-good/status", [](const json& j, bool) { return j.value("online", false); }, 15s);
+  ASSERT_TRUE(st) << readFile(path("good.log")) << readFile(path("mosquitto.log"));
+  std::this_thread::sleep_for(1500ms);
+  EXPECT_TRUE(bad.running());
+  EXPECT_TRUE(c.on("hoist/_bridge/tls-bad/status").empty());
+  const std::string blog = readFile(path("bad.log"));
+  EXPECT_EQ(countOf(blog, "cannot connect to the broker"), 1u) << blog;
+  EXPECT_NE(blog.find("not authorised"), std::string::npos) << blog;
+  EXPECT_EQ(blog.find("s3cret"), std::string::npos);
+  EXPECT_EQ(blog.find("Wr0ngPw-xyz"), std::string::npos) << "the password must never be logged";
+  good.signal(SIGTERM);
+  bad.signal(SIGTERM);
+  EXPECT_EQ(good.wait(5s), 0);
+  EXPECT_EQ(bad.wait(5s), 0);
+}

@@ -1,0 +1,262 @@
+// hoist-mqtt's pure parts: configuration, broker URL, shaft names, the bounded
+// outgoing buffer and the command parser (no sockets).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "hoist/io/error.hpp"
+#include "hoist/mqtt/command.hpp"
+#include "hoist/mqtt/config.hpp"
+#include "hoist/mqtt/outbox.hpp"
+#include "hoist/service/alarm_command.hpp"
+
+using namespace hoist::mqtt;
+
+namespace {
+
+/// The ConfigError message of applying `toml`, or "" if accepted.
+std::string configError(const std::string& toml) {
+  BridgeConfig c;
+  try {
+    applyBridgeToml(toml, "bridge.toml", c);
+  } catch (const hoist::io::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+CommandResult parse(const std::string& s, std::size_t max = 1024) {
+  return parseAckCommand(s.data(), s.size(), max, 1234567);
+}
+
+}  // namespace
+
+TEST(MqttConfig, BrokerUrls) {
+  auto u = parseBrokerUrl("mqtt://127.0.0.1:1884");
+  EXPECT_FALSE(u.tls);
+  EXPECT_EQ(u.host, "127.0.0.1");
+  EXPECT_EQ(u.port, 1884);
+  u = parseBrokerUrl("mqtts://broker.example.com");
+  EXPECT_TRUE(u.tls);
+  EXPECT_EQ(u.port, 8883);
+  EXPECT_EQ(parseBrokerUrl("mqtt://localhost").port, 1883);
+  u = parseBrokerUrl("mqtt://[::1]:1900");
+  EXPECT_EQ(u.host, "::1");
+  EXPECT_EQ(u.port, 1900);
+  for (const char* bad : {"tcp://x:1", "mqtt://", "mqtt://:1883", "mqtt://h:0", "mqtt://h:65536", "mqtt://h:12a",
+                          "mqtt://user@h:1", "mqtt://h:1/path", "mqtt://[::1", "mqtt://h:"})
+    EXPECT_THROW(parseBrokerUrl(bad), std::invalid_argument) << bad;
+}
+
+TEST(MqttConfig, ShaftNames) {
+  EXPECT_EQ(shaftName(""), "default");
+  EXPECT_EQ(shaftName("north/"), "north");
+  EXPECT_EQ(shaftName("N1_"), "N1");
+  EXPECT_EQ(shaftName("site.a-"), "site.a");
+  EXPECT_EQ(shaftName("mine/shaft2/"), "mine/shaft2");
+  EXPECT_EQ(shaftName("x"), "x");
+  EXPECT_TRUE(validChannelPrefix(""));
+  EXPECT_TRUE(validChannelPrefix("north/"));
+  EXPECT_FALSE(validChannelPrefix("a+b/"));    // MQTT wildcard
+  EXPECT_FALSE(validChannelPrefix("a#/"));
+  EXPECT_FALSE(validChannelPrefix("//"));      // empty topic level
+  EXPECT_FALSE(validChannelPrefix("_bridge/"));  // reserved for the bridge's own topics
+  EXPECT_FALSE(validChannelPrefix(std::string(65, 'a')));
+}
+
+TEST(MqttConfig, AcceptsAFullFile) {
+  const std::string key = std::filesystem::temp_directory_path() / "hoist_mqtt_unit_pw";
+  std::ofstream(key) << "s3cret\n";
+  BridgeConfig c;
+  applyBridgeToml(R"(
+[broker]
+url = "mqtt://10.0.0.5:1884"
+client_id = "bridge-1"
+keepalive = 20
+username = "twin"
+password_file = ")" + key + R"("
+reconnect_min = 0.2
+reconnect_max = 5
+[bridge]
+channel_prefixes = ["north/", "south/"]
+commands = false
+cage_rate = 2.5
+health_period = 1
+[buffer]
+max_messages = 50
+max_alarm_events = 500
+)",
+                  "bridge.toml", c);
+  EXPECT_EQ(c.url, "mqtt://10.0.0.5:1884");
+  EXPECT_EQ(c.client_id, "bridge-1");
+  EXPECT_EQ(c.keepalive, 20);
+  EXPECT_EQ(c.channel_prefixes.size(), 2u);
+  EXPECT_FALSE(c.commands);
+  EXPECT_DOUBLE_EQ(c.cage_rate, 2.5);
+  EXPECT_EQ(c.max_messages, 50);
+  EXPECT_EQ(resolvePassword(c, "bridge.toml"), "s3cret");
+  std::filesystem::remove(key);
+}
+
+TEST(MqttConfig, PasswordFromEnvironment) {
+  BridgeConfig c;
+  c.username = "u";
+  c.password_env = "HOIST_MQTT_UNIT_TEST_PW";
+  ::setenv("HOIST_MQTT_UNIT_TEST_PW", "from-env", 1);
+  EXPECT_EQ(resolvePassword(c, "x"), "from-env");
+  ::unsetenv("HOIST_MQTT_UNIT_TEST_PW");
+  EXPECT_EQ(resolvePassword(c, "x"), "");
+  c.password = "inline";
+  EXPECT_EQ(resolvePassword(c, "x"), "inline");
+}
+
+TEST(MqttConfig, ErrorsNameFileLineAndKey) {
+  struct Case {
+    const char* toml;
+    const char* expect;  // substring of the message
+  };
+  const Case cases[] = {
+      {"[broker]\nurl = \"http://x:1\"\n", "bridge.toml:2: broker.url: must start with mqtt://"},
+      {"[broker]\nurl = 5\n", "bridge.toml:2: broker.url: must be a string"},
+      {"[broker]\nurll = \"mqtt://x\"\n", "bridge.toml:2: broker.urll: unknown key (did you mean 'url'?)"},
+      {"[brokr]\nurl = \"mqtt://x\"\n", "bridge.toml:1: brokr: unknown section (did you mean 'broker'?)"},
+      {"url = \"mqtt://x\"\n", "url: key outside a section"},
+      {"[broker]\nkeepalive = 1\n", "bridge.toml:2: broker.keepalive: must be in [5, 3600]"},
+      {"[broker]\nkeepalive = 30.5\n", "broker.keepalive: must be an integer"},
+      {"[broker]\npassword = \"x\"\n", "broker.password: a password needs broker.username"},
+      {"[broker]\nusername = \"u\"\npassword_file = \"/nonexistent/pw\"\n",
+       "bridge.toml:3: broker.password_file: cannot read '/nonexistent/pw'"},
+      {"[broker]\nreconnect_min = 5\nreconnect_max = 1\n", "broker.reconnect_max: must be in [5, 3600]"},
+      {"[broker]\nclient_id = \"a b\"\n", "broker.client_id: may contain only"},
+      {"[tls]\nca_file = \"/nonexistent/ca.crt\"\n", "bridge.toml:2: tls.ca_file: cannot read"},
+      {"[broker]\nurl = \"mqtts://x\"\n", "tls.ca_file: TLS needs the broker's CA"},
+      {"[tls]\nversion = \"ssl3\"\n", "tls.version: must be \"tlsv1.2\" or \"tlsv1.3\""},
+      {"[bridge]\ncage_rate = 0\n", "bridge.toml:2: bridge.cage_rate: must be in (0, 1000]"},
+      {"[bridge]\ncage_rate = nan\n", "bridge.cage_rate: must be finite"},
+      {"[bridge]\ncage_rate = \"fast\"\n", "bridge.cage_rate: must be a number"},
+      {"[bridge]\nchannel_prefixes = \"north/\"\n", "bridge.channel_prefixes: must be an array of strings"},
+      {"[bridge]\nchannel_prefixes = [\"a+/\"]\n", "bridge.channel_prefixes: 'a+/': may contain only"},
+      {"[bridge]\nchannel_prefixes = [\"north/\", \"north_\"]\n", "give the same shaft name 'north'"},
+      {"[bridge]\ncommands = \"yes\"\n", "bridge.commands: must be true or false"},
+      {"[bridge]\nmax_command_bytes = 10\n", "bridge.max_command_bytes: must be in [64, 65536]"},
+      {"[buffer]\nmax_messages = 0\n", "bridge.toml:2: buffer.max_messages: must be in [1, 1000000]"},
+      {"[buffer]\nmax_alarm_events = -3\n", "buffer.max_alarm_events"},
+      {"[broker\n", "bridge.toml:1: TOML syntax error"},
+  };
+  for (const auto& c : cases) {
+    const std::string msg = configError(c.toml);
+    EXPECT_NE(msg.find(c.expect), std::string::npos) << "config:\n" << c.toml << "\nmessage: " << msg;
+  }
+  EXPECT_EQ(configError(""), "");
+}
+
+TEST(MqttConfig, ExampleFileIsValid) {
+  const BridgeConfig c = loadBridgeConfig(HOIST_MQTT_EXAMPLE_CONFIG);
+  EXPECT_EQ(c.url, BridgeConfig{}.url);
+  EXPECT_EQ(c.cage_rate, BridgeConfig{}.cage_rate);
+  EXPECT_EQ(c.max_messages, BridgeConfig{}.max_messages);
+}
+
+TEST(MqttOutbox, DropsOldestCageStatesFirstNeverAlarms) {
+  Outbox box(3, 100);
+  auto cage = [](int i) { return OutMsg{"c", std::to_string(i), 0, false, MsgClass::Cage}; };
+  box.push(cage(1));
+  box.push({"a", "A1", 1, true, MsgClass::Alarm});
+  box.push({"h", "H1", 0, false, MsgClass::Health});
+  box.push(cage(2));
+  box.push(cage(3));  // full (3 cage/health): drops cage 1
+  box.push(cage(4));  // drops cage 2
+  box.push({"a", "A2", 1, true, MsgClass::Alarm});  // alarms have their own bound
+  EXPECT_EQ(box.droppedCage(), 2u);
+  EXPECT_EQ(box.droppedAlarm(), 0u);
+  std::string order;
+  while (!box.empty()) {
+    order += box.front().payload + " ";
+    box.pop();
+  }
+  EXPECT_EQ(order, "A1 H1 3 4 A2 ");  // order kept, both alarms there
+  // With no cage state left, the oldest health message goes.
+  Outbox h(2, 100);
+  h.push({"h", "H1", 0, false, MsgClass::Health});
+  h.push({"h", "H2", 0, false, MsgClass::Health});
+  h.push({"h", "H3", 0, false, MsgClass::Health});
+  EXPECT_EQ(h.droppedHealth(), 1u);
+  EXPECT_EQ(h.front().payload, "H2");
+  // A flood of cage states never displaces an alarm transition.
+  Outbox f(10, 5);
+  f.push({"a", "A", 1, true, MsgClass::Alarm});
+  for (int i = 0; i < 1000; ++i) f.push(cage(i));
+  EXPECT_EQ(f.size(), 11u);
+  EXPECT_EQ(f.queuedAlarms(), 1u);
+  EXPECT_EQ(f.front().payload, "A");
+  // Past their own (large) bound alarm transitions are dropped oldest first, and counted.
+  for (int i = 0; i < 7; ++i) f.push({"a", "B" + std::to_string(i), 1, true, MsgClass::Alarm});
+  EXPECT_EQ(f.queuedAlarms(), 5u);
+  EXPECT_EQ(f.droppedAlarm(), 3u);
+}
+
+TEST(MqttCommand, ValidCommands) {
+  auto r = parse(R"({"kind":"CAGE_POS_Y","level":1,"action":1,"user":"scada-1"})");
+  ASSERT_EQ(r.reject, CommandReject::None) << r.detail;
+  EXPECT_EQ(r.ack.kind, "CAGE_POS_Y");
+  EXPECT_EQ(r.ack.level, 1);
+  EXPECT_EQ(r.ack.action, +hoist::alarm_ack_t::ACTION_ACK);
+  EXPECT_EQ(r.ack.user, "scada-1");
+  EXPECT_EQ(r.ack.utime, 1234567);  // the bridge's clock when absent
+  r = parse(R"({"kind":"*","level":0,"action":2,"shelve_duration":600})");
+  ASSERT_EQ(r.reject, CommandReject::None) << r.detail;
+  EXPECT_EQ(r.ack.shelve_duration, 600.0);
+  EXPECT_EQ(r.ack.user, "mqtt");
+  r = parse(R"({"utime":42,"kind":"","level":2,"action":3,"shelve_duration":0,"user":"x"})");
+  ASSERT_EQ(r.reject, CommandReject::None) << r.detail;
+  EXPECT_EQ(r.ack.utime, 42);
+}
+
+TEST(MqttCommand, RejectsBadPayloadsByReason) {
+  EXPECT_EQ(parse(std::string(2000, ' ')).reject, CommandReject::Oversized);
+  EXPECT_EQ(parse("ack CAGE_POS_Y").reject, CommandReject::NotJson);
+  EXPECT_EQ(parse("").reject, CommandReject::NotJson);
+  EXPECT_EQ(parse("{\"kind\":\"\xff\xfe\",\"level\":0,\"action\":1}").reject, CommandReject::NotJson);  // not UTF-8
+  EXPECT_EQ(parse(std::string("{\"kind\0", 7)).reject, CommandReject::NotJson);
+  EXPECT_EQ(parse("[1,2]").reject, CommandReject::NotObject);
+  EXPECT_EQ(parse("\"ack\"").reject, CommandReject::NotObject);
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0})").reject, CommandReject::BadFields);  // no action
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0,"action":1,"extra":1})").reject, CommandReject::BadFields);
+  EXPECT_EQ(parse(R"({"kind":7,"level":0,"action":1})").reject, CommandReject::BadFields);
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0,"action":1000})").reject, CommandReject::BadFields);  // not int8
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0,"action":"ack"})").reject, CommandReject::BadFields);
+  EXPECT_EQ(parse(R"({"kind":"NOPE","level":0,"action":1})").reject, CommandReject::UnknownKind);
+  EXPECT_EQ(parse(R"({"kind":"cage_pos_y","level":0,"action":1})").reject, CommandReject::UnknownKind);
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":3,"action":1})").reject, CommandReject::BadLevel);
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0,"action":9})").reject, CommandReject::BadAction);
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0,"action":2})").reject, CommandReject::BadShelveDuration);
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0,"action":2,"shelve_duration":-5})").reject,
+            CommandReject::BadShelveDuration);
+  // The log detail never carries the raw payload.
+  const auto r = parse("{\"kind\":\"EVIL\x1b[31m\",\"level\":0,\"action\":1}");
+  EXPECT_EQ(r.detail.find('\x1b'), std::string::npos);
+}
+
+TEST(MqttCommand, SameValidationAsTheDaemon) {
+  // The bridge and hoist-twind share hoist::svc::validateAlarmCommand.
+  hoist::svc::AlarmCommand c;
+  EXPECT_EQ(hoist::svc::validateAlarmCommand("GUIDE_ROPE", 2, 2, 30.0, c), hoist::svc::CommandError::None);
+  EXPECT_EQ(c.action, hoist::svc::AlarmAction::Shelve);
+  ASSERT_TRUE(c.kind.has_value());
+  EXPECT_EQ(*c.kind, hoist::svc::AlarmKind::GuideRope);
+  EXPECT_EQ(c.level, hoist::svc::AlarmLevel::Critical);
+  EXPECT_EQ(hoist::svc::validateAlarmCommand("*", 0, 1, 0.0, c), hoist::svc::CommandError::None);
+  EXPECT_FALSE(c.kind.has_value());
+  EXPECT_EQ(hoist::svc::validateAlarmCommand("X", 0, 1, 0.0, c), hoist::svc::CommandError::UnknownKind);
+  EXPECT_EQ(hoist::svc::validateAlarmCommand("", -1, 1, 0.0, c), hoist::svc::CommandError::BadLevel);
+  EXPECT_EQ(hoist::svc::validateAlarmCommand("", 0, 0, 0.0, c), hoist::svc::CommandError::BadAction);
+  EXPECT_EQ(hoist::svc::validateAlarmCommand("", 0, 2, std::nan(""), c),
+            hoist::svc::CommandError::BadShelveDuration);
+  for (int i = 0; i < hoist::svc::kCommandErrors; ++i)
+    EXPECT_STRNE(hoist::svc::toString(static_cast<hoist::svc::CommandError>(i)), "?");
+  for (int i = 0; i < kCommandRejects; ++i) EXPECT_STRNE(toString(static_cast<CommandReject>(i)), "?");
+}

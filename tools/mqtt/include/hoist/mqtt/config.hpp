@@ -1,0 +1,87 @@
+// hoist/mqtt/config.hpp -- hoist-mqtt's configuration (TOML; docs/mqtt.md).
+//
+//   [broker]  url, client_id, keepalive, username, password, password_file,
+//             password_env, reconnect_min, reconnect_max, connect_timeout
+//   [tls]     ca_file, ca_path, cert_file, key_file, insecure, version
+//   [bridge]  lcm_url, channel_prefixes, commands, cage_rate, health_period,
+//             max_shafts, max_command_bytes
+//   [buffer]  max_messages, max_alarm_events
+//
+// Every key is optional.  Rejected with hoist::io::ConfigError
+// ("file:line: section.key: reason", exit status 2): TOML syntax errors,
+// unknown sections and keys (with "did you mean"), wrong types, values out
+// of range, a broker URL that is not mqtt:// or mqtts://HOST[:PORT], an
+// unreadable password file, TLS files that cannot be read.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace hoist::mqtt {
+
+/// mqtt://HOST[:PORT] (default port 1883) or mqtts://HOST[:PORT] (TLS,
+/// default 8883); HOST may be a bracketed IPv6 address ([::1]).
+struct BrokerUrl {
+  bool tls = false;
+  std::string host;
+  int port = 1883;
+};
+
+/// Throws std::invalid_argument with the reason.
+BrokerUrl parseBrokerUrl(const std::string& url);
+
+struct BridgeConfig {
+  // [broker]
+  std::string url = "mqtt://127.0.0.1:1883";
+  std::string client_id;          ///< "" = hoist-mqtt-<hostname>
+  int keepalive = 30;             ///< [s], 5..3600
+  std::string username;           ///< "" = no authentication
+  std::string password;           ///< discouraged (readable in the file); see password_file / password_env
+  std::string password_file;      ///< first line of this file is the password
+  std::string password_env = "HOIST_MQTT_PASSWORD";  ///< environment variable holding the password
+  double reconnect_min = 0.5;     ///< first retry delay [s]
+  double reconnect_max = 30.0;    ///< largest retry delay [s] (the delay doubles per failure)
+  double connect_timeout = 10.0;  ///< no CONNACK within this: retry [s]
+
+  // [tls] (used when any file is set or the URL is mqtts://)
+  std::string ca_file, ca_path, cert_file, key_file;
+  bool tls_insecure = false;      ///< skip the server host name check (testing only)
+  std::string tls_version;        ///< "" (library default), "tlsv1.2" or "tlsv1.3"
+
+  // [bridge]
+  std::string lcm_url;                     ///< "" = $LCM_DEFAULT_URL, else LCM's default
+  std::vector<std::string> channel_prefixes;  ///< empty = discover from *HOIST_{HEALTH,CAGE,ALARM} channels
+  bool commands = true;                    ///< accept hoist/<shaft>/cmd/ack
+  double cage_rate = 10.0;                 ///< cage states per second per shaft [Hz], (0, 1000]
+  double health_period = 5.0;              ///< the bridge's own health topic period [s]
+  int max_shafts = 64;                     ///< discovered shafts at most
+  int max_command_bytes = 1024;            ///< larger command payloads are rejected
+
+  // [buffer] (while the broker is unreachable or the socket is congested)
+  int max_messages = 1000;       ///< cage and health messages buffered (oldest cage states dropped first)
+  int max_alarm_events = 10000;  ///< alarm transitions buffered (never dropped for cage states)
+
+  bool wantsTls() const;
+  /// Throws std::invalid_argument("section.key: reason").
+  void validate() const;
+};
+
+/// Reads and validates a configuration file.  Throws hoist::io::ConfigError.
+BridgeConfig loadBridgeConfig(const std::string& path);
+/// Applies TOML text on top of `cfg` (tests); `source` names it in errors.
+void applyBridgeToml(const std::string& text, const std::string& source, BridgeConfig& cfg);
+
+/// The password: `password`, else the first line of `password_file`, else
+/// the environment variable `password_env` (if set); "" if none.  Throws
+/// hoist::io::ConfigError (key broker.password_file) if the file is unreadable.
+std::string resolvePassword(const BridgeConfig& cfg, const std::string& source);
+
+/// MQTT shaft name of an LCM channel prefix: the prefix without one trailing
+/// separator ('/', '_', '-', '.'), or "default" for the empty prefix.
+std::string shaftName(const std::string& prefix);
+/// True if `prefix` is a valid channel prefix (the daemon's rule: letters,
+/// digits, _ - . /; at most 64 characters) whose shaft name is usable in a topic.
+bool validChannelPrefix(const std::string& prefix, std::string* why = nullptr);
+
+}  // namespace hoist::mqtt

@@ -1,0 +1,703 @@
+// hoist-mqtt's bridge: see hoist/mqtt/bridge.hpp.
+#include "hoist/mqtt/bridge.hpp"
+
+#include <mosquitto.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <lcm/lcm-cpp.hpp>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <spdlog/spdlog.h>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
+
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
+#include "hoist/bus/channels.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/health_t.hpp"
+#include "hoist/mqtt/command.hpp"
+#include "hoist/mqtt/outbox.hpp"
+#include "hoist/msg/codec.hpp"
+
+namespace hoist::mqtt {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using json = nlohmann::json;
+
+using hoist::bus::kChannelAlarm;
+using hoist::bus::kChannelAlarmAck;
+using hoist::bus::kChannelCage;
+using hoist::bus::kChannelHealth;
+constexpr int kMaxKindsPerShaft = 32;
+
+double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+/// Alarm kinds are used in topic names: upper-case letters, digits and '_'.
+bool validKind(const std::string& k) {
+  if (k.empty() || k.size() > 32) return false;
+  for (char c : k)
+    if (!((c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  return true;
+}
+
+const char* levelName(int level) { return level == 1 ? "WARNING" : level == 2 ? "CRITICAL" : "NONE"; }
+const char* eventName(int e) {
+  switch (e) {
+    case hoist::alarm_t::EVENT_RAISE: return "RAISE";
+    case hoist::alarm_t::EVENT_CLEAR: return "CLEAR";
+    case hoist::alarm_t::EVENT_ACK: return "ACK";
+    case hoist::alarm_t::EVENT_SHELVE: return "SHELVE";
+    case hoist::alarm_t::EVENT_UNSHELVE: return "UNSHELVE";
+    case hoist::alarm_t::EVENT_REANNOUNCE: return "REANNOUNCE";
+  }
+  return "?";
+}
+
+/// Allows a few log lines per window, then counts the suppressed ones.
+class LogLimiter {
+ public:
+  bool allow(Clock::time_point now, std::uint64_t& suppressed) {
+    if (now - start_ > std::chrono::seconds(10)) {
+      start_ = now;
+      suppressed = suppressed_;
+      suppressed_ = 0;
+      n_ = 0;
+    } else {
+      suppressed = 0;
+    }
+    if (n_ < 5) {
+      ++n_;
+      return true;
+    }
+    ++suppressed_;
+    return false;
+  }
+
+ private:
+  Clock::time_point start_{};
+  int n_ = 0;
+  std::uint64_t suppressed_ = 0;
+};
+
+}  // namespace
+
+struct Bridge::Impl {
+  // ---- configuration ---------------------------------------------------------
+  BridgeConfig cfg;
+  BrokerUrl broker;
+  std::string client_id;
+  std::string status_topic, bridge_health_topic;
+
+  // ---- LCM ---------------------------------------------------------------------
+  std::string lcm_url;
+  lcm::LCM lcm;
+
+  // ---- shafts ------------------------------------------------------------------
+  struct AlarmState {
+    std::optional<hoist::alarm_t> by_level[3];  // index = level (1 WARNING, 2 CRITICAL)
+    hoist::alarm_t last;                        // latest event of either level
+  };
+  struct Shaft {
+    std::string prefix, name;
+    std::string t_cage, t_health, t_alarm, t_cmd;
+    bool subscribed = false;       // command topic subscribed on the current connection
+    bool cage_new = false;
+    hoist::cage_state_t cage{};
+    std::map<std::string, AlarmState> alarms;  // by kind
+    std::int64_t instance_id = 0;
+    std::uint64_t cage_in = 0, cage_out = 0, health_in = 0, alarms_in = 0, commands = 0;
+    Clock::time_point last_health{};
+  };
+  std::map<std::string, Shaft> shafts;           // by prefix
+  std::map<std::string, std::string> cmd_topics;  // command topic -> prefix
+  bool discover = false;
+
+  // ---- MQTT --------------------------------------------------------------------
+  struct mosquitto* mosq = nullptr;
+  enum class Conn { Disconnected, Connecting, Connected } conn = Conn::Disconnected;
+  Clock::time_point next_attempt{}, connecting_since{}, connected_since_steady{};
+  std::int64_t connected_since_utime = 0;
+  double delay = 0.0;
+  bool failing = false;     // the current series of attempts has been logged as failing
+  std::string last_error;
+  // Set by libmosquitto's callbacks (called inside mosquitto_loop, this thread).
+  bool cb_connack = false;
+  int cb_connack_rc = 0;
+  bool cb_disconnected = false;
+  int cb_disconnect_rc = 0;
+
+  Outbox outbox;
+
+  // ---- counters ----------------------------------------------------------------
+  Clock::time_point started = Clock::now();
+  std::int64_t started_utime = hoist::bus::wallUtime();
+  std::uint64_t connects = 0, disconnects = 0, connect_failures = 0;
+  std::uint64_t lcm_messages = 0, ignored_channels = 0, alarm_rejected = 0;
+  std::map<std::string, std::uint64_t> decode_errors;  // "cage/truncated" -> n
+  std::uint64_t published = 0, publish_errors = 0;
+  std::uint64_t cmd_received = 0, cmd_forwarded = 0, cmd_rejected = 0, cmd_lcm_failures = 0;
+  std::array<std::uint64_t, kCommandRejects> cmd_by_reason{};
+  LogLimiter cmd_log, lcm_log;
+  bool logged_too_many_shafts = false;
+
+  Impl(const BridgeConfig& c, const std::string& password)
+      : cfg(c),
+        broker(parseBrokerUrl(c.url)),
+        lcm_url(hoist::bus::resolveLcmUrl(c.lcm_url)),
+        lcm(lcm_url),
+        outbox(static_cast<std::size_t>(c.max_messages), static_cast<std::size_t>(c.max_alarm_events)) {
+    if (!lcm.good())
+      throw std::runtime_error("cannot open LCM (" + hoist::bus::describeLcmUrl(lcm_url) +
+                               "); is loopback multicast enabled? (scripts/setup.sh)");
+    client_id = cfg.client_id;
+    if (client_id.empty()) {
+      char host[256] = "";
+      gethostname(host, sizeof host - 1);
+      client_id = "hoist-mqtt-";
+      for (const char* p = host; *p && client_id.size() < 60; ++p)
+        client_id.push_back(std::isalnum(static_cast<unsigned char>(*p)) || *p == '-' ? *p : '_');
+    }
+    status_topic = "hoist/_bridge/" + client_id + "/status";
+    bridge_health_topic = "hoist/_bridge/" + client_id + "/health";
+
+    discover = cfg.channel_prefixes.empty();
+    for (const auto& p : cfg.channel_prefixes) addShaft(p);
+    // One subscription for every shaft: ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM)" (LCM anchors it).
+    lcm.subscribe(".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" +
+                      std::string(kChannelAlarm) + ")",
+                  &Impl::onLcm, this);
+
+    mosq = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
+    if (!mosq) throw std::runtime_error("mosquitto_new failed: " + std::string(std::strerror(errno)));
+    mosquitto_int_option(mosq, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V311);
+    const std::string will = json{{"online", false}, {"client_id", client_id}, {"reason", "connection lost (last will)"}}.dump();
+    check(mosquitto_will_set(mosq, status_topic.c_str(), static_cast<int>(will.size()), will.data(), 1, true), "will");
+    if (!cfg.username.empty())
+      check(mosquitto_username_pw_set(mosq, cfg.username.c_str(), password.empty() ? nullptr : password.c_str()),
+            "username/password");
+    if (cfg.wantsTls()) {
+      check(mosquitto_tls_set(mosq, cfg.ca_file.empty() ? nullptr : cfg.ca_file.c_str(),
+                              cfg.ca_path.empty() ? nullptr : cfg.ca_path.c_str(),
+                              cfg.cert_file.empty() ? nullptr : cfg.cert_file.c_str(),
+                              cfg.key_file.empty() ? nullptr : cfg.key_file.c_str(), nullptr),
+            "TLS files (tls.ca_file, tls.cert_file, tls.key_file)");
+      check(mosquitto_tls_opts_set(mosq, 1, cfg.tls_version.empty() ? nullptr : cfg.tls_version.c_str(), nullptr),
+            "tls.version");
+      if (cfg.tls_insecure) check(mosquitto_tls_insecure_set(mosq, true), "tls.insecure");
+    }
+    mosquitto_connect_callback_set(mosq, [](struct mosquitto*, void* obj, int rc) {
+      auto* self = static_cast<Impl*>(obj);
+      self->cb_connack = true;
+      self->cb_connack_rc = rc;
+    });
+    mosquitto_disconnect_callback_set(mosq, [](struct mosquitto*, void* obj, int rc) {
+      auto* self = static_cast<Impl*>(obj);
+      self->cb_disconnected = true;
+      self->cb_disconnect_rc = rc;
+    });
+    mosquitto_message_callback_set(mosq, [](struct mosquitto*, void* obj, const struct mosquitto_message* m) {
+      static_cast<Impl*>(obj)->onMqttMessage(m);
+    });
+    delay = cfg.reconnect_min;
+  }
+
+  ~Impl() {
+    if (mosq) mosquitto_destroy(mosq);
+  }
+
+  void check(int rc, const char* what) {
+    if (rc != MOSQ_ERR_SUCCESS)
+      throw std::runtime_error(std::string("libmosquitto refused ") + what + ": " + mosquitto_strerror(rc));
+  }
+
+  std::string brokerText() const {
+    return std::string(broker.tls ? "mqtts://" : "mqtt://") + broker.host + ":" + std::to_string(broker.port);
+  }
+
+  // ---- shafts ------------------------------------------------------------------
+
+  Shaft* addShaft(const std::string& prefix) {
+    Shaft s;
+    s.prefix = prefix;
+    s.name = shaftName(prefix);
+    const std::string base = "hoist/" + s.name + "/";
+    s.t_cage = base + "cage";
+    s.t_health = base + "health";
+    s.t_alarm = base + "alarm/";
+    s.t_cmd = base + "cmd/ack";
+    auto [it, fresh] = shafts.emplace(prefix, std::move(s));
+    cmd_topics[it->second.t_cmd] = prefix;
+    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM}} -> {}{{cage,health,alarm/<KIND>}}{}", it->second.name,
+                 prefix, base,
+                 cfg.commands ? ", " + it->second.t_cmd + " -> " + hoist::bus::channel(prefix, kChannelAlarmAck) : "");
+    if (conn == Conn::Connected) subscribeCommands(it->second);
+    return &it->second;
+  }
+
+  /// The shaft of `prefix`, discovering it if allowed (from any of its
+  /// channels: an alarm may come before the first health message is heard).
+  Shaft* shaftFor(const std::string& prefix) {
+    if (auto it = shafts.find(prefix); it != shafts.end()) return &it->second;
+    if (!discover) return nullptr;
+    std::string why;
+    if (!validChannelPrefix(prefix, &why)) return nullptr;
+    const std::string name = shaftName(prefix);
+    for (const auto& [p, s] : shafts)
+      if (s.name == name) return nullptr;  // another prefix already maps to this name
+    if (static_cast<int>(shafts.size()) >= cfg.max_shafts) {
+      if (!logged_too_many_shafts)
+        spdlog::warn("more than {} shafts discovered ([bridge] max_shafts): ignoring the others", cfg.max_shafts);
+      logged_too_many_shafts = true;
+      return nullptr;
+    }
+    return addShaft(prefix);
+  }
+
+  // ---- LCM side ------------------------------------------------------------------
+
+  void decodeError(const char* type, hoist::msg::DecodeStatus st, const std::string& channel) {
+    ++decode_errors[std::string(type) + "/" + hoist::msg::toString(st)];
+    std::uint64_t suppressed = 0;
+    if (lcm_log.allow(Clock::now(), suppressed))
+      spdlog::warn("undecodable {} on {} ({}){}", type, printable(channel), hoist::msg::toString(st),
+                   suppressed ? fmt::format(" ({} similar lines suppressed)", suppressed) : "");
+  }
+
+  void onLcm(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+    try {
+      ++lcm_messages;
+      auto ends = [&](std::string_view suffix) {
+        return channel.size() >= suffix.size() &&
+               std::string_view(channel).substr(channel.size() - suffix.size()) == suffix;
+      };
+      if (ends(kChannelCage)) {
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelCage.size()));
+        if (!s) return void(++ignored_channels);
+        hoist::cage_state_t m;
+        const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
+        if (st != hoist::msg::DecodeStatus::ok) return decodeError("cage_state_t", st, channel);
+        s->cage = m;
+        s->cage_new = true;
+        ++s->cage_in;
+      } else if (ends(kChannelHealth)) {
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelHealth.size()));
+        if (!s) return void(++ignored_channels);
+        hoist::health_t m;
+        const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
+        if (st != hoist::msg::DecodeStatus::ok) return decodeError("health_t", st, channel);
+        ++s->health_in;
+        s->last_health = Clock::now();
+        if (s->instance_id != 0 && m.instance_id != s->instance_id) daemonRestarted(*s, m);
+        s->instance_id = m.instance_id;
+        publish({s->t_health, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
+      } else if (ends(kChannelAlarm)) {
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelAlarm.size()));
+        if (!s) return void(++ignored_channels);
+        hoist::alarm_t m;
+        const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
+        if (st != hoist::msg::DecodeStatus::ok) return decodeError("alarm_t", st, channel);
+        onAlarm(*s, m);
+      }
+    } catch (const std::exception& e) {  // nothing may escape an LCM callback
+      ++decode_errors["exception"];
+      spdlog::error("error handling {}: {}", printable(channel), e.what());
+    }
+  }
+
+  void onAlarm(Shaft& s, const hoist::alarm_t& m) {
+    if (!validKind(m.kind) || m.level < 1 || m.level > 2) {
+      ++alarm_rejected;
+      std::uint64_t suppressed = 0;
+      if (lcm_log.allow(Clock::now(), suppressed))
+        spdlog::warn("ignored alarm on shaft '{}' with kind '{}' level {} (kind must be [A-Z0-9_]{{1,32}}, level 1 or 2)",
+                     s.name, printable(m.kind, 32), int(m.level));
+      return;
+    }
+    auto it = s.alarms.find(m.kind);
+    if (it == s.alarms.end()) {
+      if (static_cast<int>(s.alarms.size()) >= kMaxKindsPerShaft) return void(++alarm_rejected);
+      it = s.alarms.emplace(m.kind, AlarmState{}).first;
+    }
+    it->second.by_level[m.level] = m;
+    it->second.last = m;
+    ++s.alarms_in;
+    publishAlarmState(s, it->first, it->second);
+  }
+
+  /// A new daemon process: alarm states from before its start are void (the
+  /// new daemon announces what is active from its own start).
+  void daemonRestarted(Shaft& s, const hoist::health_t& h) {
+    const std::int64_t start = h.utime - static_cast<std::int64_t>(h.uptime * 1e6);
+    spdlog::info("shaft '{}': new daemon instance; alarm states from before its start are cleared", s.name);
+    for (auto& [kind, a] : s.alarms) {
+      bool changed = false;
+      for (auto& lv : a.by_level)
+        if (lv && lv->utime < start && (lv->active || lv->shelved)) {
+          lv->active = lv->acked = lv->shelved = lv->latched = false;
+          lv->event_type = hoist::alarm_t::EVENT_CLEAR;
+          lv->message = "cleared by hoist-mqtt: the daemon restarted";
+          changed = true;
+        }
+      if (changed) publishAlarmState(s, kind, a);
+    }
+  }
+
+  json alarmStateJson(const Shaft& s, const std::string& kind, const AlarmState& a) const {
+    int level = 0;
+    bool unacked = false, shelved = false;
+    for (int lv = 1; lv <= 2; ++lv) {
+      const auto& e = a.by_level[lv];
+      if (!e) continue;
+      if (e->active && !e->shelved) level = lv;
+      unacked = unacked || (e->active && !e->acked && !e->shelved);
+      shelved = shelved || e->shelved;
+    }
+    json j = json::object();
+    j["shaft"] = s.name;
+    j["kind"] = kind;
+    j["active"] = level > 0;
+    j["level"] = levelName(level);
+    j["unacked"] = unacked;
+    j["shelved"] = shelved;
+    j["utime"] = a.last.utime;
+    j["last_event"] = eventName(a.last.event_type);
+    j["warning"] = a.by_level[1] ? hoist::msg::toJson(*a.by_level[1]) : json(nullptr);
+    j["critical"] = a.by_level[2] ? hoist::msg::toJson(*a.by_level[2]) : json(nullptr);
+    return j;
+  }
+
+  void publishAlarmState(const Shaft& s, const std::string& kind, const AlarmState& a) {
+    publish({s.t_alarm + kind, alarmStateJson(s, kind, a).dump(), 1, true, MsgClass::Alarm});
+  }
+
+  // ---- MQTT side: publishing -----------------------------------------------------
+
+  /// Publishes now if connected and nothing is waiting, else buffers (bounded).
+  void publish(OutMsg m) {
+    if (conn == Conn::Connected && outbox.empty() && !mosquitto_want_write(mosq)) {
+      if (send(m)) return;
+    }
+    outbox.push(std::move(m));
+  }
+
+  /// true if handed to libmosquitto.
+  bool send(const OutMsg& m) {
+    const int rc = mosquitto_publish(mosq, nullptr, m.topic.c_str(), static_cast<int>(m.payload.size()),
+                                     m.payload.data(), m.qos, m.retain);
+    if (rc == MOSQ_ERR_SUCCESS) {
+      ++published;
+      return true;
+    }
+    ++publish_errors;
+    if (rc == MOSQ_ERR_NO_CONN || rc == MOSQ_ERR_CONN_LOST) lost(std::string("publish: ") + mosquitto_strerror(rc));
+    return false;
+  }
+
+  void flushOutbox() {
+    while (conn == Conn::Connected && !outbox.empty() && !mosquitto_want_write(mosq)) {
+      if (!send(outbox.front())) return;
+      outbox.pop();
+    }
+  }
+
+  void publishCages() {
+    for (auto& [p, s] : shafts) {
+      if (!s.cage_new) continue;
+      s.cage_new = false;
+      ++s.cage_out;
+      publish({s.t_cage, hoist::msg::toJson(s.cage).dump(), 0, false, MsgClass::Cage});
+    }
+  }
+
+  const char* connText() const {
+    return conn == Conn::Connected ? "connected" : conn == Conn::Connecting ? "connecting" : "disconnected";
+  }
+
+  json bridgeHealth() const {
+    const auto now = Clock::now();
+    json j = json::object();
+    j["utime"] = hoist::bus::wallUtime();
+    j["client_id"] = client_id;
+    j["uptime"] = seconds(now - started);
+    j["broker"] = brokerText();
+    j["connection"] = {{"state", connText()},
+                       {"connected_since_utime", conn == Conn::Connected ? connected_since_utime : 0},
+                       {"connects", connects},
+                       {"disconnects", disconnects},
+                       {"connect_failures", connect_failures},
+                       {"last_error", last_error}};
+    json dec = json::object();
+    std::uint64_t dec_total = 0;
+    for (const auto& [k, n] : decode_errors) {
+      dec[k] = n;
+      dec_total += n;
+    }
+    j["lcm"] = {{"url", hoist::bus::describeLcmUrl(lcm_url)},
+                {"messages", lcm_messages},
+                {"decode_errors", dec_total},
+                {"decode_errors_by_reason", dec},
+                {"alarm_rejected", alarm_rejected},
+                {"ignored_channels", ignored_channels}};
+    j["mqtt"] = {{"published", published}, {"publish_errors", publish_errors}};
+    j["buffer"] = {{"queued", outbox.size()},
+                   {"queued_alarms", outbox.queuedAlarms()},
+                   {"max_messages", cfg.max_messages},
+                   {"max_alarm_events", cfg.max_alarm_events},
+                   {"dropped_cage", outbox.droppedCage()},
+                   {"dropped_health", outbox.droppedHealth()},
+                   {"dropped_alarm", outbox.droppedAlarm()}};
+    json by_reason = json::object();
+    for (int i = 1; i < kCommandRejects; ++i) by_reason[toString(static_cast<CommandReject>(i))] = cmd_by_reason[i];
+    j["commands"] = {{"enabled", cfg.commands},
+                     {"received", cmd_received},
+                     {"forwarded", cmd_forwarded},
+                     {"rejected", cmd_rejected},
+                     {"rejected_by_reason", by_reason},
+                     {"lcm_publish_failures", cmd_lcm_failures}};
+    json sh = json::array();
+    for (const auto& [p, s] : shafts) {
+      int active = 0;
+      for (const auto& [k, a] : s.alarms)
+        for (const auto& lv : a.by_level) active += lv && lv->active ? 1 : 0;
+      sh.push_back({{"name", s.name},
+                    {"channel_prefix", s.prefix},
+                    {"health_age", s.health_in ? seconds(now - s.last_health) : -1.0},
+                    {"cage_in", s.cage_in},
+                    {"cage_out", s.cage_out},
+                    {"health_in", s.health_in},
+                    {"alarm_events_in", s.alarms_in},
+                    {"alarms_active", active},
+                    {"commands", s.commands}});
+    }
+    j["shafts"] = sh;
+    return j;
+  }
+
+  void publishBridgeHealth() { publish({bridge_health_topic, bridgeHealth().dump(), 0, false, MsgClass::Health}); }
+
+  // ---- MQTT side: connection -----------------------------------------------------
+
+  void tryConnect() {
+    if (!failing && connects == 0 && connect_failures == 0)
+      spdlog::info("connecting to the broker at {} as '{}'{}", brokerText(), client_id,
+                   cfg.wantsTls() ? " (TLS)" : "");
+    errno = 0;
+    const int rc = mosquitto_connect_async(mosq, broker.host.c_str(), broker.port, cfg.keepalive);
+    if (rc == MOSQ_ERR_SUCCESS) {
+      conn = Conn::Connecting;
+      connecting_since = Clock::now();
+      return;
+    }
+    failed(rc == MOSQ_ERR_ERRNO ? std::string(std::strerror(errno)) : std::string(mosquitto_strerror(rc)));
+  }
+
+  /// A connection attempt failed: retry later, log only the first of a series.
+  void failed(const std::string& why) {
+    ++connect_failures;
+    last_error = why;
+    conn = Conn::Disconnected;
+    if (!failing)
+      spdlog::warn("cannot connect to the broker at {}: {}; retrying with backoff up to {} s "
+                   "(logged again when the connection state changes)",
+                   brokerText(), why, cfg.reconnect_max);
+    failing = true;
+    next_attempt = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delay));
+    delay = std::min(delay * 2.0, cfg.reconnect_max);
+  }
+
+  /// An established connection was lost.
+  void lost(const std::string& why) {
+    if (conn != Conn::Connected) return;
+    ++disconnects;
+    last_error = why;
+    conn = Conn::Disconnected;
+    for (auto& [p, s] : shafts) s.subscribed = false;
+    spdlog::warn("connection to the broker at {} lost: {}; reconnecting with backoff up to {} s, buffering at most "
+                 "{} messages and {} alarm transitions",
+                 brokerText(), why, cfg.reconnect_max, cfg.max_messages, cfg.max_alarm_events);
+    failing = true;  // further failed attempts are the same state
+    delay = cfg.reconnect_min;
+    next_attempt = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delay));
+    delay = std::min(delay * 2.0, cfg.reconnect_max);
+  }
+
+  void subscribeCommands(Shaft& s) {
+    if (!cfg.commands || s.subscribed) return;
+    const int rc = mosquitto_subscribe(mosq, nullptr, s.t_cmd.c_str(), 1);
+    if (rc == MOSQ_ERR_SUCCESS) s.subscribed = true;
+    else spdlog::warn("cannot subscribe to {}: {}", s.t_cmd, mosquitto_strerror(rc));
+  }
+
+  void onConnected() {
+    conn = Conn::Connected;
+    ++connects;
+    failing = false;
+    last_error.clear();
+    delay = cfg.reconnect_min;
+    connected_since_steady = Clock::now();
+    connected_since_utime = hoist::bus::wallUtime();
+    spdlog::info("connected to the broker at {} as '{}'{}", brokerText(), client_id,
+                 outbox.empty() ? std::string() : fmt::format("; sending {} buffered messages", outbox.size()));
+    const std::string online =
+        json{{"online", true}, {"client_id", client_id}, {"since_utime", connected_since_utime}}.dump();
+    send({status_topic, online, 1, true, MsgClass::Alarm});
+    for (auto& [p, s] : shafts) subscribeCommands(s);
+    flushOutbox();
+    // The broker may have restarted without its retained messages: republish
+    // every alarm's current state (after the buffered transitions, so the
+    // retained message ends up being the current state).
+    for (const auto& [p, s] : shafts)
+      for (const auto& [kind, a] : s.alarms) publishAlarmState(s, kind, a);
+    publishBridgeHealth();
+  }
+
+  void serviceCallbacks() {
+    if (cb_connack) {
+      cb_connack = false;
+      if (cb_connack_rc == 0) onConnected();
+      else failed(std::string("refused by the broker: ") + mosquitto_connack_string(cb_connack_rc));
+    }
+    if (cb_disconnected) {
+      cb_disconnected = false;
+      if (conn == Conn::Connected)
+        lost(cb_disconnect_rc == 0 ? "disconnected" : std::string(mosquitto_strerror(cb_disconnect_rc)));
+      else if (conn == Conn::Connecting)
+        failed(cb_disconnect_rc == 0 ? "disconnected" : std::string(mosquitto_strerror(cb_disconnect_rc)));
+    }
+  }
+
+  // ---- MQTT side: commands -------------------------------------------------------
+
+  void onMqttMessage(const struct mosquitto_message* m) {
+    try {
+      if (!m || !m->topic) return;
+      auto it = cmd_topics.find(m->topic);
+      if (it == cmd_topics.end() || !cfg.commands) return;
+      Shaft& s = shafts.at(it->second);
+      ++cmd_received;
+      const auto now = Clock::now();
+      std::uint64_t suppressed = 0;
+      const bool may_log = cmd_log.allow(now, suppressed);
+      if (may_log && suppressed) spdlog::warn("{} command log lines suppressed", suppressed);
+      CommandResult r = parseAckCommand(m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
+                                        static_cast<std::size_t>(cfg.max_command_bytes), hoist::bus::wallUtime());
+      if (r.reject != CommandReject::None) {
+        ++cmd_rejected;
+        ++cmd_by_reason[static_cast<int>(r.reject)];
+        if (may_log)
+          spdlog::warn("rejected command on {} ({} bytes): {}: {}", s.t_cmd, m->payloadlen, toString(r.reject),
+                       r.detail);
+        return;
+      }
+      const std::string channel = hoist::bus::channel(s.prefix, kChannelAlarmAck);
+      if (lcm.publish(channel, &r.ack) != 0) {
+        ++cmd_lcm_failures;
+        if (may_log) spdlog::error("command on {}: LCM publish on {} failed", s.t_cmd, channel);
+        return;
+      }
+      ++cmd_forwarded;
+      ++s.commands;
+      if (may_log)
+        spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", s.t_cmd, printable(r.ack.user),
+                     int(r.ack.action), r.ack.kind.empty() ? "*" : printable(r.ack.kind, 32), int(r.ack.level),
+                     r.ack.action == hoist::alarm_ack_t::ACTION_SHELVE ? fmt::format(" for {} s", r.ack.shelve_duration)
+                                                                       : std::string(),
+                     channel);
+    } catch (const std::exception& e) {
+      spdlog::error("error handling an MQTT message: {}", e.what());
+    }
+  }
+
+  // ---- the loop ------------------------------------------------------------------
+
+  int run(const volatile std::sig_atomic_t& stop) {
+    const auto cage_period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / cfg.cage_rate));
+    const auto health_period =
+        std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(cfg.health_period));
+    auto next_cage = Clock::now() + cage_period;
+    auto next_health = Clock::now() + health_period;
+    next_attempt = Clock::now();
+    spdlog::info("hoist-mqtt: LCM {}; broker {}; cage states at {} Hz; commands {}; shafts: {}",
+                 hoist::bus::describeLcmUrl(lcm_url), brokerText(), cfg.cage_rate,
+                 cfg.commands ? "accepted on hoist/<shaft>/cmd/ack" : "disabled (--no-commands)",
+                 discover ? "discovered from their *HOIST_{HEALTH,CAGE,ALARM} channels" : std::to_string(shafts.size()) + " configured");
+    const int lcm_fd = lcm.getFileno();
+    while (!stop) {
+      auto now = Clock::now();
+      if (conn == Conn::Disconnected && now >= next_attempt) tryConnect();
+      if (conn == Conn::Connecting && now - connecting_since > std::chrono::duration<double>(cfg.connect_timeout))
+        failed("no answer (CONNACK) within " + fmt::format("{}", cfg.connect_timeout) + " s");
+
+      pollfd fds[2];
+      int nfds = 0;
+      fds[nfds++] = {lcm_fd, POLLIN, 0};
+      const int sock = conn != Conn::Disconnected ? mosquitto_socket(mosq) : -1;
+      if (sock >= 0) fds[nfds++] = {sock, static_cast<short>(POLLIN | (mosquitto_want_write(mosq) ? POLLOUT : 0)), 0};
+      auto wake = std::min({next_cage, next_health, now + std::chrono::milliseconds(100)});
+      if (conn == Conn::Disconnected) wake = std::min(wake, next_attempt);
+      const int timeout_ms = static_cast<int>(
+          std::clamp<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(wake - now).count(), 0, 100));
+      const int n = ::poll(fds, nfds, timeout_ms);
+      if (n < 0 && errno != EINTR) spdlog::error("poll: {}", std::strerror(errno));
+
+      if (n > 0 && (fds[0].revents & POLLIN)) {
+        // Drain what is there, bounded so the broker side is never starved.
+        for (int i = 0; i < 256 && lcm.handleTimeout(0) > 0; ++i) {
+        }
+      }
+      if (conn != Conn::Disconnected) {
+        const int rc = mosquitto_loop(mosq, 0, 1);
+        serviceCallbacks();
+        if (rc != MOSQ_ERR_SUCCESS) {
+          const std::string why = rc == MOSQ_ERR_ERRNO ? std::string(std::strerror(errno)) : mosquitto_strerror(rc);
+          if (conn == Conn::Connected) lost(why);
+          else if (conn == Conn::Connecting) failed(why);
+        }
+      }
+      flushOutbox();
+
+      now = Clock::now();
+      if (now >= next_cage) {
+        publishCages();
+        next_cage += cage_period;
+        if (next_cage < now) next_cage = now + cage_period;
+      }
+      if (now >= next_health) {
+        publishBridgeHealth();
+        next_health += health_period;
+        if (next_health < now) next_health = now + health_period;
+      }
+    }
+
+    spdlog::info("hoist-mqtt: stopping");
+    if (conn == Conn::Connected) {
+      const std::string offline = json{{"online", false}, {"client_id", client_id}, {"reason", "shutdown"}}.dump();
+      mosquitto_publish(mosq, nullptr, status_topic.c_str(), static_cast<int>(offline.size()), offline.data(), 1, true);
+      // Give the last messages a moment to leave, then disconnect cleanly (no LWT).
+      const auto end = Clock::now() + std::chrono::milliseconds(500);
+      while (Clock::now() < end && mosquitto_want_write(mosq) && mosquitto_loop(mosq, 10, 1) == MOSQ_ERR_SUCCESS) {
+      }
+      mosquitto_disconnect(mosq);
+      mosquitto_loop(mosq, 10, 1);
+    }
+    return 0;
+  }
+};
+
+Bridge::Bridge(const BridgeConfig& cfg, const std::string& password) : impl_(std::make_unique<Impl>(cfg, password)) {}
+Bridge::~Bridge() = default;
+int Bridge::run(const volatile std::sig_atomic_t& stop) { return impl_->run(stop); }
+
+}  // namespace hoist::mqtt
