@@ -25,6 +25,7 @@
 //                       step_p50_us,...,degraded, then rejected_<reason> per reason
 // Exit status: 0 on success, 1 if the log cannot be read or a file cannot be
 // written, 2 for a bad command line.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstdio>
@@ -256,6 +257,8 @@ int main(int argc, char** argv) {
       "one file per channel (DIR/<CHANNEL>.csv).  Types are recognized by fingerprint;\n"
       "for HOIST_CAGE the first columns are t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4\n"
       "(as hoist-sim writes them)."};
+  app.name("hoist-log2csv");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-log2csv ") + hoist::kVersionString);
   std::string log_path, out_dir;
   app.add_option("LOGFILE", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
   app.add_option("--out-dir", out_dir, "output directory (created if missing)")->required();

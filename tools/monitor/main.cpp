@@ -8,6 +8,7 @@
 // (theta), the largest guide-sleeve force max|lambda_1..4|, the minimum
 // remaining clearance and the active alarms.  Alarm events are printed as
 // they arrive.  Stops on SIGINT/SIGTERM or after --duration.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <poll.h>
 #include <unistd.h>
@@ -94,6 +95,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hoist-monitor: print the digital twin's cage state once a second (time, depth, speed,\n"
       "sway, tilt, largest sleeve force, minimum clearance, active alarms) and every alarm event."};
+  app.name("hoist-monitor");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-monitor ") + hoist::kVersionString);
   std::string url, prefix;
   double period = 1.0, duration = 0.0;
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");

@@ -27,6 +27,7 @@
 // machine): feeds it at --rate for --duration, listens to its HOIST_HEALTH and
 // HOIST_CAGE, and judges deadline misses, tick lateness, step time, end-to-end
 // latency and rejected inputs against budgets (timing_test.hpp).
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <time.h>
 #include <unistd.h>
@@ -163,6 +164,8 @@ int main(int argc, char** argv) {
       "a synthetic hoist profile, a profile CSV or an LCM log, in real time or at --speed X.\n"
       "With no source it plays the paper's trapezoid (Fig. 2: 50 m -> 300 m, 60 s).\n"
       "--timing-test checks a running hoist-twind's real-time behaviour against budgets (see the end)."};
+  app.name("hoist-replay");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-replay ") + hoist::kVersionString);
   app.footer(kTimingHelp);
   std::string profile_arg, log_path, url, config_path;
   std::vector<std::string> prefixes;

@@ -3,13 +3,14 @@
 // hoist_study library: options, files, gnuplot, progress.
 //
 //   hoist-study NAME [--out-dir DIR] [--config FILE] [--profile FILE|SPEC]
-//                    [--modes N] [--dt S] [--max-step S] [--initial rest|static|config]
+//                    [--modes N] [--dt S] [--max-step S] [--initial static|rest|config]
 //                    [--jobs N] [--no-plots]
 //   NAME: response | preload | tension-difference | eccentric-load | mass | all
 //         | sweep --param KEY --values V1,V2,... | advise --clearance M ...
 //
 // Exit status: 0 success, 1 a run failed or a file could not be written,
 // 2 usage or configuration error, 3 (advise) target infeasible in the range.
+#include "hoist/version.hpp"
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -55,7 +56,7 @@ struct Common {
   int modes = 0;
   double dt = 0.01;
   double max_step = 0.0025;
-  std::string initial;  // "" -> rest for the studies, config for advise
+  std::string initial = "config";  // as hoist-sim: model.initial unless given
   int jobs = 0;
   bool no_plots = false;
 };
@@ -80,11 +81,11 @@ CLI::Validator numberAbove(double lo, bool inclusive) {
       inclusive ? "NUMBER >= 0" : "NUMBER > 0");
 }
 
-void addCommon(CLI::App* sub, Common& c, bool advisor) {
+void addCommon(CLI::App* sub, Common& c, [[maybe_unused]] bool advisor) {
   sub->add_option("--out-dir", c.out_dir, "Directory for CSVs, scripts and PNGs (created)")
       ->capture_default_str();
   sub->add_option("--config", c.config,
-                  "Shaft configuration (TOML, INTERFACES.md); default: the paper's values");
+                  "Shaft configuration (TOML, as hoist-sim --config); default: the paper's values");
   sub->add_option("--profile", c.profile,
                   "Hoist profile CSV (t,v,a[,l]) or SPEC; default: the paper's Fig. 2 trapezoid");
   sub->add_option("--modes", c.modes, "Assumed modes per rope (overrides model.modes)")
@@ -93,10 +94,10 @@ void addCommon(CLI::App* sub, Common& c, bool advisor) {
   sub->add_option("--max-step", c.max_step, "Largest integration step [s] (0: --dt)")
       ->capture_default_str()
       ->check(numberAbove(0, true));
+  // --initial: the same values, meaning and default as in hoist-sim.
   sub->add_option("--initial", c.initial,
-                  std::string("Initial state: rest (q = 0, the eccentric load as a step: the free vibration "
-                              "of the paper's figures), static (equilibrium), config (model.initial); default: ") +
-                      (advisor ? "config" : "rest"))
+                  "initial state: static (equilibrium at t = 0), rest (q = 0: the eccentric load acts as a step, as in the "
+                  "paper's figures) or config (the config's model.initial, static unless set); default: config")
       ->check(CLI::IsMember({"rest", "static", "config"}));
   sub->add_option("--jobs,-j", c.jobs, "Parallel runs (default: hardware concurrency)")
       ->check(numberAbove(0, true));
@@ -509,6 +510,8 @@ int main(int argc, char** argv) {
       "frequencies of y_c/theta/lambda_1 in the uniform-velocity and deceleration/rest stages) and\n"
       "PNG figures rendered by gnuplot (with the .gp script next to each PNG).\n"
       "Exit status: 0 ok, 1 run or file failure, 2 usage/config error, 3 advise: infeasible."};
+  app.name("hoist-study");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-study ") + hoist::kVersionString);
   app.require_subcommand(1, 1);
   app.fallthrough(false);
   Common c;
@@ -553,7 +556,6 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
 
-  if (c.initial.empty()) c.initial = advise->parsed() ? "config" : "rest";
   PlotState ps;
   ps.enabled = !c.no_plots;
   ps.gnuplot = ps.enabled ? out::findGnuplot() : "";
