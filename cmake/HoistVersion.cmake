@@ -7,6 +7,9 @@ set(_hv_args -DSRC=${PROJECT_SOURCE_DIR} -DIN=${PROJECT_SOURCE_DIR}/cmake/versio
              -DOUT=${_hv_out} -DHOIST_VERSION=${PROJECT_VERSION})
 file(MAKE_DIRECTORY ${CMAKE_BINARY_DIR}/generated/hoist)
 execute_process(COMMAND ${CMAKE_COMMAND} ${_hv_args} -P ${PROJECT_SOURCE_DIR}/cmake/write_version.cmake)
+# The same string for configure-time files (scripts such as hoist-lcm-spy):
+file(STRINGS ${_hv_out} _hv_line REGEX "kVersionString")
+string(REGEX REPLACE ".*kVersionString\\[\\] = \"([^\"]*)\".*" "\\1" HOIST_VERSION_STRING "${_hv_line}")
 add_custom_target(hoist_version_header
   COMMAND ${CMAKE_COMMAND} ${_hv_args} -P ${PROJECT_SOURCE_DIR}/cmake/write_version.cmake
   BYPRODUCTS ${_hv_out}

@@ -32,7 +32,7 @@ def run(args, env=None):
 
 
 programs = ["hoist-sim", "hoist-study", "hoist-twind", "hoist-replay", "hoist-log2csv", "hoist-monitor",
-            "hoist-alarm-ack", "hoist-wakeup-latency", "hoist-bench"]
+            "hoist-alarm-ack", "hoist-wakeup-latency", "hoist-bench", "hoist-lcm-spy"]
 for p in programs:
     exe = os.path.join(bin_dir, p)
     if not os.path.exists(exe):
