@@ -13,7 +13,7 @@
 #include <thread>
 #include <unistd.h>
 
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
 #include "hoist/version.hpp"
 
 namespace hoist::svc {
@@ -60,7 +60,7 @@ bool Daemon::start() {
   if (!lcm_.good()) {
     out_->error("cannot open LCM at {}; for multicast on one machine see docs/service.md "
                 "(ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo)",
-                describeLcmUrl(opt_.lcm_url));
+                bus::describeLcmUrl(opt_.lcm_url));
     return false;
   }
   rt_ = applyRealtime(opt_.realtime);
@@ -98,7 +98,7 @@ bool Daemon::start() {
     out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}, input {}, outputs {} {} {} {}, "
                "n={} modes, L={} m, h={} m, l0={} m",
                s.tag(), n == 1 ? "started" : "shaft",
-               toString(c.service.clock), c.service.rate, describeLcmUrl(opt_.lcm_url), s.channels().winder,
+               toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url), s.channels().winder,
                s.channels().cage, s.channels().shape, s.channels().alarm, s.channels().health, c.shaft.n,
                c.shaft.L, c.shaft.h, c.shaft.l0);
   }
@@ -111,7 +111,7 @@ int Daemon::run() {
   if (!start()) return 1;
   // Tell systemd (Type=notify) that the twin is up; a no-op without NOTIFY_SOCKET.
   sd_notifyf(0, "READY=1\nSTATUS=hoist-twind %s: %zu shaft(s), LCM %s", hoist::kVersionString, shafts_.size(),
-             describeLcmUrl(opt_.lcm_url).c_str());
+             bus::describeLcmUrl(opt_.lcm_url).c_str());
   io_.run();
   return finish() ? 0 : 1;
 }

@@ -26,7 +26,8 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/service/config_file.hpp"
+#include "hoist/bus/lcm_util.hpp"
 
 namespace {
 /// True when stderr is the systemd journal's stream: systemd sets
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  opt.lcm_url = resolveLcmUrl(lcm_url, shaft_url);
+  opt.lcm_url = hoist::bus::resolveLcmUrl(lcm_url, shaft_url);
   opt.duration = duration;
   opt.hooks.inject_fault_at = inject_fault_at;
   opt.hooks.fail_publish_every = fail_publish_every;
