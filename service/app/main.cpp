@@ -8,8 +8,8 @@
 // Subscribes to HOIST_WINDER (winder_t) and HOIST_ALARM_ACK (alarm_ack_t);
 // publishes HOIST_CAGE, HOIST_GUIDE_SHAPE, HOIST_ALARM and HOIST_HEALTH (see
 // msgs/*.lcm and docs/service.md).  Exit status: 0 after a clean stop
-// (SIGINT/SIGTERM/--duration), 1 if LCM cannot be opened, 2 for a bad
-// command line or configuration.
+// (SIGINT/SIGTERM/--duration), 1 if a well-formed LCM URL cannot be opened,
+// 2 for a bad command line, configuration or LCM URL.
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <csignal>
@@ -170,6 +170,15 @@ int main(int argc, char** argv) {
     return 0;
   }
   opt.lcm_url = hoist::bus::resolveLcmUrl(lcm_url, shaft_url);
+  if (const std::string bad = hoist::bus::lcmUrlError(opt.lcm_url); !bad.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    const std::string from = !lcm_url.empty()          ? "--lcm-url: "
+                             : (env && *env)           ? "LCM_DEFAULT_URL: "
+                             : config_paths[0].empty() ? ""
+                                                       : config_paths[0] + ": service.lcm_url: ";
+    std::cerr << "hoist-twind: configuration error: " << from << bad << "\n";
+    return 2;
+  }
   opt.duration = duration;
   opt.hooks.inject_fault_at = inject_fault_at;
   opt.hooks.fail_publish_every = fail_publish_every;

@@ -70,6 +70,21 @@ if os.path.exists(sim) and os.path.exists(study):
     rc, out = run([sim, "--initial", "bogus", "--profile", "rest:t_end=1", "--out", os.devnull])
     check(rc == 2, "hoist-sim --initial bogus exits 2")
 
+# A malformed LCM URL is bad input (exit 2) in every LCM program; a
+# well-formed one that cannot be opened stays exit 1 (environment).
+bad_urls = ["bogus://x", "udpm://10.0.0.1:7667", "udpm://239.255.76.67:99999", "udpm://239.255.76.67:7667?tll=0",
+            "239.255.76.67:7667"]
+for p, extra in (("hoist-twind", ["--duration", "1"]), ("hoist-replay", ["--profile", "rest:t_end=1"]),
+                 ("hoist-monitor", []), ("hoist-alarm-ack", []), ("hoist-lcm-spy", [])):
+    exe = os.path.join(bin_dir, p)
+    if not os.path.exists(exe):
+        continue
+    for u in bad_urls:
+        rc, out = run([exe, "--lcm-url", u] + extra)
+        check(rc == 2 and "URL" in out, f"{p} --lcm-url {u} exits 2 naming the URL (exit {rc})", out[-600:])
+    rc, out = run([exe] + extra, env={"LCM_DEFAULT_URL": "bogus://y"})
+    check(rc == 2, f"{p} with LCM_DEFAULT_URL=bogus://y exits 2 (exit {rc})", out[-600:])
+
 twind = os.path.join(bin_dir, "hoist-twind")
 if os.path.exists(twind):
     for cfg in ("example.toml", "demo.toml"):

@@ -6,7 +6,8 @@
 //
 // Default: acknowledge every active alarm ("*", both levels).  The daemon
 // answers on HOIST_ALARM with an ACK / SHELVE / UNSHELVE event (watch it with
-// hoist-monitor).  Exit status: 0 sent, 1 LCM failure, 2 bad usage.
+// hoist-monitor).  Exit status: 0 sent, 1 LCM failure, 2 bad usage (options, LCM URL,
+// a shelve longer than the daemon's limit).
 #include "hoist/version.hpp"
 #include <chrono>
 #include <cmath>
@@ -78,6 +79,10 @@ int main(int argc, char** argv) {
   m.shelve_duration = shelve;
   m.user = user;
   url = hoist::bus::resolveLcmUrl(url);
+  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
+    std::cerr << "hoist-alarm-ack: " << bad << "\n";
+    return 2;
+  }
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::cerr << "hoist-alarm-ack: cannot open LCM (" << (url.empty() ? "default URL" : url)

@@ -112,6 +112,10 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   url = hoist::bus::resolveLcmUrl(url);
+  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
+    std::fprintf(stderr, "hoist-monitor: %s\n", bad.c_str());
+    return 2;
+  }
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::fprintf(stderr, "hoist-monitor: cannot open LCM at %s\n", hoist::bus::describeLcmUrl(url).c_str());

@@ -229,6 +229,10 @@ int main(int argc, char** argv) {
   }
 
   url = hoist::bus::resolveLcmUrl(url);
+  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
+    std::cerr << "hoist-replay: " << bad << "\n";
+    return 2;
+  }
   if (timing) {
     hoist::replay::TimingTestOptions o;
     if (!(rate >= 1.0 && rate <= 1000.0)) {
