@@ -43,7 +43,7 @@ endif()
 # ---- LCM types: definitions and generated C++ headers -------------------------------
 file(GLOB _hoist_lcm_files ${PROJECT_SOURCE_DIR}/msgs/*.lcm)
 install(FILES ${_hoist_lcm_files} DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/hoist-twin/lcm COMPONENT dev)
-install(DIRECTORY ${CMAKE_BINARY_DIR}/msgs/include/hoist/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/hoist
+install(DIRECTORY ${CMAKE_BINARY_DIR}/msgs/generated/hoist/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/hoist
         COMPONENT dev FILES_MATCHING PATTERN "*.hpp")
 
 # ---- configuration, unit, docs ----------------------------------------------------
