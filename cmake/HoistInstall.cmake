@@ -131,12 +131,15 @@ set(CPACK_PACKAGE_VENDOR "hoist-twin project")
 set(CPACK_PACKAGE_CONTACT "hoist-twin maintainers <hoist-twin@localhost>")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "real-time digital twin of a cable-guided mine-shaft hoist (advisory)")
-set(CPACK_PACKAGE_DESCRIPTION
+string(CONCAT CPACK_PACKAGE_DESCRIPTION
     "hoist-twind follows the winder's speed over LCM with the Wang et al. (2016) vibration model\n"
     "and publishes the cage's sway, tilt, guide-sleeve forces and clearance alarms.  One systemd\n"
     "instance per shaft (hoist-twind@<shaft>.service).  Advisory only: never the shaft's protection.")
 set(CPACK_GENERATOR "DEB")
-set(CPACK_SET_DESTDIR ON)  # install() runs with the real prefix (/usr) under a staging DESTDIR
+# install() runs with the package's prefix (/usr, whatever CMAKE_INSTALL_PREFIX
+# is) under a staging DESTDIR, so the unit written at install time names /usr/bin.
+set(CPACK_SET_DESTDIR ON)
+set(CPACK_INSTALL_PREFIX "/usr")
 set(CPACK_PACKAGING_INSTALL_PREFIX "/usr")
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION "science")
