@@ -6,6 +6,10 @@
 // Steps are timed while the solver runs the paper's trapezoid (Fig. 2) at
 // dt = 0.01 s, so every step sees a new l, v, a; the solver is re-initialized
 // (untimed) when the trip ends.
+#include <cstdio>
+#include <string>
+
+#include "hoist/version.hpp"
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -159,4 +163,16 @@ BENCHMARK(BM_ModelSetup)->Arg(50)->Arg(200)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// BENCHMARK_MAIN() plus --version (from the one version header).
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--version") {
+      std::printf("hoist-bench %s\n", hoist::kVersionString);
+      return 0;
+    }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

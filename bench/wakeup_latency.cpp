@@ -22,6 +22,10 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "hoist/version.hpp"
+
 int main(int argc, char** argv) {
   double rate = 1000.0, seconds = 60.0;
   int prio = 0;
@@ -41,8 +45,12 @@ int main(int argc, char** argv) {
     else if (a == "--rt-priority") prio = std::atoi(next());
     else if (a == "--cpus") cpus = next();
     else if (a == "--mlockall") mlock = true;
+    else if (a == "--version") {
+      std::printf("hoist-wakeup-latency %s\n", hoist::kVersionString);
+      return 0;
+    }
     else if (a == "-h" || a == "--help") {
-      std::puts("hoist-wakeup-latency [--rate HZ] [--seconds S] [--rt-priority N] [--cpus CPU] [--mlockall]\n"
+      std::puts("hoist-wakeup-latency [--rate HZ] [--seconds S] [--rt-priority N] [--cpus CPU] [--mlockall] [--version]\n"
                 "The machine's timer wake-up latency on an absolute schedule (cyclictest-like); JSON on stdout.");
       return 0;
     } else {
@@ -96,11 +104,17 @@ int main(int argc, char** argv) {
   std::vector<double> s = late;
   std::sort(s.begin(), s.end());
   auto q = [&](double p) { return s[std::min(s.size() - 1, static_cast<std::size_t>(std::ceil(p * static_cast<double>(s.size()))) - (p > 0 ? 1 : 0))]; };
-  std::printf("{\"rate_hz\": %g, \"seconds\": %g, \"ticks\": %zu, \"deadline_misses\": %lld, "
-              "\"late_us\": {\"p50\": %.1f, \"p99\": %.1f, \"p999\": %.1f, \"max\": %.1f}, "
-              "\"over_period\": %ld, \"memory_lock\": \"%s\", \"scheduling\": \"%s\", \"affinity\": \"%s\"}\n",
-              rate, seconds, s.size(), misses, q(0.5), q(0.99), q(0.999), s.back(),
-              static_cast<long>(std::count_if(s.begin(), s.end(), [&](double x) { return x > period_ns / 1000.0; })),
-              mlock_s.c_str(), sched_s.c_str(), aff_s.c_str());
+  nlohmann::ordered_json j;
+  j["rate_hz"] = rate;
+  j["seconds"] = seconds;
+  j["ticks"] = s.size();
+  j["deadline_misses"] = misses;
+  const auto r1 = [](double x) { return std::round(x * 10.0) / 10.0; };
+  j["late_us"] = {{"p50", r1(q(0.5))}, {"p99", r1(q(0.99))}, {"p999", r1(q(0.999))}, {"max", r1(s.back())}};
+  j["over_period"] = std::count_if(s.begin(), s.end(), [&](double x) { return x > period_ns / 1000.0; });
+  j["memory_lock"] = mlock_s;
+  j["scheduling"] = sched_s;
+  j["affinity"] = aff_s;
+  std::printf("%s\n", j.dump().c_str());
   return 0;
 }

@@ -30,14 +30,16 @@ say() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
 # ---- 1. Debian packages -----------------------------------------------------
 required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev liblcm-bin
           libglib2.0-dev libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libtomlplusplus-dev
-          libcli11-dev nlohmann-json3-dev gnuplot-nox python3 iproute2)
+          libcli11-dev gnuplot-nox python3 iproute2 libsystemd-dev nlohmann-json3-dev)
 # hoist-dash's page (uPlot from npm) and its browser tests (headless Chromium
 # driven by puppeteer-core, the @foxglove/ws-protocol client): Node, npm, Chromium.
 dashboard=(nodejs npm chromium fonts-dejavu-core)
 # MQTT bridge (hoist-mqtt): the client library, and the broker, clients and openssl (TLS test) its tests and demo use.
 required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
-# Java bindings let lcm-spy decode the hoist channels; clang gives the fuzzers.
-optional=(liblcm-java default-jdk-headless clang libclang-rt-14-dev)
+# Java bindings let lcm-spy decode the hoist channels (jchart2d draws its
+# plots; xvfb lets the test open its window headless); clang gives the
+# fuzzers; dpkg-dev gives dpkg-shlibdeps for the .deb (cpack -G DEB).
+optional=(liblcm-java default-jdk-headless libjchart2d-java xvfb clang libclang-rt-14-dev dpkg-dev)
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 missing=()
 for p in "${required[@]}"; do installed "$p" || missing+=("$p"); done

@@ -4,8 +4,8 @@
 #
 #   scripts/test.sh [--no-setup] [-L LABEL] [-R REGEX] [-E REGEX] [--sanitize address|thread]
 #
-# Labels: model, io, sim, service, tools, study, integration, lcm, realtime, hardening,
-# soak (the 2-minute soak; leave it out with -E soak).
+# Labels: model, io, sim, service, tools, study, layers, integration, lcm, realtime,
+# hardening, deploy, install, soak (the 2-minute soak; leave it out with -E soak).
 # --sanitize builds into build-asan / build-tsan (HOIST_SANITIZE) and tests there.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

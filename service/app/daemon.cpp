@@ -8,10 +8,13 @@
 #include <ctime>
 #include <fstream>
 #include <map>
-#include <sstream>
+#include <nlohmann/json.hpp>
+#include <systemd/sd-daemon.h>
+#include <thread>
 #include <unistd.h>
 
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/version.hpp"
 
 namespace hoist::svc {
 
@@ -47,6 +50,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
 }
 
 Daemon::~Daemon() {
+  stopWatchdog();
   // The descriptor belongs to LCM: never let Asio close it.
   if (lcm_fd_.is_open()) lcm_fd_.release();
   log_.stop();
@@ -65,6 +69,9 @@ bool Daemon::start() {
   for (auto& s : shafts_) s->subscribe();
   lcm_fd_.assign(lcm_.getFileno());
   armLcm();
+  // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
+  // never receives them.
+  startWatchdog();
   // The stop signals are handled on this (the loop) thread; hoist-twind's
   // main() blocks them before any helper thread exists (see main.cpp).
   sigset_t stop_signals;
@@ -102,11 +109,16 @@ bool Daemon::start() {
 
 int Daemon::run() {
   if (!start()) return 1;
+  // Tell systemd (Type=notify) that the twin is up; a no-op without NOTIFY_SOCKET.
+  sd_notifyf(0, "READY=1\nSTATUS=hoist-twind %s: %zu shaft(s), LCM %s", hoist::kVersionString, shafts_.size(),
+             bus::describeLcmUrl(opt_.lcm_url).c_str());
   io_.run();
   return finish() ? 0 : 1;
 }
 
 bool Daemon::finish() {
+  sd_notify(0, "STOPPING=1");
+  stopWatchdog();
   log_.flush();
   const bool ok = writeReport();
   out_->info("hoist-twind stopped");
@@ -143,7 +155,12 @@ void Daemon::armTimer(RateGroup& g) {
 
 void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   if (ec || stopping_) return;
+  progress_.fetch_add(1, std::memory_order_relaxed);  // the watchdog's proof of life
   const auto now = Clock::now();
+  if (opt_.test_stall_at >= 0.0 && now - start_ >= duration<double>(opt_.test_stall_at)) [[unlikely]] {
+    log_.warn("--test-stall-at: the loop thread hangs now (test only)");
+    for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+  }
   // Index of the latest deadline that has passed; if it is beyond g.k the
   // ticks in between are lost (deadline misses) and the schedule skips them.
   std::int64_t k = g.k;
@@ -184,78 +201,114 @@ void Daemon::stop(const char* why) {
   io_.stop();
 }
 
+// ---- systemd watchdog --------------------------------------------------------------
+
+void Daemon::startWatchdog() {
+  // WATCHDOG_USEC (set by systemd from WatchdogSec=) enables it; ping at half
+  // the timeout, as sd_watchdog_enabled(3) recommends.
+  std::uint64_t usec = 0;
+  if (sd_watchdog_enabled(0, &usec) <= 0 || usec == 0) return;
+  const auto interval = std::chrono::microseconds(std::max<std::uint64_t>(usec / 2, 1000));
+  out_->info("systemd watchdog: {} ms timeout; pinging every {} ms while the loop makes progress", usec / 1000,
+             interval.count() / 1000);
+  wd_quit_ = false;
+  watchdog_ = std::thread([this, interval] { watchdogMain(interval); });
+}
+
+void Daemon::stopWatchdog() {
+  if (!watchdog_.joinable()) return;
+  {
+    std::lock_guard lk(wd_mu_);
+    wd_quit_ = true;
+  }
+  wd_cv_.notify_all();
+  watchdog_.join();
+}
+
+void Daemon::watchdogMain(std::chrono::microseconds interval) {
+  std::uint64_t last = progress_.load(std::memory_order_relaxed);
+  bool stalled = false;
+  std::unique_lock lk(wd_mu_);
+  while (!wd_cv_.wait_for(lk, interval, [this] { return wd_quit_; })) {
+    const std::uint64_t now = progress_.load(std::memory_order_relaxed);
+    if (now != last) {
+      sd_notify(0, "WATCHDOG=1");
+      if (stalled) out_->warn("systemd watchdog: the loop makes progress again; pings resumed");
+      stalled = false;
+      last = now;
+    } else if (!stalled) {
+      stalled = true;
+      out_->error("systemd watchdog: no tick for {} ms; withholding the ping (systemd restarts the service "
+                  "if this lasts WatchdogSec)",
+                  interval.count() / 1000);
+    }
+  }
+}
+
 // ---- the run report ------------------------------------------------------------
 
 namespace {
-std::string jsonString(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (static_cast<unsigned char>(c) < 32) {
-      char b[8];
-      std::snprintf(b, sizeof b, "\\u%04x", c);
-      o += b;
-    } else {
-      o += c;
-    }
-  }
-  return o + "\"";
-}
-
-void histogramJson(std::ostream& os, const LatencyHistogram& h) {
-  os << "{\"count\": " << h.count() << ", \"p50\": " << h.quantile(0.5) << ", \"p99\": " << h.quantile(0.99)
-     << ", \"p999\": " << h.quantile(0.999) << ", \"max\": " << h.max() << ", \"bins\": [";
-  bool first = true;
-  for (int b = 0; b < LatencyHistogram::kBins; ++b) {
-    if (h.binCount(b) == 0) continue;
-    os << (first ? "" : ", ") << "[" << LatencyHistogram::binLowerUs(b) << ", " << h.binCount(b) << "]";
-    first = false;
-  }
-  os << "]}";
+nlohmann::ordered_json histogramJson(const LatencyHistogram& h) {
+  nlohmann::ordered_json bins = nlohmann::ordered_json::array();
+  for (int b = 0; b < LatencyHistogram::kBins; ++b)
+    if (h.binCount(b) != 0) bins.push_back({LatencyHistogram::binLowerUs(b), h.binCount(b)});
+  return {{"count", h.count()}, {"p50", h.quantile(0.5)},     {"p99", h.quantile(0.99)},
+          {"p999", h.quantile(0.999)}, {"max", h.max()}, {"bins", std::move(bins)}};
 }
 }  // namespace
 
 bool Daemon::writeReport() const {
   if (opt_.report_path.empty()) return true;
-  std::ostringstream os;
-  os.precision(6);
   char host[256] = "";
   gethostname(host, sizeof host - 1);
   const std::time_t now = std::time(nullptr);
   char date[64];
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   const double ran = started_ ? duration<double>((stopping_ ? stop_time_ : Clock::now()) - start_).count() : 0.0;
-  os << "{\n  \"tool\": \"hoist-twind\",\n  \"command\": " << jsonString(opt_.command_line)
-     << ",\n  \"host\": " << jsonString(host) << ",\n  \"date\": " << jsonString(date)
-     << ",\n  \"cpus_online\": " << sysconf(_SC_NPROCESSORS_ONLN) << ",\n  \"duration_s\": " << ran
-     << ",\n  \"stop_reason\": " << jsonString(stop_reason_)
-     << ",\n  \"realtime\": {\"memory_lock\": " << jsonString(rt_.mlockall)
-     << ", \"scheduling\": " << jsonString(rt_.scheduling) << ", \"affinity\": " << jsonString(rt_.affinity)
-     << "},\n  \"log_lines_dropped\": " << log_.dropped() << ",\n  \"histogram_note\": "
-     << jsonString("times in microseconds; 20 logarithmic bins per decade from 0.1 us, so quantiles are "
-                   "bin centres (about 6 % resolution); bins are [lower edge, count]")
-     << ",\n  \"shafts\": [\n";
-  for (std::size_t i = 0; i < shafts_.size(); ++i) {
-    const ShaftRunStats s = shafts_[i]->runStats();
-    const TwinConfig& c = shafts_[i]->config();
-    os << "    {\"label\": " << jsonString(s.label) << ", \"channel_prefix\": "
-       << jsonString(c.service.channel_prefix) << ", \"clock\": " << jsonString(toString(c.service.clock))
-       << ", \"rate_hz\": " << c.service.rate << ", \"modes\": " << c.shaft.n << ", \"ticks\": " << s.ticks
-       << ", \"steps\": " << s.steps << ", \"deadline_misses\": " << s.deadline_misses
-       << ", \"inputs_accepted\": " << s.accepted << ", \"inputs_rejected\": " << s.rejected
-       << ", \"sequence_gaps\": " << s.seq_gaps << ", \"alarm_events\": " << s.alarm_events
-       << ", \"model_faults\": " << s.model_faults << ", \"publish_failures\": " << s.publish_failures
-       << ", \"nonfinite_withheld\": " << s.nonfinite_blocked << ",\n     \"step_us\": ";
-    histogramJson(os, *s.step);
-    os << ",\n     \"late_us\": ";
-    histogramJson(os, *s.late);
-    os << "}" << (i + 1 < shafts_.size() ? "," : "") << "\n";
+  nlohmann::ordered_json j;
+  j["tool"] = "hoist-twind";
+  j["version"] = hoist::kVersionString;
+  j["command"] = opt_.command_line;
+  j["host"] = host;
+  j["date"] = date;
+  j["cpus_online"] = sysconf(_SC_NPROCESSORS_ONLN);
+  j["duration_s"] = ran;
+  j["stop_reason"] = stop_reason_;
+  j["realtime"] = {{"memory_lock", rt_.mlockall}, {"scheduling", rt_.scheduling}, {"affinity", rt_.affinity}};
+  j["log_lines_dropped"] = log_.dropped();
+  j["histogram_note"] =
+      "times in microseconds; 20 logarithmic bins per decade from 0.1 us, so quantiles are "
+      "bin centres (about 6 % resolution); bins are [lower edge, count]";
+  nlohmann::ordered_json shafts = nlohmann::ordered_json::array();
+  for (const auto& sp : shafts_) {
+    const ShaftRunStats s = sp->runStats();
+    const TwinConfig& c = sp->config();
+    nlohmann::ordered_json o;
+    o["label"] = s.label;
+    o["channel_prefix"] = c.service.channel_prefix;
+    o["clock"] = toString(c.service.clock);
+    o["rate_hz"] = c.service.rate;
+    o["modes"] = c.shaft.n;
+    o["ticks"] = s.ticks;
+    o["steps"] = s.steps;
+    o["deadline_misses"] = s.deadline_misses;
+    o["inputs_accepted"] = s.accepted;
+    o["inputs_rejected"] = s.rejected;
+    o["sequence_gaps"] = s.seq_gaps;
+    o["alarm_events"] = s.alarm_events;
+    o["model_faults"] = s.model_faults;
+    o["publish_failures"] = s.publish_failures;
+    o["nonfinite_withheld"] = s.nonfinite_blocked;
+    o["step_us"] = histogramJson(*s.step);
+    o["late_us"] = histogramJson(*s.late);
+    shafts.push_back(std::move(o));
   }
-  os << "  ]\n}\n";
+  j["shafts"] = std::move(shafts);
   const std::string tmp = opt_.report_path + ".tmp";
   {
     std::ofstream f(tmp);
-    f << os.str();
+    // Invalid UTF-8 (a path or host name) is replaced, never a throw at stop.
+    f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     if (!f) {
       out_->error("cannot write the run report {}", opt_.report_path);
       return false;

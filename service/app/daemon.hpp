@@ -18,13 +18,17 @@
 
 #include <utility>  // before Asio: Boost 1.74 awaitable.hpp uses std::exchange
 
+#include <atomic>
 #include <boost/asio.hpp>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <spdlog/spdlog.h>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "hoist/service/config.hpp"
@@ -43,6 +47,7 @@ struct DaemonOptions {
   std::string report_path;          ///< write the run report (JSON) here at stop ("" = none)
   std::string command_line;         ///< for the report
   TestHooks hooks;                  ///< test-only fault injection
+  double test_stall_at = -1.0;      ///< test only: at this many seconds the loop thread hangs for good
 };
 
 class Daemon {
@@ -71,6 +76,8 @@ class Daemon {
   std::size_t shaftCount() const { return shafts_.size(); }
   const ShaftTwin& shaft(std::size_t i) const { return *shafts_[i]; }
   const RealtimeOutcome& realtimeOutcome() const { return rt_; }
+  /// Ticks handled so far (all schedules); the systemd watchdog follows it.
+  std::uint64_t loopProgress() const { return progress_.load(std::memory_order_relaxed); }
 
  private:
   struct RateGroup {
@@ -87,6 +94,9 @@ class Daemon {
   void onTick(RateGroup& g, const boost::system::error_code& ec);
   void stop(const char* why);
   bool writeReport() const;
+  void startWatchdog();
+  void stopWatchdog();
+  void watchdogMain(std::chrono::microseconds interval);
 
   DaemonOptions opt_;
   std::shared_ptr<spdlog::logger> out_;
@@ -102,6 +112,17 @@ class Daemon {
   RealtimeOutcome rt_;
   bool started_ = false, stopping_ = false;
   const char* stop_reason_ = "";
+
+  // systemd (sd_notify): READY=1 once the loop is armed; WATCHDOG=1 from a
+  // supervisor thread, only when the loop's tick counter moved since the
+  // previous check.  The loop only bumps the counter (one relaxed atomic add:
+  // no lock, no allocation, no system call); a hung loop stops the pings and
+  // systemd restarts the service after WatchdogSec.
+  std::atomic<std::uint64_t> progress_{0};
+  std::thread watchdog_;
+  std::mutex wd_mu_;
+  std::condition_variable wd_cv_;
+  bool wd_quit_ = false;
 };
 
 }  // namespace hoist::svc

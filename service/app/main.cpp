@@ -8,20 +8,51 @@
 // Subscribes to HOIST_WINDER (winder_t) and HOIST_ALARM_ACK (alarm_ack_t);
 // publishes HOIST_CAGE, HOIST_GUIDE_SHAPE, HOIST_ALARM and HOIST_HEALTH (see
 // msgs/*.lcm and docs/service.md).  Exit status: 0 after a clean stop
-// (SIGINT/SIGTERM/--duration), 1 if LCM cannot be opened, 2 for a bad
-// command line or configuration.
+// (SIGINT/SIGTERM/--duration), 1 if a well-formed LCM URL cannot be opened,
+// 2 for a bad command line, configuration or LCM URL.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <set>
+#include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
 #include "hoist/service/config_file.hpp"
 #include "hoist/bus/lcm_util.hpp"
+
+namespace {
+/// True when stderr is the systemd journal's stream: systemd sets
+/// JOURNAL_STREAM=<device>:<inode> of the socket it connects stdout/stderr to.
+bool stderrIsJournal() {
+  const char* js = std::getenv("JOURNAL_STREAM");
+  if (!js || !*js) return false;
+  unsigned long long dev = 0, ino = 0;
+  if (std::sscanf(js, "%llu:%llu", &dev, &ino) != 2) return false;
+  struct stat st {};
+  if (fstat(STDERR_FILENO, &st) != 0) return false;
+  return static_cast<unsigned long long>(st.st_dev) == dev && static_cast<unsigned long long>(st.st_ino) == ino;
+}
+
+/// spdlog flag %* -> "<N>" (sd-daemon(3) priority prefix) from the line's level.
+class SyslogPriorityFlag : public spdlog::custom_flag_formatter {
+ public:
+  void format(const spdlog::details::log_msg& msg, const std::tm&, spdlog::memory_buf_t& dest) override {
+    static constexpr const char* kPrefix[] = {"<7>", "<7>", "<6>", "<4>", "<3>", "<2>", ""};  // trace..off
+    const char* p = kPrefix[static_cast<int>(msg.level) < 7 ? static_cast<int>(msg.level) : 6];
+    dest.append(p, p + std::strlen(p));
+  }
+  std::unique_ptr<custom_flag_formatter> clone() const override { return std::make_unique<SyslogPriorityFlag>(); }
+};
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace hoist::svc;
@@ -31,6 +62,8 @@ int main(int argc, char** argv) {
       "publishes the cage state (HOIST_CAGE), guide-rope shape (HOIST_GUIDE_SHAPE), clearance\n"
       "alarms (HOIST_ALARM; commands on HOIST_ALARM_ACK) and its own health (HOIST_HEALTH).\n"
       "Runs with the paper's shaft when given no --config."};
+  app.name("hoist-twind");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-twind ") + hoist::kVersionString);
   std::vector<std::string> config_paths;
   std::string lcm_url, clock, prefix, log_level = "info", cpus, report;
   double rate = 0.0, duration = 0.0;
@@ -67,6 +100,8 @@ int main(int argc, char** argv) {
   int fail_publish_every = 0;
   app.add_option("--test-inject-fault-at", inject_fault_at)->group("");
   app.add_option("--test-fail-publish-every", fail_publish_every)->group("")->check(CLI::NonNegativeNumber);
+  double stall_at = -1.0;  // the loop thread hangs at this time: the systemd watchdog test
+  app.add_option("--test-stall-at", stall_at)->group("")->check(CLI::NonNegativeNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -135,9 +170,19 @@ int main(int argc, char** argv) {
     return 0;
   }
   opt.lcm_url = hoist::bus::resolveLcmUrl(lcm_url, shaft_url);
+  if (const std::string bad = hoist::bus::lcmUrlError(opt.lcm_url); !bad.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    const std::string from = !lcm_url.empty()          ? "--lcm-url: "
+                             : (env && *env)           ? "LCM_DEFAULT_URL: "
+                             : config_paths[0].empty() ? ""
+                                                       : config_paths[0] + ": service.lcm_url: ";
+    std::cerr << "hoist-twind: configuration error: " << from << bad << "\n";
+    return 2;
+  }
   opt.duration = duration;
   opt.hooks.inject_fault_at = inject_fault_at;
   opt.hooks.fail_publish_every = fail_publish_every;
+  opt.test_stall_at = stall_at;
   opt.realtime.mlockall = mlock;
   opt.realtime.fifo_priority = rt_priority;
   opt.report_path = report;
@@ -148,7 +193,16 @@ int main(int argc, char** argv) {
   auto sink = std::make_shared<spdlog::sinks::stderr_color_sink_mt>();
   auto log = std::make_shared<spdlog::logger>("hoist-twind", sink);
   log->set_level(spdlog::level::from_str(log_level));
-  log->set_pattern("%Y-%m-%d %H:%M:%S.%e [%^%l%$] %v");
+  if (stderrIsJournal()) {
+    // Under systemd (hoist-twind@.service) stderr is the journal, which
+    // stamps every line itself: no second timestamp, and a <N> syslog
+    // priority prefix so `journalctl -p warning` selects by level.
+    auto f = std::make_unique<spdlog::pattern_formatter>();
+    f->add_flag<SyslogPriorityFlag>('*').set_pattern("%*%v");
+    log->set_formatter(std::move(f));
+  } else {
+    log->set_pattern("%Y-%m-%d %H:%M:%S.%e [%^%l%$] %v");
+  }
   log->flush_on(spdlog::level::info);
   spdlog::register_logger(log);
 

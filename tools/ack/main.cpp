@@ -6,7 +6,9 @@
 //
 // Default: acknowledge every active alarm ("*", both levels).  The daemon
 // answers on HOIST_ALARM with an ACK / SHELVE / UNSHELVE event (watch it with
-// hoist-monitor).  Exit status: 0 sent, 1 LCM failure, 2 bad usage.
+// hoist-monitor).  Exit status: 0 sent, 1 LCM failure, 2 bad usage (options, LCM URL,
+// a shelve longer than the daemon's limit).
+#include "hoist/version.hpp"
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -17,12 +19,15 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "hoist/alarm_ack_t.hpp"
-#include "hoist/bus/lcm_util.hpp"
 #include "hoist/bus/channels.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/service/alarms.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"hoist-alarm-ack: acknowledge, shelve or unshelve hoist-twind alarms (one HOIST_ALARM_ACK message)",
                "hoist-alarm-ack"};
+  app.name("hoist-alarm-ack");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-alarm-ack ") + hoist::kVersionString);
   std::string kind = "*", level = "both", user, url, prefix;
   double shelve = 0.0;
   bool unshelve = false;
@@ -33,8 +38,22 @@ int main(int argc, char** argv) {
   app.add_option("--level", level, "warning, critical or both")
       ->capture_default_str()
       ->check(CLI::IsMember({"warning", "critical", "both"}));
-  auto* sh = app.add_option("--shelve", shelve, "shelve for this many seconds instead of acknowledging")
-                 ->check(CLI::PositiveNumber);
+  // The longest shelve the daemon grants ([alarms] max_shelve, default
+  // 3600 s): refuse more here rather than have it clamped silently.
+  const double max_shelve = hoist::svc::AlarmConfig{}.max_shelve;
+  auto* sh = app.add_option("--shelve", shelve,
+                            "shelve for this many seconds instead of acknowledging (at most " +
+                                std::to_string(static_cast<long>(max_shelve)) + " s)")
+                 ->check(CLI::PositiveNumber)
+                 ->check(CLI::Validator(
+                     [max_shelve](std::string& v) -> std::string {
+                       double d = 0.0;
+                       if (!CLI::detail::lexical_cast(v, d) || !(d <= max_shelve))
+                         return "longer than the longest shelve, " + std::to_string(static_cast<long>(max_shelve)) +
+                                " s (the daemon's [alarms] max_shelve)";
+                       return {};
+                     },
+                     "SECONDS<=" + std::to_string(static_cast<long>(max_shelve)), "max shelve"));
   app.add_flag("--unshelve", unshelve, "end a shelve early")->excludes(sh);
   app.add_option("--user", user, "operator name (logged by the daemon; default: $USER)");
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
@@ -60,6 +79,10 @@ int main(int argc, char** argv) {
   m.shelve_duration = shelve;
   m.user = user;
   url = hoist::bus::resolveLcmUrl(url);
+  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
+    std::cerr << "hoist-alarm-ack: " << bad << "\n";
+    return 2;
+  }
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::cerr << "hoist-alarm-ack: cannot open LCM (" << (url.empty() ? "default URL" : url)

@@ -7,6 +7,7 @@
 //
 // One thread, one Asio loop: the LCM file descriptor, the HTTP/WebSocket
 // server (Boost.Beast) and the 25 Hz decimation timer.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
@@ -67,6 +68,8 @@ int main(int argc, char** argv) {
       "(subprotocol foxglove.websocket.v1) on one port, with every hoist LCM channel of every shaft\n"
       "advertised under its LCM channel name in JSON encoding.  Binds loopback by default: anyone who\n"
       "can reach the port can acknowledge and shelve alarms unless --read-only (docs/security.md)."};
+  app.name("hoist-dash");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-dash ") + hoist::kVersionString);
   std::string bind = "127.0.0.1", url, web_root, log_level = "info";
   int port = 8080;
   bool read_only = false;

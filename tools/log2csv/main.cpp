@@ -33,6 +33,7 @@
 // unless --lenient -- the log had corrupt regions (bytes skipped, events
 // lost) or events that carry a hoist fingerprint but fail the checked decode;
 // 2 for a bad command line.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstdio>
@@ -310,6 +311,8 @@ int main(int argc, char** argv) {
       "(as hoist-sim writes them).  Corrupted events are skipped (resynchronising on\n"
       "the next event) and reported; the exit status is then 1 unless --lenient.\n"
       "Exit status: 0 ok, 1 unreadable log / unwritable file / data lost, 2 bad usage."};
+  app.name("hoist-log2csv");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-log2csv ") + hoist::kVersionString);
   std::string log_path, out_dir;
   bool lenient = false;
   app.add_option("LOGFILE", log_path, "LCM log file")->required()->check(CLI::ExistingFile);

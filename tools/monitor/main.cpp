@@ -16,6 +16,7 @@
 // the terminal), at most 64 active alarms are tracked, and when no HOIST_CAGE
 // or no HOIST_HEALTH arrived for more than --stale seconds (default 2) the
 // line says STALE with the age of the data.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <poll.h>
 #include <unistd.h>
@@ -167,6 +168,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hoist-monitor: print the digital twin's cage state once a second (time, depth, speed,\n"
       "sway, tilt, largest sleeve force, minimum clearance, active alarms) and every alarm event."};
+  app.name("hoist-monitor");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-monitor ") + hoist::kVersionString);
   std::string url, prefix;
   double period = 1.0, duration = 0.0;
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
@@ -184,6 +187,10 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   url = hoist::bus::resolveLcmUrl(url);
+  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
+    std::fprintf(stderr, "hoist-monitor: %s\n", bad.c_str());
+    return 2;
+  }
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::fprintf(stderr, "hoist-monitor: cannot open LCM at %s\n", hoist::bus::describeLcmUrl(url).c_str());

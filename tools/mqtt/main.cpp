@@ -8,6 +8,7 @@
 // Exit status: 0 after SIGINT/SIGTERM, 1 if LCM cannot be opened, 2 bad
 // options or configuration.  A broker that is down or goes away is never
 // fatal: the bridge retries with backoff.
+#include "hoist/version.hpp"
 #include <mosquitto.h>
 
 #include <csignal>
@@ -30,6 +31,7 @@ int main(int argc, char** argv) {
   CLI::App app{"hoist-mqtt: bridge the twin's LCM channels (cage state, health, alarms) to an MQTT broker, and "
                "operator alarm commands back (docs/mqtt.md)",
                "hoist-mqtt"};
+  app.set_version_flag("--version", std::string("hoist-mqtt ") + hoist::kVersionString);
   std::string config_path, broker, client_id, lcm_url;
   std::vector<std::string> prefixes;
   bool no_commands = false, quiet = false;

@@ -30,6 +30,7 @@
 //
 // --timing-test: an alias of hoist-timing-test (timing_cli.hpp), the
 // soft-real-time check of a running hoist-twind.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <time.h>
 #include <unistd.h>
@@ -124,6 +125,8 @@ int main(int argc, char** argv) {
       "a synthetic hoist profile, a profile CSV or an LCM log, in real time or at --speed X.\n"
       "With no source it plays the paper's trapezoid (Fig. 2: 50 m -> 300 m, 60 s).\n"
       "--timing-test ... runs hoist-timing-test (the real-time check of a running hoist-twind)."};
+  app.name("hoist-replay");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-replay ") + hoist::kVersionString);
   std::string profile_arg, log_path, url, config_path;
   std::vector<std::string> prefixes;
   double speed = 1.0, rate = 100.0;
@@ -154,6 +157,10 @@ int main(int argc, char** argv) {
   if (const auto rc = hoist::replay::parseCommandLine(app, argc, argv)) return *rc;
 
   url = hoist::bus::resolveLcmUrl(url);
+  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
+    std::cerr << "hoist-replay: " << bad << "\n";
+    return 2;
+  }
   if (prefixes.size() > 1) {
     std::cerr << "hoist-replay: --channel-prefix: only one prefix (several shafts: hoist-timing-test)\n";
     return 2;

@@ -1,4 +1,5 @@
 // The timing test's command line: see timing_cli.hpp.
+#include "hoist/version.hpp"
 #include "timing_cli.hpp"
 
 #include <unistd.h>
@@ -53,6 +54,8 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
                "for --duration, listens to its HOIST_HEALTH and HOIST_CAGE, and judges deadline misses, tick\n"
                "lateness, step time, end-to-end latency and rejected inputs against budgets (see the end)."};
   app.footer(kTimingHelp);
+  app.name(program);
+  app.set_version_flag("--version", program + " " + hoist::kVersionString);
   std::string url, config_path, report_path;
   std::vector<std::string> prefixes;
   double rate = 100.0, duration = 60.0;

@@ -2,7 +2,7 @@
 // whole hoist profile as fast as possible and write the cage response.
 //
 //   hoist-sim [--config FILE] --profile FILE|SPEC --out FILE.csv [--dt 0.01]
-//             [--modes N] [--initial static|rest] [--method fast|paper]
+//             [--modes N] [--initial static|rest|config] [--method fast|paper]
 //             [--static-correction on|off]
 //             [--shape-out FILE.csv --shape-times 18,36,60]
 //   hoist-sim study ...        (runs hoist-study: the paper's parameter studies)
@@ -11,6 +11,7 @@
 // integrals, solver), solve (time stepping, rows kept in memory), output.
 // Exit status: 0 done, 2 bad input (config, profile, options), 1 the run
 // failed (non-finite state, write error).
+#include "hoist/version.hpp"
 #include <unistd.h>
 
 #include <algorithm>
@@ -124,7 +125,7 @@ int run(const Options& o) {
   // hoist-twind validates those sections.
   if (!o.config.empty()) p = hoist::io::loadShaftConfig(o.config, {"service", "alarms"});
   if (o.modes != 0) p.n = o.modes;
-  if (!o.initial.empty()) p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
+  if (!o.initial.empty() && o.initial != "config") p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
   if (o.rho_inf >= 0.0) p.rho_inf = o.rho_inf;
   if (o.method == "paper") {
     // The paper's method is the paper's literal truncation.
@@ -302,7 +303,9 @@ int main(int argc, char** argv) {
       "Writes t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4 per output step.\n"
       "Also: 'hoist-sim study NAME ...' runs the paper's parameter studies (hoist-study --help).",
       "hoist-sim"};
-  app.add_option("--config", o.config, "shaft TOML (README / docs/model.md); missing keys take the paper's values")
+  app.name("hoist-sim");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-sim ") + hoist::kVersionString);
+  app.add_option("--config", o.config, "shaft TOML; missing keys take the paper's values (--print-config lists every key)")
       ->check(CLI::ExistingFile);
   app.add_option("--profile", o.profile, std::string("hoist profile CSV or SPEC (default: paper)\n") +
                                              hoist::io::profileSpecHelp());
@@ -316,8 +319,11 @@ int main(int argc, char** argv) {
   app.add_option("--t-end", o.t_end, "stop at this time [s] (default: the profile's end)");
   app.add_option("--modes", o.modes, "assumed modes per rope n (overrides model.modes)")
       ->check(CLI::Range(1, hoist::kMaxModes));
-  app.add_option("--initial", o.initial, "initial state (overrides model.initial)")
-      ->check(CLI::IsMember({"static", "rest"}));
+  // --initial: the same values, meaning and default as in hoist-study.
+  app.add_option("--initial", o.initial,
+                 "initial state: static (equilibrium at t = 0), rest (q = 0: the eccentric load acts as a step, as in the "
+                 "paper's figures) or config (the config's model.initial, static unless set); default: config")
+      ->check(CLI::IsMember({"static", "rest", "config"}));
   app.add_option("--method", o.method,
                  "fast: structured KKT solver (default); paper: the paper's literal partition, Eqs. (18)-(24)")
       ->capture_default_str()

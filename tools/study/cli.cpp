@@ -28,7 +28,7 @@ CLI::Validator numberAbove(double lo, bool inclusive) {
       },
       inclusive ? "NUMBER >= 0" : "NUMBER > 0");
 }
-void addCommon(CLI::App* sub, Common& c, bool advisor, bool paper) {
+void addCommon(CLI::App* sub, Common& c, [[maybe_unused]] bool advisor, bool paper) {
   sub->add_option("--out-dir", c.out_dir, "Directory for CSVs, scripts and PNGs (created)")
       ->capture_default_str();
   sub->add_option("--config", c.config,
@@ -41,10 +41,10 @@ void addCommon(CLI::App* sub, Common& c, bool advisor, bool paper) {
   sub->add_option("--max-step", c.max_step, "Largest integration step [s] (0: --dt)")
       ->capture_default_str()
       ->check(numberAbove(0, true));
+  // --initial: the same values, meaning and default as in hoist-sim.
   sub->add_option("--initial", c.initial,
-                  std::string("Initial state: rest (q = 0, the eccentric load as a step: the free vibration "
-                              "of the paper's figures), static (equilibrium), config (model.initial); default: ") +
-                      (advisor ? "config" : "rest"))
+                  "initial state: static (equilibrium at t = 0), rest (q = 0: the eccentric load acts as a step, as in the "
+                  "paper's figures) or config (the config's model.initial, static unless set); default: config")
       ->check(CLI::IsMember({"rest", "static", "config"}));
   sub->add_option("--static-correction", c.static_correction,
                   std::string("Residual flexibility of the guide ropes (overrides model.static_correction); "

@@ -26,7 +26,7 @@ struct Common {
   int modes = 0;
   double dt = 0.01;
   double max_step = 0.0025;
-  std::string initial;  // "" -> rest for the studies, config for advise
+  std::string initial = "config";  // as hoist-sim: model.initial unless given
   std::string static_correction;  // "" -> off for the paper's studies, config (default on) for sweep/advise
   int jobs = 0;
   bool no_plots = false;
@@ -38,8 +38,7 @@ std::string fmtg(double v, const char* f = "%g");
 /// Readable replacements for CLI::PositiveNumber / NonNegativeNumber (whose
 /// messages print DBL_MAX).
 CLI::Validator numberAbove(double lo, bool inclusive);
-/// The options of Common on a subcommand (`advisor`: its --initial default is "config";
-/// `paper`: one of the paper's studies, whose --static-correction default is off).
+/// The options of Common on a subcommand (`paper`: one of the paper's studies, whose --static-correction default is off).
 void addCommon(CLI::App* sub, Common& c, bool advisor, bool paper);
 /// "1,2,3" or "start:stop:count" (evenly spaced, count >= 2).  Throws UsageError.
 std::vector<double> parseValues(const std::string& s);

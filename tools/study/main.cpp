@@ -3,13 +3,14 @@
 // hoist_study library: options, files, gnuplot, progress.
 //
 //   hoist-study NAME [--out-dir DIR] [--config FILE] [--profile FILE|SPEC]
-//                    [--modes N] [--dt S] [--max-step S] [--initial rest|static|config]
+//                    [--modes N] [--dt S] [--max-step S] [--initial static|rest|config]
 //                    [--static-correction on|off] [--jobs N] [--no-plots]
 //   NAME: response | preload | tension-difference | eccentric-load | mass | all
 //         | sweep --param KEY --values V1,V2,... | advise --clearance M ...
 //
 // Exit status: 0 success, 1 a run failed or a file could not be written,
 // 2 usage or configuration error, 3 (advise) target infeasible in the range.
+#include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -37,6 +38,8 @@ int main(int argc, char** argv) {
       "frequencies of y_c/theta/lambda_1 in the uniform-velocity and deceleration/rest stages) and\n"
       "PNG figures rendered by gnuplot (with the .gp script next to each PNG).\n"
       "Exit status: 0 ok, 1 run or file failure, 2 usage/config error, 3 advise: infeasible."};
+  app.name("hoist-study");  // usage lines name the program, not the path it was run by
+  app.set_version_flag("--version", std::string("hoist-study ") + hoist::kVersionString);
   app.require_subcommand(1, 1);
   app.fallthrough(false);
   Common c;
@@ -81,7 +84,6 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
 
-  if (c.initial.empty()) c.initial = advise->parsed() ? "config" : "rest";
   // The paper's studies reproduce its figures: the paper's truncation unless asked otherwise.
   if (c.static_correction.empty() && !advise->parsed() && !sweep->parsed()) c.static_correction = "off";
   PlotState ps;
