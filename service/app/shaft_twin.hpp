@@ -53,7 +53,12 @@ class ShaftTwin {
   using Clock = std::chrono::steady_clock;
 
   /// `label` names the shaft in log lines ("" for a daemon with one shaft).
-  ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks);
+  /// `lcm` receives (and publishes unless `lcm_out` is given: the
+  /// [service] lcm_url_out instance); `instance_id` is this process's random
+  /// id, published in HOIST_CAGE and HOIST_HEALTH.
+  ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks,
+            std::int64_t instance_id = 0, lcm::LCM* lcm_out = nullptr);
+  ~ShaftTwin();
   ShaftTwin(const ShaftTwin&) = delete;
   ShaftTwin& operator=(const ShaftTwin&) = delete;
 
@@ -82,6 +87,9 @@ class ShaftTwin {
  private:
   void onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void onAck(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void onOwnHealth(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void logJunk(const std::string& what);
+  std::int64_t rssKb() const;
   double wallNow() const;
   void publishCage(std::int64_t utime);
   void publishShape(std::int64_t utime);
@@ -95,6 +103,8 @@ class ShaftTwin {
   std::string label_;  ///< as given ("" for a daemon with one shaft)
   std::string tag_;    ///< log-line prefix: "[label] " or ""
   lcm::LCM& lcm_;
+  lcm::LCM& out_;  ///< publishes (lcm_url_out, or lcm_)
+  std::int64_t instance_id_ = 0;
   RtLog& log_;
   TestHooks hooks_;
   Channels ch_;
@@ -113,7 +123,20 @@ class ShaftTwin {
   std::int64_t publish_attempts_ = 0;
   bool fault_injected_ = false;
   std::int64_t cage_seq_ = 0, alarm_id_ = 0;
-  LogRateLimiter<kRejectReasons + 3> reject_log_{5};  // + domain error, publish, alarm commands
+  // Log rate limiter keys: one per RejectReason, then these.
+  static constexpr int kLogPublish = kRejectReasons;          ///< publish failures, withheld messages
+  static constexpr int kLogJunkCommand = kRejectReasons + 1;  ///< invalid/ineffective/dropped commands
+  static constexpr int kLogCatchup = kRejectReasons + 2;      ///< limited catch-up
+  static constexpr int kLogKeys = kRejectReasons + 3;
+  LogRateLimiter<kLogKeys> reject_log_{5};
+  static constexpr std::size_t kUserMax = 64;  ///< operator names are cut to this (printable) length
+  int commands_this_tick_ = 0;
+  std::int64_t commands_dropped_ = 0, commands_invalid_ = 0;
+  std::string cmd_user_;               ///< user of the command whose events are being drained
+  double cmd_requested_shelve_ = 0.0;  ///< its requested shelve duration [s]
+  std::int64_t other_id_ = 0;          ///< another publisher's instance id
+  double other_seen_wall_ = -1.0;      ///< when it was last seen (< 0: not seen)
+  int statm_fd_ = -1;
 
   // preallocated messages and encode buffers
   hoist::winder_t winder_in_;

@@ -1,6 +1,7 @@
 // Daemon configuration: see hoist/service/config.hpp.
 #include "hoist/service/config.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -67,9 +68,30 @@ void ServiceConfig::validate() const {
   checkRange("envelope_points", envelope_points, 2, 20001);
   checkRange("log_rate_limit", log_rate_limit, 1, 1000);
   checkRange("fault_hold", fault_hold, 0.0, 3600.0);
+  checkRange("accel_tolerance", accel_tolerance, 0.0, 100.0, true);
+  checkRange("velocity_tolerance", velocity_tolerance, 0.0, 10.0);
+  checkRange("consistency_window", consistency_window, 0.0, 60.0, true);
+  checkRange("plausible_factor", plausible_factor, 2.0, 1e6);
+  checkRange("max_catchup_periods", max_catchup_periods, 1, 1000);
+  checkRange("max_commands_per_tick", max_commands_per_tick, 1, 1000);
+  if (max_step > 0.0) {
+    // Never clamp in silence: the longest interval one step may have to
+    // cover (a tick's catch-up, or an input interval with --clock input)
+    // must fit kMaxSubsteps substeps.
+    const double longest = std::max(max_catchup_periods / rate, max_time_step);
+    const double need = std::ceil(longest / max_step - 1e-9);
+    if (need > kMaxSubsteps) {
+      std::ostringstream os;
+      os << max_step << " s would need " << need << " substeps for an interval of " << longest
+         << " s (max_time_step or max_catchup_periods / rate); the limit is " << kMaxSubsteps
+         << ": use max_step >= " << longest / kMaxSubsteps << " s or 0 (no substeps)";
+      bad("service.max_step", os.str());
+    }
+  }
   for (char c : channel_prefix)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '/'))
       bad("service.channel_prefix", "may contain only letters, digits and _ - . /");
+  if (channel_prefix.size() > 64) bad("service.channel_prefix", "at most 64 characters");
 }
 
 namespace {
@@ -172,6 +194,11 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   sr.number("health_rate", s.health_rate);
   sr.string("channel_prefix", [&](const toml::node&, const std::string& v) { s.channel_prefix = v; });
   sr.string("lcm_url", [&](const toml::node&, const std::string& v) { s.lcm_url = v; });
+  sr.string("lcm_url_out", [&](const toml::node& n, const std::string& v) {
+    if (!v.empty() && v.find("://") == std::string::npos)
+      sr.fail(n, "lcm_url_out", "must be an LCM URL such as \"udpm://239.255.76.67:7668?ttl=0\" (or \"\" for lcm_url), got \"" + v + "\"");
+    s.lcm_url_out = v;
+  });
   sr.string("clock", [&](const toml::node& n, const std::string& v) {
     if (v == "wall") s.clock = ClockMode::Wall;
     else if (v == "input") s.clock = ClockMode::Input;
@@ -189,6 +216,12 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   sr.integer("envelope_points", s.envelope_points);
   sr.integer("log_rate_limit", s.log_rate_limit);
   sr.number("fault_hold", s.fault_hold);
+  sr.number("accel_tolerance", s.accel_tolerance);
+  sr.number("velocity_tolerance", s.velocity_tolerance);
+  sr.number("consistency_window", s.consistency_window);
+  sr.number("plausible_factor", s.plausible_factor);
+  sr.integer("max_catchup_periods", s.max_catchup_periods);
+  sr.integer("max_commands_per_tick", s.max_commands_per_tick);
   sr.run();
   try {
     s.validate();
@@ -261,7 +294,11 @@ std::string toToml(const TwinConfig& c) {
      << "\nstale_periods = " << Num{s.stale_periods} << "\nstale_min = " << Num{s.stale_min}
      << "\nmax_step = " << Num{s.max_step} << "\nshape_points = " << s.shape_points
      << "\nenvelope_points = " << s.envelope_points << "\nlog_rate_limit = " << s.log_rate_limit
-     << "\nfault_hold = " << Num{s.fault_hold} << "\n\n";
+     << "\nfault_hold = " << Num{s.fault_hold} << "\nlcm_url_out = \"" << s.lcm_url_out
+     << "\"\naccel_tolerance = " << Num{s.accel_tolerance} << "\nvelocity_tolerance = " << Num{s.velocity_tolerance}
+     << "\nconsistency_window = " << Num{s.consistency_window} << "\nplausible_factor = " << Num{s.plausible_factor}
+     << "\nmax_catchup_periods = " << s.max_catchup_periods << "\nmax_commands_per_tick = " << s.max_commands_per_tick
+     << "\n\n";
   const AlarmConfig& a = c.alarms;
   os << "[alarms]\ngap_pos_y = " << Num{a.gap_pos_y} << "\ngap_neg_y = " << Num{a.gap_neg_y}
      << "\nguide_rope_gap = " << Num{a.guide_rope_gap} << "\nwarning_fraction = " << Num{a.warning_fraction}

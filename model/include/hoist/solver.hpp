@@ -10,9 +10,11 @@
 //     coordinate partition G = (G0 G1), q = Phi q1 (Eqs. 18-24), reduced ODE
 //     Eq. (22), lambda recovered from Eq. (15).  Ill-conditioned near the shaft
 //     ends (MODEL.md) and O(n^3) per step: for checking, not for production.
-// Both use the same implicit, fixed-step generalized-alpha integrator
-// (rho_inf = 1: trapezoidal / Newmark average acceleration) with the equations
-// of motion enforced at t_{n+1}.
+// Both use the same implicit, fixed-step generalized-alpha integrator with the
+// equations of motion enforced at t_{n+1}; its high-frequency damping is
+// ShaftParams::rho_inf ([model] rho_inf, default 0.9; rho_inf = 1 would be the
+// undamped trapezoidal rule / Newmark average acceleration, which lets the
+// sleeve forces of the moving index-3 constraints grow without bound).
 //
 // Sign conventions (MODEL.md): lambda_k is the force the cage exerts on the
 // rope at constraint g_k, positive in +y (+x for lambda_0); the cage feels
