@@ -76,8 +76,27 @@ bool Daemon::start() {
   rt_ = applyRealtime(opt_.realtime);
   (rt_.all_granted ? out_->info("real-time settings: {}", rt_.summary())
                    : out_->warn("real-time settings: {} (running without them)", rt_.summary()));
-  for (auto& s : shafts_) s->subscribe();
-  lcm_fd_.assign(lcm_.getFileno());
+  // udpm:// (and LCM's default): our own receive path, which dispatches only
+  // the subscribed channels by exact name and stores nothing per channel
+  // name seen (LCM 1.3.1 would; udpm_receiver.hpp).  Other providers go
+  // through LCM (literal names, regex-escaped).
+  UdpmUrl udpm;
+  std::string why;
+  if (parseUdpmUrl(opt_.lcm_url, udpm, why)) {
+    receiver_ = std::make_unique<UdpmReceiver>();
+    if (!receiver_->open(udpm, why)) {
+      out_->error("cannot open the LCM input socket for {}: {}", describeLcmUrl(opt_.lcm_url), why);
+      return false;
+    }
+    for (auto& s : shafts_) {
+      s->subscribe(receiver_.get());
+      s->setIgnoredCounter(&ignored_);
+    }
+    lcm_fd_.assign(receiver_->fd());
+  } else {
+    for (auto& s : shafts_) s->subscribe();
+    lcm_fd_.assign(lcm_.getFileno());
+  }
   armLcm();
   // The stop signals are handled on this (the loop) thread; hoist-twind's
   // main() blocks them before any helper thread exists (see main.cpp).
@@ -141,8 +160,13 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
     return;
   }
   // Drain what is queued, bounded so the timers are never starved.
-  for (int i = 0; i < 256; ++i)
-    if (lcm_.handleTimeout(0) <= 0) break;
+  if (receiver_) {
+    receiver_->drain(256);
+    ignored_ = receiver_->ignored() + receiver_->malformed();
+  } else {
+    for (int i = 0; i < 256; ++i)
+      if (lcm_.handleTimeout(0) <= 0) break;
+  }
   if (!stopping_) armLcm();
 }
 
@@ -264,8 +288,9 @@ bool Daemon::writeReport() const {
      << ",\n  \"realtime\": {\"memory_lock\": " << jsonString(rt_.mlockall)
      << ", \"scheduling\": " << jsonString(rt_.scheduling) << ", \"affinity\": " << jsonString(rt_.affinity)
      << "},\n  \"log_lines_dropped\": " << log_.dropped() << ",\n  \"histogram_note\": "
-     << jsonString("times in microseconds; 20 logarithmic bins per decade from 0.1 us, so quantiles are "
-                   "bin centres (about 6 % resolution); bins are [lower edge, count]")
+     << jsonString("times in microseconds; " + std::to_string(LatencyHistogram::kPerDecade) +
+                   " logarithmic bins per decade from 0.1 us, so quantiles are bin centres (about 1.2 % "
+                   "resolution); bins are [lower edge, count]")
      << ",\n  \"shafts\": [\n";
   for (std::size_t i = 0; i < shafts_.size(); ++i) {
     const ShaftRunStats s = shafts_[i]->runStats();

@@ -33,11 +33,17 @@
 #include <vector>
 
 #include "hoist/service/config.hpp"
-#include "realtime.hpp"
-#include "rt_log.hpp"
+#include "hoist/rt/realtime.hpp"
+#include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
+#include "udpm_receiver.hpp"
 
 namespace hoist::svc {
+
+using rt::applyRealtime;
+using rt::parseCpuList;
+using rt::RealtimeOutcome;
+using rt::RealtimeRequest;
 
 struct DaemonOptions {
   std::vector<TwinConfig> shafts;   ///< effective configuration of each shaft (command line applied)
@@ -101,6 +107,8 @@ class Daemon {
   RtLog log_;
   boost::asio::io_context io_;
   lcm::LCM lcm_;
+  std::unique_ptr<UdpmReceiver> receiver_;  ///< own receive path for udpm URLs (udpm_receiver.hpp); else LCM's
+  std::int64_t ignored_ = 0;                 ///< receiver_->ignored(), mirrored for the health reports
   std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
   std::int64_t instance_id_ = 0;       ///< random per process (HOIST_CAGE/HOIST_HEALTH.instance_id)
   boost::asio::posix::stream_descriptor lcm_fd_;

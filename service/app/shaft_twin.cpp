@@ -104,14 +104,22 @@ ShaftTwin::~ShaftTwin() {
   if (statm_fd_ >= 0) ::close(statm_fd_);
 }
 
-void ShaftTwin::subscribe() {
+void ShaftTwin::subscribe(InputRouter* router) {
+  // Our own health channel too: another publisher there (by instance_id) is
+  // a second twin on our outputs.  Only seen when outputs share the input URL.
+  const bool own_health = &out_ == &lcm_;
+  if (router) {
+    router->add(ch_.winder, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onWinder(rb, c); });
+    router->add(ch_.ack, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onAck(rb, c); });
+    if (own_health)
+      router->add(ch_.health, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onOwnHealth(rb, c); });
+    return;
+  }
   // lcm::subscribe takes a regular expression: subscribe to the literal
   // names (a prefix "mine.1/" must not match "mineX1/").
   lcm_.subscribe(regexEscape(ch_.winder), &ShaftTwin::onWinder, this);
   lcm_.subscribe(regexEscape(ch_.ack), &ShaftTwin::onAck, this);
-  // Our own health channel: another publisher there (by instance_id) is a
-  // second twin on our outputs.  Only seen when outputs share the input URL.
-  if (&out_ == &lcm_) lcm_.subscribe(regexEscape(ch_.health), &ShaftTwin::onOwnHealth, this);
+  if (own_health) lcm_.subscribe(regexEscape(ch_.health), &ShaftTwin::onOwnHealth, this);
 }
 
 void ShaftTwin::onOwnHealth(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
@@ -442,6 +450,7 @@ void ShaftTwin::publishHealth(bool final_report) {
   health_msg_.commands_dropped = commands_dropped_;
   health_msg_.commands_invalid = commands_invalid_;
   health_msg_.catchup_limited = core_.catchupLimited();
+  health_msg_.datagrams_ignored = ignored_counter_ ? *ignored_counter_ : 0;
   encodeAndPublish(ch_.health, health_msg_, health_buf_);
   if (!final_report)
     log_.debug("{}health: t={:.2f} s steps={} step p50/p99/max={:.0f}/{:.0f}/{:.0f} us late "

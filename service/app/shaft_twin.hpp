@@ -10,7 +10,7 @@
 // Real time: after start-up nothing here allocates, takes a lock that another
 // thread can hold, or does I/O other than lcm::LCM::publish (a sendmsg on the
 // UDP socket, under LCM's own transmit mutex which only this thread takes).
-// Log lines go to the RtLog ring (rt_log.hpp).  tests/service/
+// Log lines go to the RtLog ring (hoist/rt/rt_log.hpp).  tests/service/
 // daemon_no_alloc_test.cpp checks the whole loop with a counting allocator.
 #pragma once
 
@@ -28,9 +28,12 @@
 #include "hoist/service/health.hpp"
 #include "hoist/service/twin_core.hpp"
 #include "hoist/winder_t.hpp"
-#include "rt_log.hpp"
+#include "hoist/rt/rt_log.hpp"
+#include "udpm_receiver.hpp"
 
 namespace hoist::svc {
+
+using rt::RtLog;
 
 /// Test-only fault injection (hidden command-line options, tests/hardening).
 struct TestHooks {
@@ -62,8 +65,12 @@ class ShaftTwin {
   ShaftTwin(const ShaftTwin&) = delete;
   ShaftTwin& operator=(const ShaftTwin&) = delete;
 
-  /// Subscribe to the input channels on `lcm` (before the loop starts).
-  void subscribe();
+  /// Subscribe to the input channels (before the loop starts): through
+  /// `router` (the daemon's own udpm receive path, exact names) when given,
+  /// else through LCM (escaped, literal names).
+  void subscribe(InputRouter* router = nullptr);
+  /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
+  void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: wall times are measured from `start`; publishes a
   /// first HOIST_HEALTH at once, the next ones `health_phase` s earlier than
   /// a full period later (the shafts of one daemon spread them out).
@@ -137,6 +144,7 @@ class ShaftTwin {
   std::int64_t other_id_ = 0;          ///< another publisher's instance id
   double other_seen_wall_ = -1.0;      ///< when it was last seen (< 0: not seen)
   int statm_fd_ = -1;
+  const std::int64_t* ignored_counter_ = nullptr;
 
   // preallocated messages and encode buffers
   hoist::winder_t winder_in_;

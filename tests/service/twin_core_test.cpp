@@ -144,13 +144,59 @@ TEST(TwinCoreInput, FollowsTheEncoderAndIntegratesWithoutIt) {
   ASSERT_TRUE(core.onInput(s, 0.1).accepted);
   EXPECT_DOUBLE_EQ(core.output().kin.l, 120.2);
   EXPECT_DOUBLE_EQ(core.output().t, 0.1);
-  // Without the encoder: trapezoidal integration of v from the last length.
+  // Without the encoder: the corrected trapezoid from the last length,
+  // l1 = l0 + h (v0 + v1)/2 + h^2 (a0 - a1)/12 (a consistent v step).
   s.utime += 100000;
   s.seq = 2;
   s.has_length = false;
-  s.v = 4.0;
+  s.v = 2.5;
+  s.a = 5.0;
   ASSERT_TRUE(core.onInput(s, 0.2).accepted);
-  EXPECT_NEAR(core.output().kin.l, 120.2 + 0.1 * 0.5 * (2.0 + 4.0), 1e-12);
+  EXPECT_NEAR(core.output().kin.l, 120.2 + 0.1 * 0.5 * (2.0 + 2.5) + 0.01 * (0.0 - 5.0) / 12.0, 1e-12);
+}
+
+TEST(TwinCoreInput, IntegratedLengthMatchesTheClosedFormOfATripWithAcceleration) {
+  // Issue 11: the twin dropped the h^2 (a0 - a1)/12 term and its test used
+  // a = 0.  A winder without encoder, 100 Hz, on an S-curve trip (constant
+  // jerk phases: the corrected trapezoid is exact) and at 10 Hz on a
+  // trapezoid whose corners fall inside intervals (bounded by h^2/12 per
+  // unit jump of a).  Without the term the first errs by 8e-6 m, the second
+  // by h^2/8 = 1.25e-3 m per corner.
+  TwinConfig cfg = smallConfig();
+  cfg.service.max_step = 0.0;  // the length, not the substeps, is under test
+  {
+    const HoistProfile p = HoistProfile::sCurve(50.0, 5.0, 1.0, 0.5, 250.0, 70.0, 0.01);
+    TwinCore core(cfg, ClockMode::Input);
+    double worst = 0.0;
+    long k = 0;
+    for (const auto& ps : p.samples()) {
+      WinderSample s;
+      s.utime = kT0 + std::llround(ps.t * 1e6);
+      s.seq = k++;
+      s.v = ps.k.v;
+      s.a = ps.k.a;
+      ASSERT_TRUE(core.onInput(s, ps.t).accepted) << ps.t;
+      worst = std::max(worst, std::fabs(core.output().kin.l - ps.k.l));
+    }
+    EXPECT_LT(worst, 1e-8);
+  }
+  {
+    const double h = 0.1;
+    const HoistProfile p = HoistProfile::trapezoid(50.0, 5.05, 1.0, 250.0, 60.0, h);
+    TwinCore core(cfg, ClockMode::Input);
+    double worst = 0.0;
+    long k = 0;
+    for (const auto& ps : p.samples()) {
+      WinderSample s;
+      s.utime = kT0 + std::llround(ps.t * 1e6);
+      s.seq = k++;
+      s.v = ps.k.v;
+      s.a = ps.k.a;
+      ASSERT_TRUE(core.onInput(s, ps.t).accepted) << ps.t;
+      if (ps.t < 6.0) worst = std::max(worst, std::fabs(core.output().kin.l - ps.k.l));
+    }
+    EXPECT_LE(worst, h * h / 12.0);
+  }
 }
 
 TEST(TwinCoreInput, RejectionsLeaveTheModelUntouched) {
