@@ -42,7 +42,7 @@ Verdict InputValidator::check(const WinderSample& s) const {
     return reject(RejectReason::LengthRange);
 
   Verdict ok;
-  if (!have_last_) return ok;
+  if (!have_last_ && !continues(s)) return ok;
   if (s.seq <= last_.seq) return reject(RejectReason::DuplicateSeq);
   if (s.utime <= last_.utime) return reject(RejectReason::TimeBackwards);
   // Difference in double: utimes may be anything an attacker sends.
@@ -71,8 +71,14 @@ double InputValidator::excess(const WinderSample& s, double dt) const {
   return dv - std::clamp(dv, lo, hi);
 }
 
+bool InputValidator::continues(const WinderSample& s) const {
+  if (!soft_ || s.seq <= last_.seq || s.utime <= last_.utime) return false;
+  const double dt = (static_cast<double>(s.utime) - static_cast<double>(last_.utime)) * 1e-6;
+  return dt <= lim_.max_time_step;
+}
+
 void InputValidator::accept(const WinderSample& s) {
-  if (have_last_) {
+  if (have_last_ || continues(s)) {
     const double dt = (static_cast<double>(s.utime) - static_cast<double>(last_.utime)) * 1e-6;
     dv_excess_ += excess(s, dt);
     if (have_lpred_ && !s.has_length) l_pred_ = integrateLength(l_pred_, last_.v, last_.a, s.v, s.a, dt);
@@ -83,7 +89,9 @@ void InputValidator::accept(const WinderSample& s) {
   } else {
     ref_utime_ = s.utime;
     dv_excess_ = 0.0;
+    have_lpred_ = false;
   }
+  soft_ = false;
   if (s.has_length) {
     l_pred_ = s.length;
     have_lpred_ = true;

@@ -41,17 +41,19 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
     case AlarmEventType::Unshelve: verb = "unshelved"; break;
     case AlarmEventType::Reannounce: verb = "still active"; break;
   }
-  char state[160];
-  char shelve[96] = "";
+  char state[96];
+  char shelve[128];
   if (e.type == AlarmEventType::Shelve) {
+    // The verb states the effective duration, and the clamp if there was one.
     const double limit = ctx.alarms ? ctx.alarms->max_shelve : 0.0;
-    if (ctx.requested_shelve > e.shelved_for + 1e-9 && limit > 0.0 && ctx.requested_shelve > limit)
-      std::snprintf(shelve, sizeof shelve, " for %.0f s (requested %g s, clamped to max_shelve = %g s)",
+    if (limit > 0.0 && ctx.requested_shelve > limit)
+      std::snprintf(shelve, sizeof shelve, "shelved for %.0f s (requested %g s, clamped to max_shelve = %g s)",
                     e.shelved_for, ctx.requested_shelve, limit);
     else
-      std::snprintf(shelve, sizeof shelve, " for %.0f s", e.shelved_for);
+      std::snprintf(shelve, sizeof shelve, "shelved for %.0f s", e.shelved_for);
+    verb = shelve;
   }
-  std::snprintf(state, sizeof state, "%s%s%s%s", shelve, e.latched ? " [latched until acknowledged]" : "",
+  std::snprintf(state, sizeof state, "%s%s%s", e.latched ? " [latched until acknowledged]" : "",
                 e.shelved ? " [shelved]" : "", (e.active && !e.acked) ? " [unacknowledged]" : "");
   const char* kind = toString(e.kind);
   const char* level = toString(e.level);

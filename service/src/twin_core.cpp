@@ -293,9 +293,8 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
   for (int attempt = 0; attempt < 2; ++attempt) {
     bool ok = solver_->finite() && !inject_fault_;
     inject_fault_ = false;
-    fault_what_ = "non-finite";
-    fault_value_ = 1.0;
-    fault_limit_ = 0.0;
+    const char* what_now = "non-finite";
+    double value_now = 1.0, limit_now = 0.0;
     if (ok) {
       const CageResponse& r = solver_->response();
       // Finite is not enough: a state beyond the plausibility bound
@@ -303,9 +302,9 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
       double value = 0.0, limit = 0.0;
       if (const char* what = implausible(r, h, bounds_, value, limit)) {
         ok = false;
-        fault_what_ = what;
-        fault_value_ = std::isfinite(value) ? value : 0.0;
-        fault_limit_ = limit;
+        what_now = what;
+        value_now = std::isfinite(value) ? value : 0.0;
+        limit_now = limit;
         counters_.reject(RejectReason::Implausible);
       }
     }
@@ -322,9 +321,9 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
       ok = allFinite(out_);
       if (ok && !(gdef <= bounds_.lateral)) {
         ok = false;
-        fault_what_ = "guide_deflection";
-        fault_value_ = gdef;
-        fault_limit_ = bounds_.lateral;
+        what_now = "guide_deflection";
+        value_now = gdef;
+        limit_now = bounds_.lateral;
         counters_.reject(RejectReason::Implausible);
       }
     }
@@ -341,6 +340,9 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
     // those are bad too).
     ++faults_;
     ++resets_;
+    fault_what_ = what_now;
+    fault_value_ = value_now;
+    fault_limit_ = limit_now;
     alarms_.setModelFaultDetail(fault_value_, fault_limit_);
     alarms_.setModelFault(t, true, events_);
     fault_until_ = t + cfg_.service.fault_hold;

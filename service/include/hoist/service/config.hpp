@@ -55,7 +55,7 @@ struct ServiceConfig {
   /// velocity_tolerance + accel_tolerance x (time since the reference); the
   /// reference moves every consistency_window seconds.
   double accel_tolerance = 1.0;     ///< [m/s^2], (0, 100]
-  double velocity_tolerance = 0.05; ///< [m/s], [0, 10]
+  double velocity_tolerance = 0.02; ///< [m/s], [0, 10]
   double consistency_window = 1.0;  ///< [s], (0, 60]
   /// Outputs beyond plausible_factor x the largest configured gap (and the
   /// force bound of hoist/plausibility.hpp) are a MODEL_FAULT, [2, 1e6].

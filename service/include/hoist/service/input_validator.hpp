@@ -57,7 +57,7 @@ struct InputLimits {
   /// dt max(a0, a1), which covers an acceleration step anywhere inside it) must
   /// stay within velocity_tolerance + accel_tolerance x (t - t_ref).
   double accel_tolerance = 1.0;     ///< [m/s^2]
-  double velocity_tolerance = 0.05; ///< [m/s]
+  double velocity_tolerance = 0.02; ///< [m/s]
   double consistency_window = 1.0;  ///< [s]
 };
 
@@ -76,10 +76,14 @@ class InputValidator {
   Verdict check(const WinderSample& s) const;
   /// Make `s` the reference for the following samples.
   void accept(const WinderSample& s);
-  /// Forget the stream reference (next sample starts a new stream).
+  /// Forget the stream reference (next sample starts a new stream) -- unless
+  /// the next sample continues the old one (sequence and utime after the
+  /// last accepted sample, within max_time_step): then it is still checked
+  /// for consistency against it, so rejected input going stale does not
+  /// open the door to the same inconsistent stream.
   void resync() {
     have_last_ = false;
-    have_lpred_ = false;
+    soft_ = true;
   }
   /// The rope length integrated from v since the last encoder length (valid
   /// when hasLengthPrediction()).
@@ -91,10 +95,13 @@ class InputValidator {
  private:
   /// Excess of the v change over the a-allowed range for `s` after last_.
   double excess(const WinderSample& s, double dt) const;
+  /// After resync(): does `s` continue the old stream?
+  bool continues(const WinderSample& s) const;
 
   InputLimits lim_;
   WinderSample last_;
   bool have_last_ = false;
+  bool soft_ = false;  // resynced, last_ kept for a continuing stream
   // consistency reference
   std::int64_t ref_utime_ = 0;
   double dv_excess_ = 0.0;  // accumulated since ref_utime_ [m/s]
