@@ -41,7 +41,13 @@ bool allFinite(const CageOutput& o) {
          std::isfinite(c.clearance_guide);
 }
 
-double largestGap(const AlarmConfig& a) { return std::max({a.gap_pos_y, a.gap_neg_y, a.guide_rope_gap}); }
+/// The lateral plausibility limit: plausible_factor x the largest gap, but
+/// never below 1 m (hoist-sim's limit): tiny test gaps must raise clearance
+/// alarms, not model faults.
+double lateralLimit(const TwinConfig& c) {
+  return std::max(1.0, c.service.plausible_factor *
+                           std::max({c.alarms.gap_pos_y, c.alarms.gap_neg_y, c.alarms.guide_rope_gap}));
+}
 
 }  // namespace
 
@@ -203,7 +209,7 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
       range_(validLengthRange(cfg.shaft)),
-      bounds_(plausibilityBounds(cfg.shaft, cfg.service.plausible_factor * largestGap(cfg.alarms))) {
+      bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))) {
   cfg_.service.validate();
   if (!range_.contains(cfg_.shaft.l0))
     throw std::invalid_argument("hoisting_rope.initial_length: " + std::to_string(cfg_.shaft.l0) +

@@ -14,7 +14,7 @@
 // Plausibility.  A state can be finite and still nonsense (y_c = -1e159 m).
 // With a lateral limit Y [m] (a cage or guide rope further than Y from its
 // axis has left the shaft; the daemon uses plausible_factor x its largest
-// configured gap, hoist-sim 1 m):
+// configured gap but at least 1 m, hoist-sim 1 m):
 //   |y_c - h theta|, |y_c + h theta|         <= Y
 //   |theta|                                   <= Y / h
 //   |x_c|                                     <= Y + 10 (m g + Fa + rho1 g L) L / EA

@@ -57,8 +57,8 @@ struct ServiceConfig {
   double accel_tolerance = 1.0;     ///< [m/s^2], (0, 100]
   double velocity_tolerance = 0.02; ///< [m/s], [0, 10]
   double consistency_window = 1.0;  ///< [s], (0, 60]
-  /// Outputs beyond plausible_factor x the largest configured gap (and the
-  /// force bound of hoist/plausibility.hpp) are a MODEL_FAULT, [2, 1e6].
+  /// Outputs beyond plausible_factor x the largest configured gap (at least
+  /// 1 m; and the force bound of hoist/plausibility.hpp) are a MODEL_FAULT, [2, 1e6].
   double plausible_factor = 10.0;
   /// With --clock wall a tick integrates at most this many periods of model
   /// time at full accuracy; a longer gap (the loop was late) is crossed with
