@@ -9,7 +9,7 @@
 #include <string_view>
 
 #include "hoist/io/config.hpp"
-#include "hoist/service/config.hpp"
+#include "hoist/service/config_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

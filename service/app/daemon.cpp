@@ -12,7 +12,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
 
 namespace hoist::svc {
 
@@ -66,11 +66,11 @@ bool Daemon::start() {
   if (!lcm_.good()) {
     out_->error("cannot open LCM at {}; for multicast on one machine see docs/service.md "
                 "(ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo)",
-                describeLcmUrl(opt_.lcm_url));
+                bus::describeLcmUrl(opt_.lcm_url));
     return false;
   }
   if (lcm_out_ && !lcm_out_->good()) {
-    out_->error("cannot open the LCM output URL {} ([service] lcm_url_out)", describeLcmUrl(opt_.lcm_url_out));
+    out_->error("cannot open the LCM output URL {} ([service] lcm_url_out)", bus::describeLcmUrl(opt_.lcm_url_out));
     return false;
   }
   rt_ = applyRealtime(opt_.realtime);
@@ -85,7 +85,7 @@ bool Daemon::start() {
   if (parseUdpmUrl(opt_.lcm_url, udpm, why)) {
     receiver_ = std::make_unique<UdpmReceiver>();
     if (!receiver_->open(udpm, why)) {
-      out_->error("cannot open the LCM input socket for {}: {}", describeLcmUrl(opt_.lcm_url), why);
+      out_->error("cannot open the LCM input socket for {}: {}", bus::describeLcmUrl(opt_.lcm_url), why);
       return false;
     }
     for (auto& s : shafts_) {
@@ -121,8 +121,8 @@ bool Daemon::start() {
     out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}{}{}, input {}, outputs {} {} {} {}, "
                "n={} modes, L={} m, h={} m, l0={} m, instance {}",
                s.tag(), n == 1 ? "started" : "shaft",
-               toString(c.service.clock), c.service.rate, describeLcmUrl(opt_.lcm_url),
-               lcm_out_ ? ", outputs to " : "", lcm_out_ ? describeLcmUrl(opt_.lcm_url_out) : std::string(),
+               toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url),
+               lcm_out_ ? ", outputs to " : "", lcm_out_ ? bus::describeLcmUrl(opt_.lcm_url_out) : std::string(),
                s.channels().winder, s.channels().cage, s.channels().shape, s.channels().alarm,
                s.channels().health, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
   }

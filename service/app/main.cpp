@@ -21,8 +21,9 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
+#include "hoist/bus/lcm_util.hpp"
 #include "hoist/service/budget.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/service/config_file.hpp"
 
 int main(int argc, char** argv) {
   using namespace hoist::svc;
@@ -137,7 +138,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  opt.lcm_url = resolveLcmUrl(lcm_url, shaft_url);
+  opt.lcm_url = hoist::bus::resolveLcmUrl(lcm_url, shaft_url);
   for (std::size_t i = 1; i < opt.shafts.size(); ++i)
     if (opt.shafts[i].service.lcm_url_out != opt.shafts[0].service.lcm_url_out) {
       std::cerr << "hoist-twind: configuration error: " << config_paths[i] << ": service.lcm_url_out: \""

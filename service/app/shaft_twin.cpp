@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 #include "hoist/alarm_ack_t.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
 #include "hoist/service/messages.hpp"
 #include "hoist/service/winder_decode.hpp"
 
@@ -297,7 +297,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
                   tag_, cfg_.service.max_catchup_periods, suppressed);
     }
     if (r.stepped && core_.hasInput()) {
-      const std::int64_t utime = wallUtime();
+      const std::int64_t utime = bus::wallUtime();
       if (k % cage_div_ == 0) publishCage(utime);
       if (cfg_.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime);
     }
@@ -374,7 +374,7 @@ void ShaftTwin::publishShape(std::int64_t utime) {
 void ShaftTwin::drainAlarmEvents() {
   const AlarmEvents& ev = core_.events();
   if (ev.empty()) return;
-  const std::int64_t utime = wallUtime();
+  const std::int64_t utime = bus::wallUtime();
   AlarmTextContext ctx;
   ctx.alarms = &cfg_.alarms;
   ctx.stale_timeout = core_.staleTimeout();
@@ -419,7 +419,7 @@ void ShaftTwin::publishHealth(bool final_report) {
   const double wall = wallNow();
   const InputCounters& c = core_.counters();
   const AlarmEngine& al = core_.alarms();
-  health_msg_.utime = wallUtime();
+  health_msg_.utime = bus::wallUtime();
   health_msg_.uptime = std::max(0.0, wall);
   health_msg_.t = core_.publishedTime(core_.modelTime());
   health_msg_.window = std::max(0.0, wall - std::max(0.0, last_health_wall_));

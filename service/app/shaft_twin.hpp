@@ -24,6 +24,7 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/bus/channels.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/health.hpp"
 #include "hoist/service/twin_core.hpp"
@@ -85,7 +86,7 @@ class ShaftTwin {
   void logFinal();
 
   const TwinConfig& config() const { return cfg_; }
-  const Channels& channels() const { return ch_; }
+  const bus::Channels& channels() const { return ch_; }
   const std::string& label() const { return label_; }
   /// "[label] " for log lines, "" for a daemon with one shaft.
   const std::string& tag() const { return tag_; }
@@ -114,7 +115,7 @@ class ShaftTwin {
   std::int64_t instance_id_ = 0;
   RtLog& log_;
   TestHooks hooks_;
-  Channels ch_;
+  bus::Channels ch_;
   TwinCore core_;
 
   Clock::time_point start_{};

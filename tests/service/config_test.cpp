@@ -1,7 +1,8 @@
 // [service] and [alarms] parsing: defaults, errors naming file:line and key.
 #include <gtest/gtest.h>
 
-#include "hoist/service/config.hpp"
+#include "hoist/bus/channels.hpp"
+#include "hoist/service/config_file.hpp"
 
 using namespace hoist::svc;
 
@@ -117,11 +118,13 @@ TEST(ServiceConfig, PrintedConfigParsesBack) {
 }
 
 TEST(Channels, Prefix) {
-  const Channels ch("A_");
+  const hoist::bus::Channels ch("A_");
   EXPECT_EQ(ch.winder, "A_HOIST_WINDER");
   EXPECT_EQ(ch.cage, "A_HOIST_CAGE");
   EXPECT_EQ(ch.shape, "A_HOIST_GUIDE_SHAPE");
   EXPECT_EQ(ch.alarm, "A_HOIST_ALARM");
   EXPECT_EQ(ch.ack, "A_HOIST_ALARM_ACK");
   EXPECT_EQ(ch.health, "A_HOIST_HEALTH");
+  EXPECT_EQ(hoist::bus::channel("north/", hoist::bus::kChannelCage), "north/HOIST_CAGE");
+  EXPECT_EQ(hoist::bus::Channels().winder, "HOIST_WINDER");
 }

@@ -17,7 +17,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "hoist/alarm_ack_t.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/channels.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"hoist-alarm-ack: acknowledge, shelve or unshelve hoist-twind alarms (one HOIST_ALARM_ACK message)",
@@ -58,14 +59,14 @@ int main(int argc, char** argv) {
                       : (shelve > 0 ? hoist::alarm_ack_t::ACTION_SHELVE : hoist::alarm_ack_t::ACTION_ACK);
   m.shelve_duration = shelve;
   m.user = user;
-  url = hoist::svc::resolveLcmUrl(url);
+  url = hoist::bus::resolveLcmUrl(url);
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::cerr << "hoist-alarm-ack: cannot open LCM (" << (url.empty() ? "default URL" : url)
               << "); is loopback multicast enabled? (scripts/setup.sh)\n";
     return 1;
   }
-  const std::string channel = prefix + "HOIST_ALARM_ACK";
+  const std::string channel = hoist::bus::channel(prefix, hoist::bus::kChannelAlarmAck);
   if (lcm.publish(channel, &m) != 0) {
     std::cerr << "hoist-alarm-ack: publish on " << channel << " failed\n";
     return 1;

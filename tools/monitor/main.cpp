@@ -24,7 +24,8 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/channels.hpp"
 
 namespace {
 
@@ -107,17 +108,18 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  url = hoist::svc::resolveLcmUrl(url);
+  url = hoist::bus::resolveLcmUrl(url);
   lcm::LCM lcm(url);
   if (!lcm.good()) {
-    std::fprintf(stderr, "hoist-monitor: cannot open LCM at %s\n", hoist::svc::describeLcmUrl(url).c_str());
+    std::fprintf(stderr, "hoist-monitor: cannot open LCM at %s\n", hoist::bus::describeLcmUrl(url).c_str());
     return 1;
   }
   Monitor mon;
-  mon.cage_channel_ = prefix + "HOIST_CAGE";
-  lcm.subscribe(prefix + "HOIST_CAGE", &Monitor::onCage, &mon);
-  lcm.subscribe(prefix + "HOIST_ALARM", &Monitor::onAlarm, &mon);
-  lcm.subscribe(prefix + "HOIST_HEALTH", &Monitor::onHealth, &mon);
+  const hoist::bus::Channels ch(prefix);
+  mon.cage_channel_ = ch.cage;
+  lcm.subscribe(ch.cage, &Monitor::onCage, &mon);
+  lcm.subscribe(ch.alarm, &Monitor::onAlarm, &mon);
+  lcm.subscribe(ch.health, &Monitor::onHealth, &mon);
   struct sigaction sa {};
   sa.sa_handler = onSignal;
   sigaction(SIGINT, &sa, nullptr);

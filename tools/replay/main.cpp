@@ -41,7 +41,8 @@
 #include <vector>
 
 #include "hoist/io/profile.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/channels.hpp"
 #include "hoist/winder_t.hpp"
 #include "hoist/io/config.hpp"
 #include "timing_test.hpp"
@@ -224,7 +225,7 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
 
-  url = hoist::svc::resolveLcmUrl(url);
+  url = hoist::bus::resolveLcmUrl(url);
   if (timing) {
     hoist::replay::TimingTestOptions o;
     if (!(rate >= 1.0 && rate <= 1000.0)) {
@@ -283,17 +284,17 @@ int main(int argc, char** argv) {
   const std::string prefix = prefixes.empty() ? std::string() : prefixes.front();
   lcm::LCM lcm(url);
   if (!lcm.good()) {
-    std::cerr << "hoist-replay: cannot open LCM at " << hoist::svc::describeLcmUrl(url) << "\n";
+    std::cerr << "hoist-replay: cannot open LCM at " << hoist::bus::describeLcmUrl(url) << "\n";
     return 1;
   }
-  const std::string channel = prefix + "HOIST_WINDER";
+  const std::string channel = hoist::bus::channel(prefix, hoist::bus::kChannelWinder);
   struct sigaction sa {};
   sa.sa_handler = onSignal;  // no SA_RESTART: interrupt the sleep
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   Progress progress(!quiet && isatty(STDERR_FILENO));
   const std::int64_t start_ns = monotonicNs();
-  const std::int64_t start_utime = hoist::svc::wallUtime();
+  const std::int64_t start_utime = hoist::bus::wallUtime();
   long sent = 0, failed = 0;
   std::vector<std::uint8_t> buf(256);
   hoist::winder_t msg{};
@@ -308,7 +309,7 @@ int main(int argc, char** argv) {
     bool first = true;
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
       if (g_signal) break;
-      if (!endsWith(ev->channel, "HOIST_WINDER")) continue;
+      if (!endsWith(ev->channel, std::string(hoist::bus::kChannelWinder))) continue;
       if (first) {
         first_ts = ev->timestamp;
         first = false;

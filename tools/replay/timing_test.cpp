@@ -28,7 +28,8 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/profile.hpp"
-#include "hoist/service/lcm_util.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/channels.hpp"
 #include "hoist/winder_t.hpp"
 #include "timing_test.hpp"
 
@@ -130,7 +131,7 @@ struct Feeder {
       : o(opt), lcm(l), trip(rt), rings(r), sent(new std::atomic<std::int64_t>[opt.prefixes.size()]),
         failed(opt.prefixes.size(), 0) {
     for (std::size_t i = 0; i < o.prefixes.size(); ++i) {
-      channels.push_back(o.prefixes[i] + "HOIST_WINDER");
+      channels.push_back(hoist::bus::channel(o.prefixes[i], hoist::bus::kChannelWinder));
       sent[i].store(0);
     }
   }
@@ -176,7 +177,7 @@ struct Feeder {
       msg.a = kin.a;
       msg.length = kin.l;
       for (std::size_t i = 0; i < channels.size(); ++i) {
-        const std::int64_t utime = hoist::svc::wallUtime();
+        const std::int64_t utime = hoist::bus::wallUtime();
         msg.utime = utime;
         msg.seq = seq[i];
         const int len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
@@ -364,7 +365,7 @@ int runTimingTest(const TimingTestOptions& o) {
 
   lcm::LCM rx(o.lcm_url), tx(o.lcm_url);
   if (!rx.good() || !tx.good()) {
-    std::cerr << "hoist-replay: cannot open LCM at " << hoist::svc::describeLcmUrl(o.lcm_url) << "\n";
+    std::cerr << "hoist-replay: cannot open LCM at " << hoist::bus::describeLcmUrl(o.lcm_url) << "\n";
     return 1;
   }
   const RoundTrip trip(o.l0, o.travel, o.vmax, o.amax);
@@ -383,8 +384,8 @@ int runTimingTest(const TimingTestOptions& o) {
     run.shafts.push_back(std::move(s));
   }
   for (auto& s : run.shafts) {
-    rx.subscribe(escapeRegex(s->res.prefix + "HOIST_HEALTH"), &Shaft::onHealth, s.get());
-    rx.subscribe(escapeRegex(s->res.prefix + "HOIST_CAGE"), &Shaft::onCage, s.get());
+    rx.subscribe(escapeRegex(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth)), &Shaft::onHealth, s.get());
+    rx.subscribe(escapeRegex(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage)), &Shaft::onCage, s.get());
   }
 
   struct sigaction sa {};
@@ -412,9 +413,9 @@ int runTimingTest(const TimingTestOptions& o) {
   };
 
   // 1. Every daemon must be there: its first HOIST_HEALTH is the baseline.
-  say("timing test: waiting for HOIST_HEALTH on " + o.prefixes.front() + "HOIST_HEALTH" +
+  say("timing test: waiting for HOIST_HEALTH on " + hoist::bus::channel(o.prefixes.front(), hoist::bus::kChannelHealth) +
       (o.prefixes.size() > 1 ? " and " + std::to_string(o.prefixes.size() - 1) + " more" : std::string()) +
-      " (LCM " + hoist::svc::describeLcmUrl(o.lcm_url) + ")");
+      " (LCM " + hoist::bus::describeLcmUrl(o.lcm_url) + ")");
   auto allHeard = [&] {
     for (auto& s : run.shafts)
       if (!s->have_base) return false;
@@ -451,7 +452,7 @@ int runTimingTest(const TimingTestOptions& o) {
                   o.rate, o.duration);
     say(line);
   }
-  run.feed_start_utime = hoist::svc::wallUtime();
+  run.feed_start_utime = hoist::bus::wallUtime();
   run.phase = Phase::Feeding;
   std::thread th;
   {

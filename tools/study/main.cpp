@@ -27,10 +27,8 @@
 #include "hoist/study/sweep.hpp"
 #include "output.hpp"
 
-#ifdef HOIST_STUDY_HAVE_IO
 #include "hoist/io/config.hpp"
 #include "hoist/io/profile.hpp"
-#endif
 
 namespace fs = std::filesystem;
 using namespace hoist;
@@ -155,7 +153,6 @@ std::pair<double, double> parseRange(const std::string& opt, const std::string& 
   }
 }
 
-#ifdef HOIST_STUDY_HAVE_IO
 // hoist_io's errors (ConfigError) already name file:line:key.
 ShaftParams studyLoadConfig(const std::string& path) {
   try {
@@ -173,16 +170,11 @@ HoistProfile studyLoadProfile(const std::string& spec, const ShaftParams& p) {
     throw UsageError(std::string("--profile: ") + e.what());
   }
 }
-#endif
 
 ShaftParams loadParams(const Common& c) {
   ShaftParams p;
   if (!c.config.empty()) {
-#ifdef HOIST_STUDY_HAVE_IO
     p = studyLoadConfig(c.config);  // throws UsageError naming file:line:key
-#else
-    throw UsageError("--config: this build has no config loader (tools/io / hoist_io is not built)");
-#endif
   }
   if (c.modes > 0) p.n = c.modes;
   if (c.initial == "rest") p.initial = InitialState::Rest;
@@ -198,12 +190,7 @@ ShaftParams loadParams(const Common& c) {
 HoistProfile loadProfile(const Common& c, const ShaftParams& p) {
   if (c.profile.empty() || c.profile == "paper" || c.profile == "trapezoid")
     return HoistProfile::trapezoid(p.l0);
-#ifdef HOIST_STUDY_HAVE_IO
   return studyLoadProfile(c.profile, p);  // throws UsageError
-#else
-  throw UsageError("--profile '" + c.profile +
-                   "': this build reads only the built-in 'trapezoid' (tools/io / hoist_io is not built)");
-#endif
 }
 
 RunOptions runOptions(const Common& c, const ShaftParams& p) {

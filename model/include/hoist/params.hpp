@@ -1,6 +1,6 @@
 // hoist/params.hpp -- every symbol of Wang et al. (2016), Section 2-3, as one
 // validated value type.  SI units throughout.  No I/O here: loading from TOML
-// lives in tools/io (hoist_io); this header only states and checks values.
+// lives in io/ (hoist_io); this header only states and checks values.
 //
 // Symbols (paper -> field):
 //   rho1 -> rho1      hoisting-rope mass per length           [kg/m]

@@ -1,5 +1,7 @@
-// hoist/service/config.hpp -- the daemon's configuration: the shaft TOML
-// (sections of INTERFACES.md, parsed by hoist_io) plus [service] and [alarms].
+// hoist/service/config.hpp -- the daemon's configuration as plain structs:
+// the shaft (ShaftParams) plus [service] and [alarms].  No parser here: the
+// I/O-free TwinCore sees only these structs.  Reading them from TOML is
+// hoist/service/config_file.hpp (target hoist_service_cfg, via hoist_io).
 // Every key is optional; a missing key takes the default below (the shaft's
 // defaults are the paper's values).  Unknown keys, wrong types, non-finite or
 // out-of-range values are errors naming the file, line and dotted key.
@@ -7,8 +9,6 @@
 
 #include <stdexcept>
 #include <string>
-
-#include <toml++/toml.h>
 
 #include "hoist/params.hpp"
 #include "hoist/service/alarms.hpp"
@@ -87,21 +87,7 @@ class ConfigError : public std::runtime_error {
   std::string key_;
 };
 
-/// Parse [service] and [alarms] from `tbl` into `cfg` (other sections are
-/// ignored here).  Throws ConfigError.
-void parseServiceSections(const toml::table& tbl, const std::string& source, TwinConfig& cfg);
-
-/// The whole configuration from a TOML file (shaft sections through hoist_io,
-/// plus [service] and [alarms]).  Throws (ConfigError or hoist_io's error).
-TwinConfig loadTwinConfig(const std::string& path);
-
 /// The effective configuration as TOML (for --print-config).
 std::string toToml(const TwinConfig& cfg);
-
-/// Channel names with the configured prefix.
-struct Channels {
-  std::string winder, cage, shape, alarm, ack, health;
-  explicit Channels(const std::string& prefix = "");
-};
 
 }  // namespace hoist::svc

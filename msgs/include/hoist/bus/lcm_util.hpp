@@ -1,5 +1,8 @@
-// hoist/service/lcm_util.hpp -- small helpers shared by every LCM program of
-// the project (hoist-twind, hoist-replay, hoist-monitor, tests).
+// hoist/bus/lcm_util.hpp -- small helpers shared by every LCM program of
+// the project (hoist-twind, hoist-replay, hoist-monitor, hoist-alarm-ack,
+// tests).  Part of the hoist_lcm target (msgs/CMakeLists.txt).
+// Namespace hoist::bus, not hoist::lcm: inside namespace hoist a
+// hoist::lcm would hide LCM's own ::lcm (lcm::LCM, lcm::ReceiveBuffer).
 #pragma once
 
 #include <chrono>
@@ -7,7 +10,7 @@
 #include <cstdlib>
 #include <string>
 
-namespace hoist::svc {
+namespace hoist::bus {
 
 /// The LCM URL to use, by precedence: --lcm-url (cli), the LCM_DEFAULT_URL
 /// environment variable, the config file's [service].lcm_url, LCM's default
@@ -29,4 +32,4 @@ inline std::int64_t wallUtime() {
   return duration_cast<microseconds>(system_clock::now().time_since_epoch()).count();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::bus

@@ -1,0 +1,41 @@
+// hoist/bus/channels.hpp -- the LCM channel names of INTERFACES.md (contract:
+// the names are exact).  Every program that publishes or subscribes uses these
+// instead of spelling the strings; a configured prefix ([service]
+// channel_prefix, --channel-prefix) is prepended to every name.
+// Part of the hoist_lcm target (msgs/CMakeLists.txt).
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace hoist::bus {
+
+inline constexpr std::string_view kChannelWinder = "HOIST_WINDER";         ///< winder_t, into the twin
+inline constexpr std::string_view kChannelCage = "HOIST_CAGE";             ///< cage_state_t, out
+inline constexpr std::string_view kChannelGuideShape = "HOIST_GUIDE_SHAPE";  ///< guide_shape_t, out
+inline constexpr std::string_view kChannelAlarm = "HOIST_ALARM";           ///< alarm_t, out
+inline constexpr std::string_view kChannelAlarmAck = "HOIST_ALARM_ACK";    ///< alarm_ack_t, into the twin
+inline constexpr std::string_view kChannelHealth = "HOIST_HEALTH";         ///< health_t, out
+
+/// prefix + name, e.g. channel("north/", kChannelCage) == "north/HOIST_CAGE".
+inline std::string channel(std::string_view prefix, std::string_view name) {
+  std::string s;
+  s.reserve(prefix.size() + name.size());
+  s.append(prefix);
+  s.append(name);
+  return s;
+}
+
+/// All channel names of one shaft with its prefix.
+struct Channels {
+  std::string winder, cage, shape, alarm, ack, health;
+  explicit Channels(std::string_view prefix = "")
+      : winder(channel(prefix, kChannelWinder)),
+        cage(channel(prefix, kChannelCage)),
+        shape(channel(prefix, kChannelGuideShape)),
+        alarm(channel(prefix, kChannelAlarm)),
+        ack(channel(prefix, kChannelAlarmAck)),
+        health(channel(prefix, kChannelHealth)) {}
+};
+
+}  // namespace hoist::bus

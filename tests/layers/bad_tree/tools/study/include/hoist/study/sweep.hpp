@@ -1,0 +1,1 @@
+// fixture: a tools/ header (tests/layers/check_layers_selftest.cmake)

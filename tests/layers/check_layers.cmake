@@ -1,0 +1,108 @@
+# check_layers.cmake -- the two main layer rules of the README's Development
+# section, run as a CTest test (tests/layers/CMakeLists.txt):
+#   1. hoist_model links nothing but Eigen (MODEL_LINKS: its LINK_LIBRARIES and
+#      INTERFACE_LINK_LIBRARIES, '|'-separated, read at configure time);
+#   2. nothing under service/ or io/ includes a header from tools/: no include
+#      path naming tools/, and no include that resolves only to a header under
+#      tools/ (e.g. "hoist/study/sweep.hpp" or "timing_report.hpp").
+# Also: model/ includes only its own headers and system/Eigen headers.
+#   cmake -DROOT=<source dir> -DMODEL_LINKS='Eigen3::Eigen' -P check_layers.cmake
+# Prints "LAYER VIOLATION: ..." for each broken rule and fails.
+cmake_minimum_required(VERSION 3.20)
+if(NOT DEFINED ROOT OR NOT IS_DIRECTORY "${ROOT}")
+  message(FATAL_ERROR "check_layers: -DROOT=<source dir> is required")
+endif()
+set(_violations 0)
+macro(_violation msg)
+  message("LAYER VIOLATION: ${msg}")
+  math(EXPR _violations "${_violations} + 1")
+endmacro()
+
+# ---- rule 1: hoist_model links Eigen only --------------------------------
+string(REPLACE "|" ";" _links "${MODEL_LINKS}")
+foreach(l IN LISTS _links)
+  # $<LINK_ONLY:X> and similar wrappers: judge the target inside.
+  string(REGEX REPLACE "^\\$<[A-Z_]+:(.*)>$" "\\1" l "${l}")
+  if(l STREQUAL "" OR l MATCHES "^Eigen3::Eigen$")
+    continue()
+  endif()
+  _violation("hoist_model links '${l}' (only Eigen3::Eigen is allowed)")
+endforeach()
+
+# ---- the headers of tools/, by every name they can be included as ----------
+file(GLOB_RECURSE _tool_headers LIST_DIRECTORIES false RELATIVE "${ROOT}/tools"
+     "${ROOT}/tools/*.hpp" "${ROOT}/tools/*.h")
+set(_tool_names "")
+foreach(h IN LISTS _tool_headers)
+  get_filename_component(_name "${h}" NAME)
+  list(APPEND _tool_names "${_name}")
+  if(h MATCHES "^[^/]+/include/(.+)$")          # tools/<x>/include/hoist/...
+    list(APPEND _tool_names "${CMAKE_MATCH_1}")
+  endif()
+  if(h MATCHES "^[^/]+/(.+)$")                  # relative to tools/<x>/
+    list(APPEND _tool_names "${CMAKE_MATCH_1}")
+  endif()
+endforeach()
+list(REMOVE_DUPLICATES _tool_names)
+
+# Include directories a service/ or io/ file may legitimately reach.
+set(_allowed_dirs "${ROOT}/model/include" "${ROOT}/io/include" "${ROOT}/msgs/include"
+                  "${ROOT}/service/include" "${ROOT}/service/app")
+
+function(_includes file out)
+  file(STRINGS "${file}" _lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]")
+  set(_incs "")
+  foreach(line IN LISTS _lines)
+    if(line MATCHES "^[ \t]*#[ \t]*include[ \t]*[<\"]([^>\"]+)[>\"]")
+      list(APPEND _incs "${CMAKE_MATCH_1}")
+    endif()
+  endforeach()
+  set(${out} "${_incs}" PARENT_SCOPE)
+endfunction()
+
+# ---- rule 2: service/ and io/ include nothing from tools/ ------------------
+foreach(layer service io)
+  file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/${layer}/*.hpp" "${ROOT}/${layer}/*.h"
+       "${ROOT}/${layer}/*.cpp")
+  foreach(f IN LISTS _files)
+    file(RELATIVE_PATH _rel "${ROOT}" "${f}")
+    get_filename_component(_dir "${f}" DIRECTORY)
+    _includes("${f}" _incs)
+    foreach(inc IN LISTS _incs)
+      if(inc MATCHES "(^|/)tools/")
+        _violation("${_rel} includes \"${inc}\" (a path into tools/)")
+        continue()
+      endif()
+      if(NOT inc IN_LIST _tool_names)
+        continue()
+      endif()
+      set(_found FALSE)
+      foreach(d IN LISTS _allowed_dirs _dir)
+        if(EXISTS "${d}/${inc}")
+          set(_found TRUE)
+        endif()
+      endforeach()
+      if(NOT _found)
+        _violation("${_rel} includes \"${inc}\", a header of tools/")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+
+# ---- model/ includes only itself (and Eigen / the standard library) --------
+file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/model/*.hpp" "${ROOT}/model/*.cpp")
+foreach(f IN LISTS _files)
+  file(RELATIVE_PATH _rel "${ROOT}" "${f}")
+  get_filename_component(_dir "${f}" DIRECTORY)
+  _includes("${f}" _incs)
+  foreach(inc IN LISTS _incs)
+    if(inc MATCHES "^hoist/" AND NOT EXISTS "${ROOT}/model/include/${inc}" AND NOT EXISTS "${_dir}/${inc}")
+      _violation("${_rel} includes \"${inc}\", which is not a model header")
+    endif()
+  endforeach()
+endforeach()
+
+if(_violations GREATER 0)
+  message(FATAL_ERROR "check_layers: ${_violations} layer violation(s); see README.md, Development")
+endif()
+message("check_layers: OK (hoist_model links: ${MODEL_LINKS}; no tools/ header in service/ or io/)")

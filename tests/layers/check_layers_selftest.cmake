@@ -1,0 +1,27 @@
+# check_layers_selftest.cmake -- shows that check_layers.cmake can fail: run
+# it on tests/layers/bad_tree (a miniature source tree breaking every rule)
+# and with a model that links spdlog; it must exit non-zero and name each
+# violation.  cmake -DCHECK=<check_layers.cmake> -DFIXTURE=<bad_tree> -P ...
+execute_process(
+  COMMAND ${CMAKE_COMMAND} -DROOT=${FIXTURE} "-DMODEL_LINKS=Eigen3::Eigen|spdlog::spdlog" -P ${CHECK}
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+set(out "${out}${err}")
+if(rc EQUAL 0)
+  message(FATAL_ERROR "check_layers passed a tree that breaks the rules:\n${out}")
+endif()
+foreach(expected
+    "hoist_model links 'spdlog::spdlog'"
+    "service/src/bad.cpp includes \"hoist/study/sweep.hpp\", a header of tools/"
+    "io/src/bad.cpp includes \"../../tools/replay/timing_report.hpp\" \\(a path into tools/\\)"
+    "model/src/bad.cpp includes \"hoist/io/config.hpp\", which is not a model header")
+  if(NOT out MATCHES "LAYER VIOLATION: ${expected}")
+    message(FATAL_ERROR "check_layers did not report: ${expected}\noutput:\n${out}")
+  endif()
+endforeach()
+foreach(ok "hoist/params.hpp\"," "<string>")
+  string(FIND "${out}" "${ok}" pos)
+  if(NOT pos EQUAL -1)
+    message(FATAL_ERROR "check_layers flagged an allowed include (${ok}):\n${out}")
+  endif()
+endforeach()
+message("check_layers_selftest: OK (4 violations reported, allowed includes not flagged)")
