@@ -27,9 +27,7 @@ HoistProfile HoistProfile::fromVelocity(const std::vector<double>& t, const std:
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (i > 0) {
       const double dt = t[i] - t[i - 1];
-      // Exact for a cubic l whose derivative is the linear-in-a Hermite of v:
-      // l1 = l0 + dt (v0 + v1)/2 + dt^2 (a0 - a1)/12.
-      l += dt * 0.5 * (v[i - 1] + v[i]) + dt * dt * (a[i - 1] - a[i]) / 12.0;
+      l = integrateLength(l, v[i - 1], a[i - 1], v[i], a[i], dt);
     }
     s[i] = {t[i], {l, v[i], a[i]}};
   }
@@ -47,14 +45,34 @@ Kinematics HoistProfile::at(double t) const {
   const double dt = s1.t - s0.t;
   const double u = (t - s0.t) / dt;
   if (u == 0.0) return s0.k;
+  return interpolate(s0.k, s1.k, dt, u);
+}
+
+Kinematics interpolate(const Kinematics& k0, const Kinematics& k1, double h, double u) {
   Kinematics k;
-  k.v = s0.k.v + u * (s1.k.v - s0.k.v);
-  k.a = s0.k.a + u * (s1.k.a - s0.k.a);
+  k.v = k0.v + u * (k1.v - k0.v);
+  k.a = k0.a + u * (k1.a - k0.a);
   // Cubic Hermite on (l, v) at both ends.
   const double h00 = (1 + 2 * u) * (1 - u) * (1 - u), h10 = u * (1 - u) * (1 - u);
   const double h01 = u * u * (3 - 2 * u), h11 = u * u * (u - 1);
-  k.l = h00 * s0.k.l + h10 * dt * s0.k.v + h01 * s1.k.l + h11 * dt * s1.k.v;
+  k.l = h00 * k0.l + h10 * h * k0.v + h01 * k1.l + h11 * h * k1.v;
   return k;
+}
+
+double integrateLength(double l0, double v0, double a0, double v1, double a1, double h) {
+  return l0 + h * 0.5 * (v0 + v1) + h * h * (a0 - a1) / 12.0;
+}
+
+int substepCount(double interval, double max_step, int limit) {
+  if (!(max_step >= 0.0) || !std::isfinite(max_step))
+    throw std::invalid_argument("max_step must be a finite number >= 0");
+  if (max_step == 0.0 || !(interval > max_step)) return 1;
+  const double c = std::ceil(interval / max_step - 1e-9);
+  if (!(c <= static_cast<double>(limit)))
+    throw std::invalid_argument("max_step " + std::to_string(max_step) + " s needs " + std::to_string(c) +
+                                " substeps for an interval of " + std::to_string(interval) + " s (limit " +
+                                std::to_string(limit) + ")");
+  return static_cast<int>(c);
 }
 
 namespace {

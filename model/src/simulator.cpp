@@ -66,11 +66,12 @@ double maxGuideRopeDeflection(const Solver& s, int samples) {
 int substepsFor(const SimulationOptions& opt) {
   if (!(opt.max_step >= 0.0) || !std::isfinite(opt.max_step))
     throw std::invalid_argument("simulate: max_step must be >= 0");
-  if (opt.max_step == 0.0 || opt.max_step >= opt.dt) return 1;
-  const double r = opt.dt / opt.max_step;
-  const double c = std::ceil(r - 1e-9);
-  if (c > 1e6) throw std::invalid_argument("simulate: dt / max_step exceeds 1e6 substeps");
-  return static_cast<int>(c);
+  if (opt.max_step >= opt.dt) return 1;
+  try {
+    return substepCount(opt.dt, opt.max_step, 1000000);
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument("simulate: dt / max_step exceeds 1e6 substeps");
+  }
 }
 
 void simulate(Solver& solver, const HoistProfile& profile, const SimulationOptions& opt,

@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 #include <systemd/sd-daemon.h>
 #include <thread>
+#include <random>
+#include <sstream>
 #include <unistd.h>
 
 #include "hoist/bus/lcm_util.hpp"
@@ -28,13 +30,22 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
       log_(out_, 4096),
       lcm_(opt_.lcm_url),
       lcm_fd_(io_),
-      signals_(io_, SIGINT, SIGTERM) {
+      signals_(io_) {
   if (opt_.shafts.empty()) throw std::invalid_argument("no shaft configured");
+  for (int sig : {SIGINT, SIGTERM, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) signals_.add(sig);
+  {
+    std::random_device rd;
+    instance_id_ = static_cast<std::int64_t>(((static_cast<std::uint64_t>(rd()) << 32) ^ rd()) >> 1);
+    if (instance_id_ == 0) instance_id_ = 1;
+  }
+  if (!opt_.lcm_url_out.empty() && opt_.lcm_url_out != opt_.lcm_url)
+    lcm_out_ = std::make_unique<lcm::LCM>(opt_.lcm_url_out);
   opt_.labels.resize(opt_.shafts.size());
   // One ShaftTwin per configuration, one schedule (timer) per distinct rate.
   std::map<double, RateGroup*> by_rate;
   for (std::size_t i = 0; i < opt_.shafts.size(); ++i) {
-    shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, opt_.hooks));
+    shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, opt_.hooks,
+                                                  instance_id_, lcm_out_.get()));
     const double rate = opt_.shafts[i].service.rate;
     RateGroup*& g = by_rate[rate];
     if (!g) {
@@ -63,11 +74,34 @@ bool Daemon::start() {
                 bus::describeLcmUrl(opt_.lcm_url));
     return false;
   }
+  if (lcm_out_ && !lcm_out_->good()) {
+    out_->error("cannot open the LCM output URL {} ([service] lcm_url_out)", bus::describeLcmUrl(opt_.lcm_url_out));
+    return false;
+  }
   rt_ = applyRealtime(opt_.realtime);
   (rt_.all_granted ? out_->info("real-time settings: {}", rt_.summary())
                    : out_->warn("real-time settings: {} (running without them)", rt_.summary()));
-  for (auto& s : shafts_) s->subscribe();
-  lcm_fd_.assign(lcm_.getFileno());
+  // udpm:// (and LCM's default): our own receive path, which dispatches only
+  // the subscribed channels by exact name and stores nothing per channel
+  // name seen (LCM 1.3.1 would; udpm_receiver.hpp).  Other providers go
+  // through LCM (literal names, regex-escaped).
+  UdpmUrl udpm;
+  std::string why;
+  if (parseUdpmUrl(opt_.lcm_url, udpm, why)) {
+    receiver_ = std::make_unique<UdpmReceiver>();
+    if (!receiver_->open(udpm, why)) {
+      out_->error("cannot open the LCM input socket for {}: {}", bus::describeLcmUrl(opt_.lcm_url), why);
+      return false;
+    }
+    for (auto& s : shafts_) {
+      s->subscribe(receiver_.get());
+      s->setIgnoredCounter(&ignored_);
+    }
+    lcm_fd_.assign(receiver_->fd());
+  } else {
+    for (auto& s : shafts_) s->subscribe();
+    lcm_fd_.assign(lcm_.getFileno());
+  }
   armLcm();
   // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
   // never receives them.
@@ -76,12 +110,9 @@ bool Daemon::start() {
   // main() blocks them before any helper thread exists (see main.cpp).
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
+  for (int sig : {SIGINT, SIGTERM, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) sigaddset(&stop_signals, sig);
   pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
-  signals_.async_wait([this](const boost::system::error_code& ec, int sig) {
-    if (!ec) stop(sig == SIGINT ? "SIGINT" : "SIGTERM");
-  });
+  armSignals();
   start_ = Clock::now();
   const std::size_t n = shafts_.size();
   for (std::size_t i = 0; i < n; ++i) {
@@ -95,12 +126,13 @@ bool Daemon::start() {
   for (const auto& sp : shafts_) {
     const ShaftTwin& s = *sp;
     const TwinConfig& c = s.config();
-    out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}, input {}, outputs {} {} {} {}, "
-               "n={} modes, L={} m, h={} m, l0={} m",
+    out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}{}{}, input {}, outputs {} {} {} {}, "
+               "n={} modes, L={} m, h={} m, l0={} m, instance {}",
                s.tag(), n == 1 ? "started" : "shaft",
-               toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url), s.channels().winder,
-               s.channels().cage, s.channels().shape, s.channels().alarm, s.channels().health, c.shaft.n,
-               c.shaft.L, c.shaft.h, c.shaft.l0);
+               toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url),
+               lcm_out_ ? ", outputs to " : "", lcm_out_ ? bus::describeLcmUrl(opt_.lcm_url_out) : std::string(),
+               s.channels().winder, s.channels().cage, s.channels().shape, s.channels().alarm,
+               s.channels().health, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
   }
   if (n > 1) out_->info("hoist-twind started: {} shafts on one loop, {} schedule(s)", n, groups_.size());
   started_ = true;
@@ -141,8 +173,13 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
     return;
   }
   // Drain what is queued, bounded so the timers are never starved.
-  for (int i = 0; i < 256; ++i)
-    if (lcm_.handleTimeout(0) <= 0) break;
+  if (receiver_) {
+    receiver_->drain(256);
+    ignored_ = receiver_->ignored() + receiver_->malformed();
+  } else {
+    for (int i = 0; i < 256; ++i)
+      if (lcm_.handleTimeout(0) <= 0) break;
+  }
   if (!stopping_) armLcm();
 }
 
@@ -180,6 +217,26 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   }
   g.k = k + 1;
   armTimer(g);
+}
+
+void Daemon::armSignals() {
+  signals_.async_wait([this](const boost::system::error_code& ec, int sig) {
+    if (ec) return;
+    switch (sig) {
+      case SIGINT: stop("SIGINT"); return;
+      case SIGTERM: stop("SIGTERM"); return;
+      case SIGQUIT: stop("SIGQUIT"); return;
+      case SIGHUP:
+        log_.info("SIGHUP: nothing to reload or reopen (the log goes to stderr / the journal); running on");
+        break;
+      case SIGUSR1:
+        log_.info("SIGUSR1: publishing a health report now");
+        for (auto& s : shafts_) s->publishHealth();
+        break;
+      default: log_.info("signal {} ignored; running on", sig); break;
+    }
+    if (!stopping_) armSignals();
+  });
 }
 
 void Daemon::stop(const char* why) {
@@ -277,8 +334,9 @@ bool Daemon::writeReport() const {
   j["realtime"] = {{"memory_lock", rt_.mlockall}, {"scheduling", rt_.scheduling}, {"affinity", rt_.affinity}};
   j["log_lines_dropped"] = log_.dropped();
   j["histogram_note"] =
-      "times in microseconds; 20 logarithmic bins per decade from 0.1 us, so quantiles are "
-      "bin centres (about 6 % resolution); bins are [lower edge, count]";
+      "times in microseconds; " + std::to_string(LatencyHistogram::kPerDecade) +
+      " logarithmic bins per decade from 0.1 us, so quantiles are bin centres (about 1.2 % resolution); "
+      "bins are [lower edge, count]";
   nlohmann::ordered_json shafts = nlohmann::ordered_json::array();
   for (const auto& sp : shafts_) {
     const ShaftRunStats s = sp->runStats();

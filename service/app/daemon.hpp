@@ -5,7 +5,12 @@
 //     an absolute schedule deadline_k = start + k * period (a tick that starts
 //     more than one period late is a deadline miss and the schedule skips the
 //     missed periods: it never bunches up ticks to catch up);
-//   * a signal_set for SIGINT/SIGTERM (clean stop, final health report).
+//   * a signal_set for SIGINT/SIGTERM/SIGQUIT (clean stop, final health
+//     report) and SIGHUP/SIGUSR1/SIGUSR2 (logged, never fatal: SIGHUP is a
+//     documented no-op -- the log goes to stderr/the journal, nothing to
+//     reopen --, SIGUSR1 publishes a health report at once); SIGPIPE,
+//     SIGTTOU and SIGTTIN are ignored (main.cpp), so a dead log reader or a
+//     closed stderr never stops the daemon (docs/service.md, Signals).
 // It hosts one or more shafts (ShaftTwin: config, channels, model, alarms);
 // all the math is in TwinCore (hoist_twin); this file only moves bytes and
 // keeps time.
@@ -32,16 +37,23 @@
 #include <vector>
 
 #include "hoist/service/config.hpp"
-#include "realtime.hpp"
-#include "rt_log.hpp"
+#include "hoist/rt/realtime.hpp"
+#include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
+#include "udpm_receiver.hpp"
 
 namespace hoist::svc {
+
+using rt::applyRealtime;
+using rt::parseCpuList;
+using rt::RealtimeOutcome;
+using rt::RealtimeRequest;
 
 struct DaemonOptions {
   std::vector<TwinConfig> shafts;   ///< effective configuration of each shaft (command line applied)
   std::vector<std::string> labels;  ///< log-line label per shaft ("" when there is one shaft)
   std::string lcm_url;              ///< resolved URL ("" = LCM default)
+  std::string lcm_url_out;          ///< outputs go here ("" = lcm_url)
   double duration = 0.0;            ///< stop after this many seconds (0 = run until signalled)
   RealtimeRequest realtime;         ///< optional mlockall / SCHED_FIFO / affinity
   std::string report_path;          ///< write the run report (JSON) here at stop ("" = none)
@@ -78,6 +90,7 @@ class Daemon {
   const RealtimeOutcome& realtimeOutcome() const { return rt_; }
   /// Ticks handled so far (all schedules); the systemd watchdog follows it.
   std::uint64_t loopProgress() const { return progress_.load(std::memory_order_relaxed); }
+  std::int64_t instanceId() const { return instance_id_; }
 
  private:
   struct RateGroup {
@@ -93,6 +106,7 @@ class Daemon {
   void armTimer(RateGroup& g);
   void onTick(RateGroup& g, const boost::system::error_code& ec);
   void stop(const char* why);
+  void armSignals();
   bool writeReport() const;
   void startWatchdog();
   void stopWatchdog();
@@ -103,6 +117,10 @@ class Daemon {
   RtLog log_;
   boost::asio::io_context io_;
   lcm::LCM lcm_;
+  std::unique_ptr<UdpmReceiver> receiver_;  ///< own receive path for udpm URLs (udpm_receiver.hpp); else LCM's
+  std::int64_t ignored_ = 0;                 ///< receiver_->ignored(), mirrored for the health reports
+  std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
+  std::int64_t instance_id_ = 0;       ///< random per process (HOIST_CAGE/HOIST_HEALTH.instance_id)
   boost::asio::posix::stream_descriptor lcm_fd_;
   boost::asio::signal_set signals_;
   std::vector<std::unique_ptr<ShaftTwin>> shafts_;

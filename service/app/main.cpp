@@ -12,6 +12,7 @@
 // 2 for a bad command line, configuration or LCM URL.
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
@@ -26,8 +27,9 @@
 #include <spdlog/spdlog.h>
 
 #include "daemon.hpp"
-#include "hoist/service/config_file.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/service/budget.hpp"
+#include "hoist/service/config_file.hpp"
 
 namespace {
 /// True when stderr is the systemd journal's stream: systemd sets
@@ -68,7 +70,7 @@ int main(int argc, char** argv) {
   std::string lcm_url, clock, prefix, log_level = "info", cpus, report;
   double rate = 0.0, duration = 0.0;
   int rt_priority = 0;
-  bool print_config = false, mlock = false;
+  bool print_config = false, mlock = false, force = false;
   app.add_option("--config", config_paths,
                  "shaft TOML (+ [service], [alarms]); default: the paper's shaft.  Repeat it to host "
                  "several shafts in one process, each with its own [service].channel_prefix")
@@ -87,6 +89,8 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
+  app.add_flag("--force", force,
+               "run even when the start-up measurement says a tick cannot fit its period (exit 2 otherwise)");
   auto* rt = app.add_option_group("real time", "optional; each is reported at start-up and the daemon runs without it if refused");
   rt->add_flag("--mlockall", mlock, "lock all memory (mlockall) so the loop never page-faults");
   rt->add_option("--rt-priority", rt_priority, "run the loop thread SCHED_FIFO at this priority, 1..99")
@@ -179,6 +183,51 @@ int main(int argc, char** argv) {
     std::cerr << "hoist-twind: configuration error: " << from << bad << "\n";
     return 2;
   }
+  for (std::size_t i = 1; i < opt.shafts.size(); ++i)
+    if (opt.shafts[i].service.lcm_url_out != opt.shafts[0].service.lcm_url_out) {
+      std::cerr << "hoist-twind: configuration error: " << config_paths[i] << ": service.lcm_url_out: \""
+                << opt.shafts[i].service.lcm_url_out << "\" differs from \"" << opt.shafts[0].service.lcm_url_out
+                << "\" in " << config_paths[0] << " (one process has one output URL)\n";
+      return 2;
+    }
+  opt.lcm_url_out = opt.shafts[0].service.lcm_url_out;
+  // Can this configuration run?  Measure a tick of each shaft on a scratch
+  // model; refuse (exit 2) when the loop cannot keep up, unless --force.
+  std::string budget_line;
+  bool budget_warn = false;
+  {
+    double use = 0.0;
+    for (std::size_t i = 0; i < opt.shafts.size(); ++i) {
+      TickBudget b;
+      try {
+        b = measureTickBudget(opt.shafts[i]);
+      } catch (const std::exception& e) {
+        std::cerr << "hoist-twind: configuration error: " << e.what() << "\n";
+        return 2;
+      }
+      use += b.use;
+      char line[256];
+      std::snprintf(line, sizeof line, "%s%s%.1f us per tick of %.0f us (%.1f %%, n = %d, %d substeps of max_step)",
+                    budget_line.empty() ? "" : "; ", opt.labels[i].empty() ? "" : (opt.labels[i] + ": ").c_str(),
+                    b.tick_us, b.period_us, 100.0 * b.use, opt.shafts[i].shaft.n,
+                    opt.shafts[i].service.max_step > 0.0
+                        ? static_cast<int>(std::ceil(1.0 / opt.shafts[i].service.rate / opt.shafts[i].service.max_step - 1e-9))
+                        : 1);
+      budget_line += line;
+    }
+    char total[96];
+    std::snprintf(total, sizeof total, " -> budget use %.1f %% of one core", 100.0 * use);
+    budget_line = "measured start-up budget: " + budget_line + total;
+    if (use > 1.0 && !force) {
+      std::cerr << "hoist-twind: configuration cannot run in real time: " << budget_line
+                << ".  Lower [model] modes or [service] rate, raise [service] max_step, or host fewer shafts; "
+                   "--force runs anyway (deadline misses, degraded outputs).\n";
+      return 2;
+    }
+    if (use > 1.0) budget_line += " -- OVER BUDGET, running because of --force";
+    else if (use > 0.5) budget_line += " -- more than half the period: little margin for jitter";
+    budget_warn = use > 0.5;
+  }
   opt.duration = duration;
   opt.hooks.inject_fault_at = inject_fault_at;
   opt.hooks.fail_publish_every = fail_publish_every;
@@ -212,11 +261,15 @@ int main(int argc, char** argv) {
   // Otherwise the kernel may deliver a signal to a helper thread that a
   // SCHED_FIFO loop pinned to the same CPU starves when overloaded, and the
   // stop request would never be seen.
+  // The same for the other signals the loop handles (daemon.hpp); SIGPIPE
+  // (a dead log reader), SIGTTOU/SIGTTIN (a background terminal) are ignored.
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
+  for (int sig : {SIGINT, SIGTERM, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) sigaddset(&stop_signals, sig);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  for (int sig : {SIGPIPE, SIGTTOU, SIGTTIN}) std::signal(sig, SIG_IGN);
+  if (budget_warn) log->warn("{}", budget_line);
+  else log->info("{}", budget_line);
 
   int rc = 0;
   try {

@@ -5,10 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/service/alarm_command.hpp"
+#include "hoist/service/messages.hpp"
 #include "hoist/service/winder_decode.hpp"
 
 namespace hoist::svc {
@@ -47,62 +50,6 @@ bool finiteAll(const hoist::health_t& m) {
          std::isfinite(m.late_p99_us) && std::isfinite(m.late_max_us) && std::isfinite(m.input_age);
 }
 
-/// A readable one-line description of an alarm event (no allocation).
-void describe(const AlarmEvent& e, const AlarmConfig& cfg, double stale_timeout, char* buf,
-              std::size_t n) {
-  const char* verb = "";
-  switch (e.type) {
-    case AlarmEventType::Raise: verb = "raised"; break;
-    case AlarmEventType::Clear: verb = "cleared"; break;
-    case AlarmEventType::Ack: verb = "acknowledged"; break;
-    case AlarmEventType::Shelve: verb = "shelved"; break;
-    case AlarmEventType::Unshelve: verb = "unshelved"; break;
-    case AlarmEventType::Reannounce: verb = "still active"; break;
-  }
-  char state[96];
-  std::snprintf(state, sizeof state, "%s%s%s", e.latched ? " [latched until acknowledged]" : "",
-                e.shelved ? " [shelved]" : "", (e.active && !e.acked) ? " [unacknowledged]" : "");
-  switch (e.kind) {
-    case AlarmKind::CagePosY:
-    case AlarmKind::CageNegY:
-    case AlarmKind::GuideRope: {
-      const bool guide = e.kind == AlarmKind::GuideRope;
-      const double gap = e.kind == AlarmKind::CagePosY   ? cfg.gap_pos_y
-                         : e.kind == AlarmKind::CageNegY ? cfg.gap_neg_y
-                                                         : cfg.guide_rope_gap;
-      std::snprintf(buf, n, "%s %s %s: %s %.1f mm (threshold %.1f mm of gap %.1f mm, clearance %.1f mm)%s",
-                    toString(e.kind), toString(e.level), verb,
-                    guide ? "guide-rope deflection" : (e.kind == AlarmKind::CagePosY ? "cage excursion toward +y" : "cage excursion toward -y"),
-                    e.value * 1e3, e.threshold * 1e3, gap * 1e3, (gap - e.value) * 1e3, state);
-      break;
-    }
-    case AlarmKind::InputStale:
-      std::snprintf(buf, n, "%s %s %s: no valid winder input for more than %.3g s; outputs degraded (l held, v = a = 0)%s",
-                    toString(e.kind), toString(e.level), verb, stale_timeout, state);
-      if (e.type == AlarmEventType::Clear)
-        std::snprintf(buf, n, "%s %s cleared: winder input is back%s", toString(e.kind),
-                      toString(e.level), state);
-      break;
-    case AlarmKind::ModelFault:
-      std::snprintf(buf, n, "%s %s %s: non-finite model state, model re-initialized at static equilibrium%s",
-                    toString(e.kind), toString(e.level), verb, state);
-      break;
-  }
-}
-
-/// At most `max` characters of `s`, non-printable ones replaced by '?' (for
-/// logging strings that come from the network).
-std::string printable(const std::string& s, std::size_t max = 64) {
-  std::string o;
-  o.reserve(std::min(s.size(), max) + 3);
-  for (std::size_t i = 0; i < s.size() && i < max; ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    o.push_back(c >= 32 && c < 127 ? static_cast<char>(c) : '?');
-  }
-  if (s.size() > max) o += "...";
-  return o;
-}
-
 int divider(double rate, double sub_rate) {
   if (!(sub_rate > 0.0)) return 1;
   return std::max(1, static_cast<int>(std::lround(rate / sub_rate)));
@@ -110,11 +57,14 @@ int divider(double rate, double sub_rate) {
 
 }  // namespace
 
-ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks)
+ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks,
+                     std::int64_t instance_id, lcm::LCM* lcm_out)
     : cfg_(cfg),
       label_(std::move(label)),
       tag_(label_.empty() ? std::string() : "[" + label_ + "] "),
       lcm_(lcm),
+      out_(lcm_out ? *lcm_out : lcm),
+      instance_id_(instance_id),
       log_(log),
       hooks_(hooks),
       ch_(cfg_.service.channel_prefix),
@@ -141,6 +91,10 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
   health_msg_.reject_reason[kRejectReasons] = "command_decode";
   health_msg_.reject_reason[kRejectReasons + 1] = "handler_exception";
   alarm_msg_.kind.reserve(64);
+  alarm_msg_.user.reserve(kUserMax + 4);
+  cage_msg_.instance_id = instance_id_;
+  health_msg_.instance_id = instance_id_;
+  statm_fd_ = ::open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
   alarm_msg_.message.reserve(sizeof text_);
   cage_buf_.resize(static_cast<std::size_t>(cage_msg_.getEncodedSize()) + 64);
   shape_buf_.resize(static_cast<std::size_t>(shape_msg_.getEncodedSize()) + 64);
@@ -149,9 +103,45 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
   text_[0] = '\0';
 }
 
-void ShaftTwin::subscribe() {
-  lcm_.subscribe(ch_.winder, &ShaftTwin::onWinder, this);
-  lcm_.subscribe(ch_.ack, &ShaftTwin::onAck, this);
+ShaftTwin::~ShaftTwin() {
+  if (statm_fd_ >= 0) ::close(statm_fd_);
+}
+
+void ShaftTwin::subscribe(InputRouter* router) {
+  // Our own health channel too: another publisher there (by instance_id) is
+  // a second twin on our outputs.  Only seen when outputs share the input URL.
+  const bool own_health = &out_ == &lcm_;
+  if (router) {
+    router->add(ch_.winder, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onWinder(rb, c); });
+    router->add(ch_.ack, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onAck(rb, c); });
+    if (own_health)
+      router->add(ch_.health, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onOwnHealth(rb, c); });
+    return;
+  }
+  // lcm::subscribe takes a regular expression: subscribe to the literal
+  // names (a prefix "mine.1/" must not match "mineX1/").
+  lcm_.subscribe(regexEscape(ch_.winder), &ShaftTwin::onWinder, this);
+  lcm_.subscribe(regexEscape(ch_.ack), &ShaftTwin::onAck, this);
+  if (own_health) lcm_.subscribe(regexEscape(ch_.health), &ShaftTwin::onOwnHealth, this);
+}
+
+void ShaftTwin::onOwnHealth(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  // instance_id is the first field after utime: read it without decoding
+  // the whole message (8-byte fingerprint, int64 utime, int64 instance_id).
+  if (rbuf->data_size < 24) return;
+  const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
+  std::int64_t fp = 0, id = 0;
+  for (int i = 0; i < 8; ++i) fp = (fp << 8) | b[i];
+  for (int i = 16; i < 24; ++i) id = static_cast<std::int64_t>((static_cast<std::uint64_t>(id) << 8) | b[i]);
+  if (fp != static_cast<std::int64_t>(hoist::health_t::getHash()) || id == instance_id_) return;
+  const double wall = wallNow();
+  if (!(other_seen_wall_ >= 0.0) || id != other_id_)
+    log_.error("{}another publisher (instance {}) on {}: a second twin with the same channels? "
+               "(this one is instance {})", tag_, id, ch_.health, instance_id_);
+  other_id_ = id;
+  other_seen_wall_ = wall;
+  core_.setDuplicatePublisher(true, static_cast<double>(id));
+  drainAlarmEvents();
 }
 
 void ShaftTwin::start(Clock::time_point start, double health_phase) {
@@ -177,7 +167,7 @@ void ShaftTwin::logReject(RejectReason r, const char* detail) {
 void ShaftTwin::handlerFailed(const char* what, const char* channel) {
   ++handler_exceptions_;
   std::int64_t suppressed = 0;
-  if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
+  if (reject_log_.allow(kLogHandlerException, wallNow(), suppressed))
     log_.error("{}exception in the {} handler caught (message dropped): {} [{} similar suppressed]", tag_, channel,
                what, suppressed);
 }
@@ -225,6 +215,7 @@ void ShaftTwin::handleWinder(const lcm::ReceiveBuffer* rbuf) {
   if (res.reinitialized)
     log_.info("{}new winder stream (seq {}): model re-initialized at l = {} m", tag_, s.seq,
               core_.output().kin.l);
+  if (res.republish) publishCage(s.utime);  // the held state, flagged degraded
   if (res.stepped) {
     const double us = duration<double, std::micro>(t1 - t0).count();
     step_hist_.add(us);
@@ -241,55 +232,67 @@ void ShaftTwin::handleWinder(const lcm::ReceiveBuffer* rbuf) {
 
 void ShaftTwin::handleAck(const lcm::ReceiveBuffer* rbuf) {
   // Operator commands are rare and outside the tick: decoding them into the
-  // message's std::strings may allocate -- but only after checkedDecode has
-  // validated every length (a 37-byte command with a string length of 0 or
-  // 0x80000000 used to kill the daemon, issue 12).
-  hoist::alarm_ack_t ack;
-  const auto size = static_cast<std::size_t>(rbuf->data_size);
-  // Anyone on the group can send commands (docs/security.md): their log lines
-  // are rate-limited, and the sender's strings are shortened and made
-  // printable before they reach the log.
-  std::int64_t suppressed = 0;
-  const bool may_log = reject_log_.allow(kRejectReasons + 2, wallNow(), suppressed);
-  if (may_log && suppressed > 0) log_.warn("{}{} alarm-command log lines suppressed", tag_, suppressed);
-  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, ack); st != hoist::msg::DecodeStatus::ok) {
-    ++command_decode_rejects_;
-    if (may_log)
-      log_.warn("{}ignored undecodable alarm command ({} bytes, {}) on {}", tag_, size, hoist::msg::toString(st),
-                ch_.ack);
+  // message's std::strings may allocate.  Anyone on the group can send
+  // commands (docs/security.md): at most max_commands_per_tick are handled
+  // per tick (the rest are dropped and counted); junk is logged under a rate
+  // limit; every EFFECTIVE command is audited (log line and the HOIST_ALARM
+  // events it causes carry the user) and never rate-limited.
+  if (++commands_this_tick_ > cfg_.service.max_commands_per_tick) {
+    ++commands_dropped_;
+    logJunk(fmt::format("alarm command dropped: more than service.max_commands_per_tick = {} this tick",
+            cfg_.service.max_commands_per_tick));
     return;
   }
-  ack.user = printable(ack.user);
-  // The same validation as hoist-mqtt's (hoist/service/alarm_command.hpp).
-  AlarmCommand cmd;
-  switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, cmd)) {
-    case CommandError::None: break;
-    case CommandError::UnknownKind:
-      if (may_log)
-        log_.warn("{}ignored alarm command from '{}': unknown alarm kind '{}'", tag_, ack.user, printable(ack.kind));
-      return;
-    case CommandError::BadLevel:
-      if (may_log) log_.warn("{}ignored alarm command from '{}': bad level {}", tag_, ack.user, int(ack.level));
-      return;
-    case CommandError::BadAction:
-      if (may_log) log_.warn("{}ignored alarm command from '{}': bad action {}", tag_, ack.user, int(ack.action));
-      return;
-    case CommandError::BadShelveDuration:
-      if (may_log) log_.warn("{}ignored shelve from '{}': shelve_duration must be > 0 s", tag_, ack.user);
-      return;
+  hoist::alarm_ack_t ack;
+  const auto size = static_cast<std::size_t>(rbuf->data_size);
+  // Every length is validated before anything is decoded (a 37-byte command
+  // with a string length of 0 or 0x80000000 used to kill the daemon, issue 12).
+  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, ack); st != hoist::msg::DecodeStatus::ok) {
+    ++command_decode_rejects_;
+    ++commands_invalid_;
+    logJunk(fmt::format("ignored undecodable alarm command ({} bytes, {})", size, hoist::msg::toString(st)));
+    return;
   }
-  const std::optional<AlarmKind> kind = cmd.kind;
-  const AlarmLevel level = cmd.level;
-  const AlarmAction action = cmd.action;
-  const int n = core_.command(action, kind, level, ack.shelve_duration);
-  const char* what = action == AlarmAction::Ack ? "acknowledge" : action == AlarmAction::Shelve ? "shelve" : "unshelve";
-  char for_s[48] = "";
-  if (action == AlarmAction::Shelve)
-    std::snprintf(for_s, sizeof for_s, " for %g s", std::min(ack.shelve_duration, cfg_.alarms.max_shelve));
-  if (may_log)
-    log_.info("{}operator '{}': {} {}/{}{} -> {} alarm(s)", tag_, ack.user, what, kind ? toString(*kind) : "*",
-              level == AlarmLevel::None ? "*" : toString(level), for_s, n);
+  const std::string user = printable(ack.user, kUserMax);
+  const char* why = "";
+  const std::optional<AckCommand> cmd = validateAck(ack, why);
+  if (!cmd) {
+    ++commands_invalid_;
+    logJunk(fmt::format("ignored alarm command from '{}' (kind '{}'): {}", user, printable(ack.kind), why));
+    return;
+  }
+  const int n = core_.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
+  const char* what = cmd->action == AlarmAction::Ack ? "acknowledge" : cmd->action == AlarmAction::Shelve ? "shelve" : "unshelve";
+  if (n == 0) {
+    // Not effective (nothing to acknowledge, already shelved, ...): no
+    // state changed, so no event and no audit line (a flood of identical
+    // commands stays silent).
+    logJunk(fmt::format("alarm command from '{}' had no effect: {} {}", user, what, cmd->kind ? toString(*cmd->kind) : "*"));
+    return;
+  }
+  char for_s[96] = "";
+  if (cmd->action == AlarmAction::Shelve) {
+    const double eff = std::min(cmd->shelve_duration, cfg_.alarms.max_shelve);
+    if (eff < cmd->shelve_duration)
+      std::snprintf(for_s, sizeof for_s, " for %g s (requested %g s, clamped to max_shelve)", eff, cmd->shelve_duration);
+    else
+      std::snprintf(for_s, sizeof for_s, " for %g s", eff);
+  }
+  log_.info("{}AUDIT operator '{}': {} {}/{}{} -> {} alarm(s)", tag_, user, what,
+            cmd->kind ? toString(*cmd->kind) : "*", cmd->level == AlarmLevel::None ? "*" : toString(cmd->level),
+            for_s, n);
+  cmd_user_ = user;
+  cmd_requested_shelve_ = cmd->action == AlarmAction::Shelve ? cmd->shelve_duration : 0.0;
   drainAlarmEvents();
+  cmd_user_.clear();
+  cmd_requested_shelve_ = 0.0;
+}
+
+void ShaftTwin::logJunk(const std::string& what) {
+  std::int64_t suppressed = 0;
+  if (!reject_log_.allow(kLogJunkCommand, wallNow(), suppressed)) return;
+  if (suppressed > 0) log_.warn("{}{} junk alarm-command log lines suppressed", tag_, suppressed);
+  log_.warn("{}{}", tag_, what);
 }
 
 // ---- the tick ------------------------------------------------------------------
@@ -301,6 +304,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   late_total_.add(late_us);
   ++ticks_;
   deadline_misses_ += skipped;
+  commands_this_tick_ = 0;
   const double wall = duration<double>(now - start_).count();
   if (hooks_.inject_fault_at >= 0.0 && !fault_injected_ && wall >= hooks_.inject_fault_at) {
     fault_injected_ = true;
@@ -319,11 +323,12 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
       step_hist_.add(us);
       step_total_.add(us);
     }
-    if (r.domain_error) {
+    if (r.catchup_limited) {
       std::int64_t suppressed = 0;
-      if (reject_log_.allow(kRejectReasons, wall, suppressed))
-        log_.warn("{}model refused the kinematics at t = {:.3f} s (l = {:.3f} m); holding the rope length [{} similar suppressed]",
-                  tag_, t, core_.output().kin.l, suppressed);
+      if (reject_log_.allow(kLogCatchup, wall, suppressed))
+        log_.warn("{}the loop fell behind: a tick had to cross more than service.max_catchup_periods = {} periods; "
+                  "crossed with longer substeps, output flagged degraded [{} similar suppressed]",
+                  tag_, cfg_.service.max_catchup_periods, suppressed);
     }
     if (r.stepped && core_.hasInput()) {
       const std::int64_t utime = bus::wallUtime();
@@ -332,6 +337,11 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
     }
   } else {
     core_.housekeeping(wall);
+  }
+  // The other publisher is gone after three health periods without a word.
+  if (other_seen_wall_ >= 0.0 && wall - other_seen_wall_ > 3.0 / cfg_.service.health_rate) {
+    other_seen_wall_ = -1.0;
+    core_.setDuplicatePublisher(false, 0.0);
   }
   drainAlarmEvents();
 
@@ -342,10 +352,10 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
 
 bool ShaftTwin::publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len) {
   const bool injected = hooks_.fail_publish_every > 0 && ++publish_attempts_ % hooks_.fail_publish_every == 0;
-  if (injected || lcm_.publish(channel, buf.data(), static_cast<unsigned int>(len)) != 0) {
+  if (injected || out_.publish(channel, buf.data(), static_cast<unsigned int>(len)) != 0) {
     ++publish_failures_;
     std::int64_t suppressed = 0;
-    if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
+    if (reject_log_.allow(kLogPublish, wallNow(), suppressed))
       log_.error("{}LCM publish failed on {} [{} similar suppressed]", tag_, channel, suppressed);
     return false;
   }
@@ -357,7 +367,7 @@ bool ShaftTwin::encodeAndPublish(const std::string& channel, const Msg& msg, std
   if (!finiteAll(msg)) {
     ++nonfinite_blocked_;
     std::int64_t suppressed = 0;
-    if (reject_log_.allow(kRejectReasons + 1, wallNow(), suppressed))
+    if (reject_log_.allow(kLogPublish, wallNow(), suppressed))
       log_.error("{}withheld a message on {}: non-finite value", tag_, channel);
     return false;
   }
@@ -376,27 +386,9 @@ bool ShaftTwin::encodeAndPublish(const std::string& channel, const Msg& msg, std
 }
 
 void ShaftTwin::publishCage(std::int64_t utime) {
-  const CageOutput& o = core_.output();
   cage_msg_.utime = utime;
   cage_msg_.seq = cage_seq_++;
-  cage_msg_.input_seq = o.input_seq;
-  cage_msg_.t = o.t;
-  cage_msg_.l = o.kin.l;
-  cage_msg_.v = o.kin.v;
-  cage_msg_.a = o.kin.a;
-  cage_msg_.x_c = o.x_c;
-  cage_msg_.y_c = o.y_c;
-  cage_msg_.theta = o.theta;
-  for (int i = 0; i < 5; ++i) cage_msg_.lambdas[i] = o.lambda[i];
-  cage_msg_.y_top = o.clearance.y_top;
-  cage_msg_.y_bottom = o.clearance.y_bottom;
-  cage_msg_.guide_deflection = o.clearance.guide_deflection;
-  cage_msg_.clearance_pos_y = o.clearance.clearance_pos;
-  cage_msg_.clearance_neg_y = o.clearance.clearance_neg;
-  cage_msg_.clearance_guide = o.clearance.clearance_guide;
-  cage_msg_.min_clearance = o.clearance.min_clearance;
-  cage_msg_.alarm_level = static_cast<int8_t>(o.alarm_level);
-  cage_msg_.degraded = o.degraded;
+  toCageMessage(core_.output(), cage_msg_);
   encodeAndPublish(ch_.cage, cage_msg_, cage_buf_);
 }
 
@@ -417,11 +409,18 @@ void ShaftTwin::drainAlarmEvents() {
   const AlarmEvents& ev = core_.events();
   if (ev.empty()) return;
   const std::int64_t utime = bus::wallUtime();
+  AlarmTextContext ctx;
+  ctx.alarms = &cfg_.alarms;
+  ctx.stale_timeout = core_.staleTimeout();
+  ctx.range = core_.validRange();
+  ctx.fault_what = core_.lastFaultWhat();
+  ctx.requested_shelve = cmd_requested_shelve_;
+  alarm_msg_.user.assign(cmd_user_);  // who caused these events ("" for the twin itself)
   for (const AlarmEvent& e : ev) {
-    describe(e, cfg_.alarms, core_.staleTimeout(), text_, sizeof text_);
+    describeAlarm(e, ctx, text_, sizeof text_);
     alarm_msg_.utime = utime;
     alarm_msg_.id = alarm_id_++;
-    alarm_msg_.t = e.t;
+    alarm_msg_.t = core_.publishedTime(e.t);  // one time origin with HOIST_CAGE.t
     alarm_msg_.kind.assign(toString(e.kind));
     alarm_msg_.level = static_cast<int8_t>(e.level);
     alarm_msg_.event_type = static_cast<int8_t>(e.type);
@@ -435,12 +434,15 @@ void ShaftTwin::drainAlarmEvents() {
     alarm_msg_.message.assign(text_);
     if (encodeAndPublish(ch_.alarm, alarm_msg_, alarm_buf_)) ++alarm_events_;
     switch (e.type) {
-      case AlarmEventType::Reannounce: log_.debug("{}alarm: {} (t = {:.2f} s)", tag_, text_, e.t); break;
+      case AlarmEventType::Reannounce: log_.debug("{}alarm: {} (t = {:.2f} s)", tag_, text_, alarm_msg_.t); break;
       case AlarmEventType::Raise:
-        if (e.level == AlarmLevel::Critical) log_.error("{}ALARM {} (t = {:.2f} s)", tag_, text_, e.t);
-        else log_.warn("{}ALARM {} (t = {:.2f} s)", tag_, text_, e.t);
+        if (e.level == AlarmLevel::Critical) log_.error("{}ALARM {} (t = {:.2f} s)", tag_, text_, alarm_msg_.t);
+        else log_.warn("{}ALARM {} (t = {:.2f} s)", tag_, text_, alarm_msg_.t);
         break;
-      default: log_.info("{}alarm: {} (t = {:.2f} s)", tag_, text_, e.t); break;
+      default:
+        if (!cmd_user_.empty()) log_.info("{}alarm: {} (t = {:.2f} s, by '{}')", tag_, text_, alarm_msg_.t, cmd_user_);
+        else log_.info("{}alarm: {} (t = {:.2f} s)", tag_, text_, alarm_msg_.t);
+        break;
     }
   }
   if (ev.dropped() > 0) log_.error("{}{} alarm events dropped (event buffer full)", tag_, ev.dropped());
@@ -453,7 +455,7 @@ void ShaftTwin::publishHealth(bool final_report) {
   const AlarmEngine& al = core_.alarms();
   health_msg_.utime = bus::wallUtime();
   health_msg_.uptime = std::max(0.0, wall);
-  health_msg_.t = core_.modelTime();
+  health_msg_.t = core_.publishedTime(core_.modelTime());
   health_msg_.window = std::max(0.0, wall - std::max(0.0, last_health_wall_));
   health_msg_.ticks = ticks_;
   health_msg_.steps = core_.steps();
@@ -480,6 +482,11 @@ void ShaftTwin::publishHealth(bool final_report) {
   health_msg_.publish_failures = publish_failures_;
   health_msg_.nonfinite_blocked = nonfinite_blocked_;
   health_msg_.degraded = core_.degraded();
+  health_msg_.rss_kb = rssKb();
+  health_msg_.commands_dropped = commands_dropped_;
+  health_msg_.commands_invalid = commands_invalid_;
+  health_msg_.catchup_limited = core_.catchupLimited();
+  health_msg_.datagrams_ignored = ignored_counter_ ? *ignored_counter_ : 0;
   encodeAndPublish(ch_.health, health_msg_, health_buf_);
   if (!final_report)
     log_.debug("{}health: t={:.2f} s steps={} step p50/p99/max={:.0f}/{:.0f}/{:.0f} us late "
@@ -512,6 +519,19 @@ void ShaftTwin::logFinal() {
     if (c.rejected[i] > 0) log_.info("{}  rejected {}: {}", tag_, toString(static_cast<RejectReason>(i)), c.rejected[i]);
   if (command_decode_rejects_ > 0) log_.info("{}  rejected alarm commands (command_decode): {}", tag_, command_decode_rejects_);
   if (handler_exceptions_ > 0) log_.info("{}  exceptions caught in LCM handlers: {}", tag_, handler_exceptions_);
+}
+
+std::int64_t ShaftTwin::rssKb() const {
+  // /proc/self/statm: size resident ... in pages.  pread into a stack
+  // buffer: no allocation.
+  if (statm_fd_ < 0) return -1;
+  char b[128];
+  const ssize_t n = ::pread(statm_fd_, b, sizeof b - 1, 0);
+  if (n <= 0) return -1;
+  b[n] = '\0';
+  long size = 0, resident = 0;
+  if (std::sscanf(b, "%ld %ld", &size, &resident) != 2) return -1;
+  return static_cast<std::int64_t>(resident) * (::sysconf(_SC_PAGESIZE) / 1024);
 }
 
 ShaftRunStats ShaftTwin::runStats() const {

@@ -10,7 +10,7 @@
 // Real time: after start-up nothing here allocates, takes a lock that another
 // thread can hold, or does I/O other than lcm::LCM::publish (a sendmsg on the
 // UDP socket, under LCM's own transmit mutex which only this thread takes).
-// Log lines go to the RtLog ring (rt_log.hpp).  tests/service/
+// Log lines go to the RtLog ring (hoist/rt/rt_log.hpp).  tests/service/
 // daemon_no_alloc_test.cpp checks the whole loop with a counting allocator.
 #pragma once
 
@@ -29,9 +29,12 @@
 #include "hoist/service/health.hpp"
 #include "hoist/service/twin_core.hpp"
 #include "hoist/winder_t.hpp"
-#include "rt_log.hpp"
+#include "hoist/rt/rt_log.hpp"
+#include "udpm_receiver.hpp"
 
 namespace hoist::svc {
+
+using rt::RtLog;
 
 /// Test-only fault injection (hidden command-line options, tests/hardening).
 struct TestHooks {
@@ -54,12 +57,21 @@ class ShaftTwin {
   using Clock = std::chrono::steady_clock;
 
   /// `label` names the shaft in log lines ("" for a daemon with one shaft).
-  ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks);
+  /// `lcm` receives (and publishes unless `lcm_out` is given: the
+  /// [service] lcm_url_out instance); `instance_id` is this process's random
+  /// id, published in HOIST_CAGE and HOIST_HEALTH.
+  ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks,
+            std::int64_t instance_id = 0, lcm::LCM* lcm_out = nullptr);
+  ~ShaftTwin();
   ShaftTwin(const ShaftTwin&) = delete;
   ShaftTwin& operator=(const ShaftTwin&) = delete;
 
-  /// Subscribe to the input channels on `lcm` (before the loop starts).
-  void subscribe();
+  /// Subscribe to the input channels (before the loop starts): through
+  /// `router` (the daemon's own udpm receive path, exact names) when given,
+  /// else through LCM (escaped, literal names).
+  void subscribe(InputRouter* router = nullptr);
+  /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
+  void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: wall times are measured from `start`; publishes a
   /// first HOIST_HEALTH at once, the next ones `health_phase` s earlier than
   /// a full period later (the shafts of one daemon spread them out).
@@ -88,6 +100,9 @@ class ShaftTwin {
   void handleWinder(const lcm::ReceiveBuffer* rbuf);
   void handleAck(const lcm::ReceiveBuffer* rbuf);
   void handlerFailed(const char* what, const char* channel);
+  void onOwnHealth(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void logJunk(const std::string& what);
+  std::int64_t rssKb() const;
   double wallNow() const;
   void publishCage(std::int64_t utime);
   void publishShape(std::int64_t utime);
@@ -101,6 +116,8 @@ class ShaftTwin {
   std::string label_;  ///< as given ("" for a daemon with one shaft)
   std::string tag_;    ///< log-line prefix: "[label] " or ""
   lcm::LCM& lcm_;
+  lcm::LCM& out_;  ///< publishes (lcm_url_out, or lcm_)
+  std::int64_t instance_id_ = 0;
   RtLog& log_;
   TestHooks hooks_;
   bus::Channels ch_;
@@ -124,7 +141,22 @@ class ShaftTwin {
   std::int64_t publish_attempts_ = 0;
   bool fault_injected_ = false;
   std::int64_t cage_seq_ = 0, alarm_id_ = 0;
-  LogRateLimiter<kRejectReasons + 3> reject_log_{5};  // + domain error, publish, alarm commands
+  // Log rate limiter keys: one per RejectReason, then these.
+  static constexpr int kLogPublish = kRejectReasons;          ///< publish failures, withheld messages
+  static constexpr int kLogJunkCommand = kRejectReasons + 1;  ///< invalid/ineffective/dropped commands
+  static constexpr int kLogCatchup = kRejectReasons + 2;      ///< limited catch-up
+  static constexpr int kLogHandlerException = kRejectReasons + 3;  ///< exceptions caught in LCM handlers
+  static constexpr int kLogKeys = kRejectReasons + 4;
+  LogRateLimiter<kLogKeys> reject_log_{5};
+  static constexpr std::size_t kUserMax = 64;  ///< operator names are cut to this (printable) length
+  int commands_this_tick_ = 0;
+  std::int64_t commands_dropped_ = 0, commands_invalid_ = 0;
+  std::string cmd_user_;               ///< user of the command whose events are being drained
+  double cmd_requested_shelve_ = 0.0;  ///< its requested shelve duration [s]
+  std::int64_t other_id_ = 0;          ///< another publisher's instance id
+  double other_seen_wall_ = -1.0;      ///< when it was last seen (< 0: not seen)
+  int statm_fd_ = -1;
+  const std::int64_t* ignored_counter_ = nullptr;
 
   // preallocated messages and encode buffers
   hoist::winder_t winder_in_;

@@ -15,6 +15,8 @@ const char* toString(AlarmKind k) {
     case AlarmKind::GuideRope: return "GUIDE_ROPE";
     case AlarmKind::InputStale: return "INPUT_STALE";
     case AlarmKind::ModelFault: return "MODEL_FAULT";
+    case AlarmKind::ModelDomain: return "MODEL_DOMAIN";
+    case AlarmKind::DuplicatePublisher: return "DUPLICATE_PUBLISHER";
   }
   return "?";
 }
@@ -90,8 +92,8 @@ void BinaryAlarm::emit(AlarmEventType type, double now, AlarmEvents& out) {
   e.level = level_;
   e.type = type;
   e.t = now;
-  e.value = value_;
-  e.threshold = s_.threshold;
+  e.value = detail_ ? detail_value_ : value_;
+  e.threshold = detail_ ? detail_limit_ : s_.threshold;
   e.active = active_;
   e.acked = acked_;
   e.shelved = shelved_;
@@ -166,6 +168,8 @@ bool BinaryAlarm::acknowledge(double now, AlarmEvents& out) {
 
 bool BinaryAlarm::shelve(double now, double duration, AlarmEvents& out) {
   if (!std::isfinite(duration) || !(duration > 0.0)) return false;
+  // Not effective: already shelved until (about) the same time.
+  if (shelved_ && std::fabs(now + duration - shelved_until_) < kReshelveResolution) return false;
   shelved_ = true;
   shelved_until_ = now + duration;
   emit(AlarmEventType::Shelve, now, out);
@@ -201,7 +205,7 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 
 namespace {
 // Slot layout: 0/1 CAGE_POS_Y W/C, 2/3 CAGE_NEG_Y W/C, 4/5 GUIDE_ROPE W/C,
-// 6 INPUT_STALE W, 7 MODEL_FAULT C.
+// 6 INPUT_STALE W, 7 MODEL_FAULT C, 8 MODEL_DOMAIN C, 9 DUPLICATE_PUBLISHER W.
 int slotOf(AlarmKind k, AlarmLevel l) {
   const int crit = l == AlarmLevel::Critical ? 1 : 0;
   switch (k) {
@@ -210,6 +214,8 @@ int slotOf(AlarmKind k, AlarmLevel l) {
     case AlarmKind::GuideRope: return 4 + crit;
     case AlarmKind::InputStale: return l == AlarmLevel::Warning ? 6 : -1;
     case AlarmKind::ModelFault: return l == AlarmLevel::Critical ? 7 : -1;
+    case AlarmKind::ModelDomain: return l == AlarmLevel::Critical ? 8 : -1;
+    case AlarmKind::DuplicatePublisher: return l == AlarmLevel::Warning ? 9 : -1;
   }
   return -1;
 }
@@ -239,6 +245,10 @@ AlarmEngine::AlarmEngine(const AlarmConfig& cfg) : cfg_(cfg) {
   alarms_[6].configure(AlarmKind::InputStale, AlarmLevel::Warning, flag);
   flag.latch = true;  // a model fault is an instant: keep it until acknowledged
   alarms_[7].configure(AlarmKind::ModelFault, AlarmLevel::Critical, flag);
+  flag.latch = cfg_.latch_critical;
+  alarms_[8].configure(AlarmKind::ModelDomain, AlarmLevel::Critical, flag);
+  flag.latch = false;
+  alarms_[9].configure(AlarmKind::DuplicatePublisher, AlarmLevel::Warning, flag);
 }
 
 void AlarmEngine::updateClearance(double now, const Clearance& c, AlarmEvents& out) {
@@ -255,6 +265,16 @@ void AlarmEngine::setInputStale(double now, bool stale, AlarmEvents& out) {
 
 void AlarmEngine::setModelFault(double now, bool fault, AlarmEvents& out) {
   alarms_[7].update(now, fault ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setModelDomain(double now, bool outside, double l, double limit, AlarmEvents& out) {
+  if (outside) alarms_[8].setDetail(l, limit);
+  alarms_[8].update(now, outside ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setDuplicatePublisher(double now, bool seen, double other_id, AlarmEvents& out) {
+  if (seen) alarms_[9].setDetail(other_id, 0.0);
+  alarms_[9].update(now, seen ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

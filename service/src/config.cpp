@@ -4,6 +4,7 @@
 #include "hoist/service/config.hpp"
 
 #include <cctype>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -45,9 +46,33 @@ void ServiceConfig::validate() const {
   checkRange("envelope_points", envelope_points, 2, 20001);
   checkRange("log_rate_limit", log_rate_limit, 1, 1000);
   checkRange("fault_hold", fault_hold, 0.0, 3600.0);
+  checkRange("accel_tolerance", accel_tolerance, 0.0, 100.0, true);
+  checkRange("velocity_tolerance", velocity_tolerance, 0.0, 10.0);
+  checkRange("consistency_window", consistency_window, 0.0, 60.0, true);
+  checkRange("plausible_factor", plausible_factor, 2.0, 1e6);
+  checkRange("max_catchup_periods", max_catchup_periods, 1, 1000);
+  checkRange("max_commands_per_tick", max_commands_per_tick, 1, 1000);
+  if (max_step > 0.0) {
+    // Never clamp in silence: the longest interval one step may have to
+    // cover (a tick's catch-up, or an input interval with --clock input)
+    // must fit kMaxSubsteps substeps.
+    const double longest = std::max(max_catchup_periods / rate, max_time_step);
+    const double need = std::ceil(longest / max_step - 1e-9);
+    if (need > kMaxSubsteps) {
+      std::ostringstream os;
+      os << max_step << " s would need " << need << " substeps for an interval of " << longest
+         << " s (max_time_step or max_catchup_periods / rate); the limit is " << kMaxSubsteps
+         << ": use max_step >= " << longest / kMaxSubsteps << " s or 0 (no substeps)";
+      bad("service.max_step", os.str());
+    }
+  }
+  if (!lcm_url_out.empty() && lcm_url_out.find("://") == std::string::npos)
+    bad("service.lcm_url_out", "must be an LCM URL such as \"udpm://239.255.76.67:7668?ttl=0\" (or \"\" for lcm_url), got \"" +
+                                   lcm_url_out + "\"");
   for (char c : channel_prefix)
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '/'))
       bad("service.channel_prefix", "may contain only letters, digits and _ - . /");
+  if (channel_prefix.size() > 64) bad("service.channel_prefix", "at most 64 characters");
 }
 
 }  // namespace hoist::svc

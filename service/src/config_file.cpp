@@ -50,6 +50,13 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   sr.integer("envelope_points", s.envelope_points);
   sr.integer("log_rate_limit", s.log_rate_limit);
   sr.number("fault_hold", s.fault_hold);
+  sr.string("lcm_url_out", [&](const toml::node&, const std::string& v) { s.lcm_url_out = v; });
+  sr.number("accel_tolerance", s.accel_tolerance);
+  sr.number("velocity_tolerance", s.velocity_tolerance);
+  sr.number("consistency_window", s.consistency_window);
+  sr.number("plausible_factor", s.plausible_factor);
+  sr.integer("max_catchup_periods", s.max_catchup_periods);
+  sr.integer("max_commands_per_tick", s.max_commands_per_tick);
   sr.run();
   try {
     s.validate();
@@ -113,7 +120,11 @@ std::string toToml(const TwinConfig& c) {
      << "\nstale_periods = " << Num{s.stale_periods} << "\nstale_min = " << Num{s.stale_min}
      << "\nmax_step = " << Num{s.max_step} << "\nshape_points = " << s.shape_points
      << "\nenvelope_points = " << s.envelope_points << "\nlog_rate_limit = " << s.log_rate_limit
-     << "\nfault_hold = " << Num{s.fault_hold} << "\n\n";
+     << "\nfault_hold = " << Num{s.fault_hold} << "\nlcm_url_out = \"" << s.lcm_url_out
+     << "\"\naccel_tolerance = " << Num{s.accel_tolerance} << "\nvelocity_tolerance = " << Num{s.velocity_tolerance}
+     << "\nconsistency_window = " << Num{s.consistency_window} << "\nplausible_factor = " << Num{s.plausible_factor}
+     << "\nmax_catchup_periods = " << s.max_catchup_periods << "\nmax_commands_per_tick = " << s.max_commands_per_tick
+     << "\n\n";
   const AlarmConfig& a = c.alarms;
   os << "[alarms]\ngap_pos_y = " << Num{a.gap_pos_y} << "\ngap_neg_y = " << Num{a.gap_neg_y}
      << "\nguide_rope_gap = " << Num{a.guide_rope_gap} << "\nwarning_fraction = " << Num{a.warning_fraction}

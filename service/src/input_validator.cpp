@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "hoist/profile.hpp"
+
 namespace hoist::svc {
 
 const char* toString(RejectReason r) {
@@ -19,6 +21,8 @@ const char* toString(RejectReason r) {
     case RejectReason::LengthRange: return "length_range";
     case RejectReason::LengthJump: return "length_jump";
     case RejectReason::ModelDomain: return "model_domain";
+    case RejectReason::AccelMismatch: return "a_mismatch";
+    case RejectReason::Implausible: return "implausible_state";
   }
   return "?";
 }
@@ -38,16 +42,22 @@ Verdict InputValidator::check(const WinderSample& s) const {
     return reject(RejectReason::LengthRange);
 
   Verdict ok;
-  if (!have_last_) return ok;
+  if (!have_last_ && !continues(s)) return ok;
   if (s.seq <= last_.seq) return reject(RejectReason::DuplicateSeq);
   if (s.utime <= last_.utime) return reject(RejectReason::TimeBackwards);
   // Difference in double: utimes may be anything an attacker sends.
   const double dt = (static_cast<double>(s.utime) - static_cast<double>(last_.utime)) * 1e-6;
   if (dt > lim_.max_time_step) return reject(RejectReason::TimeJump);
-  if (s.has_length && last_.has_length) {
-    const double predicted = last_.length + 0.5 * (last_.v + s.v) * dt;
-    if (std::fabs(s.length - predicted) > lim_.max_length_jump)
-      return reject(RejectReason::LengthJump);
+  // v against a, accumulated since the consistency reference.
+  const double total = dv_excess_ + excess(s, dt);
+  const double since_ref = (static_cast<double>(s.utime) - static_cast<double>(ref_utime_)) * 1e-6;
+  if (!(std::fabs(total) <= lim_.velocity_tolerance + lim_.accel_tolerance * since_ref))
+    return reject(RejectReason::AccelMismatch);
+  // The encoder length against the length integrated from v since the last
+  // encoder length, whatever has_length did in between.
+  if (s.has_length && have_lpred_) {
+    const double predicted = integrateLength(l_pred_, last_.v, last_.a, s.v, s.a, dt);
+    if (!(std::fabs(s.length - predicted) <= lim_.max_length_jump)) return reject(RejectReason::LengthJump);
   }
   // seq > last: the difference fits (both int64, s.seq > last_.seq).
   const auto gap = static_cast<std::uint64_t>(s.seq) - static_cast<std::uint64_t>(last_.seq);
@@ -55,7 +65,37 @@ Verdict InputValidator::check(const WinderSample& s) const {
   return ok;
 }
 
+double InputValidator::excess(const WinderSample& s, double dt) const {
+  const double dv = s.v - last_.v;
+  const double lo = std::min(last_.a, s.a) * dt, hi = std::max(last_.a, s.a) * dt;
+  return dv - std::clamp(dv, lo, hi);
+}
+
+bool InputValidator::continues(const WinderSample& s) const {
+  if (!soft_ || s.seq <= last_.seq || s.utime <= last_.utime) return false;
+  const double dt = (static_cast<double>(s.utime) - static_cast<double>(last_.utime)) * 1e-6;
+  return dt <= lim_.max_time_step;
+}
+
 void InputValidator::accept(const WinderSample& s) {
+  if (have_last_ || continues(s)) {
+    const double dt = (static_cast<double>(s.utime) - static_cast<double>(last_.utime)) * 1e-6;
+    dv_excess_ += excess(s, dt);
+    if (have_lpred_ && !s.has_length) l_pred_ = integrateLength(l_pred_, last_.v, last_.a, s.v, s.a, dt);
+    if ((static_cast<double>(s.utime) - static_cast<double>(ref_utime_)) * 1e-6 >= lim_.consistency_window) {
+      ref_utime_ = s.utime;
+      dv_excess_ = 0.0;
+    }
+  } else {
+    ref_utime_ = s.utime;
+    dv_excess_ = 0.0;
+    have_lpred_ = false;
+  }
+  soft_ = false;
+  if (s.has_length) {
+    l_pred_ = s.length;
+    have_lpred_ = true;
+  }
   last_ = s;
   have_last_ = true;
 }

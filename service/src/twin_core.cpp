@@ -10,13 +10,18 @@ namespace hoist::svc {
 namespace {
 
 InputLimits limitsFrom(const TwinConfig& c) {
+  const LengthRange r = validLengthRange(c.shaft);
   InputLimits l;
   l.max_speed = c.service.max_speed;
   l.max_accel = c.service.max_accel;
   l.max_length_jump = c.service.max_length_jump;
   l.max_time_step = c.service.max_time_step;
-  l.min_length = 0.0;
-  l.max_length = c.shaft.maxRopeLength();
+  // The validator's bounds are exclusive: [lo, hi] up to rounding.
+  l.min_length = std::nextafter(r.lo, -1.0);
+  l.max_length = std::nextafter(r.hi, 1e300);
+  l.accel_tolerance = c.service.accel_tolerance;
+  l.velocity_tolerance = c.service.velocity_tolerance;
+  l.consistency_window = c.service.consistency_window;
   return l;
 }
 
@@ -36,19 +41,181 @@ bool allFinite(const CageOutput& o) {
          std::isfinite(c.clearance_guide);
 }
 
+/// The lateral plausibility limit: plausible_factor x the largest gap, but
+/// never below 1 m (hoist-sim's limit): tiny test gaps must raise clearance
+/// alarms, not model faults.
+double lateralLimit(const TwinConfig& c) {
+  return std::max(1.0, c.service.plausible_factor *
+                           std::max({c.alarms.gap_pos_y, c.alarms.gap_neg_y, c.alarms.guide_rope_gap}));
+}
+
 }  // namespace
+
+// ---- clock policies -------------------------------------------------------------
+
+/// Model time = the input's utime (relative to the stream's first): one step
+/// and one output per accepted input.
+class InputClock final : public ClockPolicy {
+ public:
+  ClockMode mode() const override { return ClockMode::Input; }
+
+  InputResult onInput(TwinCore& c, const WinderSample& s, bool new_stream, double wall_now) override {
+    InputResult res;
+    double t;
+    Kinematics k;
+    const bool first = !c.started_;
+    if (first) {
+      t = 0.0;
+      k = Kinematics{s.has_length ? s.length : c.cfg_.shaft.l0, s.v, s.a};
+    } else {
+      // A restarted stream continues model time one nominal period later.
+      t = new_stream ? c.t_ + 1.0 / c.cfg_.service.rate
+                     : t_base_ + static_cast<double>(s.utime - utime_base_) / 1e6;
+      if (!(t > c.t_)) return reject(c, res, RejectReason::TimeBackwards);
+      k = s.has_length ? Kinematics{s.length, s.v, s.a} : c.integrate(c.kin_, s.v, s.a, t - c.t_);
+    }
+    if (!c.lengthOk(k.l)) {
+      c.setDomain(true, k.l);
+      res.republish = c.started_;
+      return reject(c, res, s.has_length ? RejectReason::LengthRange : RejectReason::ModelDomain);
+    }
+    if (first || new_stream) {
+      utime_base_ = s.utime;
+      t_base_ = t;
+    }
+    c.acceptSample(s, wall_now);
+    c.setDomain(false, k.l);
+    if (first) {
+      c.initializeAt(t, k);
+    } else if (new_stream && std::fabs(k.l - c.kin_.l) > c.cfg_.service.max_length_jump) {
+      c.initializeAt(t, k);
+      res.reinitialized = true;
+    } else if (!c.advance(t, k)) {
+      return reject(c, res, RejectReason::ModelDomain);
+    }
+    c.out_.input_utime = s.utime;
+    res.stepped = true;
+    res.accepted = true;
+    return res;
+  }
+
+  TickResult tick(TwinCore&, double, double) override { return {}; }
+  double staleTimeout(const TwinCore& c) const override { return c.cfg_.service.stale_timeout; }
+
+ private:
+  static InputResult reject(TwinCore& c, InputResult& res, RejectReason r) {
+    c.counters_.reject(r);
+    res.accepted = false;
+    res.reason = r;
+    return res;
+  }
+  std::int64_t utime_base_ = 0;  // utime at model time t_base_
+  double t_base_ = 0.0;
+};
+
+/// Model time = the daemon's timer; inputs only update the latest sample.
+class WallClock final : public ClockPolicy {
+ public:
+  ClockMode mode() const override { return ClockMode::Wall; }
+
+  InputResult onInput(TwinCore& c, const WinderSample& s, bool new_stream, double wall_now) override {
+    InputResult res;
+    // Held at the end of the valid range: an input that keeps driving the
+    // rope outward is rejected (model_domain); one that turns back resumes.
+    if (c.domain_outside_ && !s.has_length && c.started_) {
+      const bool at_top = c.kin_.l - c.range_.lo < c.range_.hi - c.kin_.l;
+      if ((at_top && s.v < 0.0) || (!at_top && s.v > 0.0)) {
+        c.counters_.reject(RejectReason::ModelDomain);
+        res.reason = RejectReason::ModelDomain;
+        return res;
+      }
+    }
+    const bool first_input = !c.have_input_;
+    c.acceptSample(s, wall_now);
+    if (s.has_length || !c.domain_outside_) c.setDomain(false, s.has_length ? s.length : c.kin_.l);
+    else c.setDomain(false, c.kin_.l);
+    if (first_input) {
+      // The twin idled at rest at l0 until now.  Start the trip here: the
+      // model is re-initialized at this input's kinematics (consistent with
+      // a winder already moving), and the published time counts from this
+      // instant (trip time, comparable with hoist-sim for the same profile).
+      const Kinematics k{s.has_length ? s.length : c.kin_.l, s.v, s.a};
+      if (c.lengthOk(k.l)) {
+        const auto resets = c.resets_;
+        res.reinitialized = s.has_length && std::fabs(s.length - c.kin_.l) > c.cfg_.service.max_length_jump;
+        // The trip starts when the input arrived (the daemon's wall clock
+        // and its tick times share one time base), not at the last tick.
+        const double t0 = std::max(c.t_, wall_now);
+        c.t_pub_offset_ = t0;
+        c.initializeAt(t0, k);
+        c.resets_ = resets;
+      }
+    } else if (new_stream && s.has_length && std::fabs(s.length - c.kin_.l) > c.cfg_.service.max_length_jump) {
+      c.initializeAt(c.t_, Kinematics{s.length, s.v, s.a});
+      res.reinitialized = true;
+    }
+    c.out_.degraded = c.degradedNow();
+    res.accepted = true;
+    return res;
+  }
+
+  TickResult tick(TwinCore& c, double t, double wall_now) override {
+    TickResult res;
+    if (!c.started_ || !(t > c.t_)) return res;
+    const double dt = t - c.t_;
+    Kinematics k;
+    if (!c.have_input_ || c.stale_) {
+      k = Kinematics{c.kin_.l, 0.0, 0.0};
+    } else if (c.last_.has_length) {
+      const double tau = std::clamp(wall_now - c.last_input_wall_, 0.0, c.staleTimeout());
+      k = Kinematics{c.last_.length + c.last_.v * tau, c.last_.v, c.last_.a};
+    } else {
+      k = c.integrate(c.kin_, c.last_.v, c.last_.a, dt);
+    }
+    if (!c.lengthOk(k.l)) {
+      // The winder drove the rope length out of the valid range: hold.
+      ++c.domain_errors_;
+      res.domain_error = true;
+      c.setDomain(true, k.l);
+      k = Kinematics{c.kin_.l, 0.0, 0.0};
+    }
+    const auto faults0 = c.faults_, catchups0 = c.catchups_;
+    if (!c.advance(t, k, c.cfg_.service.max_catchup_periods / c.cfg_.service.rate)) {
+      res.domain_error = true;
+      return res;
+    }
+    res.stepped = true;
+    res.fault = c.faults_ != faults0;
+    res.catchup_limited = c.catchups_ != catchups0;
+    return res;
+  }
+
+  double staleTimeout(const TwinCore& c) const override { return c.periodStaleTimeout(); }
+};
+
+std::unique_ptr<ClockPolicy> makeClock(ClockMode mode) {
+  if (mode == ClockMode::Input) return std::make_unique<InputClock>();
+  return std::make_unique<WallClock>();
+}
+
+// ---- TwinCore -------------------------------------------------------------------
 
 TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solver> solver)
     : cfg_(cfg),
-      clock_(clock),
+      clock_(makeClock(clock)),
       solver_(solver ? std::move(solver) : defaultSolver(cfg)),
       envelope_(solver_->model(), cfg.service.envelope_points),
       shape_(solver_->model(), cfg.service.shape_points),
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
-      lmax_(cfg.shaft.maxRopeLength()) {
+      range_(validLengthRange(cfg.shaft)),
+      bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))) {
   cfg_.service.validate();
-  if (clock_ == ClockMode::Wall) {
+  if (!range_.contains(cfg_.shaft.l0))
+    throw std::invalid_argument("hoisting_rope.initial_length: " + std::to_string(cfg_.shaft.l0) +
+                                " m is outside the model's valid range [" + std::to_string(range_.lo) + ", " +
+                                std::to_string(range_.hi) + "] m (0.05 m from either end)");
+  if (clock == ClockMode::Wall) {
     // The wall-clock twin runs from start-up: at rest at the initial length
     // until the winder speaks.
     initializeAt(0.0, Kinematics{cfg_.shaft.l0, 0.0, 0.0});
@@ -57,11 +224,16 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
 }
 
 Kinematics TwinCore::integrate(const Kinematics& k0, double v1, double a1, double dt) const {
-  Kinematics k;
-  k.l = k0.l + dt * 0.5 * (k0.v + v1);
-  k.v = v1;
-  k.a = a1;
-  return k;
+  return Kinematics{integrateLength(k0.l, k0.v, k0.a, v1, a1, dt), v1, a1};
+}
+
+void TwinCore::acceptSample(const WinderSample& s, double wall_now) {
+  validator_.accept(s);
+  last_ = s;
+  last_input_wall_ = wall_now;
+  have_input_ = true;
+  stream_ = true;
+  if (stale_) setStale(false);
 }
 
 void TwinCore::initializeAt(double t, const Kinematics& k) {
@@ -73,23 +245,27 @@ void TwinCore::initializeAt(double t, const Kinematics& k) {
   finishStep(t);
 }
 
-bool TwinCore::advance(double t, const Kinematics& k) {
-  const int n = (cfg_.service.max_step > 0.0 && t > t_)
-                    ? std::clamp(static_cast<int>(std::ceil((t - t_) / cfg_.service.max_step - 1e-9)), 1, 100000)
-                    : 1;
+bool TwinCore::advance(double t, const Kinematics& k, double max_interval) {
   const double t0 = t_, h = t - t_;
+  int n = 1;
+  try {
+    if (max_interval > 0.0 && h > max_interval * (1.0 + 1e-9)) {
+      // The loop was late by more than the catch-up bound: cross the gap
+      // with the substeps of max_interval (longer ones), flag and count it.
+      n = substepCount(max_interval, cfg_.service.max_step, kMaxSubsteps);
+      ++catchups_;
+      catchup_until_ = t;
+    } else if (h > 0.0) {
+      n = substepCount(h, cfg_.service.max_step, kMaxSubsteps);
+    }
+  } catch (const std::invalid_argument&) {
+    n = kMaxSubsteps;  // unreachable: ServiceConfig::validate() bounds max_step
+  }
   const Kinematics k0 = kin_;
   try {
     for (int j = 1; j < n; ++j) {
-      // Cubic Hermite in l (consistent with v at both ends), linear v and a.
-      const double s = static_cast<double>(j) / n;
-      const double s2 = s * s, s3 = s2 * s;
-      Kinematics ks;
-      ks.l = (2 * s3 - 3 * s2 + 1) * k0.l + (s3 - 2 * s2 + s) * h * k0.v + (-2 * s3 + 3 * s2) * k.l +
-             (s3 - s2) * h * k.v;
-      ks.v = k0.v + s * (k.v - k0.v);
-      ks.a = k0.a + s * (k.a - k0.a);
-      solver_->step(t0 + s * h, ks);
+      const double u = static_cast<double>(j) / n;
+      solver_->step(t0 + u * h, interpolate(k0, k, h, u));
     }
     solver_->step(t, k);
   } catch (const std::domain_error&) {
@@ -103,16 +279,45 @@ bool TwinCore::advance(double t, const Kinematics& k) {
   return true;
 }
 
+void TwinCore::setDomain(bool outside, double l) {
+  if (outside == domain_outside_ && !outside) return;
+  domain_outside_ = outside;
+  const double limit = l < range_.lo ? range_.lo : range_.hi;
+  alarms_.setModelDomain(t_, outside, l, limit, events_);
+  out_.degraded = degradedNow();
+  out_.alarm_level = alarms_.highestActive();
+}
+
+void TwinCore::setDuplicatePublisher(bool seen, double other_id) {
+  alarms_.setDuplicatePublisher(t_, seen, other_id, events_);
+  out_.alarm_level = alarms_.highestActive();
+}
+
 bool TwinCore::finishStep(double t, bool allow_fault_check) {
   (void)allow_fault_check;
   const double h = cfg_.shaft.h;
   for (int attempt = 0; attempt < 2; ++attempt) {
     bool ok = solver_->finite() && !inject_fault_;
     inject_fault_ = false;
+    const char* what_now = "non-finite";
+    double value_now = 1.0, limit_now = 0.0;
+    if (ok) {
+      const CageResponse& r = solver_->response();
+      // Finite is not enough: a state beyond the plausibility bound
+      // (hoist/plausibility.hpp) is a model fault too.
+      double value = 0.0, limit = 0.0;
+      if (const char* what = implausible(r, h, bounds_, value, limit)) {
+        ok = false;
+        what_now = what;
+        value_now = std::isfinite(value) ? value : 0.0;
+        limit_now = limit;
+        counters_.reject(RejectReason::Implausible);
+      }
+    }
     if (ok) {
       const CageResponse& r = solver_->response();
       const double gdef = envelope_.evaluate(*solver_);
-      out_.t = t - t_pub_offset_;
+      out_.t = publishedTime(t);
       out_.kin = r.kin;
       out_.x_c = r.x_c;
       out_.y_c = r.y_c;
@@ -120,6 +325,13 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
       out_.lambda = r.lambda;
       out_.clearance = computeClearance(r.y_c, r.theta, h, gdef, cfg_.alarms);
       ok = allFinite(out_);
+      if (ok && !(gdef <= bounds_.lateral)) {
+        ok = false;
+        what_now = "guide_deflection";
+        value_now = gdef;
+        limit_now = bounds_.lateral;
+        counters_.reject(RejectReason::Implausible);
+      }
     }
     if (ok) {
       alarms_.setModelFault(t, false, events_);
@@ -129,10 +341,15 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
       out_.input_seq = have_input_ ? last_.seq : -1;
       return true;
     }
-    // Non-finite state: raise MODEL_FAULT and restart from static equilibrium
-    // at the current kinematics (or the initial length if those are bad too).
+    // Non-finite or implausible state: raise MODEL_FAULT and restart from
+    // static equilibrium at the current kinematics (or the initial length if
+    // those are bad too).
     ++faults_;
     ++resets_;
+    fault_what_ = what_now;
+    fault_value_ = value_now;
+    fault_limit_ = limit_now;
+    alarms_.setModelFaultDetail(fault_value_, fault_limit_);
     alarms_.setModelFault(t, true, events_);
     fault_until_ = t + cfg_.service.fault_hold;
     Kinematics k = kin_;
@@ -147,12 +364,12 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
 }
 
 bool TwinCore::degradedNow() const {
-  return !have_input_ || stale_ || t_ < fault_until_;
+  return !have_input_ || stale_ || t_ < fault_until_ || domain_outside_ || t_ <= catchup_until_;
 }
 
-double TwinCore::staleTimeout() const {
+double TwinCore::periodStaleTimeout() const {
   const ServiceConfig& s = cfg_.service;
-  if (clock_ != ClockMode::Wall || !(s.stale_periods > 0.0) || !(period_est_ > 0.0)) return s.stale_timeout;
+  if (!(s.stale_periods > 0.0) || !(period_est_ > 0.0)) return s.stale_timeout;
   return std::min(s.stale_timeout, std::max(s.stale_min, s.stale_periods * period_est_));
 }
 
@@ -169,126 +386,30 @@ void TwinCore::setStale(bool stale) {
 
 InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
   if (start_wall_ < 0.0) start_wall_ = wall_now;
-  InputResult res;
   const Verdict v = validator_.check(s);
-  auto reject = [&](RejectReason r) {
-    counters_.reject(r);
-    res.accepted = false;
-    res.reason = r;
+  if (!v.ok) {
+    counters_.reject(v.reason);
+    // An encoder length outside the valid range is the MODEL_DOMAIN condition.
+    if (v.reason == RejectReason::LengthRange) setDomain(true, s.length);
+    InputResult res;
+    res.reason = v.reason;
+    res.republish = v.reason == RejectReason::LengthRange && clock_->mode() == ClockMode::Input && started_;
     return res;
-  };
-  if (!v.ok) return reject(v.reason);
+  }
   const bool new_stream = !validator_.hasReference();
   // Input period of this stream, from the sender's time stamps (immune to
   // network jitter); lost messages only make the estimate more lenient.
   const double period = new_stream ? 0.0 : static_cast<double>(s.utime - validator_.last().utime) * 1e-6;
-
-  if (clock_ == ClockMode::Input) {
-    double t;
-    Kinematics k;
-    const bool first = !started_;
-    if (first) {
-      t = 0.0;
-      k = Kinematics{s.has_length ? s.length : cfg_.shaft.l0, s.v, s.a};
-    } else {
-      if (new_stream) {
-        // A restarted stream continues model time one nominal period later.
-        t = t_ + 1.0 / cfg_.service.rate;
-      } else {
-        t = t_base_ + static_cast<double>(s.utime - utime_base_) / 1e6;
-      }
-      if (!(t > t_)) return reject(RejectReason::TimeBackwards);
-      k = s.has_length ? Kinematics{s.length, s.v, s.a} : integrate(kin_, s.v, s.a, t - t_);
-    }
-    if (!lengthOk(k.l)) return reject(RejectReason::LengthRange);
-    if (first || new_stream) {
-      utime_base_ = s.utime;
-      t_base_ = t;
-    }
-    // Accept before stepping so the output reflects the new input state.
-    validator_.accept(s);
-    last_ = s;
-    last_input_wall_ = wall_now;
-    have_input_ = true;
-    stream_ = true;
-    if (stale_) setStale(false);
-    if (first) {
-      initializeAt(t, k);
-    } else if (new_stream && std::fabs(k.l - kin_.l) > cfg_.service.max_length_jump) {
-      initializeAt(t, k);
-      res.reinitialized = true;
-    } else if (!advance(t, k)) {
-      return reject(RejectReason::ModelDomain);
-    }
-    out_.input_utime = s.utime;
-    res.stepped = true;
-  } else {
-    validator_.accept(s);
-    last_ = s;
-    last_input_wall_ = wall_now;
-    const bool first_input = !have_input_;
-    have_input_ = true;
-    stream_ = true;
-    if (stale_) setStale(false);
-    if (first_input) {
-      // The twin idled at rest at l0 until now.  Start the trip here: the
-      // model is re-initialized at this input's kinematics (consistent with
-      // a winder already moving), and the published time t counts from this
-      // instant, so HOIST_CAGE.t is trip time, comparable with hoist-sim for
-      // the same profile.
-      const Kinematics k{s.has_length ? s.length : kin_.l, s.v, s.a};
-      if (lengthOk(k.l)) {
-        const auto resets = resets_;
-        res.reinitialized = s.has_length && std::fabs(s.length - kin_.l) > cfg_.service.max_length_jump;
-        // The trip starts when the input arrived (the daemon's wall clock
-        // and its tick times share one time base), not at the last tick.
-        const double t0 = std::max(t_, wall_now);
-        t_pub_offset_ = t0;
-        initializeAt(t0, k);
-        resets_ = resets;
-      }
-    } else if (new_stream && s.has_length && std::fabs(s.length - kin_.l) > cfg_.service.max_length_jump) {
-      initializeAt(t_, Kinematics{s.length, s.v, s.a});
-      res.reinitialized = true;
-    }
-    out_.degraded = degradedNow();
-  }
+  InputResult res = clock_->onInput(*this, s, new_stream, wall_now);
+  if (!res.accepted) return res;
   if (new_stream) period_est_ = 0.0;
   else if (period > 0.0) period_est_ = period_est_ > 0.0 ? 0.9 * period_est_ + 0.1 * period : period;
   ++counters_.accepted;
   counters_.seq_gaps += v.skipped;
-  res.accepted = true;
   return res;
 }
 
-TickResult TwinCore::tick(double t, double wall_now) {
-  TickResult res;
-  if (clock_ != ClockMode::Wall || !started_ || !(t > t_)) return res;
-  const double dt = t - t_;
-  Kinematics k;
-  if (!have_input_ || stale_) {
-    k = Kinematics{kin_.l, 0.0, 0.0};
-  } else if (last_.has_length) {
-    const double tau = std::clamp(wall_now - last_input_wall_, 0.0, staleTimeout());
-    k = Kinematics{last_.length + last_.v * tau, last_.v, last_.a};
-  } else {
-    k = integrate(kin_, last_.v, last_.a, dt);
-  }
-  if (!lengthOk(k.l)) {
-    // The winder drove the integrated length out of the shaft: hold.
-    ++domain_errors_;
-    res.domain_error = true;
-    k = Kinematics{kin_.l, 0.0, 0.0};
-  }
-  const auto faults0 = faults_;
-  if (!advance(t, k)) {
-    res.domain_error = true;
-    return res;
-  }
-  res.stepped = true;
-  res.fault = faults_ != faults0;
-  return res;
-}
+TickResult TwinCore::tick(double t, double wall_now) { return clock_->tick(*this, t, wall_now); }
 
 void TwinCore::housekeeping(double wall_now) {
   if (start_wall_ < 0.0) start_wall_ = wall_now;
@@ -296,7 +417,7 @@ void TwinCore::housekeeping(double wall_now) {
   if (have_input_)
     stale_now = wall_now - last_input_wall_ > staleTimeout();
   else
-    stale_now = clock_ == ClockMode::Wall && wall_now - start_wall_ > cfg_.service.stale_timeout;
+    stale_now = clock_->mode() == ClockMode::Wall && wall_now - start_wall_ > cfg_.service.stale_timeout;
   if (stale_now && !stale_) setStale(true);
   alarms_.poll(t_, events_);
   out_.alarm_level = alarms_.highestActive();
@@ -312,6 +433,7 @@ int TwinCore::command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLe
     case AlarmAction::Unshelve: n = alarms_.unshelve(t_, kind, level, events_); break;
   }
   out_.alarm_level = alarms_.highestActive();
+  out_.degraded = degradedNow();
   return n;
 }
 

@@ -268,6 +268,19 @@ TEST(ToolsExitStatus, BadProfilesGiveStatus2NamingTheLine) {
   }
 }
 
+#ifdef HOIST_SIM
+TEST(ToolsExitStatus, SimStateLeavingThePlausibleRangeExitsNonZeroWithTimeAndValue) {
+  // Issue 12.2: `hoist-sim --profile "rest:t_end=3,l0=1e-7"` wrote 1e282 m and exited 0.
+  const auto dir = workDir("tools_implausible");
+  const ToolRun sim = run(HOIST_SIM, {"--profile", "rest:t_end=3,l0=1e-7", "--out", (dir / "o.csv").string(), "-q"});
+  EXPECT_EQ(sim.status, 1) << sim.output;
+  EXPECT_NE(sim.output.find("implausible state at t = "), std::string::npos) << sim.output;
+  EXPECT_NE(sim.output.find("valid rope lengths are [0.05, 383.95] m"), std::string::npos) << sim.output;
+  const ToolRun ok = run(HOIST_SIM, {"--profile", "rest:t_end=3,l0=0.05", "--out", (dir / "p.csv").string(), "-q"});
+  EXPECT_EQ(ok.status, 0) << ok.output;
+}
+#endif
+
 TEST(ToolsExitStatus, CrlfBomProfileIsAcceptedByTheTools) {
   const auto dir = workDir("tools_crlf");
   const auto csv = writeFile(dir / "crlf.csv", "\xEF\xBB\xBFt,v,a,l\r\n0,0,0,50\r\n0.05,0,0,50\r\n0.1,0,0,50\r\n");

@@ -264,10 +264,30 @@ TEST(Staleness, RaisedWithinThreeInputPeriodsAndClearedWhenInputReturns) {
 }
 
 TEST(Staleness, InputClockKeepsTheConfiguredTimeout) {
+  // 100 Hz input, then silence.  The wall clock would call it stale after 3
+  // periods (30 ms); the input clock waits the configured stale_timeout
+  // (0.5 s): observed through housekeeping and the INPUT_STALE event.
   Harness h(ClockMode::Input);
+  const double timeout = h.core.config().service.stale_timeout;
   std::int64_t utime = kT0;
-  for (int k = 0; k < 50; ++k, utime += 10000) ASSERT_TRUE(h.feed(encode(winder(k, utime)), 0.01 * k).accepted);
-  EXPECT_DOUBLE_EQ(h.core.staleTimeout(), h.core.config().service.stale_timeout);
+  double last = 0.0;
+  for (int k = 0; k < 50; ++k, utime += 10000) {
+    last = 0.01 * k;
+    ASSERT_TRUE(h.feed(encode(winder(k, utime)), last).accepted);
+  }
+  double raised_at = -1.0;
+  for (int ms = 1; ms <= 1000 && raised_at < 0; ++ms) {
+    const double wall = last + 1e-3 * ms;
+    h.core.housekeeping(wall);
+    for (const AlarmEvent& e : h.core.events())
+      if (e.kind == AlarmKind::InputStale && e.type == AlarmEventType::Raise) raised_at = wall;
+    h.core.clearEvents();
+    if (raised_at < 0) ASSERT_FALSE(h.core.stale()) << "stale after " << wall - last << " s";
+  }
+  ASSERT_GT(raised_at, 0.0) << "INPUT_STALE never raised";
+  EXPECT_NEAR(raised_at - last, timeout, 0.0015);
+  EXPECT_TRUE(h.core.stale());
+  EXPECT_TRUE(h.core.degraded());
 }
 
 TEST(ModelFault, InjectedFaultRaisesRecoversAndNeverOutputsNaN) {

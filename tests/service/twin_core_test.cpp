@@ -84,9 +84,14 @@ class FaultySolver final : public Solver {
 }  // namespace
 
 TEST(TwinCoreInput, MatchesSimulateStepForStep) {
+  // Without the encoder the twin integrates l from v and a: exact (to
+  // round-off) for a jerk-limited trip, whose samples the profile gives in
+  // closed form (a trapezoid's acceleration steps on samples cost
+  // h^2/12 per step, see hoist::integrateLength).
   const TwinConfig cfg = smallConfig();
-  const HoistProfile prof = HoistProfile::trapezoid(50.0, 2.0, 1.0, 10.0, 8.0, 0.01);
   for (bool with_length : {true, false}) {
+    const HoistProfile prof = with_length ? HoistProfile::trapezoid(50.0, 2.0, 1.0, 10.0, 8.0, 0.01)
+                                          : HoistProfile::sCurve(50.0, 2.0, 1.0, 2.0, 10.0, 8.0, 0.01);
     TwinCore core(cfg, ClockMode::Input);
     auto ref = makeSolver(Method::Fast, std::make_shared<const ShaftModel>(cfg.shaft));
     std::vector<CageResponse> expect;
@@ -144,13 +149,59 @@ TEST(TwinCoreInput, FollowsTheEncoderAndIntegratesWithoutIt) {
   ASSERT_TRUE(core.onInput(s, 0.1).accepted);
   EXPECT_DOUBLE_EQ(core.output().kin.l, 120.2);
   EXPECT_DOUBLE_EQ(core.output().t, 0.1);
-  // Without the encoder: trapezoidal integration of v from the last length.
+  // Without the encoder: the corrected trapezoid from the last length,
+  // l1 = l0 + h (v0 + v1)/2 + h^2 (a0 - a1)/12 (a consistent v step).
   s.utime += 100000;
   s.seq = 2;
   s.has_length = false;
-  s.v = 4.0;
+  s.v = 2.5;
+  s.a = 5.0;
   ASSERT_TRUE(core.onInput(s, 0.2).accepted);
-  EXPECT_NEAR(core.output().kin.l, 120.2 + 0.1 * 0.5 * (2.0 + 4.0), 1e-12);
+  EXPECT_NEAR(core.output().kin.l, 120.2 + 0.1 * 0.5 * (2.0 + 2.5) + 0.01 * (0.0 - 5.0) / 12.0, 1e-12);
+}
+
+TEST(TwinCoreInput, IntegratedLengthMatchesTheClosedFormOfATripWithAcceleration) {
+  // Issue 11: the twin dropped the h^2 (a0 - a1)/12 term and its test used
+  // a = 0.  A winder without encoder, 100 Hz, on an S-curve trip (constant
+  // jerk phases: the corrected trapezoid is exact) and at 10 Hz on a
+  // trapezoid whose corners fall inside intervals (bounded by h^2/12 per
+  // unit jump of a).  Without the term the first errs by 8e-6 m, the second
+  // by h^2/8 = 1.25e-3 m per corner.
+  TwinConfig cfg = smallConfig();
+  cfg.service.max_step = 0.0;  // the length, not the substeps, is under test
+  {
+    const HoistProfile p = HoistProfile::sCurve(50.0, 5.0, 1.0, 0.5, 250.0, 70.0, 0.01);
+    TwinCore core(cfg, ClockMode::Input);
+    double worst = 0.0;
+    long k = 0;
+    for (const auto& ps : p.samples()) {
+      WinderSample s;
+      s.utime = kT0 + std::llround(ps.t * 1e6);
+      s.seq = k++;
+      s.v = ps.k.v;
+      s.a = ps.k.a;
+      ASSERT_TRUE(core.onInput(s, ps.t).accepted) << ps.t;
+      worst = std::max(worst, std::fabs(core.output().kin.l - ps.k.l));
+    }
+    EXPECT_LT(worst, 1e-8);
+  }
+  {
+    const double h = 0.1;
+    const HoistProfile p = HoistProfile::trapezoid(50.0, 5.05, 1.0, 250.0, 60.0, h);
+    TwinCore core(cfg, ClockMode::Input);
+    double worst = 0.0;
+    long k = 0;
+    for (const auto& ps : p.samples()) {
+      WinderSample s;
+      s.utime = kT0 + std::llround(ps.t * 1e6);
+      s.seq = k++;
+      s.v = ps.k.v;
+      s.a = ps.k.a;
+      ASSERT_TRUE(core.onInput(s, ps.t).accepted) << ps.t;
+      if (ps.t < 6.0) worst = std::max(worst, std::fabs(core.output().kin.l - ps.k.l));
+    }
+    EXPECT_LE(worst, h * h / 12.0);
+  }
 }
 
 TEST(TwinCoreInput, RejectionsLeaveTheModelUntouched) {
@@ -180,22 +231,34 @@ TEST(TwinCoreInput, RejectionsLeaveTheModelUntouched) {
   EXPECT_EQ(core.counters().accepted, 1);
   EXPECT_TRUE(sameBits(core.output().y_c, before.y_c));
   EXPECT_EQ(core.steps(), 0);
-  // Without the encoder the integrated length is range-checked too.
+  // Without the encoder the integrated length is range-checked too: a
+  // consistent ramp to 19 m/s, then cruise until the valid range ends.
   WinderSample runaway;
   runaway.utime = kT0 + 20000;
   runaway.seq = 2;
-  runaway.v = 19.0;
-  for (int k = 0; k < 2000; ++k) {
-    runaway.utime += 900000;
+  runaway.v = 0.0;
+  bool refused = false;
+  for (int k = 0; k < 2000 && !refused; ++k) {
     ++runaway.seq;
+    if (runaway.v < 19.0) {
+      runaway.utime += 100000;
+      runaway.v += 1.0;
+      runaway.a = 10.0;
+    } else {
+      runaway.utime += 900000;
+      runaway.a = 0.0;
+    }
     const InputResult r = core.onInput(runaway, 0.02 + k);
     if (!r.accepted) {
-      EXPECT_EQ(r.reason, RejectReason::LengthRange);
-      break;
+      EXPECT_EQ(r.reason, RejectReason::ModelDomain);
+      refused = true;
     }
   }
-  EXPECT_GT(core.counters().count(RejectReason::LengthRange), 1);
-  EXPECT_LT(core.output().kin.l, cfg.shaft.maxRopeLength());
+  EXPECT_TRUE(refused);
+  EXPECT_EQ(core.counters().count(RejectReason::ModelDomain), 1);
+  EXPECT_TRUE(core.outsideDomain());
+  EXPECT_TRUE(core.degraded());
+  EXPECT_LT(core.output().kin.l, cfg.shaft.maxRopeLength() - 0.05);
 }
 
 TEST(TwinCoreWall, StaleInputHoldsAndRaisesAnAlarm) {
@@ -232,13 +295,15 @@ TEST(TwinCoreWall, StaleInputHoldsAndRaisesAnAlarm) {
   EXPECT_TRUE(core.alarms().find(AlarmKind::InputStale, AlarmLevel::Warning)->active());
   EXPECT_EQ(core.output().kin.v, 0.0);
   const double held = core.output().kin.l;
-  core.tick(2.5, 2.5);
+  core.tick(2.5, 2.5);  // a 0.5-s stall of the loop: bounded catch-up, flagged
   EXPECT_EQ(core.output().kin.l, held);
+  EXPECT_EQ(core.catchupLimited(), 1);
   // A restarted stream (new seq and time base) is accepted again.
   s.seq = 0;
   s.utime = kT0 - 5'000'000;
   ASSERT_TRUE(core.onInput(s, 2.6).accepted);
-  core.housekeeping(2.6);
+  core.tick(2.51, 2.61);
+  core.housekeeping(2.61);
   EXPECT_FALSE(core.stale());
   EXPECT_FALSE(core.degraded());
   EXPECT_FALSE(core.alarms().find(AlarmKind::InputStale, AlarmLevel::Warning)->active());

@@ -6,6 +6,7 @@
 // They share only atomics: the per-shaft rings of publish times (indexed by
 // seq) and the sent counters; the feeder's lateness histogram is read after
 // the join.
+#include <algorithm>
 #include <pthread.h>
 #include <signal.h>
 #include <sys/utsname.h>

@@ -28,6 +28,7 @@
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
 #include "hoist/shaft_model.hpp"
+#include "hoist/plausibility.hpp"
 #include "hoist/simulator.hpp"
 
 namespace {
@@ -221,12 +222,23 @@ int run(const Options& o) {
   const auto t_solve = Clock::now();
   bool failed = false;
   double fail_t = 0;
+  // Finite is not enough: a state that leaves the plausible range
+  // (hoist/plausibility.hpp, lateral limit 1 m) stops the run too.
+  const hoist::PlausibilityBounds bounds = hoist::plausibilityBounds(p, 1.0);
+  const char* implausible_what = nullptr;
+  double implausible_value = 0.0, implausible_limit = 0.0;
   struct Diverged {};
   try {
     hoist::simulate(
         *solver, profile, sim,
         [&](const hoist::CageResponse& r) {
           if (!solver->finite() || !std::isfinite(r.y_c) || !std::isfinite(r.theta) || !std::isfinite(r.x_c)) {
+            failed = true;
+            fail_t = r.t;
+            throw Diverged{};
+          }
+          implausible_what = hoist::implausible(r, p.h, bounds, implausible_value, implausible_limit);
+          if (implausible_what) {
             failed = true;
             fail_t = r.t;
             throw Diverged{};
@@ -252,7 +264,12 @@ int run(const Options& o) {
   }
   progress.done();
   const double solve_s = secondsSince(t_solve);
-  if (failed) {
+  if (failed && implausible_what) {
+    std::cerr << "hoist-sim: error: implausible state at t = " << fail_t << " s: " << implausible_what << " = "
+              << implausible_value << " (plausible: |" << implausible_what << "| <= " << implausible_limit
+              << "; valid rope lengths are [" << hoist::validLengthRange(p).lo << ", "
+              << hoist::validLengthRange(p).hi << "] m). " << rows.size() << " good rows are written.\n";
+  } else if (failed) {
     std::cerr << "hoist-sim: error: the state became non-finite at t = " << fail_t
               << " s (unstable parameters or step; try a smaller --dt / --max-step). " << rows.size()
               << " good rows are written.\n";

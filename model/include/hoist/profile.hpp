@@ -14,6 +14,33 @@ struct Kinematics {
   double a = 0.0;  ///< d2l/dt2 [m/s^2]
 };
 
+/// Kinematics inside a sampling interval [t0, t0 + h] at fraction u in [0, 1]:
+/// v and a linear in u, l by the cubic Hermite consistent with (l, v) at both
+/// ends.  The one interpolation of the project: HoistProfile::at(), the
+/// simulator's substeps and the daemon's substeps all use it.
+Kinematics interpolate(const Kinematics& k0, const Kinematics& k1, double h, double u);
+
+/// Rope length after an interval h of a winder that reports v and a but no
+/// length: the integral of the cubic Hermite interpolant of v through
+/// (v0, a0) and (v1, a1),
+///   l1 = l0 + h (v0 + v1)/2 + h^2 (a0 - a1)/12        (corrected trapezoid),
+/// exact whenever v is a polynomial of degree <= 3 over the interval (constant
+/// acceleration or constant jerk: the trapezoid's own error -h^3 v''/12 is
+/// what the second term cancels).  Where a jumps at a sample (a trapezoid
+/// trip whose corner falls on a sample, with a right-continuous a), the
+/// sample's a belongs to only one side and the term errs by at most
+/// h^2 |jump|/12 per jump; where the jump falls inside the interval at
+/// h tau, the plain trapezoid errs by h^2 tau (1 - tau) |jump|/2 (up to
+/// h^2/8) and the corrected one by at most h^2 |jump|/12.  Used by
+/// HoistProfile::fromVelocity and the daemon.
+double integrateLength(double l0, double v0, double a0, double v1, double a1, double h);
+
+/// Equal substeps of at most max_step that cover `interval` [s]:
+/// ceil(interval / max_step) (1 when max_step is 0 or >= interval).  Throws
+/// std::invalid_argument if max_step is negative or non-finite, or if more
+/// than `limit` substeps would be needed (never clamps in silence).
+int substepCount(double interval, double max_step, int limit = 1000000);
+
 struct ProfileSample {
   double t = 0.0;
   Kinematics k;

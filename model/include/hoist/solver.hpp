@@ -10,9 +10,11 @@
 //     coordinate partition G = (G0 G1), q = Phi q1 (Eqs. 18-24), reduced ODE
 //     Eq. (22), lambda recovered from Eq. (15).  Ill-conditioned near the shaft
 //     ends (docs/model.md) and O(n^3) per step: for checking, not for production.
-// Both use the same implicit, fixed-step generalized-alpha integrator with
-// spectral radius ShaftParams::rho_inf (default 0.9; 1 would be the
-// trapezoidal rule) and the equations of motion enforced at t_{n+1}.
+// Both use the same implicit, fixed-step generalized-alpha integrator with the
+// equations of motion enforced at t_{n+1}; its high-frequency damping is
+// ShaftParams::rho_inf ([model] rho_inf, default 0.9; rho_inf = 1 would be the
+// undamped trapezoidal rule / Newmark average acceleration, which lets the
+// sleeve forces of the moving index-3 constraints grow without bound).
 //
 // Frame (the one every part of the project uses; docs/model.md "Frame"):
 //   x      depth, origin at the top of the shaft (head sheave / derrick, where

@@ -15,7 +15,9 @@
 //   * every (kind, level) is one binary alarm: CAGE_POS_Y, CAGE_NEG_Y and
 //     GUIDE_ROPE each have a WARNING (warning_fraction * gap) and a CRITICAL
 //     (critical_fraction * gap) alarm; INPUT_STALE is a WARNING, MODEL_FAULT a
-//     CRITICAL;
+//     CRITICAL, MODEL_DOMAIN (rope length outside the model's valid range) a
+//     CRITICAL, DUPLICATE_PUBLISHER (another process publishes on this
+//     twin's output channels) a WARNING;
 //   * the condition comes on when value >= threshold has held for on_delay
 //     and goes off when value < threshold - deadband has held for off_delay
 //     (so a value hovering at the threshold cannot chatter);
@@ -23,7 +25,11 @@
 //     its condition is gone until an operator acknowledges it;
 //   * an operator can shelve an alarm for a time (at most max_shelve): while
 //     shelved it raises and clears silently; on unshelve (or expiry) the
-//     current state is announced;
+//     current state is announced.  Only effective commands change state and
+//     emit events: acknowledging an acknowledged alarm, unshelving an
+//     unshelved one, or re-shelving a shelved one with an expiry that moves
+//     by less than kReshelveResolution does nothing (a flood of identical
+//     commands produces no events);
 //   * active, unshelved alarms are re-announced every `reannounce` seconds.
 // Time `now` is whatever monotonic clock the caller uses, in seconds (the
 // daemon passes model time).  Each call appends the resulting events to an
@@ -38,8 +44,12 @@
 
 namespace hoist::svc {
 
-enum class AlarmKind : std::uint8_t { CagePosY, CageNegY, GuideRope, InputStale, ModelFault };
-inline constexpr int kAlarmKinds = 5;
+enum class AlarmKind : std::uint8_t {
+  CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher
+};
+inline constexpr int kAlarmKinds = 7;
+/// A re-shelve that moves the expiry by less than this [s] is not effective.
+inline constexpr double kReshelveResolution = 1.0;
 
 /// Values match alarm_t.LEVEL_*.
 enum class AlarmLevel : std::int8_t { None = 0, Warning = 1, Critical = 2 };
@@ -128,6 +138,13 @@ class BinaryAlarm {
   /// Feed the measured value at time `now` (non-decreasing).  A non-finite
   /// value counts as over the threshold (fail safe).
   void update(double now, double value, AlarmEvents& out);
+  /// Flag alarms: the value and limit their events report (e.g. the rope
+  /// length and the range limit of MODEL_DOMAIN) instead of the 0/1 flag.
+  void setDetail(double value, double limit) {
+    detail_ = true;
+    detail_value_ = value;
+    detail_limit_ = limit;
+  }
   /// Operator acknowledgement; false if there was nothing to acknowledge.
   bool acknowledge(double now, AlarmEvents& out);
   /// Shelve for `duration` seconds (> 0).  Re-shelving extends/shortens.
@@ -159,6 +176,8 @@ class BinaryAlarm {
   double shelved_until_ = 0.0;
   double last_announce_ = 0.0;
   double value_ = 0.0;
+  bool detail_ = false;
+  double detail_value_ = 0.0, detail_limit_ = 0.0;
 };
 
 /// Clearance figures of one cage state.
@@ -180,7 +199,7 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 /// All alarms of the twin.
 class AlarmEngine {
  public:
-  static constexpr int kSlots = 8;
+  static constexpr int kSlots = 10;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
   const AlarmConfig& config() const { return cfg_; }
@@ -189,6 +208,15 @@ class AlarmEngine {
   void setInputStale(double now, bool stale, AlarmEvents& out);
   /// `fault` true for the step where the model state became non-finite.
   void setModelFault(double now, bool fault, AlarmEvents& out);
+  /// `outside` true while the requested rope length `l` is outside the
+  /// model's valid range; `limit` is the range end it crossed.
+  void setModelDomain(double now, bool outside, double l, double limit, AlarmEvents& out);
+  /// `seen` true while another publisher is seen on the output channels;
+  /// `other_id` its instance id (reported as the event's value).
+  void setDuplicatePublisher(double now, bool seen, double other_id, AlarmEvents& out);
+  /// MODEL_FAULT events report `value` against `limit` (e.g. an implausible
+  /// output and its bound; 1/0 for a non-finite state).
+  void setModelFaultDetail(double value, double limit) { alarms_[7].setDetail(value, limit); }
   /// Runs shelve expiry and re-announcement without a new value.
   void poll(double now, AlarmEvents& out);
 

@@ -16,6 +16,8 @@
 namespace hoist::svc {
 
 enum class ClockMode { Wall, Input };
+/// Most substeps one model step may take (service.max_step is checked against it).
+inline constexpr int kMaxSubsteps = 100000;
 const char* toString(ClockMode c);
 
 /// The [service] section.  Rates in Hz, times in seconds, lengths in metres.
@@ -26,6 +28,10 @@ struct ServiceConfig {
   double health_rate = 1.0;     ///< HOIST_HEALTH publish rate, (0, 10]
   std::string channel_prefix;   ///< prepended to every channel name
   std::string lcm_url;          ///< used when neither --lcm-url nor LCM_DEFAULT_URL is set
+  /// Outputs (HOIST_CAGE, _GUIDE_SHAPE, _ALARM, _HEALTH) go to this URL, so
+  /// that the daemon's input socket does not receive its own publications;
+  /// "" = the input URL.  Same syntax as lcm_url.
+  std::string lcm_url_out;
   ClockMode clock = ClockMode::Wall;  ///< "wall" or "input"
   double max_speed = 20.0;      ///< input limit |v| [m/s]
   double max_accel = 10.0;      ///< input limit |a| [m/s^2]
@@ -43,6 +49,23 @@ struct ServiceConfig {
   int envelope_points = 401;    ///< depth samples for the guide-rope deflection alarm, [2, 20001]
   int log_rate_limit = 5;       ///< log lines per second per rejection reason, [1, 1000]
   double fault_hold = 1.0;      ///< outputs flagged degraded after a model re-init [s]
+  /// Cross-sample consistency (docs/service.md): within a stream, the change
+  /// of v since a reference sample must match the integral of a, each
+  /// interval allowed anything between its two a values, within
+  /// velocity_tolerance + accel_tolerance x (time since the reference); the
+  /// reference moves every consistency_window seconds.
+  double accel_tolerance = 1.0;     ///< [m/s^2], (0, 100]
+  double velocity_tolerance = 0.02; ///< [m/s], [0, 10]
+  double consistency_window = 1.0;  ///< [s], (0, 60]
+  /// Outputs beyond plausible_factor x the largest configured gap (at least
+  /// 1 m; and the force bound of hoist/plausibility.hpp) are a MODEL_FAULT, [2, 1e6].
+  double plausible_factor = 10.0;
+  /// With --clock wall a tick integrates at most this many periods of model
+  /// time at full accuracy; a longer gap (the loop was late) is crossed with
+  /// proportionally longer substeps, counted and flagged degraded, [1, 1000].
+  int max_catchup_periods = 4;
+  /// Operator commands handled per tick; more are dropped and counted, [1, 1000].
+  int max_commands_per_tick = 4;
 
   void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
 };

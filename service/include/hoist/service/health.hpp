@@ -5,36 +5,13 @@
 #include <array>
 #include <cstdint>
 
+#include "hoist/rt/histogram.hpp"
+
 namespace hoist::svc {
 
-/// Histogram of durations in microseconds on fixed log-spaced bins
-/// (kBinsPerDecade per decade from 0.1 us to 10 s), plus the exact maximum.
-/// Quantiles are read at the geometric centre of the bin (relative error
-/// below 10^(1/(2*kBinsPerDecade)) - 1, i.e. < 6 %).  add() is O(1); nothing
-/// allocates.
-class LatencyHistogram {
- public:
-  static constexpr int kBinsPerDecade = 20;
-  static constexpr double kMinUs = 0.1;
-  static constexpr int kDecades = 8;  // 0.1 us .. 10 s
-  static constexpr int kBins = kBinsPerDecade * kDecades + 2;  // + underflow and overflow
-
-  void add(double us);
-  void reset();
-  std::int64_t count() const { return count_; }
-  double max() const { return count_ ? max_ : 0.0; }
-  /// q in [0, 1]; 0 when empty.  Never more than max().
-  double quantile(double q) const;
-  /// Raw bin counts (for reports): bin 0 holds samples below kMinUs, bin b in
-  /// [1, kBins-2] holds [binLowerUs(b), binLowerUs(b+1)), the last bin the rest.
-  std::int64_t binCount(int b) const { return bins_[static_cast<std::size_t>(b)]; }
-  static double binLowerUs(int b);
-
- private:
-  std::array<std::int64_t, kBins> bins_{};
-  std::int64_t count_ = 0;
-  double max_ = 0.0;
-};
+/// The step-time and lateness histogram: the project's one histogram type
+/// (hoist/rt/histogram.hpp), shared with hoist-replay --timing-test.
+using LatencyHistogram = hoist::rt::LatencyHistogram;
 
 /// At most `per_second` log lines per key per one-second window; the rest are
 /// counted so the next allowed line can say how many were suppressed.

@@ -24,11 +24,14 @@ enum class RejectReason : std::uint8_t {
   DuplicateSeq,   ///< "duplicate_seq": seq equal to or older than the last accepted
   TimeBackwards,  ///< "time_backwards": utime not after the last accepted utime
   TimeJump,       ///< "time_jump": utime more than max_time_step after the last accepted
-  LengthRange,    ///< "length_range": rope length outside (0, L - 2h)
-  LengthJump,     ///< "length_jump": encoder length off the v-predicted length by > max_length_jump
-  ModelDomain,    ///< "model_domain": the model refused the step (l left its range)
+  LengthRange,    ///< "length_range": encoder length outside the model's valid range [d, L - 2h - d]
+  LengthJump,     ///< "length_jump": encoder length off the length integrated from v (across
+                  ///< samples without a length too) by > max_length_jump
+  ModelDomain,    ///< "model_domain": the kinematics (integrated from v) left the valid range
+  AccelMismatch,  ///< "a_mismatch": v changed otherwise than the reported a allows (see InputLimits)
+  Implausible,    ///< "implausible_state": a model output beyond the plausibility bound (MODEL_FAULT)
 };
-inline constexpr int kRejectReasons = 10;
+inline constexpr int kRejectReasons = 12;
 const char* toString(RejectReason r);
 
 /// One winder input, already decoded.
@@ -48,6 +51,14 @@ struct InputLimits {
   double max_time_step = 1.0;    ///< largest utime step within a stream [s]
   double min_length = 0.0;       ///< exclusive lower bound of l [m]
   double max_length = 384.0;     ///< exclusive upper bound of l (L - 2h) [m]
+  /// Cross-sample consistency of v and a: over the samples since a reference
+  /// (renewed every consistency_window s), the change of v beyond what the
+  /// reported a allows (each interval: anything between dt min(a0, a1) and
+  /// dt max(a0, a1), which covers an acceleration step anywhere inside it) must
+  /// stay within velocity_tolerance + accel_tolerance x (t - t_ref).
+  double accel_tolerance = 1.0;     ///< [m/s^2]
+  double velocity_tolerance = 0.02; ///< [m/s]
+  double consistency_window = 1.0;  ///< [s]
 };
 
 struct Verdict {
@@ -65,15 +76,37 @@ class InputValidator {
   Verdict check(const WinderSample& s) const;
   /// Make `s` the reference for the following samples.
   void accept(const WinderSample& s);
-  /// Forget the stream reference (next sample starts a new stream).
-  void resync() { have_last_ = false; }
+  /// Forget the stream reference (next sample starts a new stream) -- unless
+  /// the next sample continues the old one (sequence and utime after the
+  /// last accepted sample, within max_time_step): then it is still checked
+  /// for consistency against it, so rejected input going stale does not
+  /// open the door to the same inconsistent stream.
+  void resync() {
+    have_last_ = false;
+    soft_ = true;
+  }
+  /// The rope length integrated from v since the last encoder length (valid
+  /// when hasLengthPrediction()).
+  bool hasLengthPrediction() const { return have_lpred_; }
+  double lengthPrediction() const { return l_pred_; }
   bool hasReference() const { return have_last_; }
   const WinderSample& last() const { return last_; }
 
  private:
+  /// Excess of the v change over the a-allowed range for `s` after last_.
+  double excess(const WinderSample& s, double dt) const;
+  /// After resync(): does `s` continue the old stream?
+  bool continues(const WinderSample& s) const;
+
   InputLimits lim_;
   WinderSample last_;
   bool have_last_ = false;
+  bool soft_ = false;  // resynced, last_ kept for a continuing stream
+  // consistency reference
+  std::int64_t ref_utime_ = 0;
+  double dv_excess_ = 0.0;  // accumulated since ref_utime_ [m/s]
+  bool have_lpred_ = false;
+  double l_pred_ = 0.0;     // length integrated from v since the last encoder length [m]
 };
 
 /// Accepted/rejected counters by reason (plain integers, no allocation).

@@ -7,20 +7,33 @@
 // sleeves, v = dl/dt > 0 descending, a = dv/dt):
 //   * when a winder sample carries the encoder length the twin follows it;
 //   * otherwise l is integrated from v, starting at the shaft config's
-//     initial_length (or the first encoder length seen), by the trapezoidal
-//     rule with the a-consistent end correction
-//       l1 = l0 + dt (v0 + v1)/2 + dt^2 (a0 - a1)/12
-//     (exact for piecewise-cubic l, so it reproduces HoistProfile's l).
+//     initial_length (or the first encoder length seen), with the model's
+//     hoist::integrateLength (corrected trapezoid, exact for piecewise-cubic
+//     l; its derivation and error bounds are in hoist/profile.hpp), the same
+//     function HoistProfile::fromVelocity uses;
+//   * substeps (service.max_step) interpolate with hoist::interpolate, the
+//     profile's own Hermite interpolation, and count with
+//     hoist::substepCount, as hoist::simulate does.
+//   * the rope length must stay in the model's valid range
+//     hoist::validLengthRange = [0.05 m, L - 2h - 0.05 m]; outside it the
+//     input is rejected (length_range / model_domain), MODEL_DOMAIN is raised
+//     naming the length and the limit, the model holds its last valid state
+//     and every output is flagged degraded.
 //
-// Clocks:
-//   * ClockMode::Input -- onInput() steps the model exactly to each accepted
+// Clocks (a policy object, ClockPolicy, chosen at construction):
+//   * InputClock -- onInput() steps the model exactly to each accepted
 //     sample's time t = (utime - utime_first) / 1e6 s; one output per input.
 //     Deterministic: the same input sequence gives bit-identical outputs.
-//   * ClockMode::Wall -- onInput() only stores the latest sample; tick(t)
-//     steps the model to model time t (the daemon's timer).  Between samples
-//     the encoder length is extrapolated with v for at most stale_timeout.
-//     While the input is stale the twin holds l with v = a = 0.
+//   * WallClock -- onInput() only stores the latest sample; tick(t) steps the
+//     model to model time t (the daemon's timer).  Between samples the
+//     encoder length is extrapolated with v for at most stale_timeout.
+//     While the input is stale the twin holds l with v = a = 0.  A tick
+//     integrates at most max_catchup_periods periods at full accuracy.
 //
+// Time origin: every published time (HOIST_CAGE.t, HOIST_ALARM.t,
+// HOIST_HEALTH.t, HOIST_GUIDE_SHAPE.t) is publishedTime(model time): seconds
+// since the trip start = the first accepted winder input.  Before the first
+// input (the wall-clock twin idles at rest) it counts from the daemon's start.
 // Every time-dependent alarm rule (delays, shelving, re-announce) runs on
 // model time.  Staleness is judged on the caller's wall clock (`wall_now`,
 // seconds, monotonic).
@@ -36,6 +49,7 @@
 #include "hoist/service/alarms.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/input_validator.hpp"
+#include "hoist/plausibility.hpp"
 #include "hoist/solver.hpp"
 
 namespace hoist::svc {
@@ -58,14 +72,35 @@ struct InputResult {
   bool accepted = false;
   RejectReason reason = RejectReason::Decode;  ///< valid when !accepted
   bool stepped = false;        ///< a new output is ready (input clock)
+  bool republish = false;      ///< input clock, rejected for the model's domain: publish the held state (degraded)
   bool reinitialized = false;  ///< the model was re-initialized (new stream, fault)
 };
 
 struct TickResult {
   bool stepped = false;
-  bool fault = false;          ///< non-finite state; model re-initialized
-  bool domain_error = false;   ///< the model refused the kinematics; state held
+  bool fault = false;          ///< non-finite or implausible state; model re-initialized
+  bool domain_error = false;   ///< the kinematics left the valid range; state held
+  bool catchup_limited = false;  ///< the gap exceeded max_catchup_periods: crossed with longer substeps
 };
+
+class TwinCore;
+
+/// How model time follows inputs and ticks (the daemon's clock mode), as a
+/// policy object: Drake's LcmDrivenLoop takes a time converter likewise.
+/// Implementations (twin_core.cpp): InputClock, WallClock.
+class ClockPolicy {
+ public:
+  virtual ~ClockPolicy() = default;
+  virtual ClockMode mode() const = 0;
+  /// A validated input (new_stream: the validator had no reference): step
+  /// the model (input clock) or store it (wall clock).
+  virtual InputResult onInput(TwinCore& core, const WinderSample& s, bool new_stream, double wall_now) = 0;
+  /// The timer's tick at model time t (wall clock); no-op for the input clock.
+  virtual TickResult tick(TwinCore& core, double t, double wall_now) = 0;
+  /// The staleness timeout in force [s].
+  virtual double staleTimeout(const TwinCore& core) const = 0;
+};
+std::unique_ptr<ClockPolicy> makeClock(ClockMode mode);
 
 // AlarmAction (operator command, alarm_ack_t): hoist/service/alarm_command.hpp.
 
@@ -93,6 +128,21 @@ class TwinCore {
               double shelve_duration);
 
   const CageOutput& output() const { return out_; }
+  /// Model time -> published time (seconds since the trip start; see above).
+  double publishedTime(double model_t) const { return model_t - t_pub_offset_; }
+  /// Why the last MODEL_FAULT was raised: "non-finite" or the implausible
+  /// quantity ("y_c", "lambda_1", ...), with its value and bound.
+  const char* lastFaultWhat() const { return fault_what_; }
+  double lastFaultValue() const { return fault_value_; }
+  double lastFaultLimit() const { return fault_limit_; }
+  /// The model's valid range of rope length.
+  const LengthRange& validRange() const { return range_; }
+  /// MODEL_DOMAIN condition (requested length outside the valid range).
+  bool outsideDomain() const { return domain_outside_; }
+  /// Ticks whose gap exceeded max_catchup_periods (wall clock).
+  std::int64_t catchupLimited() const { return catchups_; }
+  /// Another publisher on the output channels (from the daemon).
+  void setDuplicatePublisher(bool seen, double other_id);
   /// Alarm events since the last clearEvents() (the caller publishes them).
   const AlarmEvents& events() const { return events_; }
   void clearEvents() { events_.clear(); }
@@ -105,7 +155,7 @@ class TwinCore {
   const InputCounters& counters() const { return counters_; }
   const AlarmEngine& alarms() const { return alarms_; }
   const TwinConfig& config() const { return cfg_; }
-  ClockMode clock() const { return clock_; }
+  ClockMode clock() const { return clock_->mode(); }
   double modelTime() const { return t_; }
   bool started() const { return started_; }
   bool stale() const { return stale_; }
@@ -118,7 +168,7 @@ class TwinCore {
   /// The staleness timeout in force [s]: stale_timeout, or with --clock wall
   /// stale_periods input periods (clamped to [stale_min, stale_timeout]) once
   /// the current stream's period is known.
-  double staleTimeout() const;
+  double staleTimeout() const { return clock_->staleTimeout(*this); }
   /// Estimated input period of the current stream [s] (0 until known).
   double inputPeriod() const { return period_est_; }
   std::int64_t steps() const { return steps_; }
@@ -128,18 +178,27 @@ class TwinCore {
   const Solver& solver() const { return *solver_; }
 
  private:
-  bool lengthOk(double l) const { return l > 0.0 && l < lmax_; }
+  friend class InputClock;
+  friend class WallClock;
+  bool lengthOk(double l) const { return range_.contains(l); }
   Kinematics integrate(const Kinematics& k0, double v1, double a1, double dt) const;
   void initializeAt(double t, const Kinematics& k);
-  /// Step to (t, k) with substeps; false if the model refused (domain_error).
-  bool advance(double t, const Kinematics& k);
+  /// Step to (t, k) with substeps (at most `max_interval` of model time at
+  /// full accuracy); false if the model refused (domain_error).
+  bool advance(double t, const Kinematics& k, double max_interval = 0.0);
+  /// Set or clear the MODEL_DOMAIN condition for a requested length l.
+  void setDomain(bool outside, double l);
+  /// Make `s` the stream's latest accepted sample.
+  void acceptSample(const WinderSample& s, double wall_now);
+  /// The period-based staleness timeout (wall clock).
+  double periodStaleTimeout() const;
   /// After a step or init: fault check, clearance, alarms, output.
   bool finishStep(double t, bool allow_fault_check = true);
   void setStale(bool stale);
   bool degradedNow() const;
 
   TwinConfig cfg_;
-  ClockMode clock_;
+  std::unique_ptr<ClockPolicy> clock_;
   std::unique_ptr<Solver> solver_;
   GuideRopeEnvelope envelope_;
   GuideRopeEnvelope shape_;
@@ -148,7 +207,8 @@ class TwinCore {
   AlarmEvents events_;
   InputCounters counters_;
   CageOutput out_;
-  double lmax_;
+  LengthRange range_;
+  PlausibilityBounds bounds_;
 
   bool started_ = false;        // model initialized
   double t_ = 0.0;              // model time [s]
@@ -159,15 +219,17 @@ class TwinCore {
   WinderSample last_;           // last accepted sample
   double last_input_wall_ = 0.0;
   double period_est_ = 0.0;     // input period estimate (EWMA of utime steps) [s]
-  std::int64_t utime_base_ = 0; // input clock: utime at model time t_base_
-  double t_base_ = 0.0;
   double t_pub_offset_ = 0.0;   // wall clock: model time of the first input (published t counts from it)
   bool stale_ = false;
   double start_wall_ = -1.0;
   double fault_until_ = -1.0;   // degraded until this model time after a re-init
   bool fault_pending_clear_ = false;
   bool inject_fault_ = false;
-  std::int64_t steps_ = 0, faults_ = 0, resets_ = 0, domain_errors_ = 0;
+  std::int64_t steps_ = 0, faults_ = 0, resets_ = 0, domain_errors_ = 0, catchups_ = 0;
+  double catchup_until_ = -1.0;   // degraded through this model time after a limited catch-up
+  bool domain_outside_ = false;
+  const char* fault_what_ = "";
+  double fault_value_ = 0.0, fault_limit_ = 0.0;
 };
 
 }  // namespace hoist::svc

@@ -24,7 +24,7 @@
 #include <thread>
 #include <vector>
 
-namespace hoist::svc {
+namespace hoist::rt {
 
 class RtLog {
  public:
@@ -134,4 +134,4 @@ class RtLog {
   std::thread thread_;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::rt

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace hoist::svc {
+namespace hoist::rt {
 
 struct RealtimeRequest {
   bool mlockall = false;
@@ -34,4 +34,4 @@ std::vector<int> parseCpuList(const std::string& text, const std::string& what);
 /// Apply `req` to the calling thread (and, for mlockall, the process).
 RealtimeOutcome applyRealtime(const RealtimeRequest& req);
 
-}  // namespace hoist::svc
+}  // namespace hoist::rt

@@ -1,5 +1,5 @@
 // Optional real-time settings: see realtime.hpp.
-#include "realtime.hpp"
+#include "hoist/rt/realtime.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -10,7 +10,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
-namespace hoist::svc {
+namespace hoist::rt {
 
 namespace {
 std::string errnoText(int e) {
@@ -117,4 +117,4 @@ std::string RealtimeOutcome::summary() const {
   return "memory lock: " + mlockall + "; scheduling: " + scheduling + "; affinity: " + affinity;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::rt

@@ -1,0 +1,158 @@
+// hoist-twind's own udpm receive path: see udpm_receiver.hpp.
+#include "udpm_receiver.hpp"
+
+#include <arpa/inet.h>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+namespace hoist::svc {
+
+namespace {
+constexpr std::uint32_t kMagicShort = 0x4c433032;  // "LC02"
+constexpr std::size_t kMaxChannel = 63;            // LCM_MAX_CHANNEL_NAME_LENGTH
+}  // namespace
+
+bool parseUdpmUrl(const std::string& url, UdpmUrl& out, std::string& why) {
+  out = UdpmUrl{};
+  if (url.empty()) return true;
+  const std::string scheme = "udpm://";
+  if (url.compare(0, scheme.size(), scheme) != 0) {
+    why = "not a udpm:// URL";
+    return false;
+  }
+  std::string rest = url.substr(scheme.size());
+  std::string query;
+  if (const auto q = rest.find('?'); q != std::string::npos) {
+    query = rest.substr(q + 1);
+    rest = rest.substr(0, q);
+  }
+  if (!rest.empty()) {
+    const auto colon = rest.find(':');
+    out.group = rest.substr(0, colon);
+    if (colon != std::string::npos) {
+      char* end = nullptr;
+      const long p = std::strtol(rest.c_str() + colon + 1, &end, 10);
+      if (!end || *end != '\0' || p < 1 || p > 65535) {
+        why = "bad port in " + url;
+        return false;
+      }
+      out.port = static_cast<int>(p);
+    }
+  }
+  in_addr a{};
+  if (inet_pton(AF_INET, out.group.c_str(), &a) != 1 || (ntohl(a.s_addr) >> 28) != 0xE) {
+    why = "not an IPv4 multicast group: " + out.group;
+    return false;
+  }
+  std::size_t pos = 0;
+  while (pos < query.size()) {
+    const auto amp = query.find('&', pos);
+    const std::string kv = query.substr(pos, amp == std::string::npos ? std::string::npos : amp - pos);
+    pos = amp == std::string::npos ? query.size() : amp + 1;
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) continue;
+    if (kv.substr(0, eq) == "recv_buf_size") {
+      char* end = nullptr;
+      const long n = std::strtol(kv.c_str() + eq + 1, &end, 10);
+      if (!end || *end != '\0' || n < 0 || n > (1L << 30)) {
+        why = "bad recv_buf_size in " + url;
+        return false;
+      }
+      out.recv_buf_size = static_cast<int>(n);
+    }
+  }
+  return true;
+}
+
+UdpmReceiver::~UdpmReceiver() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool UdpmReceiver::open(const UdpmUrl& url, std::string& why) {
+  fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd_ < 0) {
+    why = std::string("socket: ") + std::strerror(errno);
+    return false;
+  }
+  const int one = 1;
+  ::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+#ifdef SO_REUSEPORT
+  ::setsockopt(fd_, SOL_SOCKET, SO_REUSEPORT, &one, sizeof one);
+#endif
+  if (url.recv_buf_size > 0)
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &url.recv_buf_size, sizeof url.recv_buf_size);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_ANY);
+  addr.sin_port = htons(static_cast<std::uint16_t>(url.port));
+  if (::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) {
+    why = std::string("bind to port ") + std::to_string(url.port) + ": " + std::strerror(errno);
+    return false;
+  }
+  ip_mreq mreq{};
+  inet_pton(AF_INET, url.group.c_str(), &mreq.imr_multiaddr);
+  mreq.imr_interface.s_addr = htonl(INADDR_ANY);
+  if (::setsockopt(fd_, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) < 0) {
+    why = std::string("join ") + url.group + ": " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+void UdpmReceiver::add(const std::string& channel, RawHandler handler) {
+  routes_.push_back(Route{channel, std::move(handler)});
+}
+
+int UdpmReceiver::drain(int max) {
+  int n = 0;
+  for (; n < max; ++n) {
+    const ssize_t len = ::recv(fd_, buf_.data(), buf_.size(), 0);
+    if (len < 0) break;  // EAGAIN: nothing pending (or an error: try again next time)
+    ++received_;
+    const auto size = static_cast<std::size_t>(len);
+    if (size < 9) {
+      ++malformed_;
+      continue;
+    }
+    std::uint32_t magic = 0;
+    std::memcpy(&magic, buf_.data(), 4);
+    if (ntohl(magic) != kMagicShort) {
+      ++malformed_;  // fragments ("LC03") and foreign traffic
+      continue;
+    }
+    const char* name = reinterpret_cast<const char*>(buf_.data() + 8);
+    const std::size_t room = std::min(size - 8, kMaxChannel + 1);
+    const void* nul = std::memchr(name, '\0', room);
+    if (!nul) {
+      ++malformed_;
+      continue;
+    }
+    const std::size_t name_len = static_cast<const char*>(nul) - name;
+    const Route* route = nullptr;
+    for (const Route& r : routes_)
+      if (r.channel.size() == name_len && std::memcmp(r.channel.data(), name, name_len) == 0) {
+        route = &r;
+        break;
+      }
+    if (!route) {
+      ++ignored_;
+      continue;
+    }
+    lcm::ReceiveBuffer rb{};
+    rb.data = buf_.data() + 8 + name_len + 1;
+    rb.data_size = static_cast<std::uint32_t>(size - 8 - name_len - 1);
+    timeval tv{};
+    ::gettimeofday(&tv, nullptr);
+    rb.recv_utime = static_cast<std::int64_t>(tv.tv_sec) * 1000000 + tv.tv_usec;
+    route->handler(&rb, route->channel);
+  }
+  return n;
+}
+
+}  // namespace hoist::svc

@@ -1,0 +1,85 @@
+// udpm_receiver.hpp -- hoist-twind's own receive path for LCM's UDP
+// multicast transport (udpm://), in place of LCM 1.3.1's.
+//
+// Why: LCM 1.3.1 keeps, per lcm_t, a hash table entry (channel name string +
+// handler array) for EVERY channel name it has ever received on the group,
+// subscribed or not, and never frees them (lcm.c lcm_get_handlers): a sender
+// cycling through distinct channel names grows the daemon's memory without
+// bound (about 11 MB per 100k names).  This receiver reads the datagrams
+// itself and dispatches only the channels subscribed by exact name (no
+// regular expressions either): nothing is allocated per datagram or per
+// name, so memory stays flat whatever arrives.  LCM is still used to publish
+// (lcm::LCM creates no receive socket and no receive thread while nobody
+// subscribes or asks for its file descriptor).
+//
+// Wire format (lcm-proj/lcm, lcm/lcm_udpm.c, udpm_util.h): a "short"
+// datagram is  u32 magic 0x4c433032 ("LC02") | u32 sequence number |
+// channel name, NUL-terminated | payload  (big-endian); on Linux every
+// message up to 65 499 bytes is sent short.  Fragmented messages (magic
+// "LC03", larger than that) are never inputs of the twin: they are counted
+// and dropped.  Channel names longer than 63 bytes (LCM's own limit) or
+// without a terminator are dropped and counted.
+//
+// Socket options as LCM's: SO_REUSEADDR (+ SO_REUSEPORT) so that other LCM
+// programs on the machine share the port, bound to INADDR_ANY:port, joined
+// to the group on INADDR_ANY; SO_RCVBUF from the URL's recv_buf_size.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <vector>
+
+namespace hoist::svc {
+
+using RawHandler = std::function<void(const lcm::ReceiveBuffer*, const std::string&)>;
+
+/// Where a shaft registers its input channels (exact names).
+class InputRouter {
+ public:
+  virtual ~InputRouter() = default;
+  virtual void add(const std::string& channel, RawHandler handler) = 0;
+};
+
+/// Parsed udpm URL.  parseUdpmUrl() returns false (and `why`) for anything
+/// else; "" is LCM's default, udpm://239.255.76.67:7667?ttl=0.
+struct UdpmUrl {
+  std::string group = "239.255.76.67";
+  int port = 7667;
+  int recv_buf_size = 0;  ///< bytes, 0 = the system default
+};
+bool parseUdpmUrl(const std::string& url, UdpmUrl& out, std::string& why);
+
+class UdpmReceiver final : public InputRouter {
+ public:
+  UdpmReceiver() = default;
+  ~UdpmReceiver() override;
+  UdpmReceiver(const UdpmReceiver&) = delete;
+  UdpmReceiver& operator=(const UdpmReceiver&) = delete;
+
+  /// Open the socket (non-blocking); false and `why` on failure.
+  bool open(const UdpmUrl& url, std::string& why);
+  int fd() const { return fd_; }
+  void add(const std::string& channel, RawHandler handler) override;
+  /// Read and dispatch at most `max` datagrams; returns how many were read
+  /// (0: nothing pending).  No allocation.
+  int drain(int max);
+
+  std::int64_t received() const { return received_; }
+  std::int64_t ignored() const { return ignored_; }      ///< datagrams on channels nobody subscribed
+  std::int64_t malformed() const { return malformed_; }  ///< bad magic, no/long channel name, fragments
+
+ private:
+  struct Route {
+    std::string channel;
+    RawHandler handler;
+  };
+  int fd_ = -1;
+  std::vector<Route> routes_;
+  std::array<std::uint8_t, 65536> buf_{};
+  std::int64_t received_ = 0, ignored_ = 0, malformed_ = 0;
+};
+
+}  // namespace hoist::svc

@@ -1,0 +1,51 @@
+// hoist/service/messages.hpp -- the pure parts of hoist-twind's LCM shell:
+// TwinCore output -> LCM message mapping, alarm text, validation of operator
+// commands (alarm_ack_t), channel-name handling.  No I/O, no clock; the
+// mapping and the alarm text do not allocate (preallocated messages).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "hoist/service/alarm_command.hpp"
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/service/twin_core.hpp"
+
+namespace hoist::svc {
+
+/// Fill `m` (preallocated) from the twin's output; utime, seq and
+/// instance_id are the caller's.
+void toCageMessage(const CageOutput& o, hoist::cage_state_t& m);
+
+/// What the alarm text needs besides the event.
+struct AlarmTextContext {
+  const AlarmConfig* alarms = nullptr;
+  double stale_timeout = 0.0;      ///< [s] in force
+  LengthRange range;               ///< the model's valid range (MODEL_DOMAIN)
+  const char* fault_what = "";     ///< MODEL_FAULT: "non-finite" or the implausible quantity
+  double requested_shelve = 0.0;   ///< SHELVE events: the duration the operator asked for [s]
+  double published_t = 0.0;        ///< unused by the text; kept with the event
+};
+
+/// A readable one-line description of an alarm event into buf[0..n)
+/// (truncated, always terminated; no allocation).
+void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n);
+
+/// At most `max` characters of `s`, every byte outside printable ASCII
+/// replaced by '?', "..." appended when cut (for network strings in logs).
+std::string printable(const std::string& s, std::size_t max = 64);
+
+/// A validated operator command (the rule is validateAlarmCommand, shared with hoist-mqtt).
+using AckCommand = AlarmCommand;
+/// nullopt and `why` set (a static string) if `ack` is not a valid command.
+std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*& why);
+
+/// `name` with every regular-expression metacharacter escaped: LCM's
+/// subscribe() takes a regex, so a literal channel name needs this.
+std::string regexEscape(const std::string& name);
+
+}  // namespace hoist::svc

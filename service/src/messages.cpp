@@ -1,0 +1,147 @@
+// The pure parts of hoist-twind's LCM shell: see hoist/service/messages.hpp.
+#include "hoist/service/messages.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+namespace hoist::svc {
+
+void toCageMessage(const CageOutput& o, hoist::cage_state_t& m) {
+  m.input_seq = o.input_seq;
+  m.t = o.t;
+  m.l = o.kin.l;
+  m.v = o.kin.v;
+  m.a = o.kin.a;
+  m.x_c = o.x_c;
+  m.y_c = o.y_c;
+  m.theta = o.theta;
+  for (int i = 0; i < 5; ++i) m.lambdas[i] = o.lambda[static_cast<std::size_t>(i)];
+  m.y_top = o.clearance.y_top;
+  m.y_bottom = o.clearance.y_bottom;
+  m.guide_deflection = o.clearance.guide_deflection;
+  m.clearance_pos_y = o.clearance.clearance_pos;
+  m.clearance_neg_y = o.clearance.clearance_neg;
+  m.clearance_guide = o.clearance.clearance_guide;
+  m.min_clearance = o.clearance.min_clearance;
+  m.alarm_level = static_cast<int8_t>(o.alarm_level);
+  m.degraded = o.degraded;
+}
+
+void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n) {
+  if (n == 0) return;
+  buf[0] = '\0';
+  const char* verb = "";
+  switch (e.type) {
+    case AlarmEventType::Raise: verb = "raised"; break;
+    case AlarmEventType::Clear: verb = "cleared"; break;
+    case AlarmEventType::Ack: verb = "acknowledged"; break;
+    case AlarmEventType::Shelve: verb = "shelved"; break;
+    case AlarmEventType::Unshelve: verb = "unshelved"; break;
+    case AlarmEventType::Reannounce: verb = "still active"; break;
+  }
+  char state[96];
+  char shelve[128];
+  if (e.type == AlarmEventType::Shelve) {
+    // The verb states the effective duration, and the clamp if there was one.
+    const double limit = ctx.alarms ? ctx.alarms->max_shelve : 0.0;
+    if (limit > 0.0 && ctx.requested_shelve > limit)
+      std::snprintf(shelve, sizeof shelve, "shelved for %.0f s (requested %g s, clamped to max_shelve = %g s)",
+                    e.shelved_for, ctx.requested_shelve, limit);
+    else
+      std::snprintf(shelve, sizeof shelve, "shelved for %.0f s", e.shelved_for);
+    verb = shelve;
+  }
+  std::snprintf(state, sizeof state, "%s%s%s", e.latched ? " [latched until acknowledged]" : "",
+                e.shelved ? " [shelved]" : "", (e.active && !e.acked) ? " [unacknowledged]" : "");
+  const char* kind = toString(e.kind);
+  const char* level = toString(e.level);
+  switch (e.kind) {
+    case AlarmKind::CagePosY:
+    case AlarmKind::CageNegY:
+    case AlarmKind::GuideRope: {
+      const AlarmConfig dflt{};
+      const AlarmConfig& cfg = ctx.alarms ? *ctx.alarms : dflt;
+      const bool guide = e.kind == AlarmKind::GuideRope;
+      const double gap = e.kind == AlarmKind::CagePosY   ? cfg.gap_pos_y
+                         : e.kind == AlarmKind::CageNegY ? cfg.gap_neg_y
+                                                         : cfg.guide_rope_gap;
+      std::snprintf(buf, n, "%s %s %s: %s %.1f mm (threshold %.1f mm of gap %.1f mm, clearance %.1f mm)%s",
+                    kind, level, verb,
+                    guide ? "guide-rope deflection"
+                          : (e.kind == AlarmKind::CagePosY ? "cage excursion toward +y" : "cage excursion toward -y"),
+                    e.value * 1e3, e.threshold * 1e3, gap * 1e3, (gap - e.value) * 1e3, state);
+      break;
+    }
+    case AlarmKind::InputStale:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: winder input is back%s", kind, level, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: no valid winder input for more than %.3g s; outputs degraded (l held, v = a = 0)%s",
+                      kind, level, verb, ctx.stale_timeout, state);
+      break;
+    case AlarmKind::ModelFault:
+      if (std::strcmp(ctx.fault_what, "non-finite") == 0 || ctx.fault_what[0] == '\0')
+        std::snprintf(buf, n, "%s %s %s: non-finite model state, model re-initialized at static equilibrium%s",
+                      kind, level, verb, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: implausible model state, %s = %.4g beyond the plausibility bound %.4g; "
+                      "model re-initialized at static equilibrium%s",
+                      kind, level, verb, ctx.fault_what, e.value, e.threshold, state);
+      break;
+    case AlarmKind::ModelDomain:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: rope length back inside the model's valid range [%.3f, %.3f] m%s",
+                      kind, level, ctx.range.lo, ctx.range.hi, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: rope length %.3f m outside the model's valid range [%.3f, %.3f] m "
+                      "(limit %.3f m); holding the last valid state, outputs degraded%s",
+                      kind, level, verb, e.value, ctx.range.lo, ctx.range.hi, e.threshold, state);
+      break;
+    case AlarmKind::DuplicatePublisher:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: no other publisher seen on this twin's output channels%s", kind,
+                      level, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: another process (instance %.0f) publishes on this twin's output "
+                      "channels; its states interleave with ours (same channel_prefix twice?)%s",
+                      kind, level, verb, e.value, state);
+      break;
+  }
+}
+
+std::string printable(const std::string& s, std::size_t max) {
+  std::string o;
+  o.reserve(std::min(s.size(), max) + 3);
+  for (std::size_t i = 0; i < s.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    o.push_back(c >= 32 && c < 127 ? static_cast<char>(c) : '?');
+  }
+  if (s.size() > max) o += "...";
+  return o;
+}
+
+std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*& why) {
+  AckCommand c;
+  switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, c)) {
+    case CommandError::None: return c;
+    case CommandError::UnknownKind: why = "unknown alarm kind"; break;
+    case CommandError::BadLevel: why = "bad level (0 both, 1 warning, 2 critical)"; break;
+    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve)"; break;
+    case CommandError::BadShelveDuration: why = "shelve_duration must be a finite number > 0 s"; break;
+  }
+  return std::nullopt;
+}
+
+std::string regexEscape(const std::string& name) {
+  std::string o;
+  o.reserve(name.size() * 2);
+  for (char c : name) {
+    if (std::strchr("\\^$.|?*+()[]{}-/", c) && c != '\0') o.push_back('\\');
+    o.push_back(c);
+  }
+  return o;
+}
+
+}  // namespace hoist::svc

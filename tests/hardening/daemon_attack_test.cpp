@@ -1,0 +1,344 @@
+// Issue 12 sections 3-6 and issue 15.3/15.4 against the real daemon over LCM
+// (UDP multicast on loopback, ttl=0, ports 7851..7860): the exact attacks,
+// asserting the daemon stays alive and what it publishes and logs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/health_t.hpp"
+#include "hoist/winder_t.hpp"
+#include "lcm_fixtures.hpp"
+
+using namespace hoist::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::int64_t nowUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+hoist::winder_t winder(std::int64_t seq, std::int64_t utime, double v, double length) {
+  hoist::winder_t m{};
+  m.utime = utime;
+  m.seq = seq;
+  m.v = v;
+  m.has_length = true;
+  m.length = length;
+  return m;
+}
+
+std::int64_t reason(const hoist::health_t& h, const std::string& r) {
+  for (int i = 0; i < h.n_reasons; ++i)
+    if (h.reject_reason[i] == r) return h.rejected[i];
+  return -1;
+}
+
+class DaemonAttack : public ::testing::Test {
+ protected:
+  void start(int port, const std::string& name, const std::string& prefix = "") {
+    url_ = urlFor(port);
+    dir_ = testDir(name);
+    prefix_ = prefix;
+    std::string why;
+    if (!loopbackMulticastWorks(url_, why)) FAIL() << why << ".\n" << kMulticastHelp;
+    listen();
+  }
+  void listen() {
+    listener_ = std::make_unique<Listener>(url_);
+    ASSERT_TRUE(listener_->good()) << kMulticastHelp;
+    listener_->subscribe(".*HOIST_HEALTH");
+    listener_->subscribe(".*HOIST_CAGE");
+    listener_->subscribe(".*HOIST_ALARM");
+  }
+  std::string writeConfig(const std::string& file, const std::string& text) {
+    const auto p = (dir_ / file).string();
+    std::ofstream(p) << text;
+    return p;
+  }
+  std::unique_ptr<Process> startDaemon(std::vector<std::string> extra, const std::string& log_name,
+                                       const std::string& health = "HOIST_HEALTH") {
+    std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--log-level", "info"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return startDaemonAndWait(*listener_, argv, (dir_ / log_name).string(), health);
+  }
+  hoist::health_t lastHealth(const std::string& ch = "HOIST_HEALTH") {
+    auto hs = listener_->decoded<hoist::health_t>(ch);
+    return hs.empty() ? hoist::health_t{} : hs.back();
+  }
+  hoist::health_t waitHealth(const std::function<bool(const hoist::health_t&)>& pred, std::chrono::milliseconds timeout,
+                             const std::string& ch = "HOIST_HEALTH") {
+    hoist::health_t h{};
+    listener_->waitFor(
+        [&] {
+          auto hs = listener_->decoded<hoist::health_t>(ch);
+          if (hs.empty()) return false;
+          h = hs.back();
+          return pred(h);
+        },
+        timeout);
+    return h;
+  }
+  void feed(const std::string& channel, int n, double v = 0.0, double l0 = 100.0, std::int64_t seq0 = 0) {
+    std::int64_t utime = nowUs();
+    for (int k = 0; k < n; ++k, utime += 10000) {
+      const auto m = winder(seq0 + k, utime, v, l0 + v * 0.01 * k);
+      listener_->lcm().publish(channel, &m);
+      listener_->pump(std::chrono::milliseconds(10));
+    }
+  }
+
+  std::string url_, prefix_;
+  fs::path dir_;
+  std::unique_ptr<Listener> listener_;
+};
+
+}  // namespace
+
+TEST_F(DaemonAttack, MillionDistinctChannelNamesKeepMemoryFlat) {
+  // Issue 12.3: LCM 1.3.1 caches a handler entry per channel name seen
+  // (11 MB per 100k names, never freed).  The daemon's own receive path
+  // stores nothing per name: RSS growth < 2 MB after 1M distinct names.
+  start(7851, "chanspam");
+  auto d = startDaemon({}, "twind.log");
+  const hoist::health_t h0 = waitHealth([](const hoist::health_t& h) { return h.rss_kb > 0; }, 3s);
+  ASSERT_GT(h0.rss_kb, 0);
+  // The listener would cache the names too: close it during the spam.  Send
+  // distinct names in chunks until the daemon has received a million of
+  // them (a loaded machine drops some in the socket buffer).
+  hoist::health_t h1{};
+  int sent = 0;
+  while (sent < 3'000'000) {
+    listener_.reset();
+    {
+      lcm::LCM pub(url_);  // publish only: no receive socket
+      ASSERT_TRUE(pub.good());
+      const char payload[8] = {1, 2, 3, 4, 5, 6, 7, 8};
+      char name[40];
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int i = 0; i < 200'000; ++i, ++sent) {
+        std::snprintf(name, sizeof name, "SPAM_%07d", sent);
+        pub.publish(name, payload, sizeof payload);
+        if (i % 1000 == 999) std::this_thread::sleep_until(t0 + std::chrono::microseconds(10 * (i + 1)));
+      }
+    }
+    const std::int64_t after = nowUs();
+    listen();
+    h1 = waitHealth([&](const hoist::health_t& h) { return h.utime > after; }, 5s);
+    if (h1.datagrams_ignored >= 1'000'000) break;
+  }
+  EXPECT_TRUE(d->running());
+  EXPECT_GE(h1.datagrams_ignored, 1'000'000) << "sent " << sent << " names";
+  EXPECT_LT(h1.rss_kb - h0.rss_kb, 2048) << "RSS grew from " << h0.rss_kb << " to " << h1.rss_kb << " KiB";
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+}
+
+TEST_F(DaemonAttack, ChannelPrefixIsALiteralNotARegex) {
+  // Issue 12.5: prefixes "mine.1/" and "mine_1/" in one process; a feeder
+  // on mine.1/ drives only that shaft, "mineX1/" drives none, a shelve on
+  // mine_1/ reaches only mine_1/.
+  start(7852, "prefix");
+  const auto a = writeConfig("a.toml", "[service]\nchannel_prefix = \"mine.1/\"\n");
+  const auto b = writeConfig("b.toml", "[service]\nchannel_prefix = \"mine_1/\"\n");
+  auto d = startDaemon({"--config", a, "--config", b}, "twind.log", "mine_1/HOIST_HEALTH");
+  feed("mineX1/HOIST_WINDER", 30);
+  feed("mine.1/HOIST_WINDER", 50, 0.0, 100.0, 100);
+  hoist::alarm_ack_t ack{};
+  ack.kind = "*";
+  ack.action = hoist::alarm_ack_t::ACTION_SHELVE;
+  ack.shelve_duration = 60.0;
+  ack.user = "op";
+  listener_->lcm().publish("mine.1XHOIST_ALARM_ACK", &ack);
+  listener_->lcm().publish("mine_1/HOIST_ALARM_ACK", &ack);
+  listener_->pump(1500ms);
+  const auto dot = lastHealth("mine.1/HOIST_HEALTH");
+  const auto und = lastHealth("mine_1/HOIST_HEALTH");
+  EXPECT_GE(dot.accepted, 40);
+  EXPECT_LE(dot.accepted, 50) << "the mineX1/ feeder reached mine.1/";
+  EXPECT_EQ(und.accepted, 0) << "mine_1/ followed another shaft's feeder";
+  EXPECT_EQ(dot.alarms_shelved, 0);
+  EXPECT_EQ(und.alarms_shelved, 10);
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+}
+
+TEST_F(DaemonAttack, SecondPublisherOnTheSameChannelsIsDetected) {
+  // Issue 12.5: two daemons with the same channels interleave contradictory
+  // states; each must notice the other (instance_id) and alarm.
+  start(7853, "duplicate");
+  auto d1 = startDaemon({}, "twind1.log");
+  auto d2 = startDaemon({}, "twind2.log");
+  std::set<std::int64_t> ids;
+  bool alarm = listener_->waitFor(
+      [&] {
+        for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
+          if (a.kind == "DUPLICATE_PUBLISHER" && a.event_type == hoist::alarm_t::EVENT_RAISE) return true;
+        return false;
+      },
+      5s);
+  EXPECT_TRUE(alarm);
+  for (const auto& h : listener_->decoded<hoist::health_t>("HOIST_HEALTH")) ids.insert(h.instance_id);
+  EXPECT_EQ(ids.size(), 2u);
+  stopDaemonCleanly(*d1, (dir_ / "twind1.log").string());
+  stopDaemonCleanly(*d2, (dir_ / "twind2.log").string());
+  const std::string log = readFile((dir_ / "twind1.log").string()) + readFile((dir_ / "twind2.log").string());
+  EXPECT_NE(log.find("another publisher"), std::string::npos);
+}
+
+TEST_F(DaemonAttack, SignalsAndADeadLogReaderDoNotKill) {
+  // Issue 12.6: SIGHUP, SIGUSR1 and SIGPIPE killed the daemon at once.
+  start(7854, "signals");
+  // stderr into a pipe whose reader is gone: every log line hits EPIPE.
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_adddup2(&fa, fds[1], STDERR_FILENO);
+  posix_spawn_file_actions_adddup2(&fa, fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_addclose(&fa, fds[0]);
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--log-level", "debug"};
+  std::vector<char*> args;
+  for (auto& a : argv) args.push_back(a.data());
+  args.push_back(nullptr);
+  pid_t pid = -1;
+  ASSERT_EQ(posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&fa);
+  ::close(fds[1]);
+  ASSERT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > 0; }, 10s));
+  ::close(fds[0]);  // the log reader dies
+  for (int sig : {SIGHUP, SIGUSR1, SIGUSR2, SIGPIPE, SIGHUP}) {
+    ::kill(pid, sig);
+    listener_->pump(200ms);
+  }
+  feed("HOIST_WINDER", 50);  // log lines (debug health, stream start) onto the dead pipe
+  const std::size_t before = listener_->count("HOIST_HEALTH");
+  listener_->pump(1500ms);
+  int st = 0;
+  EXPECT_EQ(::waitpid(pid, &st, WNOHANG), 0) << "the daemon died (status " << st << ")";
+  EXPECT_GT(listener_->count("HOIST_HEALTH"), before) << "no health after the signals";
+  ::kill(pid, SIGTERM);
+  for (int i = 0; i < 200 && ::waitpid(pid, &st, WNOHANG) == 0; ++i) std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(WIFEXITED(st)) << "killed by signal " << (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+  EXPECT_EQ(WEXITSTATUS(st), 0);
+}
+
+TEST_F(DaemonAttack, ConfigsThatCannotRunAreRefusedAndForcedOnesStayResponsive) {
+  // Issue 12.4: modes = 1000 at 1 kHz and max_step = 1e-9 started in silence.
+  start(7855, "budget");
+  const auto tiny = writeConfig("tiny.toml", "[service]\nmax_step = 1e-9\n");
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--config", tiny, "--lcm-url", url_}, (dir_ / "tiny.log").string(), 30s), 2);
+  const std::string tiny_log = readFile((dir_ / "tiny.log").string());
+  EXPECT_NE(tiny_log.find("service.max_step"), std::string::npos) << tiny_log;
+  // modes = 400 at 1 kHz with 4 substeps per tick: about 3.5 ms per 1-ms
+  // tick even on an idle machine (1000 modes would take longer to set up
+  // than this test waits).
+  const auto heavy =
+      writeConfig("heavy.toml", "[model]\nmodes = 400\n[service]\nrate = 1000\nmax_step = 0.00025\n");
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--config", heavy, "--lcm-url", url_}, (dir_ / "heavy.log").string(), 60s), 2);
+  const std::string heavy_log = readFile((dir_ / "heavy.log").string());
+  EXPECT_NE(heavy_log.find("cannot run in real time"), std::string::npos) << heavy_log;
+  EXPECT_NE(heavy_log.find("--force"), std::string::npos);
+  // --force: it runs, overloaded, and stays responsive: health about 1 Hz,
+  // SIGTERM honoured within a second.
+  auto d = startDaemon({"--config", heavy, "--force"}, "forced.log");
+  feed("HOIST_WINDER", 100, 1.0);
+  const std::size_t n0 = listener_->count("HOIST_HEALTH");
+  listener_->pump(3000ms);
+  EXPECT_GE(listener_->count("HOIST_HEALTH") - n0, 2u) << "health went silent under overload";
+  const auto t0 = std::chrono::steady_clock::now();
+  d->signal(SIGTERM);
+  EXPECT_EQ(d->wait(10s), 0);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+  const std::string log = readFile((dir_ / "forced.log").string());
+  EXPECT_NE(log.find("OVER BUDGET"), std::string::npos) << log;
+  EXPECT_NE(log.find("the loop fell behind"), std::string::npos) << log;
+}
+
+TEST_F(DaemonAttack, EffectiveCommandsAreAuditedWithTheirUser) {
+  // Issue 12.3: five invalid commands, then a '*' shelve from "mallory":
+  // the shelve is in HOIST_ALARM (user field) and the log, whatever the
+  // junk limiter did.  A shelve beyond max_shelve states the clamp (15.4).
+  start(7856, "audit");
+  auto d = startDaemon({"--config", writeConfig("one.toml", "[service]\nlog_rate_limit = 1\n")}, "twind.log");
+  hoist::alarm_ack_t bad{};
+  bad.kind = "NOPE";
+  bad.user = "junk";
+  for (int i = 0; i < 5; ++i) listener_->lcm().publish("HOIST_ALARM_ACK", &bad);
+  listener_->pump(50ms);
+  hoist::alarm_ack_t ack{};
+  ack.kind = "*";
+  ack.action = hoist::alarm_ack_t::ACTION_SHELVE;
+  ack.shelve_duration = 99999.0;
+  ack.user = "mallory";
+  listener_->lcm().publish("HOIST_ALARM_ACK", &ack);
+  // The same command again: not effective, no events.
+  for (int i = 0; i < 100; ++i) listener_->lcm().publish("HOIST_ALARM_ACK", &ack);
+  listener_->pump(1000ms);
+  int shelves = 0;
+  for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
+    if (a.event_type == hoist::alarm_t::EVENT_SHELVE) {
+      ++shelves;
+      EXPECT_EQ(a.user, "mallory");
+      EXPECT_NE(a.message.find("clamped to max_shelve = 3600 s"), std::string::npos) << a.message;
+      EXPECT_NEAR(a.shelved_for, 3600.0, 1.0);
+    }
+  EXPECT_EQ(shelves, 10) << "one event per alarm, the repeats silent";
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+  const std::string log = readFile((dir_ / "twind.log").string());
+  EXPECT_NE(log.find("AUDIT operator 'mallory': shelve */* for 3600 s (requested 99999 s, clamped to max_shelve)"),
+            std::string::npos)
+      << log;
+}
+
+TEST_F(DaemonAttack, AlarmAndCageShareOneTimeOrigin) {
+  // Issue 15.3: HOIST_ALARM.t counted from daemon start, HOIST_CAGE.t from
+  // the first input.  Idle 2 s, 1 s of input, silence: INPUT_STALE comes
+  // within a stale timeout of the last cage state, on the same clock.
+  start(7857, "origin");
+  auto d = startDaemon({}, "twind.log");
+  listener_->pump(2000ms);
+  listener_->clear();
+  feed("HOIST_WINDER", 100);
+  listener_->pump(1500ms);
+  const auto cages = listener_->decoded<hoist::cage_state_t>("HOIST_CAGE");
+  ASSERT_FALSE(cages.empty());
+  double stale_t = -1.0;
+  for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
+    if (a.kind == "INPUT_STALE" && a.event_type == hoist::alarm_t::EVENT_RAISE) stale_t = a.t;
+  ASSERT_GE(stale_t, 0.0);
+  double last_fresh = 0.0;
+  for (const auto& c : cages)
+    if (!c.degraded) last_fresh = c.t;
+  EXPECT_NEAR(stale_t, last_fresh, 0.6) << "alarm t " << stale_t << " vs cage t " << last_fresh;
+  EXPECT_LT(cages.front().t, 0.5);
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+}
+
+TEST_F(DaemonAttack, OutputsGoToLcmUrlOut) {
+  // Issue 13: [service] lcm_url_out -- the daemon publishes there and does
+  // not receive its own outputs on its input socket.
+  start(7858, "urlout");
+  const std::string out_url = urlFor(7859);
+  Listener out(out_url);
+  ASSERT_TRUE(out.good());
+  out.subscribe("HOIST_.*");
+  const auto cfg = writeConfig("out.toml", "[service]\nlcm_url_out = \"" + out_url + "\"\n");
+  auto p = std::make_unique<Process>(std::vector<std::string>{HOIST_TWIND, "--config", cfg, "--lcm-url", url_},
+                                     (dir_ / "twind.log").string());
+  ASSERT_TRUE(out.waitFor([&] { return out.count("HOIST_HEALTH") > 0; }, 10s)) << readFile((dir_ / "twind.log").string());
+  out.pump(200ms);
+  feed("HOIST_WINDER", 50);
+  out.pump(300ms);
+  EXPECT_GT(out.count("HOIST_CAGE"), 20u);
+  EXPECT_EQ(listener_->count("HOIST_CAGE"), 0u);
+  EXPECT_EQ(listener_->count("HOIST_HEALTH"), 0u);
+  stopDaemonCleanly(*p, (dir_ / "twind.log").string());
+  const auto bad = writeConfig("bad.toml", "[service]\nlcm_url_out = \"nonsense\"\n");
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--config", bad, "--lcm-url", url_}, (dir_ / "bad.log").string(), 30s), 2);
+  EXPECT_NE(readFile((dir_ / "bad.log").string()).find("service.lcm_url_out"), std::string::npos);
+}

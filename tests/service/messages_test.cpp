@@ -1,0 +1,141 @@
+// The pure parts of hoist-twind's LCM shell (hoist/service/messages.hpp):
+// output -> cage_state_t mapping, alarm text, operator-command validation,
+// literal channel names for LCM's regex subscribe.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <regex>
+
+#include "hoist/service/messages.hpp"
+
+using namespace hoist;
+using namespace hoist::svc;
+
+TEST(Messages, CageMappingCopiesEveryField) {
+  CageOutput o;
+  o.t = 1.5;
+  o.kin = {120.0, 2.0, 0.5};
+  o.x_c = 1e-3;
+  o.y_c = 2e-3;
+  o.theta = 3e-4;
+  o.lambda = {8848.0, -31.0, 31.0, -30.0, 30.0};
+  o.clearance = computeClearance(o.y_c, o.theta, 8.0, 0.004, AlarmConfig{});
+  o.alarm_level = AlarmLevel::Warning;
+  o.degraded = true;
+  o.input_seq = 42;
+  hoist::cage_state_t m{};
+  toCageMessage(o, m);
+  EXPECT_EQ(m.input_seq, 42);
+  EXPECT_EQ(m.t, 1.5);
+  EXPECT_EQ(m.l, 120.0);
+  EXPECT_EQ(m.v, 2.0);
+  EXPECT_EQ(m.a, 0.5);
+  EXPECT_EQ(m.x_c, 1e-3);
+  EXPECT_EQ(m.y_c, 2e-3);
+  EXPECT_EQ(m.theta, 3e-4);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(m.lambdas[i], o.lambda[static_cast<std::size_t>(i)]);
+  EXPECT_EQ(m.y_top, o.clearance.y_top);
+  EXPECT_EQ(m.y_bottom, o.clearance.y_bottom);
+  EXPECT_EQ(m.guide_deflection, 0.004);
+  EXPECT_EQ(m.clearance_pos_y, o.clearance.clearance_pos);
+  EXPECT_EQ(m.clearance_neg_y, o.clearance.clearance_neg);
+  EXPECT_EQ(m.clearance_guide, o.clearance.clearance_guide);
+  EXPECT_EQ(m.min_clearance, o.clearance.min_clearance);
+  EXPECT_EQ(m.alarm_level, 1);
+  EXPECT_TRUE(m.degraded);
+}
+
+TEST(Messages, AlarmTextNamesWhatTheOperatorNeeds) {
+  AlarmConfig cfg;
+  AlarmTextContext ctx;
+  ctx.alarms = &cfg;
+  ctx.range = {0.05, 383.95};
+  char buf[256];
+  AlarmEvent e;
+  e.kind = AlarmKind::ModelDomain;
+  e.level = AlarmLevel::Critical;
+  e.type = AlarmEventType::Raise;
+  e.value = 384.2;
+  e.threshold = 383.95;
+  e.active = true;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_NE(std::string(buf).find("MODEL_DOMAIN CRITICAL raised: rope length 384.200 m outside the model's valid "
+                                  "range [0.050, 383.950] m (limit 383.950 m)"),
+            std::string::npos)
+      << buf;
+  // A shelve clamped to max_shelve says so (issue 15.4).
+  e = AlarmEvent{};
+  e.kind = AlarmKind::GuideRope;
+  e.type = AlarmEventType::Shelve;
+  e.shelved = true;
+  e.shelved_for = 3600.0;
+  ctx.requested_shelve = 99999.0;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_NE(std::string(buf).find("shelved for 3600 s (requested 99999 s, clamped to max_shelve = 3600 s)"),
+            std::string::npos)
+      << buf;
+  ctx.requested_shelve = 600.0;
+  e.shelved_for = 600.0;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_EQ(std::string(buf).find("clamped"), std::string::npos) << buf;
+  // An implausible state names the quantity and the bound.
+  e = AlarmEvent{};
+  e.kind = AlarmKind::ModelFault;
+  e.level = AlarmLevel::Critical;
+  e.value = -1e159;
+  e.threshold = 3.0;
+  ctx.fault_what = "y_c";
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_NE(std::string(buf).find("y_c = -1e+159 beyond the plausibility bound 3"), std::string::npos) << buf;
+  // Truncation keeps the terminator.
+  char small[16];
+  describeAlarm(e, ctx, small, sizeof small);
+  EXPECT_EQ(std::strlen(small), 15u);
+}
+
+TEST(Messages, AckValidation) {
+  hoist::alarm_ack_t a{};
+  a.kind = "*";
+  a.level = 0;
+  a.action = hoist::alarm_ack_t::ACTION_SHELVE;
+  a.shelve_duration = 600.0;
+  const char* why = "";
+  auto c = validateAck(a, why);
+  ASSERT_TRUE(c);
+  EXPECT_FALSE(c->kind);
+  EXPECT_EQ(c->action, AlarmAction::Shelve);
+  EXPECT_EQ(c->shelve_duration, 600.0);
+  a.kind = "MODEL_DOMAIN";
+  c = validateAck(a, why);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(*c->kind, AlarmKind::ModelDomain);
+  for (auto bad : {std::string("NOPE"), std::string("cage_pos_y")}) {
+    a.kind = bad;
+    EXPECT_FALSE(validateAck(a, why));
+    EXPECT_STREQ(why, "unknown alarm kind");
+  }
+  a.kind = "";
+  a.level = 3;
+  EXPECT_FALSE(validateAck(a, why));
+  a.level = 2;
+  a.action = 9;
+  EXPECT_FALSE(validateAck(a, why));
+  a.action = hoist::alarm_ack_t::ACTION_SHELVE;
+  for (double d : {0.0, -1.0, std::nan(""), static_cast<double>(INFINITY)}) {
+    a.shelve_duration = d;
+    EXPECT_FALSE(validateAck(a, why)) << d;
+  }
+}
+
+TEST(Messages, PrintableAndRegexEscape) {
+  EXPECT_EQ(printable("\x1b[31mevil\x1b[0m"), "?[31mevil?[0m");
+  EXPECT_EQ(printable(std::string(100, 'x'), 64), std::string(64, 'x') + "...");
+  // LCM subscribes to "^<name>$" as a regular expression (GRegex, PCRE).
+  const std::string name = "mine.1/HOIST_WINDER";
+  const std::regex re("^" + regexEscape(name) + "$");
+  EXPECT_TRUE(std::regex_match(name, re));
+  EXPECT_FALSE(std::regex_match(std::string("mineX1/HOIST_WINDER"), re));
+  EXPECT_FALSE(std::regex_match(std::string("mine_1/HOIST_WINDER"), re));
+  EXPECT_EQ(regexEscape("a-b.c/d_e"), "a\\-b\\.c\\/d_e");
+}
