@@ -9,6 +9,7 @@
 #include <sstream>
 #include <sys/stat.h>
 
+#include "hoist/plausibility.hpp"
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
 
@@ -262,13 +263,16 @@ HoistProfile loadProfile(const std::string& arg, double l0, const ProfileLimits&
 }
 
 void checkProfileInShaft(const HoistProfile& profile, const ShaftParams& p, const std::string& source) {
-  const double lmax = p.maxRopeLength();
+  // The model's valid range (hoist/plausibility.hpp): the sleeves stay on the
+  // guide ropes, and a documented distance from both shaft ends.
+  const LengthRange r = validLengthRange(p);
   for (const auto& s : profile.samples()) {
-    if (!(s.k.l > 0.0) || !(s.k.l < lmax)) {
+    if (!(s.k.l >= r.lo) || !(s.k.l <= r.hi)) {
       std::ostringstream os;
       os << "at t = " << s.t << " s the rope length l = " << s.k.l
-         << " m leaves the shaft: it must stay in (0, L - 2h) = (0, " << lmax
-         << ") m so that the cage's sleeves stay on the guide ropes";
+         << " m leaves the shaft: valid rope lengths are [" << r.lo << ", " << r.hi
+         << "] m (the cage's sleeves on the guide ropes, " << r.lo << " m clear of both ends of (0, L - 2h) = (0, "
+         << p.maxRopeLength() << ") m; docs/model.md)";
       throw ProfileError(source, 0, "l", os.str());
     }
   }
