@@ -47,13 +47,17 @@ Kinematics HoistProfile::at(double t) const {
   const double dt = s1.t - s0.t;
   const double u = (t - s0.t) / dt;
   if (u == 0.0) return s0.k;
+  return hermiteKinematics(s0.k, s1.k, dt, u);
+}
+
+Kinematics hermiteKinematics(const Kinematics& k0, const Kinematics& k1, double dt, double u) {
   Kinematics k;
-  k.v = s0.k.v + u * (s1.k.v - s0.k.v);
-  k.a = s0.k.a + u * (s1.k.a - s0.k.a);
+  k.v = k0.v + u * (k1.v - k0.v);
+  k.a = k0.a + u * (k1.a - k0.a);
   // Cubic Hermite on (l, v) at both ends.
   const double h00 = (1 + 2 * u) * (1 - u) * (1 - u), h10 = u * (1 - u) * (1 - u);
   const double h01 = u * u * (3 - 2 * u), h11 = u * u * (u - 1);
-  k.l = h00 * s0.k.l + h10 * dt * s0.k.v + h01 * s1.k.l + h11 * dt * s1.k.v;
+  k.l = h00 * k0.l + h10 * dt * k0.v + h01 * k1.l + h11 * dt * k1.v;
   return k;
 }
 

@@ -14,6 +14,13 @@ struct Kinematics {
   double a = 0.0;  ///< d2l/dt2 [m/s^2]
 };
 
+/// Kinematics at fraction u in [0, 1] of an interval of h seconds from k0 to
+/// k1: l by the cubic Hermite consistent with (l, v) at both ends, v and a
+/// linear.  The one interpolation used between samples by HoistProfile::at
+/// (hence hoist-sim's substeps) and by the forecast's substeps; the daemon's
+/// substeps (TwinCore::advance) should call it too to be bit-identical.
+Kinematics hermiteKinematics(const Kinematics& k0, const Kinematics& k1, double h, double u);
+
 struct ProfileSample {
   double t = 0.0;
   Kinematics k;
