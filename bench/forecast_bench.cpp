@@ -62,6 +62,8 @@ void BM_ForecastPlan(benchmark::State& s) { forecastBench(s, Kind::Plan); }
 
 // Args: n, max_step in 0.1 ms (25 = the daemon's default 2.5 ms; 100 = no substeps).
 BENCHMARK(BM_ForecastEstop)->Args({20, 25})->Args({50, 25})->Args({50, 100})->Unit(benchmark::kMillisecond);
+// The converged setting for the tilt (README: n = 200); a few iterations suffice.
+BENCHMARK(BM_ForecastEstop)->Args({200, 25})->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_ForecastContinue)->Args({20, 25})->Args({50, 25})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ForecastPlan)->Args({50, 25})->Unit(benchmark::kMillisecond);
 
