@@ -421,6 +421,66 @@ void FastSolver::step(double t1, const Kinematics& k1) {
   updateResponse(t1, k1);
 }
 
+FastSolverState::FastSolverState(int n) {
+  if (n < 1) throw std::invalid_argument("FastSolverState: n must be >= 1");
+  const int N = 2 * n + 2;
+  x = xd = xdd = xa = VectorXd::Zero(N);
+  y = yd = ydd = ya = VectorXd::Zero(n);
+}
+
+void FastSolver::saveState(FastSolverState& s) const {
+  s.t = t_;
+  s.kin = kin_;
+  s.x = x_;
+  s.xd = xd_;
+  s.xdd = xdd_;
+  s.xa = xa_;
+  s.lam = lam_;
+  s.R = R_;
+  s.Rc = Rc_;
+  s.Zd = Zd_;
+  s.delta = delta_;
+  s.lamS = lamS_;
+  s.y = y_;
+  s.yd = yd_;
+  s.ydd = ydd_;
+  s.ya = ya_;
+  s.lambda0 = lambda0_;
+  s.last_iters = last_iters_;
+  s.fallbacks = fallbacks_;
+  s.response = resp_;
+  s.valid = true;
+}
+
+void FastSolver::restoreState(const FastSolverState& s) {
+  if (!s.valid) throw std::invalid_argument("FastSolver::restoreState: the state was never saved");
+  if (s.modes() != n_ || s.x.size() != N_)
+    throw std::invalid_argument("FastSolver::restoreState: state saved with another number of modes");
+  t_ = s.t;
+  kin_ = s.kin;
+  x_ = s.x;
+  xd_ = s.xd;
+  xdd_ = s.xdd;
+  xa_ = s.xa;
+  lam_ = s.lam;
+  R_ = s.R;
+  Rc_ = s.Rc;
+  Zd_ = s.Zd;
+  delta_ = s.delta;
+  lamS_ = s.lamS;
+  y_ = s.y;
+  yd_ = s.yd;
+  ydd_ = s.ydd;
+  ya_ = s.ya;
+  lambda0_ = s.lambda0;
+  last_iters_ = s.last_iters;
+  fallbacks_ = s.fallbacks;
+  resp_ = s.response;
+  // Sd_ depends on the step size only; Gt_, Y_, Ek_ are rebuilt by every
+  // step before use.  Recomputing Sd_ gives the same bits.
+  h_cached_ = -1.0;
+}
+
 // With the static correction the shape is y = U.(V z) + sum R(x, a_k) lam_k,
 // R(x, a) = G(x, a) - U(x)^T K^-1 U(a): the modal part is shifted by
 // -K^-1 sum U(a_k) lam_k (in modal coordinates -kappa^-1 .* G^T lam) and the

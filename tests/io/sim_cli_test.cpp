@@ -10,6 +10,9 @@
 #include <sstream>
 
 #include "process.hpp"
+#include "hoist/forecast.hpp"
+#include "hoist/scenario.hpp"
+#include "hoist/simulator.hpp"
 #include "test_util.hpp"
 
 namespace fs = std::filesystem;
@@ -195,4 +198,57 @@ TEST_F(SimCli, HelpDescribesTheOptions) {
                           "--static-correction", "--shape-out",
                           "--shape-times", "trapezoid:"})
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+}
+
+// Issue 17: `hoist-sim --estop-at T` is the same run as the look-ahead
+// forecast's "estop" scenario made from the twin's state at T.
+TEST_F(SimCli, EstopAtIsTheForecastsEstopScenario) {
+  const SimRun r = sim({"--profile", "paper", "--modes", "20", "--estop-at", "20", "--estop-decel", "2.5",
+                        "--estop-jerk", "8", "--t-end", "35", "-q", "--out", path("o.csv")});
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Table t = readCsv(path("o.csv"));
+  // The forecast from the snapshot at 20 s, horizon 15 s.
+  hoist::ShaftParams p;
+  p.n = 20;
+  auto model = std::make_shared<const hoist::ShaftModel>(p);
+  hoist::ForecastOptions o;
+  o.horizon = 15.0;
+  hoist::FastSolver s(model);
+  hoist::SimulationOptions so;
+  so.dt = 0.01;
+  so.max_step = 0.0025;
+  so.t_end = 20.0;
+  hoist::simulate(s, hoist::HoistProfile::trapezoid(), so, {});
+  hoist::FastSolverState st(20);
+  s.saveState(st);
+  hoist::ForecastWorkspace ws(model, o);
+  hoist::ForecastSummary f;
+  const hoist::MotionProfile stop = hoist::estopProfile(st.t, st.kin, 2.5, 8.0);
+  hoist::forecast(ws, st, stop, f);
+  ASSERT_EQ(f.status, hoist::ForecastStatus::Ok);
+  double l0min = 1e300, l0max = -1e300, yc = 0, th = 0, lam1 = 0;
+  const int ct = t.col("t"), cl0 = t.col("lambda_0"), cy = t.col("y_c"), cth = t.col("theta"), c1 = t.col("lambda_1");
+  int n = 0;
+  for (const auto& row : t.rows) {
+    if (row[ct] < 20.0 - 1e-9) continue;
+    ++n;
+    l0min = std::min(l0min, row[cl0]);
+    l0max = std::max(l0max, row[cl0]);
+    yc = std::max(yc, std::abs(row[cy]));
+    th = std::max(th, std::abs(row[cth]));
+    lam1 = std::max(lam1, std::abs(row[c1]));
+  }
+  EXPECT_EQ(n, 1501);
+  auto rel = [](double a, double b) { return std::abs(a - b) / std::max(std::abs(a), std::abs(b)); };
+  EXPECT_LE(rel(l0min, f.lambda0_min), 1e-9) << l0min << " " << f.lambda0_min;
+  EXPECT_LE(rel(l0max, f.lambda0_max), 1e-9);
+  EXPECT_LE(rel(yc, f.peak_y_c), 1e-9);
+  EXPECT_LE(rel(th, f.peak_theta), 1e-9);
+  EXPECT_LE(rel(lam1, f.peak_lambda[0]), 1e-9);
+  // The stop itself: at rest at the scenario's end length from its end on.
+  EXPECT_NEAR(t.rows.back()[t.col("l")], stop.end().l, 1e-12);
+  EXPECT_EQ(t.rows.back()[t.col("v")], 0.0);
+  // Bad values are bad input.
+  EXPECT_EQ(sim({"--estop-at", "100", "-q", "--out", path("x.csv")}).status, 2);
+  EXPECT_EQ(sim({"--estop-at", "20", "--estop-decel", "0", "-q", "--out", path("x.csv")}).status, 2);
 }

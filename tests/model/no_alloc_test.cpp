@@ -4,6 +4,8 @@
 #include <new>
 
 #include "hoist/fast_solver.hpp"
+#include "hoist/forecast.hpp"
+#include "hoist/scenario.hpp"
 #include "hoist/simulator.hpp"
 
 // malloc and friends are interposed for the whole process (tests/support
@@ -63,6 +65,48 @@ TEST(NoAlloc, ReinitializeAllocatesNothing) {
       s.initialize(t, prof.at(t), InitialState::Rest);
       s.step(t + 0.01, prof.at(t + 0.01));
       acc += s.response().y_c;
+    }
+    Eigen::internal::set_is_malloc_allowed(true);
+    EXPECT_EQ(allocationCount() - before, 0) << "n = " << n;
+    EXPECT_TRUE(std::isfinite(acc));
+  }
+}
+
+TEST(NoAlloc, SnapshotAndForecastAllocateNothing) {
+  // Issue 17: the loop saves a snapshot (into a preallocated state), the
+  // worker builds the scenarios and runs the forecasts: none of it allocates
+  // once the workspace is set up.
+  for (int n : {10, 50}) {
+    ShaftParams p;
+    p.n = n;
+    p.Tb2 = 32000;
+    auto model = std::make_shared<const ShaftModel>(p);
+    FastSolver s(model);
+    ForecastOptions o;
+    o.horizon = 3.0;
+    ForecastWorkspace ws(model, o);
+    FastSolverState snap(n), copy(n);
+    ForecastSummary out;
+    MotionProfile plan;
+    const HoistProfile prof = HoistProfile::trapezoid();
+    s.initialize(0.0, prof.at(0.0));
+    const long before = allocationCount();
+    Eigen::internal::set_is_malloc_allowed(false);
+    double acc = 0;
+    for (int k = 1; k <= 2500; ++k) {
+      const double t = k * 0.01;
+      s.step(t, prof.at(t));
+      if (k % 500 != 0) continue;
+      s.saveState(snap);  // loop thread
+      copy = snap;        // mailbox hand-over (same size: no allocation)
+      forecast(ws, copy, estopProfile(copy.t, copy.kin, 3.0, 10.0), out);
+      acc += out.min_clearance + out.lambda0_min;
+      forecast(ws, copy, continueProfile(copy.t, copy.kin, 5.0, 1.0, p.maxRopeLength()), out);
+      acc += out.peak_lambda[0];
+      const PlanCheck c = planProfile(copy.t, copy.kin, TripPlan{300.0, 5.0, 1.0, 1.0}, p.maxRopeLength(), plan);
+      if (c.ok()) forecast(ws, copy, plan, out);
+      acc += out.peak_y_c + static_cast<double>(c.error);
+      s.restoreState(snap);
     }
     Eigen::internal::set_is_malloc_allowed(true);
     EXPECT_EQ(allocationCount() - before, 0) << "n = " << n;

@@ -27,6 +27,7 @@
 #include "hoist/io/config.hpp"
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
+#include "hoist/scenario.hpp"
 #include "hoist/shaft_model.hpp"
 #include "hoist/plausibility.hpp"
 #include "hoist/simulator.hpp"
@@ -39,6 +40,7 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 struct Options {
   std::string config, profile = "paper", out, shape_out, shape_times = "18,36,60", write_profile;
   double dt = 0.01, max_step = 0.0025, t_end = -1.0, rho_inf = -1.0;
+  double estop_at = std::nan(""), estop_decel = 3.0, estop_jerk = 10.0;
   int modes = 0, shape_points = 401;
   std::string initial, method = "fast", static_correction;
   bool quiet = false, print_config = false;
@@ -145,7 +147,31 @@ int run(const Options& o) {
     std::cout << hoist::io::toToml(p);
     return 0;
   }
-  const hoist::HoistProfile profile = hoist::io::loadProfile(o.profile, p.l0);
+  hoist::HoistProfile profile = hoist::io::loadProfile(o.profile, p.l0);
+  if (!std::isnan(o.estop_at)) {
+    // The forecast's "estop" scenario (hoist/scenario.hpp) from T: the profile
+    // up to T, then the jerk-limited stop from its (l, v, a) at T, sampled on
+    // the output grid.  T is rounded to the nearest output step (the forecast
+    // starts at a step of the twin), so the run equals the twin's e-stop
+    // forecast made at T.
+    const double p_end = o.t_end < 0 ? profile.endTime() : o.t_end;
+    if (!std::isfinite(o.estop_at) || o.estop_at < profile.startTime() || o.estop_at >= p_end)
+      throw UsageError("--estop-at: " + std::to_string(o.estop_at) + " s is outside the run [" +
+                       std::to_string(profile.startTime()) + ", " + std::to_string(p_end) + ") s");
+    const double T =
+        profile.startTime() + std::round((o.estop_at - profile.startTime()) / o.dt) * o.dt;
+    hoist::MotionProfile stop;
+    try {
+      stop = hoist::estopProfile(T, profile.at(T), o.estop_decel, o.estop_jerk);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--estop-decel/--estop-jerk: ") + e.what());
+    }
+    profile = hoist::spliceProfile(profile, T, stop, o.dt, std::max(p_end, profile.endTime()));
+    if (!o.quiet)
+      std::cerr << "hoist-sim: emergency stop at t = " << T << " s from l = " << stop.start().l
+                << " m, v = " << stop.start().v << " m/s, a = " << stop.start().a << " m/s^2: rest at t = "
+                << stop.endTime() << " s, l = " << stop.end().l << " m\n";
+  }
   if (!o.write_profile.empty()) {
     std::ofstream pf(o.write_profile);
     hoist::io::writeProfileCsv(pf, profile);
@@ -356,6 +382,17 @@ int main(int argc, char** argv) {
   app.add_option("--shape-points", o.shape_points, "depth samples per shape")
       ->capture_default_str()
       ->check(CLI::Range(2, 100000));
+  app.add_option("--estop-at", o.estop_at,
+                 "emergency stop at this time [s] (rounded to an output step): the profile up to it, then the "
+                 "look-ahead forecast's 'estop' scenario -- |a| builds up at --estop-jerk to --estop-decel against "
+                 "the motion, holds, eases off so that v and a reach 0 together, then rest");
+  app.add_option("--estop-decel", o.estop_decel, "emergency-stop deceleration for --estop-at [m/s^2]")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-6, 100.0));
+  app.add_option("--estop-jerk", o.estop_jerk,
+                 "emergency-stop jerk for --estop-at [m/s^3] (brake build-up: decel/jerk = 0.3 s by default)")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-6, 1e6));
   app.add_option("--write-profile", o.write_profile, "also write the profile used as CSV t,l,v,a");
   app.add_flag("--print-config", o.print_config, "print the effective shaft configuration as TOML and exit");
   app.add_flag("-q,--quiet", o.quiet, "no progress or summary");

@@ -35,6 +35,38 @@
 
 namespace hoist {
 
+/// Everything FastSolver needs to continue integrating bit-identically from
+/// one instant (the forecast's copy of the twin).  Vectors are sized once by
+/// FastSolverState(n) (or the first saveState()); saving into and restoring
+/// from a state of the same n allocates nothing, and so does copying one
+/// state into another of the same n (Eigen assignment keeps the buffers).
+/// Constant model data (M, C, K, the modal bases) is not part of it: a state
+/// restores into any FastSolver built on a model with the same parameters.
+struct FastSolverState {
+  double t = 0.0;        ///< model time [s]
+  Kinematics kin;        ///< l, v, a at t
+  // lateral/torsional, modal coordinates (2n + 2): z_1, z_2, y_c, theta
+  VectorXd x, xd, xdd, xa;   ///< state, rate, acceleration, pseudo-acceleration
+  Eigen::Vector4d lam = Eigen::Vector4d::Zero();  ///< lambda_1..4 [N]
+  // static correction (zero without it): residual flexibility, step
+  // compliance, wave impedance at the sleeves, residual displacement and the
+  // spring part of lambda at the last step
+  Eigen::Matrix4d R = Eigen::Matrix4d::Zero(), Rc = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d Zd = Eigen::Vector4d::Zero(), delta = Eigen::Vector4d::Zero(), lamS = Eigen::Vector4d::Zero();
+  // longitudinal: hoisting-rope modal coordinates (n)
+  VectorXd y, yd, ydd, ya;   ///< state, rate, acceleration, pseudo-acceleration
+  double lambda0 = 0.0;      ///< lambda_0 [N]
+  int last_iters = 0;        ///< diagnostics carried along
+  long fallbacks = 0;
+  CageResponse response;     ///< the response at t
+  bool valid = false;        ///< set by saveState()
+
+  FastSolverState() = default;
+  /// Sized for n modes per rope (2n + 2 lateral, n longitudinal), zeroed.
+  explicit FastSolverState(int n);
+  int modes() const { return static_cast<int>(y.size()); }
+};
+
 class FastSolver final : public Solver {
  public:
   explicit FastSolver(std::shared_ptr<const ShaftModel> model);
@@ -48,6 +80,15 @@ class FastSolver final : public Solver {
   void residualSleeveLoads(SleeveLoads& out) const override;
   bool finite() const override;
   Method method() const override { return Method::Fast; }
+
+  // ---- snapshot (look-ahead forecasts) -------------------------------------
+  /// Copies the integration state into `s` (no allocation when s was sized
+  /// for this n).  Restoring it later and stepping with the same inputs gives
+  /// bit-identical results.
+  void saveState(FastSolverState& s) const;
+  /// Continues from `s` (throws std::invalid_argument if it is not valid or
+  /// was saved with another n; allocates nothing).
+  void restoreState(const FastSolverState& s);
 
   // ---- state access (tests, energy checks) --------------------------------
   /// Lateral state in physical coordinates [q1; q2; y_c; theta] and its rate.

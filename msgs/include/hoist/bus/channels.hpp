@@ -16,6 +16,8 @@ inline constexpr std::string_view kChannelGuideShape = "HOIST_GUIDE_SHAPE";  ///
 inline constexpr std::string_view kChannelAlarm = "HOIST_ALARM";           ///< alarm_t, out
 inline constexpr std::string_view kChannelAlarmAck = "HOIST_ALARM_ACK";    ///< alarm_ack_t, into the twin
 inline constexpr std::string_view kChannelHealth = "HOIST_HEALTH";         ///< health_t, out
+inline constexpr std::string_view kChannelForecast = "HOIST_FORECAST";     ///< forecast_t, out (issue 17)
+inline constexpr std::string_view kChannelTripPlan = "HOIST_TRIP_PLAN";    ///< trip_plan_t, into the twin (issue 17)
 
 /// prefix + name, e.g. channel("north/", kChannelCage) == "north/HOIST_CAGE".
 inline std::string channel(std::string_view prefix, std::string_view name) {
@@ -28,14 +30,16 @@ inline std::string channel(std::string_view prefix, std::string_view name) {
 
 /// All channel names of one shaft with its prefix.
 struct Channels {
-  std::string winder, cage, shape, alarm, ack, health;
+  std::string winder, cage, shape, alarm, ack, health, forecast, trip_plan;
   explicit Channels(std::string_view prefix = "")
       : winder(channel(prefix, kChannelWinder)),
         cage(channel(prefix, kChannelCage)),
         shape(channel(prefix, kChannelGuideShape)),
         alarm(channel(prefix, kChannelAlarm)),
         ack(channel(prefix, kChannelAlarmAck)),
-        health(channel(prefix, kChannelHealth)) {}
+        health(channel(prefix, kChannelHealth)),
+        forecast(channel(prefix, kChannelForecast)),
+        trip_plan(channel(prefix, kChannelTripPlan)) {}
 };
 
 }  // namespace hoist::bus

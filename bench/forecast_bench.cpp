@@ -1,0 +1,72 @@
+// Cost of one look-ahead forecast (issue 17): one scenario integrated over a
+// 20-s horizon from the paper trip's state at t = 20 s, at the daemon's
+// defaults (output step 0.01 s, 2.5-ms substeps, 401-point guide-rope
+// envelope per output step).  The counter `ms_per_horizon_s` is the figure
+// docs/lookahead.md reports: milliseconds of CPU per scenario per second of
+// horizon.
+//
+//   build/bin/hoist-forecast-bench
+//   build/bin/hoist-forecast-bench --benchmark_filter=Estop/50
+#include <benchmark/benchmark.h>
+
+#include <memory>
+
+#include "hoist/forecast.hpp"
+#include "hoist/scenario.hpp"
+#include "hoist/simulator.hpp"
+
+namespace {
+
+using namespace hoist;
+
+enum class Kind { Estop, Continue, Plan };
+
+void forecastBench(benchmark::State& state, Kind kind) {
+  ShaftParams p;
+  p.n = static_cast<int>(state.range(0));
+  auto model = std::make_shared<const ShaftModel>(p);
+  ForecastOptions o;
+  o.horizon = 20.0;
+  o.max_step = static_cast<double>(state.range(1)) * 1e-4;  // 25 -> 2.5 ms
+  FastSolver s(model);
+  SimulationOptions so;
+  so.dt = o.dt;
+  so.max_step = o.max_step;
+  so.t_end = 20.0;
+  simulate(s, HoistProfile::trapezoid(), so, {});
+  FastSolverState st(p.n);
+  s.saveState(st);
+  ForecastWorkspace ws(model, o);
+  ForecastSummary out;
+  for (auto _ : state) {
+    MotionProfile sc;
+    switch (kind) {
+      case Kind::Estop: sc = estopProfile(st.t, st.kin, 3.0, 10.0); break;
+      case Kind::Continue: sc = continueProfile(st.t, st.kin, 5.0, 1.0, p.maxRopeLength()); break;
+      case Kind::Plan: planProfile(st.t, st.kin, TripPlan{300.0, 5.0, 1.0, 1.0}, p.maxRopeLength(), sc); break;
+    }
+    forecast(ws, st, sc, out);
+    benchmark::DoNotOptimize(out.min_clearance);
+  }
+  state.counters["n"] = p.n;
+  state.counters["steps"] = static_cast<double>(ws.steps() * ws.substeps());
+  // seconds per (scenario x horizon second), shown in ms by the factor.
+  state.counters["ms_per_horizon_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * o.horizon / 1e3,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void BM_ForecastEstop(benchmark::State& s) { forecastBench(s, Kind::Estop); }
+void BM_ForecastContinue(benchmark::State& s) { forecastBench(s, Kind::Continue); }
+void BM_ForecastPlan(benchmark::State& s) { forecastBench(s, Kind::Plan); }
+
+// Args: n, max_step in 0.1 ms (25 = the daemon's default 2.5 ms; 100 = no substeps).
+BENCHMARK(BM_ForecastEstop)->Args({20, 25})->Args({50, 25})->Args({50, 100})->Unit(benchmark::kMillisecond);
+// The converged setting for the tilt (README: n = 200); a few iterations suffice.
+BENCHMARK(BM_ForecastEstop)->Args({200, 25})->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_ForecastContinue)->Args({20, 25})->Args({50, 25})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForecastPlan)->Args({50, 25})->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
