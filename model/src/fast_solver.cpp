@@ -476,9 +476,12 @@ void FastSolver::restoreState(const FastSolverState& s) {
   last_iters_ = s.last_iters;
   fallbacks_ = s.fallbacks;
   resp_ = s.response;
-  // Sd_ depends on the step size only; Gt_, Y_, Ek_ are rebuilt by every
-  // step before use.  Recomputing Sd_ gives the same bits.
+  // Sd_ depends on the step size only: recomputing it gives the same bits.
+  // Gt_ (the sleeve rows at l) is read between steps by the shapes and the
+  // envelope (the static correction's residual term), so rebuild it at the
+  // restored l; Y_ and Ek_ are rebuilt by every step before use.
   h_cached_ = -1.0;
+  fillConstraintRows(kin_.l);
 }
 
 // With the static correction the shape is y = U.(V z) + sum R(x, a_k) lam_k,
