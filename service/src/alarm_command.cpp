@@ -1,4 +1,5 @@
 // Operator alarm commands: see hoist/service/alarm_command.hpp.
+#include <algorithm>
 #include "hoist/service/alarm_command.hpp"
 
 #include <cmath>
@@ -45,6 +46,17 @@ CommandError validateAlarmCommand(std::string_view kind, int level, int action, 
   c.shelve_duration = c.action == AlarmAction::Shelve ? shelve_duration : 0.0;
   out = c;
   return CommandError::None;
+}
+
+std::string printable(const std::string& s, std::size_t max) {
+  std::string o;
+  o.reserve(std::min(s.size(), max) + 3);
+  for (std::size_t i = 0; i < s.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    o.push_back(c >= 32 && c < 127 ? static_cast<char>(c) : '?');
+  }
+  if (s.size() > max) o += "...";
+  return o;
 }
 
 }  // namespace hoist::svc

@@ -111,17 +111,6 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
   }
 }
 
-std::string printable(const std::string& s, std::size_t max) {
-  std::string o;
-  o.reserve(std::min(s.size(), max) + 3);
-  for (std::size_t i = 0; i < s.size() && i < max; ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    o.push_back(c >= 32 && c < 127 ? static_cast<char>(c) : '?');
-  }
-  if (s.size() > max) o += "...";
-  return o;
-}
-
 std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*& why) {
   AckCommand c;
   switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, c)) {

@@ -23,17 +23,6 @@ const char* toString(CommandReject r) {
   return "?";
 }
 
-std::string printable(const std::string& s, std::size_t max) {
-  std::string o;
-  o.reserve(std::min(s.size(), max) + 3);
-  for (std::size_t i = 0; i < s.size() && i < max; ++i) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    o.push_back(c >= 32 && c < 127 ? static_cast<char>(c) : '?');
-  }
-  if (s.size() > max) o += "...";
-  return o;
-}
-
 CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime) {
   CommandResult r;
   try {

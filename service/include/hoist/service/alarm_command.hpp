@@ -4,6 +4,7 @@
 // commands.  Pure: no I/O, no LCM types, no allocation.
 #pragma once
 
+#include <string>
 #include <optional>
 #include <string_view>
 
@@ -36,5 +37,9 @@ struct AlarmCommand {
 /// Fills `out` and returns CommandError::None when valid.
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
                                   AlarmCommand& out);
+
+/// At most `max` characters of `s`, every byte outside printable ASCII
+/// replaced by '?', "..." appended when cut (for network strings in logs).
+std::string printable(const std::string& s, std::size_t max = 64);
 
 }  // namespace hoist::svc

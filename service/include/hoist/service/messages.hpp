@@ -35,9 +35,7 @@ struct AlarmTextContext {
 /// (truncated, always terminated; no allocation).
 void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n);
 
-/// At most `max` characters of `s`, every byte outside printable ASCII
-/// replaced by '?', "..." appended when cut (for network strings in logs).
-std::string printable(const std::string& s, std::size_t max = 64);
+// printable(): hoist/service/alarm_command.hpp.
 
 /// A validated operator command (the rule is validateAlarmCommand, shared with hoist-mqtt).
 using AckCommand = AlarmCommand;

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "hoist/alarm_ack_t.hpp"
+#include "hoist/service/alarm_command.hpp"
 
 namespace hoist::mqtt {
 
@@ -43,8 +44,7 @@ struct CommandResult {
 /// Parses and validates one payload.  Never throws.
 CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime);
 
-/// At most `max` characters of `s`, non-printable ones replaced by '?' (for
-/// logging strings that came from the network).
-std::string printable(const std::string& s, std::size_t max = 64);
+/// printable(): the daemon's own, hoist/service/alarm_command.hpp.
+using hoist::svc::printable;
 
 }  // namespace hoist::mqtt
