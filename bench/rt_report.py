@@ -34,7 +34,7 @@ def fmt_us(x):
 
 
 def merged(bins, per_decade=5):
-    """20 bins per decade -> `per_decade` bins: [(lower, upper, count)]."""
+    """The histogram's bins (hoist::rt::LatencyHistogram, 100 per decade) -> `per_decade` bins: [(lower, upper, count)]."""
     out = {}
     for lower, count in bins:
         if lower <= 0:
@@ -103,7 +103,7 @@ def main():
     out.append("Step time = one model step (with `[service].max_step` substeps) plus alarm evaluation, as "
                "timed by the daemon; tick lateness = start of a shaft's tick minus its deadline on the absolute "
                "schedule; a deadline miss = a whole period skipped.  Quantiles come from logarithmic histograms "
-               "(20 bins per decade, about 6 % resolution).  The feeder (`hoist-replay --timing-test`) runs on "
+               "(100 bins per decade, about 1.2 % resolution).  The feeder (`hoist-replay --timing-test`) runs on "
                "another CPU and publishes the winder stream at the step rate over UDP multicast on loopback.")
     out.append("")
     out.append("| point | run | ticks | deadline misses | step p50 / p99 / p99.9 / max | lateness p50 / p99 / p99.9 / max | timing test |")

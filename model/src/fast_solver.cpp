@@ -518,22 +518,6 @@ void FastSolver::residualSleeveLoads(SleeveLoads& out) const {
   out.f = {lamS_(0), lamS_(1), lamS_(2), lamS_(3)};
 }
 
-void FastSolver::guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const {
-  VectorXd q1, q2, U(n_);
-  guideRopeCoordinates(q1, q2);
-  SleeveLoads loads;
-  residualSleeveLoads(loads);
-  y1.resize(x.size());
-  y2.resize(x.size());
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    model_->guideModes(x(i) / model_->params().L, U);
-    y1(i) = U.dot(q1);
-    y2(i) = U.dot(q2);
-    for (int k = 0; k < loads.count; ++k)
-      (loads.rope[k] == 1 ? y1(i) : y2(i)) += model_->guideGreen(loads.rope[k], x(i), loads.x[k]) * loads.f[k];
-  }
-}
-
 void FastSolver::lateralState(VectorXd& q, VectorXd& qd) const {
   q.resize(N_);
   qd.resize(N_);

@@ -200,18 +200,6 @@ void PaperSolver::guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const {
   }
 }
 
-void PaperSolver::guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const {
-  VectorXd q1, q2, U(n_);
-  guideRopeCoordinates(q1, q2);
-  y1.resize(x.size());
-  y2.resize(x.size());
-  for (Eigen::Index i = 0; i < x.size(); ++i) {
-    model_->guideModes(x(i) / model_->params().L, U);
-    y1(i) = U.dot(q1);
-    y2(i) = U.dot(q2);
-  }
-}
-
 bool PaperSolver::finite() const {
   return z_.allFinite() && zd_.allFinite() && zdd_.allFinite() && q_.allFinite() && lam_.allFinite();
 }

@@ -58,6 +58,23 @@ double GuideRopeEnvelope::evaluate(const Solver& s) {
   return std::max(y1_.cwiseAbs().maxCoeff(), y2_.cwiseAbs().maxCoeff());
 }
 
+void Solver::guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const {
+  VectorXd q1, q2;
+  guideRopeCoordinates(q1, q2);
+  VectorXd U(q1.size());
+  SleeveLoads loads;
+  residualSleeveLoads(loads);
+  y1.resize(x.size());
+  y2.resize(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    model_->guideModes(x(i) / model_->params().L, U);
+    y1(i) = U.dot(q1);
+    y2(i) = U.dot(q2);
+    for (int k = 0; k < loads.count; ++k)
+      (loads.rope[k] == 1 ? y1(i) : y2(i)) += model_->guideGreen(loads.rope[k], x(i), loads.x[k]) * loads.f[k];
+  }
+}
+
 double maxGuideRopeDeflection(const Solver& s, int samples) {
   GuideRopeEnvelope env(s.model(), samples);
   return env.evaluate(s);

@@ -210,7 +210,7 @@ class AbsurdSolver final : public Solver {
     bad_.y_c = -1e159;
     return bad_;
   }
-  void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override { inner_->guideRopeShapes(x, y1, y2); }
+  void residualSleeveLoads(SleeveLoads& out) const override { inner_->residualSleeveLoads(out); }
   void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override { inner_->guideRopeCoordinates(q1, q2); }
   bool finite() const override { return inner_->finite(); }
   Method method() const override { return Method::Fast; }
@@ -277,7 +277,7 @@ class CountingSolver final : public Solver {
     inner_->step(t1, k1);
   }
   const CageResponse& response() const override { return inner_->response(); }
-  void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override { inner_->guideRopeShapes(x, y1, y2); }
+  void residualSleeveLoads(SleeveLoads& out) const override { inner_->residualSleeveLoads(out); }
   void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override { inner_->guideRopeCoordinates(q1, q2); }
   bool finite() const override { return inner_->finite(); }
   Method method() const override { return Method::Fast; }

@@ -63,9 +63,7 @@ class FaultySolver final : public Solver {
     bad_.y_c = std::numeric_limits<double>::quiet_NaN();
     return bad_;
   }
-  void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override {
-    inner_->guideRopeShapes(x, y1, y2);
-  }
+  void residualSleeveLoads(SleeveLoads& out) const override { inner_->residualSleeveLoads(out); }
   void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override {
     inner_->guideRopeCoordinates(q1, q2);
   }

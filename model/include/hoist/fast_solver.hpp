@@ -75,7 +75,6 @@ class FastSolver final : public Solver {
   using Solver::initialize;
   void step(double t1, const Kinematics& k1) override;
   const CageResponse& response() const override { return resp_; }
-  void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const override;
   void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override;
   void residualSleeveLoads(SleeveLoads& out) const override;
   bool finite() const override;

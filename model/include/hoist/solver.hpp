@@ -92,8 +92,11 @@ class Solver {
 
   virtual const CageResponse& response() const = 0;
 
-  /// Lateral displacement of both guide ropes at depths x (same size outputs).
-  virtual void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const = 0;
+  /// Lateral displacement of both guide ropes at depths x (same size outputs):
+  /// the modal part (guideRopeCoordinates) plus the exact static deflection
+  /// under residualSleeveLoads, as SleeveLoads states.  One implementation
+  /// for every solver.
+  void guideRopeShapes(const VectorXd& x, VectorXd& y1, VectorXd& y2) const;
 
   /// Guide-rope modal coordinates in the sine basis of Eq. (13) (q_1,i and q_2,i):
   /// the modal part of the shape (see SleeveLoads for the rest).
