@@ -5,6 +5,9 @@
 // Input: byte 0 selects the type (byte % number of types) and, with bit 7
 // set, writes that type's fingerprint over the next 8 bytes (so the fuzzer
 // gets past the fingerprint at once); the rest is the LCM payload.
+// Built with -DHOIST_FUZZ_ONE_TYPE=<type> (the fuzz_msg_<type> targets, one
+// per decoded type): the same input format and seeds, but byte 0 no longer
+// selects, only that type's decoder runs, so the whole budget goes to it.
 // Checked for every input:
 //   * checkedDecode never crashes, leaks or allocates more than the type's
 //     largest valid encoding implies (ASan, -rss_limit_mb, -malloc_limit_mb);
@@ -75,19 +78,28 @@ void check(const std::uint8_t* data, std::size_t size) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
+  std::vector<std::uint8_t> buf(data + 1, data + size);
+#ifdef HOIST_FUZZ_ONE_TYPE
+  const auto fp = static_cast<std::uint64_t>(hoist::HOIST_FUZZ_ONE_TYPE::getHash());
+#else
   const auto& types = allTypes();
   const std::size_t k = data[0] % types.size();
-  std::vector<std::uint8_t> buf(data + 1, data + size);
+  const auto fp = static_cast<std::uint64_t>(types[k].fingerprint);
+#endif
   if ((data[0] & 0x80) != 0 && buf.size() >= 8) {
-    const auto fp = static_cast<std::uint64_t>(types[k].fingerprint);
     for (int i = 0; i < 8; ++i) buf[i] = static_cast<std::uint8_t>(fp >> (8 * (7 - i)));
   }
-  // Every type's decoder sees the bytes (only the matching one gets past the
-  // fingerprint).  `buf` holds exactly the payload, so ASan sees any overread.
+  // `buf` holds exactly the payload, so ASan sees any overread.
   static const std::uint8_t empty = 0;
   const std::uint8_t* p = buf.empty() ? &empty : buf.data();
+#ifdef HOIST_FUZZ_ONE_TYPE
+  check<hoist::HOIST_FUZZ_ONE_TYPE>(p, buf.size());
+#else
+  // Every type's decoder sees the bytes (only the matching one gets past the
+  // fingerprint).
 #define HOIST_FUZZ_TYPE(T) check<hoist::T>(p, buf.size());
   HOIST_MSG_FOR_EACH_TYPE(HOIST_FUZZ_TYPE)
 #undef HOIST_FUZZ_TYPE
+#endif
   return 0;
 }

@@ -6,8 +6,10 @@
 #
 # Targets: config (TOML loader), csv (profile CSV reader), winder (LCM input
 # decoder + validator + TwinCore), msgs (every LCM type of msgs/ through the
-# generated checked decoders and JSON), lcmlog (the safe LCM log reader).
-# Default: all five, 600 s each.  The seed
+# generated checked decoders and JSON), lcmlog (the safe LCM log reader),
+# msg_<type> (one per msgs/<type>.lcm: that decoder alone, seeded with
+# fuzz/corpus/msgs/<type>_*), types (all the msg_<type> targets).
+# Default: config csv winder msgs lcmlog and every msg_<type>, 600 s each.  The seed
 # corpus is fuzz/corpus/<target>/ (committed); new inputs go to
 # BUILD/corpus/<target>/, crashes to BUILD/artifacts/<target>/, logs to
 # BUILD/logs/<target>.log.  Prints executions and coverage per target; exit
@@ -20,12 +22,19 @@ while [[ $# -gt 0 ]]; do
     --time) time_s="$2"; shift 2 ;;
     --build-dir) build_dir="$2"; shift 2 ;;
     --no-build) build=0; shift ;;
-    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     config|csv|winder|msgs|lcmlog) targets+=("$1"); shift ;;
+    types) for f in "$here"/msgs/*.lcm; do b=$(basename "$f" .lcm); targets+=("msg_$b"); done; shift ;;
+    msg_*)
+      [[ -f "$here/msgs/${1#msg_}.lcm" ]] || { echo "fuzz.sh: no type msgs/${1#msg_}.lcm for target $1" >&2; exit 2; }
+      targets+=("$1"); shift ;;
     *) echo "fuzz.sh: unknown option or target $1 (see --help)" >&2; exit 2 ;;
   esac
 done
-[[ ${#targets[@]} -gt 0 ]] || targets=(config csv winder msgs lcmlog)
+if [[ ${#targets[@]} -eq 0 ]]; then
+  targets=(config csv winder msgs lcmlog)
+  for f in "$here"/msgs/*.lcm; do targets+=("msg_$(basename "$f" .lcm)"); done
+fi
 if [[ $build -eq 1 ]]; then
   command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found" >&2; exit 2; }
   CC=clang CXX=clang++ cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DHOIST_FUZZ=ON \
@@ -33,17 +42,23 @@ if [[ $build -eq 1 ]]; then
   cmake --build "$build_dir" -j"$(nproc)" --target $(printf 'fuzz_%s ' "${targets[@]}")
 fi
 declare -A max_len=([config]=4096 [csv]=8192 [winder]=2048 [msgs]=4096 [lcmlog]=8192)
+for t in "${targets[@]}"; do [[ $t == msg_* ]] && max_len[$t]=4096; done
 rc=0
 summary=""
 for t in "${targets[@]}"; do
   mkdir -p "$build_dir/corpus/$t" "$build_dir/artifacts/$t" "$build_dir/logs"
   log="$build_dir/logs/$t.log"
+  seeds="$here/fuzz/corpus/$t"
+  if [[ $t == msg_* ]]; then   # that type's seeds out of the msgs corpus
+    seeds="$build_dir/seeds/$t"; mkdir -p "$seeds"
+    cp "$here/fuzz/corpus/msgs/${t#msg_}"_* "$seeds"/ 2>/dev/null || true
+  fi
   echo "[fuzz] $t for $time_s s (log $log)"
   set +e
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     "$build_dir/bin/fuzz_$t" -max_total_time="$time_s" -max_len="${max_len[$t]}" -timeout=10 \
     -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build_dir/artifacts/$t/" \
-    "$build_dir/corpus/$t" "$here/fuzz/corpus/$t" >"$log" 2>&1
+    "$build_dir/corpus/$t" "$seeds" >"$log" 2>&1
   st=$?
   set -e
   execs=$(awk '/stat::number_of_executed_units/{print $NF}' "$log" | tail -1)
