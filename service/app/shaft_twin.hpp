@@ -70,6 +70,10 @@ class ShaftTwin {
   /// `router` (the daemon's own udpm receive path, exact names) when given,
   /// else through LCM (escaped, literal names).
   void subscribe(InputRouter* router = nullptr);
+  /// With [service] lcm_url_out on another URL: watch our own HOIST_HEALTH
+  /// on the output group through `router` (a receive-only socket there), so
+  /// that a second publisher is detected there too.
+  void watchOwnOutputs(InputRouter* router);
   /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
   void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: wall times are measured from `start`; publishes a

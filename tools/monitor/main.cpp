@@ -200,9 +200,11 @@ int main(int argc, char** argv) {
   const hoist::bus::Channels ch(prefix);
   mon.cage_channel_ = ch.cage;
   mon.stale_s_ = stale;
-  lcm.subscribe(ch.cage, &Monitor::onCage, &mon);
-  lcm.subscribe(ch.alarm, &Monitor::onAlarm, &mon);
-  lcm.subscribe(ch.health, &Monitor::onHealth, &mon);
+  // Literal names: subscribe() takes a regular expression, and a prefix
+  // "mine.1/" must not show the shaft "mineX1/".
+  lcm.subscribe(hoist::bus::regexEscape(ch.cage), &Monitor::onCage, &mon);
+  lcm.subscribe(hoist::bus::regexEscape(ch.alarm), &Monitor::onAlarm, &mon);
+  lcm.subscribe(hoist::bus::regexEscape(ch.health), &Monitor::onHealth, &mon);
   struct sigaction sa {};
   sa.sa_handler = onSignal;
   sigaction(SIGINT, &sa, nullptr);

@@ -51,14 +51,6 @@ std::int64_t monotonicNs() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
-std::string escapeRegex(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (std::string_view(".[]{}()\\*+?^$|").find(c) != std::string_view::npos) o += '\\';
-    o += c;
-  }
-  return o;
-}
 
 /// Publish times of one shaft's inputs, indexed by seq (preallocated; the
 /// feeder writes, the listener reads).
@@ -389,8 +381,8 @@ int runTimingTest(const TimingTestOptions& o) {
     run.shafts.push_back(std::move(s));
   }
   for (auto& s : run.shafts) {
-    rx.subscribe(escapeRegex(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth)), &Shaft::onHealth, s.get());
-    rx.subscribe(escapeRegex(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage)), &Shaft::onCage, s.get());
+    rx.subscribe(hoist::bus::regexEscape(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth)), &Shaft::onHealth, s.get());
+    rx.subscribe(hoist::bus::regexEscape(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage)), &Shaft::onCage, s.get());
   }
 
   struct sigaction sa {};
