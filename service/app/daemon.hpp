@@ -40,7 +40,7 @@
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
-#include "udpm_receiver.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
 
 namespace hoist::svc {
 

@@ -30,11 +30,16 @@
 #include "hoist/service/twin_core.hpp"
 #include "hoist/winder_t.hpp"
 #include "hoist/rt/rt_log.hpp"
-#include "udpm_receiver.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
 
 namespace hoist::svc {
 
 using rt::RtLog;
+using bus::InputRouter;
+using bus::parseUdpmUrl;
+using bus::RawHandler;
+using bus::UdpmReceiver;
+using bus::UdpmUrl;
 
 /// Test-only fault injection (hidden command-line options, tests/hardening).
 struct TestHooks {
