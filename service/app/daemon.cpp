@@ -2,9 +2,11 @@
 #include "daemon.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -16,6 +18,7 @@
 #include <unistd.h>
 
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/io/checked_file.hpp"
 #include "hoist/version.hpp"
 
 namespace hoist::svc {
@@ -409,17 +412,19 @@ bool Daemon::writeReport() const {
   }
   j["shafts"] = std::move(shafts);
   const std::string tmp = opt_.report_path + ".tmp";
-  {
-    std::ofstream f(tmp);
+  try {
+    // Every byte checked, with the errno text (hoist/io/checked_file.hpp).
+    hoist::io::CheckedFile f(tmp, "--report");
     // Invalid UTF-8 (a path or host name) is replaced, never a throw at stop.
-    f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-    if (!f) {
-      out_->error("cannot write the run report {}", opt_.report_path);
-      return false;
-    }
+    f.write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    f.close();
+  } catch (const hoist::io::WriteError& e) {
+    out_->error("cannot write the run report: {}", e.what());
+    std::remove(tmp.c_str());
+    return false;
   }
   if (std::rename(tmp.c_str(), opt_.report_path.c_str()) != 0) {
-    out_->error("cannot write the run report {}", opt_.report_path);
+    out_->error("cannot write the run report {}: rename from {}: {}", opt_.report_path, tmp, std::strerror(errno));
     return false;
   }
   out_->info("run report written to {}", opt_.report_path);

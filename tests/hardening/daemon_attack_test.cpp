@@ -375,3 +375,25 @@ TEST_F(DaemonAttack, SecondPublisherIsDetectedOnASeparateOutputUrl) {
   EXPECT_NE(readFile((dir_ / "twind1.log").string()).find("another publisher"), std::string::npos);
   EXPECT_NE(readFile((dir_ / "twind2.log").string()).find("another publisher"), std::string::npos);
 }
+
+TEST(DaemonFiles, RunReportWriteFailureIsExitOneWithPathAndErrno) {
+  // Issue 12.6: every file a program writes is checked; hoist-twind's run
+  // report (--report) into a directory that does not exist: exit 1, the
+  // option, the path and the errno text (memq://: no network needed).
+  const auto dir = testDir("report_fail");
+  const std::string report = (dir / "no" / "such" / "r.json").string();
+  const std::string log = (dir / "twind.log").string();
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--lcm-url", "memq://", "--duration", "0.5", "--report", report}, log, 30s), 1)
+      << readFile(log);
+  const std::string text = readFile(log);
+  EXPECT_NE(text.find("--report " + report + ".tmp: cannot open for writing: No such file or directory"),
+            std::string::npos)
+      << text;
+  // And a good path is written completely.
+  const std::string good = (dir / "r.json").string();
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--lcm-url", "memq://", "--duration", "0.5", "--report", good}, log, 30s), 0)
+      << readFile(log);
+  const std::string json = readFile(good);
+  EXPECT_NE(json.find("\"tool\": \"hoist-twind\""), std::string::npos) << json;
+  EXPECT_EQ(json.back(), '\n');
+}

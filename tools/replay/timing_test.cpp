@@ -27,6 +27,7 @@
 
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/io/checked_file.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/profile.hpp"
 #include "hoist/bus/lcm_util.hpp"
@@ -348,11 +349,14 @@ std::size_t ringSize(double rate, std::size_t shafts) {
 }  // namespace
 
 int runTimingTest(const TimingTestOptions& o) {
-  std::ofstream report;
+  // Opened now, so a bad path fails before the run; every byte checked at
+  // the end (hoist/io/checked_file.hpp).
+  hoist::io::CheckedFile report;
   if (!o.report_path.empty()) {
-    report.open(o.report_path, std::ios::out | std::ios::trunc);
-    if (!report) {
-      std::cerr << "hoist-timing-test: --report: cannot write " << o.report_path << "\n";
+    try {
+      report = hoist::io::CheckedFile(o.report_path, "--report");
+    } catch (const hoist::io::WriteError& e) {
+      std::cerr << "hoist-timing-test: " << e.what() << "\n";
       return 2;
     }
   }
@@ -398,14 +402,20 @@ int runTimingTest(const TimingTestOptions& o) {
     const Evaluation e = evaluate(res, o);
     const std::string text = formatReport(res, o, e);
     std::cout << text << std::flush;
-    if (report.is_open()) {
-      report << text;
-      report.close();
-      if (!report) std::cerr << "hoist-timing-test: --report: writing " << o.report_path << " failed\n";
+    bool report_failed = false;
+    if (report.isOpen()) {
+      try {
+        report.write(text);
+        report.close();
+      } catch (const hoist::io::WriteError& e) {
+        std::cerr << "hoist-timing-test: " << e.what() << "\n";
+        report_failed = true;
+      }
     }
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
     if (res.interrupted) return 128 + res.signal;
+    if (report_failed) return 1;
     return e.verdict == Verdict::Pass ? 0 : 1;
   };
 
@@ -424,7 +434,14 @@ int runTimingTest(const TimingTestOptions& o) {
   }
   if (g_signal.load()) {
     std::cerr << "hoist-timing-test: stopped before the timing test started\n";
-    if (report.is_open()) report << "VERDICT: INCONCLUSIVE (shortened run: stopped before the test started)\n";
+    if (report.isOpen()) {
+      try {
+        report.write("VERDICT: INCONCLUSIVE (shortened run: stopped before the test started)\n");
+        report.close();
+      } catch (const hoist::io::WriteError& e) {
+        std::cerr << "hoist-timing-test: " << e.what() << "\n";
+      }
+    }
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
     return 128 + g_signal.load();
