@@ -68,7 +68,8 @@ TEST_F(ToolAttack, ChannelNameSpamKeepsToolMemoryFlat) {
     char name[40];
     const auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < 300'000; ++i) {
-      std::snprintf(name, sizeof name, "SPAM_HOIST_CAGE_%07d", i);  // contains HOIST_: dash's filter looks at it
+      // Names no tool subscribes to: LCM 1.3.1 cached every one of them anyway.
+      std::snprintf(name, sizeof name, "SPAM_%07d", i);
       pub.publish(name, payload, sizeof payload);
       if (i % 1000 == 999) std::this_thread::sleep_until(t0 + std::chrono::microseconds(10 * (i + 1)));
     }
