@@ -278,6 +278,25 @@ void checkProfileInShaft(const HoistProfile& profile, const ShaftParams& p, cons
   }
 }
 
+void writeProfileCsv(CheckedFile& out, const HoistProfile& profile) {
+  std::string s = "t,l,v,a\n";
+  for (const auto& p : profile.samples()) {
+    appendNumber(s, p.t);
+    s += ',';
+    appendNumber(s, p.k.l);
+    s += ',';
+    appendNumber(s, p.k.v);
+    s += ',';
+    appendNumber(s, p.k.a);
+    s += '\n';
+    if (s.size() >= 65536) {
+      out.write(s);
+      s.clear();
+    }
+  }
+  out.write(s);
+}
+
 void writeProfileCsv(std::ostream& out, const HoistProfile& profile) {
   out << "t,l,v,a\n";
   std::string s;

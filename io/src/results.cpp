@@ -9,6 +9,11 @@ void writeResultHeader(std::ostream& out) { out << kResultHeader << '\n'; }
 void writeResultRow(std::ostream& out, const CageResponse& r) {
   std::string s;
   s.reserve(256);
+  appendResultRow(s, r);
+  out << s;
+}
+
+void appendResultRow(std::string& s, const CageResponse& r) {
   const double cols[] = {r.t,     r.kin.l,     r.kin.v,     r.kin.a,     r.x_c,       r.y_c,
                          r.theta, r.lambda[0], r.lambda[1], r.lambda[2], r.lambda[3], r.lambda[4]};
   bool first = true;
@@ -18,15 +23,18 @@ void writeResultRow(std::ostream& out, const CageResponse& r) {
     appendNumber(s, c);
   }
   s += '\n';
-  out << s;
 }
 
 void writeShapeHeader(std::ostream& out) { out << kShapeHeader << '\n'; }
 
 void writeShapeRows(std::ostream& out, double t, const VectorXd& x, const VectorXd& y1, const VectorXd& y2) {
   std::string s;
+  appendShapeRows(s, t, x, y1, y2);
+  out << s;
+}
+
+void appendShapeRows(std::string& s, double t, const VectorXd& x, const VectorXd& y1, const VectorXd& y2) {
   for (Eigen::Index i = 0; i < x.size(); ++i) {
-    s.clear();
     appendNumber(s, t);
     s += ',';
     appendNumber(s, x[i]);
@@ -35,7 +43,6 @@ void writeShapeRows(std::ostream& out, double t, const VectorXd& x, const Vector
     s += ',';
     appendNumber(s, y2[i]);
     s += '\n';
-    out << s;
   }
 }
 

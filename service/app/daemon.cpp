@@ -2,9 +2,11 @@
 #include "daemon.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -16,6 +18,7 @@
 #include <unistd.h>
 
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/io/checked_file.hpp"
 #include "hoist/version.hpp"
 
 namespace hoist::svc {
@@ -30,6 +33,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
       log_(out_, 4096),
       lcm_(opt_.lcm_url),
       lcm_fd_(io_),
+      out_fd_(io_),
       signals_(io_) {
   if (opt_.shafts.empty()) throw std::invalid_argument("no shaft configured");
   for (int sig : {SIGINT, SIGTERM, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) signals_.add(sig);
@@ -64,6 +68,7 @@ Daemon::~Daemon() {
   stopWatchdog();
   // The descriptor belongs to LCM: never let Asio close it.
   if (lcm_fd_.is_open()) lcm_fd_.release();
+  if (out_fd_.is_open()) out_fd_.release();  // out_receiver_ closes it
   log_.stop();
 }
 
@@ -103,6 +108,30 @@ bool Daemon::start() {
     lcm_fd_.assign(lcm_.getFileno());
   }
   armLcm();
+  // [service] lcm_url_out elsewhere: the input socket cannot see a second
+  // publisher of our outputs, so a receive-only socket on the output group
+  // watches our own HOIST_HEALTH channels (issue 12.5).
+  if (lcm_out_) {
+    UdpmUrl out_udpm;
+    std::string out_why;
+    if (!parseUdpmUrl(opt_.lcm_url_out, out_udpm, out_why)) {
+      out_->warn("[service] lcm_url_out {} is not a udpm:// URL ({}): a second publisher on the output "
+                 "channels (DUPLICATE_PUBLISHER) cannot be detected",
+                 bus::describeLcmUrl(opt_.lcm_url_out), out_why);
+    } else {
+      out_receiver_ = std::make_unique<UdpmReceiver>();
+      if (!out_receiver_->open(out_udpm, out_why)) {
+        out_->warn("cannot watch the output URL {} for a second publisher ({}); DUPLICATE_PUBLISHER "
+                   "detection is off",
+                   bus::describeLcmUrl(opt_.lcm_url_out), out_why);
+        out_receiver_.reset();
+      } else {
+        for (auto& s : shafts_) s->watchOwnOutputs(out_receiver_.get());
+        out_fd_.assign(out_receiver_->fd());
+        armOutWatch();
+      }
+    }
+  }
   // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
   // never receives them.
   startWatchdog();
@@ -183,6 +212,22 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
   if (!stopping_) armLcm();
 }
 
+void Daemon::armOutWatch() {
+  out_fd_.async_wait(asio::posix::stream_descriptor::wait_read,
+                     [this](const boost::system::error_code& ec) { onOutReadable(ec); });
+}
+
+void Daemon::onOutReadable(const boost::system::error_code& ec) {
+  if (stopping_ || ec == asio::error::operation_aborted) return;
+  if (ec) {
+    log_.error("output-URL watch descriptor error: {}; DUPLICATE_PUBLISHER detection stops", ec.message());
+    return;
+  }
+  // Mostly our own outputs come back here (loopback); bounded like the input.
+  out_receiver_->drain(256);
+  if (!stopping_) armOutWatch();
+}
+
 // ---- timers ------------------------------------------------------------------
 
 void Daemon::armTimer(RateGroup& g) {
@@ -254,6 +299,10 @@ void Daemon::stop(const char* why) {
   if (lcm_fd_.is_open()) {
     lcm_fd_.cancel();
     lcm_fd_.release();
+  }
+  if (out_fd_.is_open()) {
+    out_fd_.cancel();
+    out_fd_.release();
   }
   io_.stop();
 }
@@ -363,17 +412,19 @@ bool Daemon::writeReport() const {
   }
   j["shafts"] = std::move(shafts);
   const std::string tmp = opt_.report_path + ".tmp";
-  {
-    std::ofstream f(tmp);
+  try {
+    // Every byte checked, with the errno text (hoist/io/checked_file.hpp).
+    hoist::io::CheckedFile f(tmp, "--report");
     // Invalid UTF-8 (a path or host name) is replaced, never a throw at stop.
-    f << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-    if (!f) {
-      out_->error("cannot write the run report {}", opt_.report_path);
-      return false;
-    }
+    f.write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    f.close();
+  } catch (const hoist::io::WriteError& e) {
+    out_->error("cannot write the run report: {}", e.what());
+    std::remove(tmp.c_str());
+    return false;
   }
   if (std::rename(tmp.c_str(), opt_.report_path.c_str()) != 0) {
-    out_->error("cannot write the run report {}", opt_.report_path);
+    out_->error("cannot write the run report {}: rename from {}: {}", opt_.report_path, tmp, std::strerror(errno));
     return false;
   }
   out_->info("run report written to {}", opt_.report_path);

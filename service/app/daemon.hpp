@@ -40,7 +40,7 @@
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
-#include "udpm_receiver.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
 
 namespace hoist::svc {
 
@@ -103,6 +103,8 @@ class Daemon {
 
   void armLcm();
   void onLcmReadable(const boost::system::error_code& ec);
+  void armOutWatch();
+  void onOutReadable(const boost::system::error_code& ec);
   void armTimer(RateGroup& g);
   void onTick(RateGroup& g, const boost::system::error_code& ec);
   void stop(const char* why);
@@ -120,8 +122,13 @@ class Daemon {
   std::unique_ptr<UdpmReceiver> receiver_;  ///< own receive path for udpm URLs (udpm_receiver.hpp); else LCM's
   std::int64_t ignored_ = 0;                 ///< receiver_->ignored(), mirrored for the health reports
   std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
+  /// Receive-only socket on the udpm lcm_url_out group: dispatches only our
+  /// own HOIST_HEALTH channels (another instance_id there is a second
+  /// publisher, DUPLICATE_PUBLISHER), by exact name, nothing stored per name.
+  std::unique_ptr<UdpmReceiver> out_receiver_;
   std::int64_t instance_id_ = 0;       ///< random per process (HOIST_CAGE/HOIST_HEALTH.instance_id)
   boost::asio::posix::stream_descriptor lcm_fd_;
+  boost::asio::posix::stream_descriptor out_fd_;  ///< out_receiver_'s socket (owned by it)
   boost::asio::signal_set signals_;
   std::vector<std::unique_ptr<ShaftTwin>> shafts_;
   std::vector<std::unique_ptr<RateGroup>> groups_;

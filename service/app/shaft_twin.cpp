@@ -109,7 +109,8 @@ ShaftTwin::~ShaftTwin() {
 
 void ShaftTwin::subscribe(InputRouter* router) {
   // Our own health channel too: another publisher there (by instance_id) is
-  // a second twin on our outputs.  Only seen when outputs share the input URL.
+  // a second twin on our outputs.  Here when outputs share the input URL;
+  // else the daemon watches the output URL (watchOwnOutputs).
   const bool own_health = &out_ == &lcm_;
   if (router) {
     router->add(ch_.winder, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onWinder(rb, c); });
@@ -123,6 +124,10 @@ void ShaftTwin::subscribe(InputRouter* router) {
   lcm_.subscribe(regexEscape(ch_.winder), &ShaftTwin::onWinder, this);
   lcm_.subscribe(regexEscape(ch_.ack), &ShaftTwin::onAck, this);
   if (own_health) lcm_.subscribe(regexEscape(ch_.health), &ShaftTwin::onOwnHealth, this);
+}
+
+void ShaftTwin::watchOwnOutputs(InputRouter* router) {
+  router->add(ch_.health, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onOwnHealth(rb, c); });
 }
 
 void ShaftTwin::onOwnHealth(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {

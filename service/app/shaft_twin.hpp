@@ -30,11 +30,16 @@
 #include "hoist/service/twin_core.hpp"
 #include "hoist/winder_t.hpp"
 #include "hoist/rt/rt_log.hpp"
-#include "udpm_receiver.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
 
 namespace hoist::svc {
 
 using rt::RtLog;
+using bus::InputRouter;
+using bus::parseUdpmUrl;
+using bus::RawHandler;
+using bus::UdpmReceiver;
+using bus::UdpmUrl;
 
 /// Test-only fault injection (hidden command-line options, tests/hardening).
 struct TestHooks {
@@ -70,6 +75,10 @@ class ShaftTwin {
   /// `router` (the daemon's own udpm receive path, exact names) when given,
   /// else through LCM (escaped, literal names).
   void subscribe(InputRouter* router = nullptr);
+  /// With [service] lcm_url_out on another URL: watch our own HOIST_HEALTH
+  /// on the output group through `router` (a receive-only socket there), so
+  /// that a second publisher is detected there too.
+  void watchOwnOutputs(InputRouter* router);
   /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
   void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: wall times are measured from `start`; publishes a

@@ -1,5 +1,6 @@
 // The pure parts of hoist-twind's LCM shell: see hoist/service/messages.hpp.
 #include "hoist/service/messages.hpp"
+#include "hoist/bus/lcm_util.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -123,14 +124,6 @@ std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*
   return std::nullopt;
 }
 
-std::string regexEscape(const std::string& name) {
-  std::string o;
-  o.reserve(name.size() * 2);
-  for (char c : name) {
-    if (std::strchr("\\^$.|?*+()[]{}-/", c) && c != '\0') o.push_back('\\');
-    o.push_back(c);
-  }
-  return o;
-}
+std::string regexEscape(const std::string& name) { return bus::regexEscape(name); }
 
 }  // namespace hoist::svc

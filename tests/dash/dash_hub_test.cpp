@@ -11,6 +11,7 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
+#include "attack_bytes.hpp"
 #include "hub.hpp"
 #include "static_files.hpp"
 
@@ -141,6 +142,40 @@ TEST_F(HubTest, GarbageAndWrongTypesFromLcmAreCountedNotForwarded) {
   for (const auto& [k, v] : counters.items())
     if (k.rfind("lcm_rejected_decode_", 0) == 0) decode_fail += v.get<std::uint64_t>();
   EXPECT_EQ(decode_fail, 1u);
+}
+
+// Issue 12.1: the exact attack bytes (string lengths 0 and 0x80000000,
+// huge and negative array counts) on the channels hoist-dash decodes are
+// counted as decode rejections before anything is allocated from them;
+// nothing reaches a client, nothing throws.
+TEST_F(HubTest, Issue12AttackBytesAreCountedNotForwarded) {
+  namespace atk = hoist::test::attack;
+  Hub hub = make(false);
+  RecClient c;
+  hub.addClient(c);
+  int id = 1;
+  for (const char* ch : {"HOIST_HEALTH", "HOIST_GUIDE_SHAPE", "HOIST_ALARM"})
+    hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", id++}, {"channelId", channelId(c, ch)}}}}}.dump());
+  EXPECT_EQ(hub.counter("ws_subscriptions"), 3u);
+  c.data.clear();
+  int sent = 0;
+  for (std::int32_t n : {0x7fffffff, -1, INT32_MIN, 100001}) {
+    const auto h = atk::healthCount(n), g = atk::guideShapeCount(n);
+    hub.onLcm("HOIST_HEALTH", h.data(), h.size());
+    hub.onLcm("HOIST_GUIDE_SHAPE", g.data(), g.size());
+    sent += 2;
+  }
+  for (std::uint32_t len : {0u, 0x80000000u, 0xffffffffu, 0x7fffffffu}) {
+    const auto a = atk::alarmStringLen(len);
+    hub.onLcm("HOIST_ALARM", a.data(), a.size());
+    ++sent;
+  }
+  EXPECT_TRUE(c.data.empty());
+  EXPECT_EQ(hub.counter("lcm_decoded"), 0u);
+  EXPECT_EQ(hub.counter("lcm_handler_exceptions"), 0u);
+  EXPECT_EQ(hub.counter("lcm_rejected_decode_bad_count"), 8u);
+  EXPECT_EQ(hub.counter("lcm_rejected_decode_bad_string"), 4u);
+  EXPECT_EQ(hub.counter("lcm_messages"), static_cast<std::uint64_t>(sent));
 }
 
 TEST_F(HubTest, PrefixesAreDiscoveredFromHealthAndEarlierAlarmsKept) {

@@ -269,14 +269,14 @@ TEST(ToolsExitStatus, BadProfilesGiveStatus2NamingTheLine) {
 }
 
 #ifdef HOIST_SIM
-TEST(ToolsExitStatus, SimStateLeavingThePlausibleRangeExitsNonZeroWithTimeAndValue) {
+TEST(ToolsExitStatus, SimProfileOutsideTheValidRangeIsRefusedUpFront) {
   // Issue 12.2: `hoist-sim --profile "rest:t_end=3,l0=1e-7"` wrote 1e282 m and exited 0.
   const auto dir = workDir("tools_implausible");
   const ToolRun sim = run(HOIST_SIM, {"--profile", "rest:t_end=3,l0=1e-7", "--out", (dir / "o.csv").string(), "-q"});
   // Rejected before it runs (bad input, exit 2): the profile leaves the model's
   // valid range, 0.05 m clear of both shaft ends; the message names the time and
-  // the value.  (With the static correction on, this start no longer diverges;
-  // the implausible-state path itself is covered in attack_core_test.)
+  // the value.  (The run-time path, a state that leaves the plausible range:
+  // exit 1 with the time and the quantity, SimCli.ImplausibleStateExitsOneNamingTimeAndQuantity.)
   EXPECT_EQ(sim.status, 2) << sim.output;
   EXPECT_NE(sim.output.find("at t = 0 s the rope length l = 1e-07 m"), std::string::npos) << sim.output;
   EXPECT_NE(sim.output.find("valid rope lengths are [0.05, 383.95] m"), std::string::npos) << sim.output;

@@ -1,11 +1,12 @@
 // Issue 12 sections 3-6 and issue 15.3/15.4 against the real daemon over LCM
-// (UDP multicast on loopback, ttl=0, ports 7851..7860): the exact attacks,
+// (UDP multicast on loopback, ttl=0, ports 7851..7859, 7862-7863): the exact attacks,
 // asserting the daemon stays alive and what it publishes and logs.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <set>
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
@@ -195,36 +196,23 @@ TEST_F(DaemonAttack, SignalsAndADeadLogReaderDoNotKill) {
   start(7854, "signals");
   // stderr into a pipe whose reader is gone: every log line hits EPIPE.
   int fds[2];
-  ASSERT_EQ(::pipe(fds), 0);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_adddup2(&fa, fds[1], STDERR_FILENO);
-  posix_spawn_file_actions_adddup2(&fa, fds[1], STDOUT_FILENO);
-  posix_spawn_file_actions_addclose(&fa, fds[0]);
-  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--log-level", "debug"};
-  std::vector<char*> args;
-  for (auto& a : argv) args.push_back(a.data());
-  args.push_back(nullptr);
-  pid_t pid = -1;
-  ASSERT_EQ(posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&fa);
+  ASSERT_EQ(::pipe2(fds, O_CLOEXEC), 0);  // the child keeps only its dup2'd copies of the write end
+  Process d({HOIST_TWIND, "--lcm-url", url_, "--log-level", "debug"}, fds[1]);
+  ASSERT_TRUE(d.started());
   ::close(fds[1]);
   ASSERT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > 0; }, 10s));
   ::close(fds[0]);  // the log reader dies
   for (int sig : {SIGHUP, SIGUSR1, SIGUSR2, SIGPIPE, SIGHUP}) {
-    ::kill(pid, sig);
+    d.signal(sig);
     listener_->pump(200ms);
   }
   feed("HOIST_WINDER", 50);  // log lines (debug health, stream start) onto the dead pipe
   const std::size_t before = listener_->count("HOIST_HEALTH");
   listener_->pump(1500ms);
-  int st = 0;
-  EXPECT_EQ(::waitpid(pid, &st, WNOHANG), 0) << "the daemon died (status " << st << ")";
+  EXPECT_TRUE(d.running()) << "the daemon died (status " << d.wait(0ms) << ")";
   EXPECT_GT(listener_->count("HOIST_HEALTH"), before) << "no health after the signals";
-  ::kill(pid, SIGTERM);
-  for (int i = 0; i < 200 && ::waitpid(pid, &st, WNOHANG) == 0; ++i) std::this_thread::sleep_for(10ms);
-  ASSERT_TRUE(WIFEXITED(st)) << "killed by signal " << (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
-  EXPECT_EQ(WEXITSTATUS(st), 0);
+  d.signal(SIGTERM);
+  EXPECT_EQ(d.wait(2s), 0) << "not a clean exit after SIGTERM (128 + signal if killed)";
 }
 
 TEST_F(DaemonAttack, ConfigsThatCannotRunAreRefusedAndForcedOnesStayResponsive) {
@@ -341,4 +329,71 @@ TEST_F(DaemonAttack, OutputsGoToLcmUrlOut) {
   const auto bad = writeConfig("bad.toml", "[service]\nlcm_url_out = \"nonsense\"\n");
   EXPECT_EQ(runProcess({HOIST_TWIND, "--config", bad, "--lcm-url", url_}, (dir_ / "bad.log").string(), 30s), 2);
   EXPECT_NE(readFile((dir_ / "bad.log").string()).find("service.lcm_url_out"), std::string::npos);
+}
+
+TEST_F(DaemonAttack, SecondPublisherIsDetectedOnASeparateOutputUrl) {
+  // Issue 12.5 with [service] lcm_url_out on another group: the input socket
+  // never sees the outputs, so the daemon watches its own HOIST_HEALTH on the
+  // output URL with a receive-only socket.  One daemon alone raises nothing
+  // (it sees only its own id there); a second one with the same prefix and
+  // the same output URL is detected by both.
+  start(7862, "duplicate_out");
+  const std::string out_url = urlFor(7863);
+  std::string why;
+  ASSERT_TRUE(loopbackMulticastWorks(out_url, why)) << why;
+  Listener out(out_url);
+  ASSERT_TRUE(out.good());
+  out.subscribe("HOIST_HEALTH");
+  out.subscribe("HOIST_ALARM");
+  const auto cfg = writeConfig("out.toml", "[service]\nlcm_url_out = \"" + out_url + "\"\n");
+  auto startOne = [&](const std::string& log) {
+    auto p = std::make_unique<Process>(std::vector<std::string>{HOIST_TWIND, "--config", cfg, "--lcm-url", url_,
+                                                                "--log-level", "info"},
+                                       (dir_ / log).string());
+    const std::size_t before = out.count("HOIST_HEALTH");
+    EXPECT_TRUE(out.waitFor([&] { return out.count("HOIST_HEALTH") > before; }, 10s)) << readFile((dir_ / log).string());
+    return p;
+  };
+  auto duplicateRaised = [&] {
+    for (const auto& a : out.decoded<hoist::alarm_t>("HOIST_ALARM"))
+      if (a.kind == "DUPLICATE_PUBLISHER" && a.event_type == hoist::alarm_t::EVENT_RAISE) return true;
+    return false;
+  };
+  auto d1 = startOne("twind1.log");
+  out.pump(2500ms);  // two health periods of its own messages on the output group
+  EXPECT_FALSE(duplicateRaised()) << "a daemon alone took its own outputs for a second publisher";
+  auto d2 = startOne("twind2.log");
+  EXPECT_TRUE(out.waitFor(duplicateRaised, 5s)) << "no DUPLICATE_PUBLISHER with two daemons on one output URL";
+  out.pump(1500ms);
+  std::set<std::int64_t> ids;
+  for (const auto& h : out.decoded<hoist::health_t>("HOIST_HEALTH")) ids.insert(h.instance_id);
+  EXPECT_EQ(ids.size(), 2u);
+  EXPECT_EQ(listener_->count("HOIST_HEALTH"), 0u) << "outputs on the input URL";
+  stopDaemonCleanly(*d1, (dir_ / "twind1.log").string());
+  stopDaemonCleanly(*d2, (dir_ / "twind2.log").string());
+  // Both noticed the other.
+  EXPECT_NE(readFile((dir_ / "twind1.log").string()).find("another publisher"), std::string::npos);
+  EXPECT_NE(readFile((dir_ / "twind2.log").string()).find("another publisher"), std::string::npos);
+}
+
+TEST(DaemonFiles, RunReportWriteFailureIsExitOneWithPathAndErrno) {
+  // Issue 12.6: every file a program writes is checked; hoist-twind's run
+  // report (--report) into a directory that does not exist: exit 1, the
+  // option, the path and the errno text (memq://: no network needed).
+  const auto dir = testDir("report_fail");
+  const std::string report = (dir / "no" / "such" / "r.json").string();
+  const std::string log = (dir / "twind.log").string();
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--lcm-url", "memq://", "--duration", "0.5", "--report", report}, log, 30s), 1)
+      << readFile(log);
+  const std::string text = readFile(log);
+  EXPECT_NE(text.find("--report " + report + ".tmp: cannot open for writing: No such file or directory"),
+            std::string::npos)
+      << text;
+  // And a good path is written completely.
+  const std::string good = (dir / "r.json").string();
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--lcm-url", "memq://", "--duration", "0.5", "--report", good}, log, 30s), 0)
+      << readFile(log);
+  const std::string json = readFile(good);
+  EXPECT_NE(json.find("\"tool\": \"hoist-twind\""), std::string::npos) << json;
+  EXPECT_EQ(json.back(), '\n');
 }

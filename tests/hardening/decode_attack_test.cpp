@@ -1,4 +1,4 @@
-// Issue 12 s.1 through real LCM (UDP multicast on loopback, ports 7751-7753):
+// Issue 12 s.1 and s.5 through real LCM (UDP multicast on loopback, ports 7751-7753):
 //   * hoist-twind receives the 37-byte alarm_ack_t with a string length of 0
 //     and of 0x80000000 (it used to die), health_t/guide_shape_t payloads with
 //     huge and negative counts on its input channels, and truncations of a
@@ -8,7 +8,9 @@
 //   * hoist-monitor receives an alarm_t whose message carries terminal escape
 //     sequences, health_t with impossible counts and garbage: no control
 //     character reaches its output, the undecodable messages are counted, it
-//     says STALE when the daemon goes quiet, and it exits 0 with bounded memory.
+//     says STALE when the daemon goes quiet, and it exits 0 with bounded memory;
+//   * hoist-monitor --channel-prefix "mine.1/" does not show the look-alike
+//     shaft "mineX1/" (LCM's subscribe takes a regular expression).
 #include <gtest/gtest.h>
 
 #include <map>
@@ -19,7 +21,7 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
-#include "run_util.hpp"
+#include "process.hpp"
 
 using namespace hoist::test;
 namespace atk = hoist::test::attack;
@@ -169,6 +171,36 @@ TEST_F(DecodeAttack, MonitorSanitizesStringsAndFlagsStaleData) {
   EXPECT_NE(text.find("FAKE: all clear"), std::string::npos) << text;  // shown, but inert
   EXPECT_NE(text.find("undecodable messages: 5"), std::string::npos) << text;
   EXPECT_NE(text.find("STALE: no HOIST_CAGE"), std::string::npos) << text;
+}
+
+TEST_F(DecodeAttack, MonitorPrefixIsALiteralNotARegex) {
+  // Issue 12.5 in hoist-monitor: its channels were regular expressions, so
+  // the prefix "mine.1/" also showed the cage of "mineX1/".
+  start(7753, "decode_attack_monitor_prefix");
+  const std::string out = (dir_ / "monitor.out").string();
+  Process mon({HOIST_MONITOR, "--lcm-url", url_, "--channel-prefix", "mine.1/", "--period", "0.25", "--duration",
+               "2.5"},
+              out);
+  ASSERT_TRUE(mon.started());
+  listener_->pump(700ms);  // let it subscribe
+  hoist::cage_state_t cage{};
+  cage.t = 1.0;
+  cage.l = 123.45;
+  for (int i = 0; i < 3; ++i) {
+    listener_->lcm().publish("mineX1/HOIST_CAGE", &cage);
+    listener_->pump(100ms);
+  }
+  listener_->pump(500ms);
+  cage.l = 222.22;
+  for (int i = 0; i < 3; ++i) {
+    listener_->lcm().publish("mine.1/HOIST_CAGE", &cage);
+    listener_->pump(100ms);
+  }
+  const int st = mon.wait(10s);
+  const std::string text = readFile(out);
+  EXPECT_EQ(st, 0) << text;
+  EXPECT_EQ(text.find("123.45"), std::string::npos) << "the mineX1/ shaft reached a mine.1/ monitor:\n" << text;
+  EXPECT_NE(text.find("222.22"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -19,7 +19,7 @@
 #include "hoist/io/lcm_log.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
-#include "run_util.hpp"
+#include "process.hpp"
 
 namespace fs = std::filesystem;
 namespace atk = hoist::test::attack;

@@ -252,3 +252,141 @@ TEST_F(SimCli, EstopAtIsTheForecastsEstopScenario) {
   EXPECT_EQ(sim({"--estop-at", "100", "-q", "--out", path("x.csv")}).status, 2);
   EXPECT_EQ(sim({"--estop-at", "20", "--estop-decel", "0", "-q", "--out", path("x.csv")}).status, 2);
 }
+
+// ---- issue 12: hostile and careless runs ------------------------------------
+
+// Issue 12.2: a state that leaves the plausible range stops the run with exit
+// status 1, naming the time and the quantity.  A real input reaches it: a
+// 200 kN eccentric load on the paper's 800-kg cage (accepted: the load has no
+// upper bound) applied as a step (rest start) tilts the cage so far that its
+// sleeves are more than 1 m off the axis after 0.1 s.
+TEST_F(SimCli, ImplausibleStateExitsOneNamingTimeAndQuantity) {
+  const std::string cfg = write("ecc.toml", "[load]\neccentric_force = 2e5\n");
+  const SimRun r = sim({"--config", cfg, "--profile", "paper", "--initial", "rest", "--out", path("o.csv"), "-q"});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("implausible state at t = 0.1 s: y_c = "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(plausible: |y_c| <= 1;"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("10 good rows are written"), std::string::npos) << r.output;
+  // The good rows are in the file, complete (streamed before the failure).
+  const Table t = readCsv(path("o.csv"));
+  ASSERT_EQ(t.rows.size(), 10u);
+  EXPECT_NEAR(t.rows.back()[0], 0.09, 1e-12);
+}
+
+// Issue 12.6: rows are streamed, so --t-end no longer sizes a vector
+// (--t-end 1e9 died with std::bad_alloc); runs that cannot fit are refused
+// up front, naming the option.
+TEST_F(SimCli, HugeTEndIsRefusedNamingTheOptionNotBadAlloc) {
+  // 1e11 rows (~18 TB) onto a regular file: more than the disk has.
+  SimRun r = sim({"--profile", "paper", "--t-end", "1e9", "--out", path("o.csv")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("hoist-sim: error: --t-end 1e+09: the output would be about 18.0 TB (1e+11 rows"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("are free for --out"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("bad_alloc"), std::string::npos) << r.output;
+  // More than 1e12 output steps: refused whatever the output (here a device).
+  r = sim({"--profile", "paper", "--t-end", "1e11", "--out", "/dev/null"});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--t-end 1e+11: 1e+13 output steps at --dt 0.01 s, more than 1e+12"), std::string::npos)
+      << r.output;
+  r = sim({"--profile", "paper", "--t-end", "nan", "--out", path("o.csv")});
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--t-end"), std::string::npos) << r.output;
+}
+
+namespace {
+/// VmRSS of a running process [KiB], 0 if unknown.
+long vmRssKb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+}  // namespace
+
+// Issue 12.6: a long run (1e8 rows, to /dev/null) states its estimated rows,
+// size and time before it starts, and its memory stays flat while it runs
+// (it used to keep every row: 9.6 GB for these 1e8 rows).
+TEST_F(SimCli, LongRunStatesItsSizeAndStreamsWithFlatMemory) {
+  const std::string log = path("sim.log");
+  hoist::test::Process p({HOIST_SIM, "--profile", "paper", "--t-end", "1e6", "--max-step", "0.01", "--out",
+                          "/dev/null"},
+                         log);
+  ASSERT_TRUE(p.started());
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (hoist::test::readFile(log).find("large run") == std::string::npos && p.running() &&
+         std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::string text = hoist::test::readFile(log);
+  ASSERT_TRUE(p.running()) << text;
+  EXPECT_NE(text.find("hoist-sim: large run: about 1e+08 rows, 18.0 GB to /dev/null, about "), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("us per step measured)"), std::string::npos) << text;
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  const long rss1 = vmRssKb(p.pid());
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+  const long rss2 = vmRssKb(p.pid());
+  ASSERT_TRUE(p.running());
+  p.signal(SIGKILL);
+  EXPECT_GT(rss1, 0);
+#ifndef HOIST_SANITIZED  // a sanitizer runtime has its own, larger footprint
+  EXPECT_LT(rss2, 64 * 1024) << "KiB";
+#endif
+  EXPECT_LT(rss2 - rss1, 2048) << "RSS grew from " << rss1 << " to " << rss2 << " KiB in 2 s of streaming";
+}
+
+// Without a terminal, --progress gives one line per 10 %; -q alone is silent.
+TEST_F(SimCli, ProgressLinesWithoutATerminal) {
+  SimRun r = sim({"--profile", "trapezoid:t_end=2", "--out", path("o.csv"), "-q", "--progress"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("hoist-sim: progress  10 %"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("hoist-sim: progress 100 %"), std::string::npos) << r.output;
+  r = sim({"--profile", "trapezoid:t_end=2", "--out", path("o.csv"), "-q"});
+  ASSERT_EQ(r.status, 0);
+  EXPECT_EQ(r.output, "");
+}
+
+// Issue 12.6: every file written to its last byte, or exit 1 naming the
+// option, the path and the errno text (the streaming writer included).
+TEST_F(SimCli, FullDiskAndUnwritablePathsExitOneNamingTheFile) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string expect;
+  };
+  const std::vector<Case> cases = {
+      {{"--profile", "paper", "--out", "/dev/full"}, "--out /dev/full: write failed: No space left on device"},
+      {{"--profile", "paper", "--out", path("o.csv"), "--shape-out", "/dev/full"},
+       "--shape-out /dev/full: write failed: No space left on device"},
+      {{"--profile", "paper", "--write-profile", "/dev/full"},
+       "--write-profile /dev/full: write failed: No space left on device"},
+      {{"--profile", "paper", "--out", path("no/such/dir/o.csv")},
+       "--out " + path("no/such/dir/o.csv") + ": cannot open for writing: No such file or directory"},
+  };
+  for (const auto& c : cases) {
+    const SimRun r = sim(c.args);
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_NE(r.output.find("hoist-sim: error: " + c.expect), std::string::npos) << "want '" << c.expect << "' in:\n"
+                                                                                 << r.output;
+    EXPECT_EQ(r.output.find("wrote "), std::string::npos) << "success claimed:\n" << r.output;
+  }
+}
+
+// Issue 12.6: out of memory is exit 1 with the options of the run, never an
+// uncaught std::bad_alloc (abort, exit 134).  The address space is limited
+// below what n = 1000 modes need (not under a sanitizer: its shadow memory
+// needs the address space).
+TEST_F(SimCli, OutOfMemoryIsExitOneNamingTheOptions) {
+#ifdef HOIST_SANITIZED
+  GTEST_SKIP() << "ulimit -v and a sanitizer runtime do not mix";
+#endif
+  const SimRun r = hoist::test::runCaptured(
+      "/bin/sh", {"-c", "ulimit -v 120000 && exec \"$0\" --modes 1000 --profile paper --t-end 1 -q --out \"$1\"",
+                  HOIST_SIM, path("o.csv")});
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("hoist-sim: error: out of memory (std::bad_alloc) in: hoist-sim --modes 1000 --profile "
+                          "paper --t-end 1 -q --out"),
+            std::string::npos)
+      << r.output;
+}

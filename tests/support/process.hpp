@@ -1,12 +1,14 @@
 // tests/support/process.hpp -- running the project's programs from tests:
-// a child process with a timeout and its output in a log file (Process,
-// runProcess), a program run to completion with its output captured
-// (runCaptured), and small file helpers.
+// a child process with a timeout and its output in a log file or on a given
+// descriptor (Process, runProcess), a program run to completion with its
+// peak memory (runMeasured) or its output captured (runCaptured), and small
+// file helpers.  The one spawn/wait implementation of the tests.
 #pragma once
 
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -28,17 +30,22 @@ using namespace std::chrono_literals;
 /// A child process; killed (SIGKILL) if still running when destroyed.
 class Process {
  public:
+  /// stdout and stderr appended to `log_path`, stdin from /dev/null.
   Process(std::vector<std::string> argv, const std::string& log_path) : argv_(std::move(argv)) {
     posix_spawn_file_actions_t fa;
     posix_spawn_file_actions_init(&fa);
     posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
     posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
-    posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-    std::vector<char*> args;
-    for (auto& a : argv_) args.push_back(a.data());
-    args.push_back(nullptr);
-    if (posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&fa);
+    spawn(fa);
+  }
+  /// stdout and stderr onto the descriptor `output_fd` (e.g. a pipe's write
+  /// end; the caller keeps and closes its own copy), stdin from /dev/null.
+  Process(std::vector<std::string> argv, int output_fd) : argv_(std::move(argv)) {
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_adddup2(&fa, output_fd, STDOUT_FILENO);
+    posix_spawn_file_actions_adddup2(&fa, output_fd, STDERR_FILENO);
+    spawn(fa);
   }
   ~Process() {
     if (running()) {
@@ -51,13 +58,16 @@ class Process {
   Process& operator=(const Process&) = delete;
 
   bool started() const { return pid_ > 0; }
+  pid_t pid() const { return pid_; }
   bool running() {
     if (pid_ <= 0 || done_) return false;
     int st;
-    const pid_t r = ::waitpid(pid_, &st, WNOHANG);
+    rusage ru{};
+    const pid_t r = ::wait4(pid_, &st, WNOHANG, &ru);
     if (r == pid_) {
       done_ = true;
       status_ = st;
+      max_rss_kb_ = ru.ru_maxrss;
       return false;
     }
     return true;
@@ -75,12 +85,24 @@ class Process {
     if (pid_ <= 0) return -1;
     return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
   }
+  /// Peak resident set size of the finished child [KiB] (0 while it runs).
+  long maxRssKb() const { return max_rss_kb_; }
 
  private:
+  void spawn(posix_spawn_file_actions_t& fa) {
+    posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+    std::vector<char*> args;
+    for (auto& a : argv_) args.push_back(a.data());
+    args.push_back(nullptr);
+    if (posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&fa);
+  }
+
   std::vector<std::string> argv_;
   pid_t pid_ = -1;
   bool done_ = false;
   int status_ = 0;
+  long max_rss_kb_ = 0;
 };
 
 /// Run to completion (with timeout); returns the exit status or -1.
@@ -89,6 +111,24 @@ inline int runProcess(std::vector<std::string> argv, const std::string& log_path
   Process p(std::move(argv), log_path);
   if (!p.started()) return -1;
   return p.wait(timeout);
+}
+
+struct RunResult {
+  int status = -1;      ///< exit status, 128 + signal if killed, -1 if not started or timed out
+  long max_rss_kb = 0;  ///< peak resident set size of the child [KiB]
+};
+
+/// Runs argv to completion (at most `timeout`) with stdout+stderr appended
+/// to `log_path`; its exit status and peak memory (for "bounded memory"
+/// assertions on hostile input).
+inline RunResult runMeasured(std::vector<std::string> argv, const std::string& log_path,
+                             std::chrono::milliseconds timeout = std::chrono::minutes(2)) {
+  Process p(std::move(argv), log_path);
+  RunResult r;
+  if (!p.started()) return r;
+  r.status = p.wait(timeout);
+  r.max_rss_kb = p.maxRssKb();
+  return r;
 }
 
 inline std::string readFile(const std::string& path) {

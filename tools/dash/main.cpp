@@ -21,6 +21,8 @@
 #include <spdlog/spdlog.h>
 
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
+#include "hoist/msg/codec.hpp"
 #include "src/hub.hpp"
 #include "src/server.hpp"
 #include "src/static_files.hpp"
@@ -53,7 +55,7 @@ struct LcmPump {
       hub->onLcm(channel, rbuf->data, rbuf->data_size);
     } catch (const std::exception& e) {
       hub->count("lcm_handler_exceptions");
-      spdlog::error("LCM message on {}: {}", channel, e.what());
+      spdlog::error("LCM message on {}: {}", hoist::msg::terminalSafe(channel, 64), e.what());
     } catch (...) {
       hub->count("lcm_handler_exceptions");
     }
@@ -161,7 +163,29 @@ int main(int argc, char** argv) {
       },
       wallNs);
   LcmPump pump{&lcm, &hub};
-  lcm.subscribe(".*HOIST_.*", &LcmPump::onMessage, &pump);
+  // udpm:// (and LCM's default): our own receive path, which stores nothing
+  // per channel name (LCM 1.3.1 caches every name it ever receives, so a
+  // sender cycling names would grow this process without bound;
+  // hoist/bus/udpm_receiver.hpp).  LCM then only publishes.  Other
+  // providers: LCM's receive path.
+  std::unique_ptr<hoist::bus::UdpmReceiver> rx;
+  {
+    hoist::bus::UdpmUrl udpm;
+    std::string why;
+    if (hoist::bus::parseUdpmUrl(url, udpm, why)) {
+      rx = std::make_unique<hoist::bus::UdpmReceiver>();
+      if (!rx->open(udpm, why)) {
+        std::fprintf(stderr, "hoist-dash: cannot open the LCM receive socket for %s: %s\n",
+                     hoist::bus::describeLcmUrl(url).c_str(), why.c_str());
+        return 1;
+      }
+      // LCM's ".*HOIST_.*" (anchored): any name containing HOIST_.
+      rx->addMatching([](std::string_view n) { return n.find("HOIST_") != std::string_view::npos; },
+                      [&pump](const lcm::ReceiveBuffer* rb, const std::string& ch) { pump.onMessage(rb, ch); });
+    } else {
+      lcm.subscribe(".*HOIST_.*", &LcmPump::onMessage, &pump);
+    }
+  }
 
   net::io_context io;
   hoist::dash::Server::Limits lim;
@@ -178,11 +202,15 @@ int main(int argc, char** argv) {
   }
 
   // LCM: its socket in the same loop.
-  net::posix::stream_descriptor lcm_fd(io, ::dup(lcm.getFileno()));
+  net::posix::stream_descriptor lcm_fd(io, ::dup(rx ? rx->fd() : lcm.getFileno()));
   std::function<void()> waitLcm = [&]() {
     lcm_fd.async_wait(net::posix::stream_descriptor::wait_read, [&](boost::system::error_code e) {
       if (e) return;
-      for (int i = 0; i < 1000 && lcm.handleTimeout(0) > 0; ++i) {
+      if (rx) {
+        rx->drain(1000);
+      } else {
+        for (int i = 0; i < 1000 && lcm.handleTimeout(0) > 0; ++i) {
+        }
       }
       waitLcm();
     });

@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "hoist/alarm_t.hpp"
@@ -35,6 +36,7 @@
 #include "hoist/health_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
 #include "hoist/msg/codec.hpp"
 
 namespace {
@@ -200,9 +202,30 @@ int main(int argc, char** argv) {
   const hoist::bus::Channels ch(prefix);
   mon.cage_channel_ = ch.cage;
   mon.stale_s_ = stale;
-  lcm.subscribe(ch.cage, &Monitor::onCage, &mon);
-  lcm.subscribe(ch.alarm, &Monitor::onAlarm, &mon);
-  lcm.subscribe(ch.health, &Monitor::onHealth, &mon);
+  // udpm:// (and LCM's default): our own receive path, exact names, nothing
+  // stored per channel name (hoist/bus/udpm_receiver.hpp); else LCM's, with
+  // literal names: subscribe() takes a regular expression, and a prefix
+  // "mine.1/" must not show the shaft "mineX1/".
+  std::unique_ptr<hoist::bus::UdpmReceiver> rx;
+  {
+    hoist::bus::UdpmUrl udpm;
+    std::string why;
+    if (hoist::bus::parseUdpmUrl(url, udpm, why)) {
+      rx = std::make_unique<hoist::bus::UdpmReceiver>();
+      if (!rx->open(udpm, why)) {
+        std::fprintf(stderr, "hoist-monitor: cannot open the LCM receive socket for %s: %s\n",
+                     hoist::bus::describeLcmUrl(url).c_str(), why.c_str());
+        return 1;
+      }
+      rx->add(ch.cage, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onCage(rb, c); });
+      rx->add(ch.alarm, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onAlarm(rb, c); });
+      rx->add(ch.health, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onHealth(rb, c); });
+    } else {
+      lcm.subscribe(hoist::bus::regexEscape(ch.cage), &Monitor::onCage, &mon);
+      lcm.subscribe(hoist::bus::regexEscape(ch.alarm), &Monitor::onAlarm, &mon);
+      lcm.subscribe(hoist::bus::regexEscape(ch.health), &Monitor::onHealth, &mon);
+    }
+  }
   struct sigaction sa {};
   sa.sa_handler = onSignal;
   sigaction(SIGINT, &sa, nullptr);
@@ -210,7 +233,7 @@ int main(int argc, char** argv) {
 
   const auto start = Clock::now();
   auto next = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period));
-  const int fd = lcm.getFileno();
+  const int fd = rx ? rx->fd() : lcm.getFileno();
   while (!g_stop) {
     const auto now = Clock::now();
     if (duration > 0.0 && now - start >= std::chrono::duration<double>(duration)) break;
@@ -223,7 +246,10 @@ int main(int argc, char** argv) {
     const int wait_ms = static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(next - now).count()) + 1;
     pollfd p{fd, POLLIN, 0};
     const int r = ::poll(&p, 1, std::min(wait_ms, 200));
-    if (r > 0) lcm.handle();
+    if (r > 0) {
+      if (rx) rx->drain(256);
+      else lcm.handle();
+    }
   }
   return 0;
 }

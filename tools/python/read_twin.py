@@ -62,6 +62,13 @@ def lcm_messages(url):
             yield box.pop(0)
 
 
+def safe(s, limit=200):
+    """A string from the network, safe to print on a terminal: control characters
+    (C0, DEL, C1: escape sequences, bell, carriage return) shown as \\xHH, cut to `limit`."""
+    out = "".join(c if (" " <= c < "\x7f" or c > "\x9f") else f"\\x{ord(c):02x}" for c in str(s)[:limit])
+    return out + ("..." if len(str(s)) > limit else "")
+
+
 def main():
     ap = argparse.ArgumentParser(prog="read_twin.py", description=__doc__.split("\n")[0])
     ap.add_argument("--lcm-url", default="udpm://239.255.76.67:7667?ttl=0")
@@ -96,7 +103,7 @@ def main():
         if channel == cage_ch:
             try:
                 m = hoist.cage_state_t.decode(data)
-            except ValueError:  # another fingerprint: a different version of the types
+            except Exception:  # another fingerprint (ValueError), truncated or hostile bytes: skip it
                 continue
             print(f"t={m.t:8.2f} s  l={m.l:7.2f} m  y_c={m.y_c * 1e3:+8.3f} mm  theta={m.theta * 1e3:+7.4f} mrad  "
                   f"lambda_1={m.lambdas[1]:8.1f} N  min_clearance={m.min_clearance * 1e3:7.1f} mm  "
@@ -107,9 +114,9 @@ def main():
         elif channel == alarm_ch:
             try:
                 e = hoist.alarm_t.decode(data)
-            except ValueError:
+            except Exception:
                 continue
-            print(f">> {e.kind} level={e.level} event_type={e.event_type}: {e.message}", flush=True)
+            print(f">> {safe(e.kind, 40)} level={e.level} event_type={e.event_type}: {safe(e.message)}", flush=True)
     return 1
 
 

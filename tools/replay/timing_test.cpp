@@ -27,6 +27,7 @@
 
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/io/checked_file.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/profile.hpp"
 #include "hoist/bus/lcm_util.hpp"
@@ -51,14 +52,6 @@ std::int64_t monotonicNs() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
-std::string escapeRegex(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (std::string_view(".[]{}()\\*+?^$|").find(c) != std::string_view::npos) o += '\\';
-    o += c;
-  }
-  return o;
-}
 
 /// Publish times of one shaft's inputs, indexed by seq (preallocated; the
 /// feeder writes, the listener reads).
@@ -356,11 +349,14 @@ std::size_t ringSize(double rate, std::size_t shafts) {
 }  // namespace
 
 int runTimingTest(const TimingTestOptions& o) {
-  std::ofstream report;
+  // Opened now, so a bad path fails before the run; every byte checked at
+  // the end (hoist/io/checked_file.hpp).
+  hoist::io::CheckedFile report;
   if (!o.report_path.empty()) {
-    report.open(o.report_path, std::ios::out | std::ios::trunc);
-    if (!report) {
-      std::cerr << "hoist-timing-test: --report: cannot write " << o.report_path << "\n";
+    try {
+      report = hoist::io::CheckedFile(o.report_path, "--report");
+    } catch (const hoist::io::WriteError& e) {
+      std::cerr << "hoist-timing-test: " << e.what() << "\n";
       return 2;
     }
   }
@@ -389,8 +385,8 @@ int runTimingTest(const TimingTestOptions& o) {
     run.shafts.push_back(std::move(s));
   }
   for (auto& s : run.shafts) {
-    rx.subscribe(escapeRegex(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth)), &Shaft::onHealth, s.get());
-    rx.subscribe(escapeRegex(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage)), &Shaft::onCage, s.get());
+    rx.subscribe(hoist::bus::regexEscape(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth)), &Shaft::onHealth, s.get());
+    rx.subscribe(hoist::bus::regexEscape(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage)), &Shaft::onCage, s.get());
   }
 
   struct sigaction sa {};
@@ -406,14 +402,20 @@ int runTimingTest(const TimingTestOptions& o) {
     const Evaluation e = evaluate(res, o);
     const std::string text = formatReport(res, o, e);
     std::cout << text << std::flush;
-    if (report.is_open()) {
-      report << text;
-      report.close();
-      if (!report) std::cerr << "hoist-timing-test: --report: writing " << o.report_path << " failed\n";
+    bool report_failed = false;
+    if (report.isOpen()) {
+      try {
+        report.write(text);
+        report.close();
+      } catch (const hoist::io::WriteError& e) {
+        std::cerr << "hoist-timing-test: " << e.what() << "\n";
+        report_failed = true;
+      }
     }
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
     if (res.interrupted) return 128 + res.signal;
+    if (report_failed) return 1;
     return e.verdict == Verdict::Pass ? 0 : 1;
   };
 
@@ -432,7 +434,14 @@ int runTimingTest(const TimingTestOptions& o) {
   }
   if (g_signal.load()) {
     std::cerr << "hoist-timing-test: stopped before the timing test started\n";
-    if (report.is_open()) report << "VERDICT: INCONCLUSIVE (shortened run: stopped before the test started)\n";
+    if (report.isOpen()) {
+      try {
+        report.write("VERDICT: INCONCLUSIVE (shortened run: stopped before the test started)\n");
+        report.close();
+      } catch (const hoist::io::WriteError& e) {
+        std::cerr << "hoist-timing-test: " << e.what() << "\n";
+      }
+    }
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
     return 128 + g_signal.load();

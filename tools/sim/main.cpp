@@ -8,14 +8,27 @@
 //   hoist-sim study ...        (runs hoist-study: the paper's parameter studies)
 //
 // Phases, each timed in the summary: load (config, profile), setup (mode
-// integrals, solver), solve (time stepping, rows kept in memory), output.
+// integrals, solver), solve (time stepping), output (formatting and writing
+// the rows, which are streamed to the file as they are computed: memory
+// stays flat whatever --t-end).  Before a large run (over 1e7 rows, 1 GB or
+// an estimated 30 s) one line states the estimated rows, size and time; a
+// run whose output cannot fit the free space of --out's file system is
+// refused.  Every file is written to its last byte or the run fails naming
+// it (hoist/io/checked_file.hpp).
 // Exit status: 0 done, 2 bad input (config, profile, options), 1 the run
-// failed (non-finite state, write error).
+// failed (non-finite or implausible state -- the message names the time, the
+// quantity and its value --, write error, out of memory).
 #include "hoist/version.hpp"
 #include <unistd.h>
 
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
+#include <new>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -24,6 +37,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "hoist/io/checked_file.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
@@ -43,8 +57,11 @@ struct Options {
   double estop_at = std::nan(""), estop_decel = 3.0, estop_jerk = 10.0;
   int modes = 0, shape_points = 401;
   std::string initial, method = "fast", static_correction;
-  bool quiet = false, print_config = false;
+  bool quiet = false, print_config = false, progress = false;
 };
+
+/// The command line, for the messages of unexpected failures (out of memory).
+std::string g_command_line;
 
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -72,27 +89,112 @@ std::vector<double> parseTimes(const std::string& s) {
   return out;
 }
 
-/// One progress line on a terminal, rewritten in place.
+/// Progress on stderr: on a terminal one line rewritten in place; with
+/// --progress and no terminal, one line per 10 % (a log stays readable).
 class Progress {
  public:
-  explicit Progress(bool on) : on_(on), start_(Clock::now()) {}
+  enum class Mode { Off, Terminal, Lines };
+  explicit Progress(Mode m) : mode_(m), start_(Clock::now()) {}
   void update(double frac, double t_model) {
-    if (!on_) return;
+    if (mode_ == Mode::Off) return;
     const double el = secondsSince(start_);
-    const int width = 30, filled = static_cast<int>(frac * width);
     const double eta = frac > 0.01 ? el * (1.0 - frac) / frac : 0.0;
+    if (mode_ == Mode::Lines) {
+      const int decile = static_cast<int>(frac * 10.0 + 1e-9);
+      if (decile <= last_decile_) return;
+      last_decile_ = decile;
+      std::fprintf(stderr, "hoist-sim: progress %3d %%  t = %.2f s  elapsed %.1f s  eta %.1f s\n", decile * 10,
+                   t_model, el, eta);
+      std::fflush(stderr);
+      return;
+    }
+    const int width = 30, filled = static_cast<int>(frac * width);
     std::fprintf(stderr, "\r  [%.*s%*s] %3.0f%%  t = %7.2f s  elapsed %5.1f s  eta %5.1f s ", filled,
                  "==============================", width - filled, "", frac * 100.0, t_model, el, eta);
     std::fflush(stderr);
   }
   void done() {
-    if (on_) std::fprintf(stderr, "\r%*s\r", 90, "");
+    if (mode_ == Mode::Terminal) std::fprintf(stderr, "\r%*s\r", 90, "");
   }
 
  private:
-  bool on_;
+  Mode mode_;
   Clock::time_point start_;
+  int last_decile_ = 0;
 };
+
+/// Human-readable byte count.
+std::string bytesText(double b) {
+  char buf[64];
+  if (b >= 1e12) std::snprintf(buf, sizeof buf, "%.1f TB", b / 1e12);
+  else if (b >= 1e9) std::snprintf(buf, sizeof buf, "%.1f GB", b / 1e9);
+  else if (b >= 1e6) std::snprintf(buf, sizeof buf, "%.1f MB", b / 1e6);
+  else std::snprintf(buf, sizeof buf, "%.0f kB", b / 1e3);
+  return buf;
+}
+
+std::string secondsText(double s) {
+  char buf[64];
+  if (s >= 86400.0) std::snprintf(buf, sizeof buf, "%.1f days", s / 86400.0);
+  else if (s >= 3600.0) std::snprintf(buf, sizeof buf, "%.1f h", s / 3600.0);
+  else if (s >= 60.0) std::snprintf(buf, sizeof buf, "%.1f min", s / 60.0);
+  else std::snprintf(buf, sizeof buf, "%.1f s", s);
+  return buf;
+}
+
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// Size of a result row: 12 columns of shortest round-trip doubles, about 15
+// bytes each with the separator (measured: 164 B/row at rest, 181 B/row on
+// the paper trip).
+constexpr double kBytesPerRow = 12 * 15.0;
+// A run over any of these gets the estimate line before it starts.
+constexpr double kLargeRows = 1e7, kLargeBytes = 1e9, kLargeSeconds = 30.0;
+// More output steps than this are refused (1e12 rows are 180 TB).
+constexpr double kMaxOutputSteps = 1e12;
+
+/// Free bytes on the file system that would hold `path` (plus the size of
+/// the file it would replace), or < 0 when unknown or not a regular file
+/// (a device such as /dev/null, a pipe).
+double freeBytesFor(const std::string& path) {
+  struct stat st {};
+  double existing = 0.0;
+  if (::stat(path.c_str(), &st) == 0) {
+    if (!S_ISREG(st.st_mode)) return -1.0;
+    existing = static_cast<double>(st.st_size);
+  }
+  std::string dir = path;
+  const auto slash = dir.find_last_of('/');
+  dir = slash == std::string::npos ? std::string(".") : dir.substr(0, slash == 0 ? 1 : slash);
+  struct statvfs vf {};
+  if (::statvfs(dir.c_str(), &vf) != 0) return -1.0;
+  return static_cast<double>(vf.f_bavail) * static_cast<double>(vf.f_frsize) + existing;
+}
+
+/// Step cost [us per integration step] of this configuration, measured on
+/// a scratch solver over at most 200 steps or 0.2 s; < 0 if it failed.
+double measureStepUs(const std::shared_ptr<const hoist::ShaftModel>& model, hoist::Method method,
+                     const hoist::HoistProfile& profile, double t0, double h, hoist::InitialState init) {
+  try {
+    auto s = hoist::makeSolver(method, model);
+    s->initialize(t0, profile.at(t0), init);
+    const auto start = Clock::now();
+    int n = 0;
+    while (n < 200) {
+      const double t = t0 + static_cast<double>(n + 1) * h;
+      s->step(t, profile.at(t));
+      ++n;
+      if (secondsSince(start) > 0.2) break;
+    }
+    return 1e6 * secondsSince(start) / n;
+  } catch (const std::exception&) {
+    return -1.0;
+  }
+}
 
 struct Peak {
   double value = 0.0, t = 0.0;
@@ -173,24 +275,36 @@ int run(const Options& o) {
                 << stop.endTime() << " s, l = " << stop.end().l << " m\n";
   }
   if (!o.write_profile.empty()) {
-    std::ofstream pf(o.write_profile);
+    hoist::io::CheckedFile pf(o.write_profile, "--write-profile");
     hoist::io::writeProfileCsv(pf, profile);
-    if (!pf.flush()) throw std::runtime_error("cannot write " + o.write_profile);
+    pf.close();
     if (!o.quiet) std::cerr << "hoist-sim: profile written to " << o.write_profile << "\n";
     if (o.out.empty()) return 0;
   }
   if (o.out.empty()) throw UsageError("--out FILE.csv is required (or --write-profile / --print-config alone)");
   const double t0 = profile.startTime();
+  if (!std::isfinite(o.t_end)) throw UsageError("--t-end " + num(o.t_end) + ": must be a finite time in seconds");
   const double t_end = o.t_end < 0 ? profile.endTime() : o.t_end;
-  if (!(t_end > t0)) throw UsageError("--t-end must be after the profile start");
-  hoist::HoistProfile checked = profile;
+  if (!(t_end > t0))
+    throw UsageError("--t-end " + num(t_end) + ": must be after the profile start (" + num(t0) + " s)");
+  // How much output this is, before anything is allocated or written.
+  const double steps_d = std::round((t_end - t0) / o.dt);
+  const std::string t_end_opt = "--t-end " + num(t_end) + (o.t_end < 0 ? " (the profile's end)" : "");
+  if (steps_d > kMaxOutputSteps)
+    throw UsageError(t_end_opt + ": " + num(steps_d) + " output steps at --dt " + num(o.dt) + " s, more than " +
+                     num(kMaxOutputSteps) + " (" + bytesText(kMaxOutputSteps * kBytesPerRow) +
+                     " of CSV); shorten --t-end or raise --dt");
   {
     // Only the part that will be simulated must stay in the shaft.
-    std::vector<hoist::ProfileSample> part;
-    for (const auto& s : profile.samples())
-      if (s.t <= t_end + o.dt) part.push_back(s);
-    if (part.size() >= 2) hoist::io::checkProfileInShaft(hoist::HoistProfile(part), p, o.profile);
-    else hoist::io::checkProfileInShaft(profile, p, o.profile);
+    if (t_end + o.dt >= profile.endTime()) {
+      hoist::io::checkProfileInShaft(profile, p, o.profile);
+    } else {
+      std::vector<hoist::ProfileSample> part;
+      for (const auto& s : profile.samples())
+        if (s.t <= t_end + o.dt) part.push_back(s);
+      if (part.size() >= 2) hoist::io::checkProfileInShaft(hoist::HoistProfile(part), p, o.profile);
+      else hoist::io::checkProfileInShaft(profile, p, o.profile);
+    }
   }
   hoist::SimulationOptions sim;
   sim.dt = o.dt;
@@ -212,39 +326,61 @@ int run(const Options& o) {
         throw UsageError("--shape-times: " + std::to_string(ts) + " s is outside the run [" + std::to_string(t0) +
                          ", " + std::to_string(t_end) + "] s");
   }
-  // Open outputs before the long part so a bad path fails at once.
-  std::ofstream out(o.out);
-  if (!out) throw std::runtime_error("cannot open --out " + o.out + " for writing");
-  std::ofstream shape_file;
-  if (!o.shape_out.empty()) {
-    shape_file.open(o.shape_out);
-    if (!shape_file) throw std::runtime_error("cannot open --shape-out " + o.shape_out + " for writing");
-  }
+  const double rows_est = steps_d + 1.0;
+  const double shape_bytes_est =
+      static_cast<double>(shape_times.size()) * std::max(2, o.shape_points) * 4 * 15.0;
+  const double bytes_est = rows_est * kBytesPerRow;
+  // A run that cannot fit the disk is refused now, not after hours.
+  if (const double free = freeBytesFor(o.out); free >= 0.0 && bytes_est > free)
+    throw UsageError(t_end_opt + ": the output would be about " + bytesText(bytes_est) + " (" + num(rows_est) +
+                     " rows of about " + num(kBytesPerRow) + " B at --dt " + num(o.dt) + " s), but only " +
+                     bytesText(free) + " are free for --out " + o.out + "; shorten --t-end or raise --dt");
+  // Open outputs before the long part so a bad path fails at once; rows are
+  // streamed into them as they are computed.
+  hoist::io::CheckedFile out(o.out, "--out");
+  hoist::io::CheckedFile shape_file;
+  if (!o.shape_out.empty()) shape_file = hoist::io::CheckedFile(o.shape_out, "--shape-out");
   const double load_s = secondsSince(t_load);
 
   // ---- setup ------------------------------------------------------------
   const auto t_setup = Clock::now();
   auto model = std::make_shared<const hoist::ShaftModel>(p);
   auto solver = hoist::makeSolver(sim.method, model);
+  double step_us = -1.0;
+  if (!o.quiet) step_us = measureStepUs(model, sim.method, profile, t0, o.dt / sub, p.initial);
   const double setup_s = secondsSince(t_setup);
 
-  const long steps = std::lround((t_end - t0) / o.dt);
-  if (!o.quiet)
+  const long steps = static_cast<long>(steps_d);
+  if (!o.quiet) {
     std::cerr << "hoist-sim: " << hoist::toString(sim.method) << " path, n = " << p.n << ", initial = "
               << hoist::toString(p.initial) << ", static correction "
               << (p.static_correction ? "on" : "off") << ", t = " << t0 << " .. " << t_end << " s, dt = " << o.dt << " s ("
               << sub << " substep" << (sub > 1 ? "s" : "") << " of " << o.dt / sub << " s), " << steps
               << " output steps\n";
+    const double secs_est = step_us > 0.0 ? step_us * 1e-6 * steps_d * sub : 0.0;
+    if (rows_est > kLargeRows || bytes_est + shape_bytes_est > kLargeBytes || secs_est > kLargeSeconds)
+      std::cerr << "hoist-sim: large run: about " << num(rows_est) << " rows, " << bytesText(bytes_est + shape_bytes_est)
+                << " to " << o.out << ", about "
+                << (step_us > 0.0 ? secondsText(secs_est) + " of computing (" + num(step_us) + " us per step measured)"
+                                  : std::string("? of computing (step cost not measured)"))
+                << "\n";
+  }
 
   // ---- solve --------------------------------------------------------------
-  std::vector<hoist::CageResponse> rows;
-  rows.reserve(static_cast<std::size_t>(steps) + 1);
   const hoist::VectorXd xs = hoist::VectorXd::LinSpaced(std::max(2, o.shape_points), 0.0, p.L);
   hoist::VectorXd y1(xs.size()), y2(xs.size());
-  std::string shapes;
   std::size_t next_shape = 0;
   Peak pk_y, pk_th, pk_x, pk_l[5];
-  Progress progress(!o.quiet && ::isatty(2));
+  const Progress::Mode pmode = o.progress ? (::isatty(2) ? Progress::Mode::Terminal : Progress::Mode::Lines)
+                               : (!o.quiet && ::isatty(2)) ? Progress::Mode::Terminal
+                                                           : Progress::Mode::Off;
+  Progress progress(pmode);
+  out.write(std::string(hoist::io::kResultHeader) + "\n");
+  if (shape_file.isOpen()) shape_file.write(std::string(hoist::io::kShapeHeader) + "\n");
+  std::string line;
+  line.reserve(512);
+  std::size_t rows = 0;
+  double out_s = 0.0;
   const auto t_solve = Clock::now();
   bool failed = false;
   double fail_t = 0;
@@ -269,61 +405,61 @@ int run(const Options& o) {
             fail_t = r.t;
             throw Diverged{};
           }
-          rows.push_back(r);
+          const auto tw = Clock::now();
+          line.clear();
+          hoist::io::appendResultRow(line, r);
+          out.write(line);
+          ++rows;
           pk_x.see(r.x_c, r.t);
           pk_y.see(r.y_c, r.t);
           pk_th.see(r.theta, r.t);
           for (int k = 0; k < 5; ++k) pk_l[k].see(r.lambda[static_cast<std::size_t>(k)], r.t);
           while (next_shape < shape_times.size() && r.t >= shape_times[next_shape] - 0.5 * o.dt) {
             solver->guideRopeShapes(xs, y1, y2);
-            std::ostringstream os;
-            hoist::io::writeShapeRows(os, r.t, xs, y1, y2);
-            shapes += os.str();
+            line.clear();
+            hoist::io::appendShapeRows(line, r.t, xs, y1, y2);
+            shape_file.write(line);
             ++next_shape;
           }
+          out_s += secondsSince(tw);
         },
         [&](double f) { progress.update(f, t0 + f * (t_end - t0)); });
   } catch (const Diverged&) {
   } catch (const std::domain_error& e) {
     progress.done();
     throw std::runtime_error(std::string("the model left its domain: ") + e.what());
+  } catch (...) {
+    progress.done();
+    throw;
   }
   progress.done();
-  const double solve_s = secondsSince(t_solve);
+  const double solve_s = secondsSince(t_solve) - out_s;
   if (failed && implausible_what) {
     std::cerr << "hoist-sim: error: implausible state at t = " << fail_t << " s: " << implausible_what << " = "
               << implausible_value << " (plausible: |" << implausible_what << "| <= " << implausible_limit
               << "; valid rope lengths are [" << hoist::validLengthRange(p).lo << ", "
-              << hoist::validLengthRange(p).hi << "] m). " << rows.size() << " good rows are written.\n";
+              << hoist::validLengthRange(p).hi << "] m). " << rows << " good rows are written.\n";
   } else if (failed) {
     std::cerr << "hoist-sim: error: the state became non-finite at t = " << fail_t
-              << " s (unstable parameters or step; try a smaller --dt / --max-step). " << rows.size()
+              << " s (unstable parameters or step; try a smaller --dt / --max-step). " << rows
               << " good rows are written.\n";
   }
 
-  // ---- output -----------------------------------------------------------
+  // ---- output: the last bytes -------------------------------------------
   const auto t_out = Clock::now();
-  hoist::io::writeResultHeader(out);
-  for (const auto& r : rows) hoist::io::writeResultRow(out, r);
-  out.flush();
-  if (!out) throw std::runtime_error("write error on " + o.out);
-  if (shape_file.is_open()) {
-    hoist::io::writeShapeHeader(shape_file);
-    shape_file << shapes;
-    shape_file.flush();
-    if (!shape_file) throw std::runtime_error("write error on " + o.shape_out);
-  }
-  const double out_s = secondsSince(t_out);
+  out.close();
+  shape_file.close();
+  out_s += secondsSince(t_out);
 
   if (!o.quiet) {
-    const double total_steps = rows.empty() ? 0.0 : static_cast<double>(rows.size() - 1) * sub;
+    const double total_steps = rows == 0 ? 0.0 : static_cast<double>(rows - 1) * sub;
     std::fprintf(stderr,
                  "hoist-sim: wrote %zu rows to %s%s%s\n"
                  "  peak |x_c|      = %.4e m    at t = %.2f s\n"
                  "  peak |y_c|      = %.4e m    at t = %.2f s\n"
                  "  peak |theta|    = %.4e rad  at t = %.2f s\n"
                  "  peak |lambda_0| = %.4e N    at t = %.2f s\n",
-                 rows.size(), o.out.c_str(), o.shape_out.empty() ? "" : ", shapes to ", o.shape_out.c_str(), pk_x.value,
+                 rows, o.out.c_str(), o.shape_out.empty() ? "" : ", shapes to ", o.shape_out.c_str(), pk_x.value,
                  pk_x.t, pk_y.value, pk_y.t, pk_th.value, pk_th.t, pk_l[0].value, pk_l[0].t);
     for (int k = 1; k < 5; ++k)
       std::fprintf(stderr, "  peak |lambda_%d| = %.4e N    at t = %.2f s\n", k, pk_l[k].value, pk_l[k].t);
@@ -395,12 +531,18 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-6, 1e6));
   app.add_option("--write-profile", o.write_profile, "also write the profile used as CSV t,l,v,a");
   app.add_flag("--print-config", o.print_config, "print the effective shaft configuration as TOML and exit");
-  app.add_flag("-q,--quiet", o.quiet, "no progress or summary");
+  app.add_flag("-q,--quiet", o.quiet, "no progress, estimate or summary");
+  app.add_flag("--progress", o.progress,
+               "show progress on stderr even with -q or without a terminal (then one line per 10 %)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
+  }
+  for (int i = 0; i < argc; ++i) {
+    if (i) g_command_line += ' ';
+    g_command_line += i == 0 ? std::string("hoist-sim") : std::string(argv[i]);
   }
   try {
     return run(o);
@@ -410,8 +552,20 @@ int main(int argc, char** argv) {
   } catch (const UsageError& e) {
     std::cerr << "hoist-sim: error: " << e.what() << "\n";
     return 2;
-  } catch (const std::exception& e) {
+  } catch (const hoist::io::WriteError& e) {
+    // Names the option and the file, with the errno text.
     std::cerr << "hoist-sim: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "hoist-sim: error: out of memory (std::bad_alloc) in: " << g_command_line
+              << "\n  (the memory grows with --modes, --shape-points and the profile's length; the output rows are "
+                 "streamed and cost none)\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "hoist-sim: error: " << e.what() << "\n  in: " << g_command_line << "\n";
+    return 1;
+  } catch (...) {
+    std::cerr << "hoist-sim: error: unexpected failure in: " << g_command_line << "\n";
     return 1;
   }
 }

@@ -30,9 +30,16 @@ File openOut(const std::string& path) {
   return f;
 }
 
+/// Every byte checked: the last fflush, the error flag and fclose (a full
+/// disk shows here), with the errno text.
 void finish(File& f, const std::string& path) {
-  if (std::ferror(f.get()) || std::fclose(f.release()) != 0)
-    throw std::runtime_error(path + ": write failed");
+  errno = 0;
+  int err = 0;
+  if (std::fflush(f.get()) != 0) err = errno ? errno : EIO;
+  if (err == 0 && std::ferror(f.get())) err = EIO;
+  errno = 0;
+  if (std::fclose(f.release()) != 0 && err == 0) err = errno ? errno : EIO;
+  if (err != 0) throw std::runtime_error(path + ": write failed: " + std::strerror(err));
 }
 
 std::string csvQuote(const std::string& s) {

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <spdlog/spdlog.h>
@@ -23,6 +24,7 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/mqtt/command.hpp"
@@ -103,6 +105,9 @@ struct Bridge::Impl {
   // ---- LCM ---------------------------------------------------------------------
   std::string lcm_url;
   lcm::LCM lcm;
+  /// udpm://: our own receive path (nothing stored per channel name; LCM
+  /// 1.3.1 caches every name it receives, hoist/bus/udpm_receiver.hpp).
+  std::unique_ptr<hoist::bus::UdpmReceiver> rx;
 
   // ---- shafts ------------------------------------------------------------------
   struct AlarmState {
@@ -174,10 +179,27 @@ struct Bridge::Impl {
 
     discover = cfg.channel_prefixes.empty();
     for (const auto& p : cfg.channel_prefixes) addShaft(p);
-    // One subscription for every shaft: ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM)" (LCM anchors it).
-    lcm.subscribe(".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" +
-                      std::string(kChannelAlarm) + ")",
-                  &Impl::onLcm, this);
+    hoist::bus::UdpmUrl udpm;
+    std::string why;
+    if (hoist::bus::parseUdpmUrl(lcm_url, udpm, why)) {
+      rx = std::make_unique<hoist::bus::UdpmReceiver>();
+      if (!rx->open(udpm, why))
+        throw std::runtime_error("cannot open the LCM receive socket for " + hoist::bus::describeLcmUrl(lcm_url) +
+                                 ": " + why);
+      rx->addMatching(
+          [](std::string_view n) {
+            auto ends = [&](std::string_view suffix) {
+              return n.size() >= suffix.size() && n.substr(n.size() - suffix.size()) == suffix;
+            };
+            return ends(kChannelCage) || ends(kChannelHealth) || ends(kChannelAlarm);
+          },
+          [this](const lcm::ReceiveBuffer* rb, const std::string& channel) { onLcm(rb, channel); });
+    } else {
+      // One subscription for every shaft: ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM)" (LCM anchors it).
+      lcm.subscribe(".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" +
+                        std::string(kChannelAlarm) + ")",
+                    &Impl::onLcm, this);
+    }
 
     mosq = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
     if (!mosq) throw std::runtime_error("mosquitto_new failed: " + std::string(std::strerror(errno)));
@@ -313,6 +335,8 @@ struct Bridge::Impl {
     } catch (const std::exception& e) {  // nothing may escape an LCM callback
       ++decode_errors["exception"];
       spdlog::error("error handling {}: {}", printable(channel), e.what());
+    } catch (...) {
+      ++decode_errors["exception"];
     }
   }
 
@@ -633,7 +657,7 @@ struct Bridge::Impl {
                  hoist::bus::describeLcmUrl(lcm_url), brokerText(), cfg.cage_rate,
                  cfg.commands ? "accepted on hoist/<shaft>/cmd/ack" : "disabled (--no-commands)",
                  discover ? "discovered from their *HOIST_{HEALTH,CAGE,ALARM} channels" : std::to_string(shafts.size()) + " configured");
-    const int lcm_fd = lcm.getFileno();
+    const int lcm_fd = rx ? rx->fd() : lcm.getFileno();
     while (!stop) {
       auto now = Clock::now();
       if (conn == Conn::Disconnected && now >= next_attempt) tryConnect();
@@ -654,7 +678,11 @@ struct Bridge::Impl {
 
       if (n > 0 && (fds[0].revents & POLLIN)) {
         // Drain what is there, bounded so the broker side is never starved.
-        for (int i = 0; i < 256 && lcm.handleTimeout(0) > 0; ++i) {
+        if (rx) {
+          rx->drain(256);
+        } else {
+          for (int i = 0; i < 256 && lcm.handleTimeout(0) > 0; ++i) {
+          }
         }
       }
       if (conn != Conn::Disconnected) {

@@ -22,6 +22,7 @@
 #include <iosfwd>
 #include <string>
 
+#include "hoist/io/checked_file.hpp"
 #include "hoist/io/error.hpp"
 #include "hoist/params.hpp"
 #include "hoist/profile.hpp"
@@ -55,6 +56,8 @@ void checkProfileInShaft(const HoistProfile& profile, const ShaftParams& p, cons
 
 /// Write `t,l,v,a` rows (shortest round-trip doubles).
 void writeProfileCsv(std::ostream& out, const HoistProfile& profile);
+/// The same, every byte checked (throws WriteError naming the file).
+void writeProfileCsv(CheckedFile& out, const HoistProfile& profile);
 
 /// One paragraph describing the SPEC syntax, for --help texts.
 const char* profileSpecHelp();

@@ -19,11 +19,14 @@ inline constexpr const char* kResultHeader =
 
 void writeResultHeader(std::ostream& out);
 void writeResultRow(std::ostream& out, const CageResponse& r);
+/// The same row appended to `s` (streaming writers).
+void appendResultRow(std::string& s, const CageResponse& r);
 
 inline constexpr const char* kShapeHeader = "t,x,y1,y2";
 void writeShapeHeader(std::ostream& out);
 /// Rows t,x(i),y1(i),y2(i) for all i.
 void writeShapeRows(std::ostream& out, double t, const VectorXd& x, const VectorXd& y1, const VectorXd& y2);
+void appendShapeRows(std::string& s, double t, const VectorXd& x, const VectorXd& y1, const VectorXd& y2);
 
 /// Append the shortest round-trip decimal form of v to `s`.
 void appendNumber(std::string& s, double v);

@@ -22,6 +22,20 @@ inline std::string resolveLcmUrl(const std::string& cli, const std::string& conf
   return config;
 }
 
+/// `name` as a regular expression that matches exactly that channel name:
+/// lcm::LCM::subscribe() takes a regular expression (GLib's, anchored), so
+/// a channel prefix "mine.1/" would also match "mineX1/".  Every program
+/// that subscribes to a name built from a prefix goes through this.
+inline std::string regexEscape(const std::string& name) {
+  std::string o;
+  o.reserve(name.size() * 2);
+  for (char c : name) {
+    if (c != '\0' && std::string_view("\\^$.|?*+()[]{}-/").find(c) != std::string_view::npos) o.push_back('\\');
+    o.push_back(c);
+  }
+  return o;
+}
+
 /// For messages: "LCM default" when url is empty.
 inline std::string describeLcmUrl(const std::string& url) {
   return url.empty() ? std::string("LCM default (udpm://239.255.76.67:7667?ttl=0)") : url;

@@ -1,5 +1,5 @@
-// hoist-twind's own udpm receive path: see udpm_receiver.hpp.
-#include "udpm_receiver.hpp"
+// The project's own udpm receive path: see hoist/bus/udpm_receiver.hpp.
+#include "hoist/bus/udpm_receiver.hpp"
 
 #include <arpa/inet.h>
 #include <cerrno>
@@ -11,7 +11,7 @@
 #include <sys/time.h>
 #include <unistd.h>
 
-namespace hoist::svc {
+namespace hoist::bus {
 
 namespace {
 constexpr std::uint32_t kMagicShort = 0x4c433032;  // "LC02"
@@ -109,6 +109,11 @@ void UdpmReceiver::add(const std::string& channel, RawHandler handler) {
   routes_.push_back(Route{channel, std::move(handler)});
 }
 
+void UdpmReceiver::addMatching(std::function<bool(std::string_view)> match, RawHandler handler) {
+  matchers_.push_back(MatchRoute{std::move(match), std::move(handler)});
+  name_.reserve(kMaxChannel + 1);
+}
+
 int UdpmReceiver::drain(int max) {
   int n = 0;
   for (; n < max; ++n) {
@@ -140,7 +145,14 @@ int UdpmReceiver::drain(int max) {
         route = &r;
         break;
       }
-    if (!route) {
+    const MatchRoute* matched = nullptr;
+    if (!route)
+      for (const MatchRoute& m : matchers_)
+        if (m.match(std::string_view(name, name_len))) {
+          matched = &m;
+          break;
+        }
+    if (!route && !matched) {
       ++ignored_;
       continue;
     }
@@ -150,9 +162,14 @@ int UdpmReceiver::drain(int max) {
     timeval tv{};
     ::gettimeofday(&tv, nullptr);
     rb.recv_utime = static_cast<std::int64_t>(tv.tv_sec) * 1000000 + tv.tv_usec;
-    route->handler(&rb, route->channel);
+    if (route) {
+      route->handler(&rb, route->channel);
+    } else {
+      name_.assign(name, name_len);
+      matched->handler(&rb, name_);
+    }
   }
   return n;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::bus

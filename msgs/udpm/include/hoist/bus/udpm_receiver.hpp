@@ -1,14 +1,19 @@
-// udpm_receiver.hpp -- hoist-twind's own receive path for LCM's UDP
-// multicast transport (udpm://), in place of LCM 1.3.1's.
+// hoist/bus/udpm_receiver.hpp -- the project's own receive path for LCM's
+// UDP multicast transport (udpm://), in place of LCM 1.3.1's: hoist-twind
+// (inputs, and its own outputs on lcm_url_out), hoist-dash, hoist-mqtt and
+// hoist-monitor.  Target hoist_lcm_udpm (msgs/CMakeLists.txt; not installed).
 //
 // Why: LCM 1.3.1 keeps, per lcm_t, a hash table entry (channel name string +
 // handler array) for EVERY channel name it has ever received on the group,
 // subscribed or not, and never frees them (lcm.c lcm_get_handlers): a sender
-// cycling through distinct channel names grows the daemon's memory without
-// bound (about 11 MB per 100k names).  This receiver reads the datagrams
-// itself and dispatches only the channels subscribed by exact name (no
-// regular expressions either): nothing is allocated per datagram or per
-// name, so memory stays flat whatever arrives.  LCM is still used to publish
+// cycling through distinct channel names grows the memory of every
+// subscriber without bound (about 11 MB per 100k names).  This receiver
+// reads the datagrams itself and dispatches only the channels it was given,
+// by exact name (add(): no regular expressions either, and nothing is
+// allocated per datagram) or by a predicate on the name (addMatching(): the
+// name is copied into a preallocated string; used by the tools that discover
+// prefixes): nothing is stored per name, so memory stays flat whatever
+// arrives.  LCM is still used to publish
 // (lcm::LCM creates no receive socket and no receive thread while nobody
 // subscribes or asks for its file descriptor).
 //
@@ -30,9 +35,10 @@
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
-namespace hoist::svc {
+namespace hoist::bus {
 
 using RawHandler = std::function<void(const lcm::ReceiveBuffer*, const std::string&)>;
 
@@ -63,6 +69,9 @@ class UdpmReceiver final : public InputRouter {
   bool open(const UdpmUrl& url, std::string& why);
   int fd() const { return fd_; }
   void add(const std::string& channel, RawHandler handler) override;
+  /// Every channel whose name satisfies `match` (checked after the exact
+  /// names).  The handler's channel string is reused between calls.
+  void addMatching(std::function<bool(std::string_view)> match, RawHandler handler);
   /// Read and dispatch at most `max` datagrams; returns how many were read
   /// (0: nothing pending).  No allocation.
   int drain(int max);
@@ -78,8 +87,14 @@ class UdpmReceiver final : public InputRouter {
   };
   int fd_ = -1;
   std::vector<Route> routes_;
+  struct MatchRoute {
+    std::function<bool(std::string_view)> match;
+    RawHandler handler;
+  };
+  std::vector<MatchRoute> matchers_;
+  std::string name_;  ///< the channel name for matched routes (capacity reserved)
   std::array<std::uint8_t, 65536> buf_{};
   std::int64_t received_ = 0, ignored_ = 0, malformed_ = 0;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::bus

@@ -1,5 +1,6 @@
 // attack_bytes.hpp -- the exact hostile payloads of issue 12, section 1, as
-// bytes (shared by codec_test, decode_attack_test and the fuzz seed writer).
+// bytes (shared by codec_test, decode_attack_test, lcm_log_test, tool_attack_test
+// and dash_hub_test; fuzz/make_seeds.py writes the same cases as seeds).
 //
 // Layouts (LCM: big-endian; strings = int32 length incl. NUL, bytes, NUL):
 //   alarm_ack_t: fp(8) utime(8) kind(str) level(1) action(1) shelve_duration(8) user(str)
@@ -7,11 +8,13 @@
 //   guide_shape_t: fp(8) utime(8) t(8) l(8) h(8) n(int32) x[n] y1[n] y2[n]
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
 
@@ -68,6 +71,27 @@ inline Bytes guideShapeCount(std::int32_t n) {
   be(b, 1700000000000000ull, 8);
   for (int i = 0; i < 3; ++i) be(b, 0, 8);  // t, l, h
   be(b, static_cast<std::uint32_t>(n), 4);
+  return b;
+}
+
+/// A valid alarm_t whose `kind` string length field is then overwritten with
+/// `kind_len` (0, 0x80000000, ...): the same string attack on the daemon's
+/// output type, which hoist-monitor, hoist-dash and hoist-mqtt decode.
+inline Bytes alarmStringLen(std::uint32_t kind_len) {
+  hoist::alarm_t a{};
+  a.kind = "KINDKINDKIND";
+  a.message = "m";
+  a.user = "u";
+  Bytes b(static_cast<std::size_t>(a.getEncodedSize()));
+  a.encode(b.data(), 0, static_cast<int>(b.size()));
+  const std::string needle = a.kind;
+  std::size_t off = 0;
+  for (std::size_t i = 4; i + needle.size() <= b.size(); ++i)
+    if (std::equal(needle.begin(), needle.end(), b.begin() + static_cast<std::ptrdiff_t>(i))) {
+      off = i - 4;
+      break;
+    }
+  for (int i = 0; i < 4; ++i) b[off + i] = static_cast<std::uint8_t>(kind_len >> (8 * (3 - i)));
   return b;
 }
 
