@@ -458,12 +458,14 @@ TEST(TwinCoreAlarms, EmergencyStopWhileDescendingOverloadsTheRope) {
   EXPECT_GE(r.overload_raises, 1);
   EXPECT_EQ(r.slack_raises, 0);
   EXPECT_GT(r.lambda0_max, 1.5 * F);
-  // A higher overload_fraction (2.0 x = 17.7 kN) keeps it quiet, and the
-  // published threshold follows the configuration.
-  cfg.alarms.overload_fraction = 2.0;
+  // The abrupt stop's rope oscillation peaks at about 2.4 x (hoist-sim,
+  // n = 50): a higher overload_fraction (3 x = 26.5 kN) keeps it quiet, and
+  // the published threshold follows the configuration.
+  EXPECT_LT(r.lambda0_max, 3.0 * F);
+  cfg.alarms.overload_fraction = 3.0;
   r = runRope(cfg, HoistProfile::emergencyStop(100.0, 5.0, 2.0, 8.0, 5.0, 0.01));
   EXPECT_EQ(r.overload_raises, 0);
-  EXPECT_NEAR(r.overload_thr, 2.0 * F, 1e-9 * F);
+  EXPECT_NEAR(r.overload_thr, 3.0 * F, 1e-9 * F);
 }
 
 TEST(TwinCoreAlarms, ThePaperTripRaisesNoRopeForceAlarm) {
