@@ -148,7 +148,7 @@ check(dashStats.counters.lcm_rejected_decode_bad_count === 1,
       `the forecast with a lying nested count was dropped by the checked decoder (${dashStats.counters.lcm_rejected_decode_bad_count})`);
 
 // 7. Against what lcm-logger recorded.
-const log = readLog(path.join(dir, "run.lcm"), dir);
+const log = readLog(path.join(dir, "run.lcm"), dir, { undecodable: 1 });  // the lying forecast
 const cage = log.HOIST_CAGE || [];
 const row = cage.find((r) => Number(r.utime) === shown.utime);
 if (!row) fail(`no HOIST_CAGE with utime ${shown.utime} in lcm-logger's log (${cage.length} rows)`);

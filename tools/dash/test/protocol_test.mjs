@@ -10,10 +10,9 @@
 // exact doubles).  Also publishes one HOIST_ALARM_ACK as a client channel, and
 // checks HOIST_FORECAST (nested forecast_scenario_t) end to end.
 import foxglove from "@foxglove/ws-protocol";
-import { spawnSync } from "node:child_process";
 import path from "node:path";
 import WebSocket from "ws";
-import { check, fail, lcmUrl, readLog, sleep, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
+import { check, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
 
 const { FoxgloveClient } = foxglove;
 const lcmPort = Number(process.argv[2] || 7872);
@@ -81,8 +80,10 @@ for (const [topic, fields] of Object.entries(expect)) {
   check(item.title === "hoist.forecast_scenario_t" && want.every((k) => item.properties[k]) && item.additionalProperties === false,
         "HOIST_FORECAST schema inlines forecast_scenario_t with every field");
   if (!process.env.HOIST_FORECAST_PUB) fail("HOIST_FORECAST_PUB (tests/dash: hoist-test-forecast-pub) is not set");
-  const pub = spawnSync(process.env.HOIST_FORECAST_PUB, [lcm, "", "3", "100"], { encoding: "utf8" });
-  check(pub.status === 0, `synthetic forecasts published (${pub.stdout.trim().split("\n").length} lines)`);
+  // Not spawnSync: the event loop must keep reading the WebSocket meanwhile.
+  const pub = start("forecast-pub", process.env.HOIST_FORECAST_PUB, [lcm, "", "3", "100"], dir);
+  const res = await pub.exited;
+  check(res.code === 0, `synthetic forecasts published (${pub.out.trim().split("\n").length} lines)`);
   await waitFor(() => forecasts.length >= 3, 5000, "3 HOIST_FORECAST messages");
   const f = forecasts[0];
   const [e, o] = f.scenarios;
@@ -118,7 +119,7 @@ await stop(twin.logger, "SIGINT");
 await stop(dash.proc);
 
 // Every decoded message equals the one lcm-logger recorded (same utime).
-const log = readLog(path.join(dir, "run.lcm"), dir);
+const log = readLog(path.join(dir, "run.lcm"), dir, { undecodable: 1 });  // the lying forecast
 const rows = new Map((log.HOIST_CAGE || []).map((r) => [r.utime, r]));
 let compared = 0;
 for (const m of decoded) {
