@@ -43,7 +43,7 @@ hoist::forecast_scenario_t scenario(const std::string& name, int n, double worst
   for (int i = 0; i < n; ++i) {
     const double t = 20.0 * (i + 1) / n;
     s.series_t.push_back(t);
-    s.series_min_clearance.push_back(worst + 0.002 * (t - t_worst) * (t - t_worst));
+    s.series_min_clearance.push_back(worst + 0.0002 * (t - t_worst) * (t - t_worst));
     s.series_lambda0_min.push_back(8848.0 - 3000.0 * (i % 7) / 6.0);
     s.series_lambda0_max.push_back(8848.0 + 3000.0 * (i % 5) / 4.0);
   }
