@@ -26,7 +26,8 @@ bool finiteAll(const hoist::cage_state_t& m) {
             std::isfinite(m.y_top) && std::isfinite(m.y_bottom) &&
             std::isfinite(m.guide_deflection) && std::isfinite(m.clearance_pos_y) &&
             std::isfinite(m.clearance_neg_y) && std::isfinite(m.clearance_guide) &&
-            std::isfinite(m.min_clearance);
+            std::isfinite(m.min_clearance) && std::isfinite(m.rope_slack_threshold) &&
+            std::isfinite(m.rope_overload_threshold);
   for (double v : m.lambdas) ok = ok && std::isfinite(v);
   return ok;
 }

@@ -109,10 +109,16 @@ export function cpuTicks(pid) {
 }
 
 /// lcm-logger's log -> { CHANNEL: [ {column: string} ] } through hoist-log2csv.
-export function readLog(logFile, dir) {
+/// `undecodable`: the number of events the test itself sent that must fail
+/// the checked decoder (hoist-log2csv then exits 1 unless --lenient): exactly
+/// that many, no more.
+export function readLog(logFile, dir, { undecodable = 0 } = {}) {
   const out = path.join(dir, "csv");
-  const r = spawnSync(path.join(binDir, "hoist-log2csv"), [logFile, "--out-dir", out], { encoding: "utf8" });
+  const args = [logFile, "--out-dir", out, ...(undecodable ? ["--lenient"] : [])];
+  const r = spawnSync(path.join(binDir, "hoist-log2csv"), args, { encoding: "utf8" });
   if (r.status !== 0) fail(`hoist-log2csv failed: ${r.stderr}`);
+  if (undecodable && !r.stderr.includes(`${undecodable} undecodable)`))
+    fail(`expected exactly ${undecodable} undecodable event(s) in the log: ${r.stderr}`);
   const res = {};
   for (const f of fs.readdirSync(out)) {
     if (!f.endsWith(".csv")) continue;
