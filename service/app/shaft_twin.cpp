@@ -20,6 +20,11 @@ using std::chrono::duration;
 
 namespace {
 
+/// Steady-clock span in nanoseconds (the cost split).
+inline std::int64_t nanos(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
+}
+
 bool finiteAll(const hoist::cage_state_t& m) {
   bool ok = std::isfinite(m.t) && std::isfinite(m.l) && std::isfinite(m.v) && std::isfinite(m.a) &&
             std::isfinite(m.x_c) && std::isfinite(m.y_c) && std::isfinite(m.theta) &&
@@ -318,6 +323,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
     const TickResult r = core_.tick(t, wall);
     core_.housekeeping(wall);
     const auto t1 = Clock::now();
+    ns_model_ += nanos(t1 - t0);
     if (r.stepped) {
       const double us = duration<double, std::micro>(t1 - t0).count();
       step_hist_.add(us);
@@ -331,9 +337,11 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
                   tag_, cfg_.service.max_catchup_periods, suppressed);
     }
     if (r.stepped && core_.hasInput()) {
+      const auto p0 = Clock::now();
       const std::int64_t utime = bus::wallUtime();
       if (k % cage_div_ == 0) publishCage(utime);
       if (cfg_.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime);
+      ns_publish_ += nanos(Clock::now() - p0);
     }
   } else {
     core_.housekeeping(wall);
@@ -345,7 +353,12 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   }
   drainAlarmEvents();
 
-  if (wall - last_health_wall_ >= 1.0 / cfg_.service.health_rate - 0.5 / cfg_.service.rate) publishHealth();
+  if (wall - last_health_wall_ >= 1.0 / cfg_.service.health_rate - 0.5 / cfg_.service.rate) {
+    const auto p0 = Clock::now();
+    publishHealth();
+    ns_publish_ += nanos(Clock::now() - p0);
+  }
+  ns_tick_ += nanos(Clock::now() - now);
 }
 
 // ---- outputs -----------------------------------------------------------------
@@ -550,6 +563,12 @@ ShaftRunStats ShaftTwin::runStats() const {
   s.nonfinite_blocked = nonfinite_blocked_;
   s.step = &step_total_;
   s.late = &late_total_;
+  s.ns_model = ns_model_;
+  s.ns_envelope = core_.envelopeNanos();
+  s.ns_publish = ns_publish_;
+  s.ns_tick = ns_tick_;
+  s.envelope_exact = core_.envelope().exactEvaluations();
+  s.envelope_bounded = core_.envelope().boundedEvaluations();
   return s;
 }
 

@@ -50,6 +50,12 @@ struct ShaftRunStats {
   std::int64_t alarm_events = 0, model_faults = 0, publish_failures = 0, nonfinite_blocked = 0;
   const LatencyHistogram* step = nullptr;  ///< model step time [us]
   const LatencyHistogram* late = nullptr;  ///< tick lateness [us]
+  // Cost split, whole run [ns of steady clock] (issue 13): the model
+  // (core tick + housekeeping, the envelope included), of which the
+  // deflection envelope; publishing (encode + sendmsg of every output); the
+  // whole tick() call.
+  std::int64_t ns_model = 0, ns_envelope = 0, ns_publish = 0, ns_tick = 0;
+  std::int64_t envelope_exact = 0, envelope_bounded = 0;  ///< envelope evaluations
 };
 
 class ShaftTwin {
@@ -128,6 +134,7 @@ class ShaftTwin {
   double last_shape_t_ = -1e300;  ///< input clock: model time of the last shape message
   double last_health_wall_ = 0.0;
   std::int64_t ticks_ = 0, deadline_misses_ = 0;
+  std::int64_t ns_model_ = 0, ns_publish_ = 0, ns_tick_ = 0;  ///< cost split (ShaftRunStats)
 
   // statistics
   LatencyHistogram step_hist_, late_hist_;    // this health window

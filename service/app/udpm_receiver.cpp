@@ -8,6 +8,7 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <sys/time.h>
 #include <unistd.h>
 
@@ -74,7 +75,7 @@ UdpmReceiver::~UdpmReceiver() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool UdpmReceiver::open(const UdpmUrl& url, std::string& why) {
+bool UdpmReceiver::open(const UdpmUrl& url, std::string& why, int default_rcvbuf) {
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd_ < 0) {
     why = std::string("socket: ") + std::strerror(errno);
@@ -85,8 +86,18 @@ bool UdpmReceiver::open(const UdpmUrl& url, std::string& why) {
 #ifdef SO_REUSEPORT
   ::setsockopt(fd_, SOL_SOCKET, SO_REUSEPORT, &one, sizeof one);
 #endif
-  if (url.recv_buf_size > 0)
-    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &url.recv_buf_size, sizeof url.recv_buf_size);
+  const int want = url.recv_buf_size > 0 ? url.recv_buf_size : default_rcvbuf;
+  if (want > 0) {
+#ifdef SO_RCVBUFFORCE
+    if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &want, sizeof want) != 0)
+#endif
+      ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &want, sizeof want);
+  }
+  socklen_t optlen = sizeof rcvbuf_;
+  if (::getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf_, &optlen) != 0) rcvbuf_ = 0;
+#ifdef SO_RXQ_OVFL
+  ::setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof one);
+#endif
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_addr.s_addr = htonl(INADDR_ANY);
@@ -112,9 +123,25 @@ void UdpmReceiver::add(const std::string& channel, RawHandler handler) {
 int UdpmReceiver::drain(int max) {
   int n = 0;
   for (; n < max; ++n) {
-    const ssize_t len = ::recv(fd_, buf_.data(), buf_.size(), 0);
+    // recvmsg: the payload, and (SO_RXQ_OVFL) the socket's drop counter.
+    iovec iov{buf_.data(), buf_.size()};
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(std::uint32_t))];
+    msghdr mh{};
+    mh.msg_iov = &iov;
+    mh.msg_iovlen = 1;
+    mh.msg_control = control;
+    mh.msg_controllen = sizeof control;
+    const ssize_t len = ::recvmsg(fd_, &mh, 0);
     if (len < 0) break;  // EAGAIN: nothing pending (or an error: try again next time)
     ++received_;
+#ifdef SO_RXQ_OVFL
+    for (cmsghdr* c = CMSG_FIRSTHDR(&mh); c; c = CMSG_NXTHDR(&mh, c))
+      if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+        std::uint32_t drops = 0;
+        std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
+        kernel_drops_ = drops;
+      }
+#endif
     const auto size = static_cast<std::size_t>(len);
     if (size < 9) {
       ++malformed_;

@@ -22,7 +22,15 @@
 //
 // Socket options as LCM's: SO_REUSEADDR (+ SO_REUSEPORT) so that other LCM
 // programs on the machine share the port, bound to INADDR_ANY:port, joined
-// to the group on INADDR_ANY; SO_RCVBUF from the URL's recv_buf_size.
+// to the group on INADDR_ANY; SO_RCVBUF from the URL's recv_buf_size, else
+// the caller's default (hoist-twind sizes it for 200 ms of its inputs: a
+// tick of many shafts must not overflow it, issue 13), asked for with
+// SO_RCVBUFFORCE first (root / CAP_NET_ADMIN may exceed net.core.rmem_max),
+// then SO_RCVBUF (capped at rmem_max by the kernel); rcvbuf() is what the
+// kernel granted.  SO_RXQ_OVFL makes the kernel report, with every
+// datagram, how many it dropped on this socket because the buffer was full:
+// kernelDrops() (the "inputs lost" that no sequence number can attribute to
+// a shaft when the lost datagram was someone else's).
 #pragma once
 
 #include <array>
@@ -60,7 +68,12 @@ class UdpmReceiver final : public InputRouter {
   UdpmReceiver& operator=(const UdpmReceiver&) = delete;
 
   /// Open the socket (non-blocking); false and `why` on failure.
-  bool open(const UdpmUrl& url, std::string& why);
+  /// `default_rcvbuf` [bytes] applies when the URL gives no recv_buf_size.
+  bool open(const UdpmUrl& url, std::string& why, int default_rcvbuf = 0);
+  /// The receive buffer the kernel granted [bytes] (getsockopt SO_RCVBUF).
+  int rcvbuf() const { return rcvbuf_; }
+  /// Datagrams the kernel dropped on this socket (buffer full), as last reported.
+  std::int64_t kernelDrops() const { return kernel_drops_; }
   int fd() const { return fd_; }
   void add(const std::string& channel, RawHandler handler) override;
   /// Read and dispatch at most `max` datagrams; returns how many were read
@@ -77,6 +90,8 @@ class UdpmReceiver final : public InputRouter {
     RawHandler handler;
   };
   int fd_ = -1;
+  int rcvbuf_ = 0;
+  std::int64_t kernel_drops_ = 0;
   std::vector<Route> routes_;
   std::array<std::uint8_t, 65536> buf_{};
   std::int64_t received_ = 0, ignored_ = 0, malformed_ = 0;
