@@ -10,19 +10,23 @@
 # cost split, and writes docs/multishaft-report.md.
 #
 #   bench/multishaft.sh [--counts "100 200 300"] [--seconds S] [--setting MODES:on|off ...]
-#                       [--daemon NAME=PATH[,key=value...] ...] [--rate HZ] [--max-step S]
-#                       [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--same-url] [--out FILE] [--port P]
+#                       [--daemon NAME=PATH[,key=value...] ...] [--feeder PATH] [--rate HZ] [--max-step S]
+#                       [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--feeder-rt] [--same-url] [--out FILE] [--port P]
 #
 # --setting (repeatable; default 50:on): n modes and [model] static_correction.
 # --daemon (repeatable; default this=build/bin/hoist-twind): the binaries to
 #   compare, each run side by side (interleaved) for every setting and N; extra
 #   key=value pairs go into the [service] section of its configs (e.g.
-#   envelope_tolerance=0).  The feeder is always this build's hoist-replay.
+#   envelope_tolerance=0).  The feeder (--feeder PATH; default this build's
+#   hoist-replay) is the same for every daemon.
 # Defaults: counts "100 200 300 400", 60 s each, 100 Hz, [service] max_step
 # 0.01 s (one model step per tick), outputs to [service] lcm_url_out on port
 # P+1 (--same-url: on the input URL, as before issue 13), daemon on the last
 # CPU with --mlockall --rt-priority 80 (reported, not fatal, when refused),
-# feeder on CPU 0, UDP multicast on loopback port P = 7880 (ttl=0).
+# feeder on CPU 0 (--feeder-rt: with SCHED_FIFO 50, so that a busy CPU 0 does
+# not make it late: a late feeder's bunched inputs fail the daemon's
+# consistency check and show up as rejected), UDP multicast on loopback port
+# P = 7880 (ttl=0).
 set -euo pipefail
 orig_args="$*"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -30,9 +34,11 @@ counts="100 200 300 400"
 seconds=60
 settings=()
 daemons=()
+feeder="$here/build/bin/hoist-replay"
 rate=100
 max_step=0.01
 rt=1
+feeder_rt=0
 same_url=0
 ncpu=$(nproc)
 daemon_cpu=$((ncpu > 1 ? ncpu - 1 : 0))
@@ -46,15 +52,17 @@ while [[ $# -gt 0 ]]; do
     --setting) settings+=("$2"); shift 2 ;;
     --modes) settings+=("$2:on"); shift 2 ;;
     --daemon) daemons+=("$2"); shift 2 ;;
+    --feeder) feeder="$2"; shift 2 ;;
     --rate) rate="$2"; shift 2 ;;
     --max-step) max_step="$2"; shift 2 ;;
     --daemon-cpu) daemon_cpu="$2"; shift 2 ;;
     --feeder-cpu) feeder_cpu="$2"; shift 2 ;;
     --no-rt) rt=0; shift ;;
+    --feeder-rt) feeder_rt=1; shift ;;
     --same-url) same_url=1; shift ;;
     --out) out="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,29p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "multishaft.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -63,7 +71,6 @@ done
 for s in "${settings[@]}"; do
   [[ "$s" =~ ^[0-9]+:(on|off)$ ]] || { echo "multishaft.sh: --setting: MODES:on|off, got '$s'" >&2; exit 2; }
 done
-feeder="$here/build/bin/hoist-replay"
 [[ -x "$feeder" ]] || { echo "multishaft.sh: $feeder not found; build first (scripts/setup.sh)" >&2; exit 2; }
 for d in "${daemons[@]}"; do
   [[ "$d" == *=* ]] || { echo "multishaft.sh: --daemon: NAME=PATH[,key=value...], got '$d'" >&2; exit 2; }
@@ -118,7 +125,9 @@ for setting in "${settings[@]}"; do
       steal0=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
       t0=$(date +%s.%N)
       set +e
-      taskset -c "$feeder_cpu" "$feeder" --timing-test --lcm-url "$url" "${outargs[@]}" --shafts "$N" --rate "$rate" \
+      frt=()
+      [[ $feeder_rt -eq 1 ]] && frt=(chrt -f 50)
+      taskset -c "$feeder_cpu" "${frt[@]}" "$feeder" --timing-test --lcm-url "$url" "${outargs[@]}" --shafts "$N" --rate "$rate" \
         --duration "$seconds" --max-misses 0 --quiet --report "$raw/$tag.timing.md" > "$raw/$tag.feeder.log"
       verdict=$?
       set -e
@@ -136,6 +145,6 @@ for setting in "${settings[@]}"; do
   done
 done
 python3 "$here/bench/multishaft_report.py" --max-step "$max_step" --command "bench/multishaft.sh $orig_args" \
-  --seconds "$seconds" --out-dir "$(dirname "$out")" --same-url "$same_url" "${rows[@]}" > "$out"
+  --seconds "$seconds" --out-dir "$(dirname "$out")" --same-url "$same_url" --feeder-rt "$feeder_rt" "${rows[@]}" > "$out"
 echo "[multishaft] wrote $out" >&2
 cat "$out"

@@ -26,6 +26,7 @@ def main():
     ap.add_argument("--seconds", default="")
     ap.add_argument("--max-step", default="")
     ap.add_argument("--same-url", default="0")
+    ap.add_argument("--feeder-rt", default="0")
     ap.add_argument("--out-dir", default=".")
     ap.add_argument("items", nargs="+")
     a = ap.parse_args()
@@ -52,7 +53,8 @@ def main():
     rt = first.get("realtime", {})
     out.append("One `hoist-twind` process hosts N shafts (100 Hz; every output on: HOIST_CAGE every step, "
                "HOIST_GUIDE_SHAPE at 5 Hz, HOIST_HEALTH at 1 Hz, alarms), **the whole process pinned to one CPU**, "
-               "fed N winder streams at the step rate by `hoist-replay --timing-test --shafts N` on another CPU. "
+               "fed N winder streams at the step rate by `hoist-replay --timing-test --shafts N` on another CPU"
+               + (" (with SCHED_FIFO 50). " if a.feeder_rt == "1" else ". ") +
                f"Real-time settings: memory lock {rt.get('memory_lock', '?')}, scheduling {rt.get('scheduling', '?')}, "
                f"affinity {rt.get('affinity', '?')}.  `[service] max_step` = {a.max_step} s (one model step per "
                f"tick).  {a.seconds} s per row.  "
@@ -63,17 +65,18 @@ def main():
                "shafts stepped before it in the same tick.")
     out.append("")
     out.append("| setting | twins | daemon | deadline misses | worst lateness p99 / max | step p50 / p99 | CPU used "
-               "| steal | inputs lost (seq. gaps) | kernel drops | timing test |")
-    out.append("|---|---|---|---|---|---|---|---|---|---|---|")
+               "| steal | inputs lost (seq. gaps) | of which rejected | kernel drops | timing test |")
+    out.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for x in rows:
         r = x["r"]
         setting = f"n = {x['setting'].replace(':', ', correction ')}"
         if not r:
-            out.append(f"| {setting} | {x['n']} | {x['name']} | (no report) | | | {x['cpu']:.0f} % | {x['steal']} s | | | |")
+            out.append(f"| {setting} | {x['n']} | {x['name']} | (no report) | | | {x['cpu']:.0f} % | {x['steal']} s | | | | |")
             continue
         sh = r["shafts"]
         x["misses"] = sum(s["deadline_misses"] for s in sh)
         x["gaps"] = sum(s["sequence_gaps"] for s in sh)
+        rejected = sum(s.get("inputs_rejected", 0) for s in sh)
         drops = r.get("input_socket", {}).get("kernel_drops")
         x["drops"] = drops or 0
         lp99 = max(s["late_us"]["p99"] for s in sh)
@@ -81,13 +84,15 @@ def main():
         sp50 = sorted(s["step_us"]["p50"] for s in sh)[len(sh) // 2]
         sp99 = max(s["step_us"]["p99"] for s in sh)
         out.append(f"| {setting} | {x['n']} | {x['name']} | **{x['misses']}** | {fmt_us(lp99)} / {fmt_us(lmax)} | "
-                   f"{fmt_us(sp50)} / {fmt_us(sp99)} | {x['cpu']:.0f} % | {x['steal'] or '?'} s | **{x['gaps']}** | "
+                   f"{fmt_us(sp50)} / {fmt_us(sp99)} | {x['cpu']:.0f} % | {x['steal'] or '?'} s | **{x['gaps']}** | {rejected} | "
                    f"{'—' if drops is None else drops} | {verdict(x['md'])} "
                    f"([report]({os.path.relpath(x['md'], a.out_dir)})) |")
     out.append("")
     out.append("\"CPU used\": the process's user + system time over the run (100 % = the whole core); \"steal\": "
                "time the hypervisor gave the daemon's virtual CPU to something else (`/proc/stat`); \"inputs "
-               "lost\": sequence gaps seen by the daemon (every shaft's stream is contiguous); \"kernel drops\": "
+               "lost\": sequence gaps seen by the daemon (every shaft's stream is contiguous; a rejected input, e.g. by "
+               "the consistency check when a late feeder bunches its inputs, also leaves a gap: \"of which "
+               "rejected\"); \"kernel drops\": "
                "datagrams the kernel dropped on the daemon's input socket because its buffer was full "
                "(SO_RXQ_OVFL; — where the daemon does not report it).")
     out.append("")
