@@ -138,7 +138,7 @@ class ShaftTwin {
 
   // statistics
   LatencyHistogram step_hist_, late_hist_;    // this health window
-  LatencyHistogram step_total_, late_total_;  // whole run (final report)
+  LatencyHistogram step_total_, late_total_;  // whole run (final report): the windows merged at each health report
   std::int64_t publish_failures_ = 0, nonfinite_blocked_ = 0, alarm_events_ = 0;
   // Extra HOIST_HEALTH reasons after the winder reasons (not in rejected_total,
   // which counts winder inputs): undecodable alarm commands, and exceptions
