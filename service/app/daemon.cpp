@@ -375,7 +375,7 @@ bool Daemon::writeReport() const {
   if (receiver_)
     j["input_socket"] = {{"rcvbuf_bytes", receiver_->rcvbuf()},
                          {"datagrams", receiver_->received()},
-                         {"kernel_drops", receiver_->kernelDrops()},
+                         {"kernel_drops", receiver_->refreshKernelDrops()},
                          {"ignored", receiver_->ignored()},
                          {"malformed", receiver_->malformed()}};
   {

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <linux/sock_diag.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/uio.h>
@@ -114,6 +115,17 @@ bool UdpmReceiver::open(const UdpmUrl& url, std::string& why, int default_rcvbuf
     return false;
   }
   return true;
+}
+
+std::int64_t UdpmReceiver::refreshKernelDrops() {
+#if defined(SO_MEMINFO)
+  std::uint32_t mem[SK_MEMINFO_VARS] = {};
+  socklen_t len = sizeof mem;
+  if (fd_ >= 0 && ::getsockopt(fd_, SOL_SOCKET, SO_MEMINFO, mem, &len) == 0 &&
+      len >= (SK_MEMINFO_DROPS + 1) * sizeof(std::uint32_t))
+    kernel_drops_ = mem[SK_MEMINFO_DROPS];
+#endif
+  return kernel_drops_;
 }
 
 void UdpmReceiver::add(const std::string& channel, RawHandler handler) {

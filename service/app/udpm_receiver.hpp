@@ -72,8 +72,14 @@ class UdpmReceiver final : public InputRouter {
   bool open(const UdpmUrl& url, std::string& why, int default_rcvbuf = 0);
   /// The receive buffer the kernel granted [bytes] (getsockopt SO_RCVBUF).
   int rcvbuf() const { return rcvbuf_; }
-  /// Datagrams the kernel dropped on this socket (buffer full), as last reported.
+  /// Datagrams the kernel dropped on this socket (buffer full), as last
+  /// reported by SO_RXQ_OVFL: each datagram carries the count at the time it
+  /// was queued, so drops show with the next datagram read after them.
   std::int64_t kernelDrops() const { return kernel_drops_; }
+  /// Ask the kernel for the current drop count (SO_MEMINFO,
+  /// SK_MEMINFO_DROPS; not for the loop: a system call); updates and returns
+  /// kernelDrops().
+  std::int64_t refreshKernelDrops();
   int fd() const { return fd_; }
   void add(const std::string& channel, RawHandler handler) override;
   /// Read and dispatch at most `max` datagrams; returns how many were read
