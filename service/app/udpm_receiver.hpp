@@ -38,6 +38,10 @@
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
+#include <string_view>
+#include <sys/socket.h>
+#include <sys/uio.h>
+#include <unordered_map>
 #include <vector>
 
 namespace hoist::svc {
@@ -82,9 +86,11 @@ class UdpmReceiver final : public InputRouter {
   std::int64_t refreshKernelDrops();
   int fd() const { return fd_; }
   void add(const std::string& channel, RawHandler handler) override;
-  /// Read and dispatch at most `max` datagrams; returns how many were read
-  /// (0: nothing pending).  No allocation.
+  /// Read and dispatch at most `max` datagrams, up to kBatch per system
+  /// call (recvmmsg); returns how many were read (0: nothing pending).  No
+  /// allocation (the batch buffers are allocated by open()).
   int drain(int max);
+  static constexpr int kBatch = 16;  ///< datagrams per recvmmsg
 
   std::int64_t received() const { return received_; }
   std::int64_t ignored() const { return ignored_; }      ///< datagrams on channels nobody subscribed
@@ -95,11 +101,20 @@ class UdpmReceiver final : public InputRouter {
     std::string channel;
     RawHandler handler;
   };
+  void dispatch(std::uint8_t* data, std::size_t size, bool truncated);
+  static constexpr std::size_t kSlotBytes = 65536;  ///< any UDP datagram fits
   int fd_ = -1;
   int rcvbuf_ = 0;
   std::int64_t kernel_drops_ = 0;
   std::vector<Route> routes_;
-  std::array<std::uint8_t, 65536> buf_{};
+  std::unordered_map<std::string_view, const Route*> index_;  ///< exact channel name -> route
+  std::vector<std::uint8_t> slots_;                           ///< kBatch x kSlotBytes
+  std::array<mmsghdr, kBatch> msgs_{};
+  std::array<iovec, kBatch> iov_{};
+  struct alignas(cmsghdr) Control {
+    char b[CMSG_SPACE(sizeof(std::uint32_t))];
+  };
+  std::array<Control, kBatch> control_{};
   std::int64_t received_ = 0, ignored_ = 0, malformed_ = 0;
 };
 
