@@ -11,7 +11,8 @@
 #
 #   bench/multishaft.sh [--counts "100 200 300"] [--seconds S] [--setting MODES:on|off ...]
 #                       [--daemon NAME=PATH[,key=value...] ...] [--feeder PATH] [--rate HZ] [--max-step S]
-#                       [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--feeder-rt] [--same-url] [--out FILE] [--port P]
+#                       [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--feeder-rt] [--perf NAME]
+#                       [--same-url] [--out FILE] [--port P]
 #
 # --setting (repeatable; default 50:on): n modes and [model] static_correction.
 # --daemon (repeatable; default this=build/bin/hoist-twind): the binaries to
@@ -26,7 +27,8 @@
 # feeder on CPU 0 (--feeder-rt: with SCHED_FIFO 50, so that a busy CPU 0 does
 # not make it late: a late feeder's bunched inputs fail the daemon's
 # consistency check and show up as rejected), UDP multicast on loopback port
-# P = 7880 (ttl=0).
+# P = 7880 (ttl=0).  --perf NAME: `perf record -e cpu-clock` on daemon NAME
+# for the middle half of each of its runs; the report lists its hottest symbols.
 set -euo pipefail
 orig_args="$*"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -39,6 +41,7 @@ rate=100
 max_step=0.01
 rt=1
 feeder_rt=0
+perf_name=""
 same_url=0
 ncpu=$(nproc)
 daemon_cpu=$((ncpu > 1 ? ncpu - 1 : 0))
@@ -59,10 +62,11 @@ while [[ $# -gt 0 ]]; do
     --feeder-cpu) feeder_cpu="$2"; shift 2 ;;
     --no-rt) rt=0; shift ;;
     --feeder-rt) feeder_rt=1; shift ;;
+    --perf) perf_name="$2"; shift 2 ;;
     --same-url) same_url=1; shift ;;
     --out) out="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,29p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,32p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "multishaft.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -125,12 +129,25 @@ for setting in "${settings[@]}"; do
       steal0=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
       t0=$(date +%s.%N)
       set +e
+      perf_pid=""
+      if [[ -n "$perf_name" && "$name" == "$perf_name" ]] && command -v perf > /dev/null; then
+        (sleep "$(python3 -c "print($seconds / 4)")"
+         exec perf record -q -e cpu-clock -F 499 -p "$daemon_pid" -o "$raw/$tag.perf.data" -- sleep "$(python3 -c "print($seconds / 2)")") \
+          > /dev/null 2>&1 &
+        perf_pid=$!
+      fi
       frt=()
       [[ $feeder_rt -eq 1 ]] && frt=(chrt -f 50)
       taskset -c "$feeder_cpu" "${frt[@]}" "$feeder" --timing-test --lcm-url "$url" "${outargs[@]}" --shafts "$N" --rate "$rate" \
         --duration "$seconds" --max-misses 0 --quiet --report "$raw/$tag.timing.md" > "$raw/$tag.feeder.log"
       verdict=$?
       set -e
+      if [[ -n "$perf_pid" ]]; then
+        wait "$perf_pid" || true
+        perf report -i "$raw/$tag.perf.data" --stdio --no-children --sort symbol --percent-limit 1 2> /dev/null \
+          | grep -E '^ +[0-9.]+%' > "$raw/$tag.perf.txt" || true
+        rm -f "$raw/$tag.perf.data" "$raw/$tag.perf.data.old"
+      fi
       read -r -a st1 < <(cut -d' ' -f14,15 "/proc/$daemon_pid/stat")
       steal1=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
       t1=$(date +%s.%N)

@@ -134,6 +134,34 @@ def main():
                        " | ".join(f"{c.get(k, float('nan')):.2f}" for k, _ in PHASES) +
                        f" | {c.get('process_cpu', float('nan')):.2f} | {frac} |")
         out.append("")
+    # perf profiles (bench/multishaft.sh --perf NAME): the largest count of each setting.
+    for setting in dict.fromkeys(x["setting"] for x in rows):
+        prof = [x for x in rows if x["setting"] == setting and os.path.exists(x["md"].replace(".timing.md", ".perf.txt"))]
+        if not prof:
+            continue
+        x = max(prof, key=lambda y: y["n"])
+        path = x["md"].replace(".timing.md", ".perf.txt")
+        with open(path) as f:
+            lines = [ln.strip() for ln in f if ln.strip()][:15]
+        if not lines:
+            continue
+        out.append(f"## Profile: n = {setting.replace(':', ', correction ')}, {x['n']} twins, daemon `{x['name']}`")
+        out.append("")
+        out.append("`perf record -e cpu-clock` on the daemon for the middle half of the run, symbols above 1 % "
+                   f"([all]({os.path.relpath(path, a.out_dir)})); `[k]` is the kernel.  On this virtual machine the "
+                   "kernel's interrupt-enable at system-call entry (`pvm_irq_enable`) is where system calls cost.")
+        out.append("")
+        out.append("| share | where |")
+        out.append("|---:|---|")
+        for ln in lines:
+            parts = ln.split(None, 2)
+            if len(parts) < 3:
+                continue
+            sym = parts[2].replace("|", "\\|")
+            if len(sym) > 110:
+                sym = sym[:107] + "..."
+            out.append(f"| {parts[0]} | {parts[1]} `{sym}` |")
+        out.append("")
     print("\n".join(out))
 
 
