@@ -157,7 +157,7 @@ def main():
             parts = ln.split(None, 2)
             if len(parts) < 3:
                 continue
-            sym = parts[2].replace("|", "\\|")
+            sym = parts[2].strip().replace("|", "\\|")
             if len(sym) > 110:
                 sym = sym[:107] + "..."
             out.append(f"| {parts[0]} | {parts[1]} `{sym}` |")
