@@ -11,6 +11,7 @@ import argparse
 import json
 import os
 import platform
+import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -157,7 +158,7 @@ def main():
             parts = ln.split(None, 2)
             if len(parts) < 3:
                 continue
-            sym = parts[2].strip().replace("|", "\\|")
+            sym = re.split(r"\s{2,}", parts[2].strip())[0].replace("|", "\\|")
             if len(sym) > 110:
                 sym = sym[:107] + "..."
             out.append(f"| {parts[0]} | {parts[1]} `{sym}` |")
