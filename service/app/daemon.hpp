@@ -41,6 +41,7 @@
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
 #include "udpm_receiver.hpp"
+#include "udpm_sender.hpp"
 
 namespace hoist::svc {
 
@@ -103,6 +104,7 @@ class Daemon {
 
   void armLcm();
   void drainInput();  ///< the own receive path: read what is queued (timed)
+  void flushOutputs();  ///< the own publisher: send what the tick queued (timed)
   void onLcmReadable(const boost::system::error_code& ec);
   void armTimer(RateGroup& g);
   void onTick(RateGroup& g, const boost::system::error_code& ec);
@@ -124,6 +126,8 @@ class Daemon {
   // cost split (report): steady-clock ns in the ticks (without the drains
   // inside them) and in the drains; process CPU time at start
   std::int64_t ns_ticks_ = 0, ns_receive_ = 0, cpu0_ = 0;
+  std::unique_ptr<UdpmSender> sender_;      ///< own publisher for udpm output URLs (udpm_sender.hpp); else LCM's
+  std::int64_t ns_flush_ = 0;               ///< cost split: steady-clock ns in sender_->flush()
   std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
   std::int64_t instance_id_ = 0;       ///< random per process (HOIST_CAGE/HOIST_HEALTH.instance_id)
   boost::asio::posix::stream_descriptor lcm_fd_;

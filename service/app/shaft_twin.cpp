@@ -336,8 +336,8 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
     if (r.stepped && core_.hasInput()) {
       const auto p0 = Clock::now();
       const std::int64_t utime = bus::wallUtime();
-      if (k % cage_div_ == 0) publishCage(utime);
-      if (cfg_.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime);
+      if (k % cage_div_ == 0) publishCage(utime, true);
+      if (cfg_.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime, true);
       ns_publish_ += nanos(Clock::now() - p0);
     }
   } else {
@@ -360,9 +360,15 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
 
 // ---- outputs -----------------------------------------------------------------
 
-bool ShaftTwin::publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len) {
+bool ShaftTwin::publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len, bool batch) {
   const bool injected = hooks_.fail_publish_every > 0 && ++publish_attempts_ % hooks_.fail_publish_every == 0;
-  if (injected || out_.publish(channel, buf.data(), static_cast<unsigned int>(len)) != 0) {
+  const auto n = static_cast<std::size_t>(len);
+  bool ok = false;
+  if (injected) ok = false;
+  else if (sender_ && batch && sender_->queue(channel, buf.data(), n, &publish_failures_)) ok = true;
+  else if (sender_ && n <= UdpmSender::kMaxPayload) ok = sender_->send(channel, buf.data(), n);
+  else ok = out_.publish(channel, buf.data(), static_cast<unsigned int>(len)) == 0;
+  if (!ok) {
     ++publish_failures_;
     std::int64_t suppressed = 0;
     if (reject_log_.allow(kLogPublish, wallNow(), suppressed))
@@ -373,7 +379,8 @@ bool ShaftTwin::publishBytes(const std::string& channel, const std::vector<std::
 }
 
 template <class Msg>
-bool ShaftTwin::encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf) {
+bool ShaftTwin::encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
+                                 bool batch) {
   if (!finiteAll(msg)) {
     ++nonfinite_blocked_;
     std::int64_t suppressed = 0;
@@ -392,17 +399,17 @@ bool ShaftTwin::encodeAndPublish(const std::string& channel, const Msg& msg, std
     ++publish_failures_;
     return false;
   }
-  return publishBytes(channel, buf, len);
+  return publishBytes(channel, buf, len, batch);
 }
 
-void ShaftTwin::publishCage(std::int64_t utime) {
+void ShaftTwin::publishCage(std::int64_t utime, bool batch) {
   cage_msg_.utime = utime;
   cage_msg_.seq = cage_seq_++;
   toCageMessage(core_.output(), cage_msg_);
-  encodeAndPublish(ch_.cage, cage_msg_, cage_buf_);
+  encodeAndPublish(ch_.cage, cage_msg_, cage_buf_, batch);
 }
 
-void ShaftTwin::publishShape(std::int64_t utime) {
+void ShaftTwin::publishShape(std::int64_t utime, bool batch) {
   core_.evaluateShape();
   const GuideRopeEnvelope& sh = core_.shape();
   shape_msg_.utime = utime;
@@ -412,7 +419,7 @@ void ShaftTwin::publishShape(std::int64_t utime) {
     shape_msg_.y1[i] = sh.y1()(i);
     shape_msg_.y2[i] = sh.y2()(i);
   }
-  encodeAndPublish(ch_.shape, shape_msg_, shape_buf_);
+  encodeAndPublish(ch_.shape, shape_msg_, shape_buf_, batch);
 }
 
 void ShaftTwin::drainAlarmEvents() {

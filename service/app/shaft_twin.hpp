@@ -31,6 +31,7 @@
 #include "hoist/winder_t.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "udpm_receiver.hpp"
+#include "udpm_sender.hpp"
 
 namespace hoist::svc {
 
@@ -76,6 +77,9 @@ class ShaftTwin {
   /// `router` (the daemon's own udpm receive path, exact names) when given,
   /// else through LCM (escaped, literal names).
   void subscribe(InputRouter* router = nullptr);
+  /// The daemon's own udpm publisher (udpm_sender.hpp), used instead of
+  /// LCM's publish when set (udpm output URLs).
+  void setSender(UdpmSender* s) { sender_ = s; }
   /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
   void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: wall times are measured from `start`; publishes a
@@ -110,19 +114,24 @@ class ShaftTwin {
   void logJunk(const std::string& what);
   std::int64_t rssKb() const;
   double wallNow() const;
-  void publishCage(std::int64_t utime);
-  void publishShape(std::int64_t utime);
+  // batch: queued on the daemon's UdpmSender (sent at its next flush, in the
+  // same tick); only for the tick's cage and shape, whose buffers are not
+  // touched again before then.
+  void publishCage(std::int64_t utime, bool batch = false);
+  void publishShape(std::int64_t utime, bool batch = false);
   void drainAlarmEvents();
-  bool publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len);
+  bool publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len, bool batch = false);
   template <class Msg>
-  bool encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf);
+  bool encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
+                        bool batch = false);
   void logReject(RejectReason r, const char* detail);
 
   TwinConfig cfg_;
   std::string label_;  ///< as given ("" for a daemon with one shaft)
   std::string tag_;    ///< log-line prefix: "[label] " or ""
   lcm::LCM& lcm_;
-  lcm::LCM& out_;  ///< publishes (lcm_url_out, or lcm_)
+  lcm::LCM& out_;  ///< publishes (lcm_url_out, or lcm_) unless sender_ is set
+  UdpmSender* sender_ = nullptr;
   std::int64_t instance_id_ = 0;
   RtLog& log_;
   TestHooks hooks_;

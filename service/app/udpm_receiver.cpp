@@ -67,6 +67,14 @@ bool parseUdpmUrl(const std::string& url, UdpmUrl& out, std::string& why) {
         return false;
       }
       out.recv_buf_size = static_cast<int>(n);
+    } else if (kv.substr(0, eq) == "ttl") {
+      char* end = nullptr;
+      const long n = std::strtol(kv.c_str() + eq + 1, &end, 10);
+      if (!end || *end != '\0' || n < 0 || n > 255) {
+        why = "bad ttl in " + url;
+        return false;
+      }
+      out.ttl = static_cast<int>(n);
     }
   }
   return true;

@@ -61,6 +61,7 @@ struct UdpmUrl {
   std::string group = "239.255.76.67";
   int port = 7667;
   int recv_buf_size = 0;  ///< bytes, 0 = the system default
+  int ttl = 0;            ///< multicast TTL (publishing), 0 = this machine only
 };
 bool parseUdpmUrl(const std::string& url, UdpmUrl& out, std::string& why);
 
