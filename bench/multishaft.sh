@@ -14,7 +14,9 @@
 #                       [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--feeder-rt] [--perf NAME]
 #                       [--same-url] [--out FILE] [--port P]
 #
-# --setting (repeatable; default 50:on): n modes and [model] static_correction.
+# --setting (repeatable; default 50:off and 25:on: the paper's n without the
+#   static correction, and the converged setting with it, issue 13): n modes
+#   and [model] static_correction.
 # --daemon (repeatable; default this=build/bin/hoist-twind): the binaries to
 #   compare, each run side by side (interleaved) for every setting and N; extra
 #   key=value pairs go into the [service] section of its configs (e.g.
@@ -66,11 +68,11 @@ while [[ $# -gt 0 ]]; do
     --same-url) same_url=1; shift ;;
     --out) out="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,32p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,34p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "multishaft.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
-[[ ${#settings[@]} -eq 0 ]] && settings=("50:on")
+[[ ${#settings[@]} -eq 0 ]] && settings=("50:off" "25:on")
 [[ ${#daemons[@]} -eq 0 ]] && daemons=("this=$here/build/bin/hoist-twind")
 for s in "${settings[@]}"; do
   [[ "$s" =~ ^[0-9]+:(on|off)$ ]] || { echo "multishaft.sh: --setting: MODES:on|off, got '$s'" >&2; exit 2; }
