@@ -68,7 +68,7 @@ while [[ $# -gt 0 ]]; do
     --same-url) same_url=1; shift ;;
     --out) out="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,34p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,33p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "multishaft.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
