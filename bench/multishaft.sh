@@ -123,10 +123,19 @@ for setting in "${settings[@]}"; do
         cfgs+=(--config "$cfgdir/shaft$i.toml")
       done
       echo "[multishaft] n = $modes (correction $corr), N = $N, daemon $name: daemon (all threads) on CPU $daemon_cpu, feeder on CPU $feeder_cpu, $seconds s ..." >&2
-      taskset -c "$daemon_cpu" "$bin" "${cfgs[@]}" --lcm-url "$url" --cpus "$daemon_cpu" "${rtargs[@]}" \
+      # --force: run even when the daemon's start-up measurement says the
+      # ticks will not fit (an overloaded count is a result too).
+      taskset -c "$daemon_cpu" "$bin" "${cfgs[@]}" --lcm-url "$url" --cpus "$daemon_cpu" "${rtargs[@]}" --force \
         --report "$raw/$tag.json" --log-level warn 2> "$raw/$tag.daemon.log" &
       daemon_pid=$!
       sleep 3
+      if [[ ! -e "/proc/$daemon_pid/stat" ]]; then
+        echo "[multishaft] $tag: the daemon exited at start (see $raw/$tag.daemon.log)" >&2
+        wait "$daemon_pid" || true
+        daemon_pid=""
+        rm -rf "$cfgdir"
+        continue
+      fi
       read -r -a st0 < <(cut -d' ' -f14,15 "/proc/$daemon_pid/stat")
       steal0=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
       t0=$(date +%s.%N)
@@ -159,6 +168,7 @@ for setting in "${settings[@]}"; do
       cpu=$(python3 -c "print(f'{100.0 * ((${st1[0]} + ${st1[1]}) - (${st0[0]} + ${st0[1]})) / $clk / ($t1 - $t0):.0f}')")
       steal=$(python3 -c "print(f'{($steal1 - $steal0) / $clk:.2f}')")
       echo "[multishaft] $tag: timing test exit $verdict, daemon CPU $cpu %, steal $steal s" >&2
+      rm -rf "$cfgdir"
       rows+=("$name" "$modes:$corr" "$N" "$raw/$tag.json" "$raw/$tag.timing.md" "$cpu/$steal")
     done
   done

@@ -97,22 +97,35 @@ def main():
                "datagrams the kernel dropped on the daemon's input socket because its buffer was full "
                "(SO_RXQ_OVFL; — where the daemon does not report it).")
     out.append("")
-    # Summary: per setting and daemon, the largest count with no miss and no input lost.
+    # Summary: per setting and daemon, the largest count that keeps up.
     out.append("## Twins per core")
     out.append("")
-    out.append("| setting | daemon | largest count with zero misses and zero inputs lost | its CPU use | twins per core at that CPU use (N x 100 / CPU %) |")
-    out.append("|---|---|---|---|---|")
+    out.append("A count **keeps up** when no input was lost and the deadline misses stay below 0.5 % of the "
+               "twin-ticks: on this shared VM the vCPU itself stalls for tens of milliseconds now and then (every "
+               "hosted shaft then misses the same tick, so misses come in multiples of N), which no daemon can "
+               "avoid; an overloaded daemon misses thousands of ticks.  The last column extrapolates from the CPU "
+               "the daemon used at that count.")
+    out.append("")
+    out.append("| setting | daemon | largest count that keeps up | its misses (platform stalls) | its CPU use | "
+               "twins per core at that CPU use (N x 100 / CPU %) |")
+    out.append("|---|---|---|---|---|---|")
     for setting in dict.fromkeys(x["setting"] for x in rows):
         for d in daemons:
-            ok = [x for x in rows if x["setting"] == setting and x["name"] == d and x["r"]
-                  and x["misses"] == 0 and x["gaps"] == 0]
             label = f"n = {setting.replace(':', ', correction ')}"
+            ok = []
+            for x in rows:
+                if x["setting"] != setting or x["name"] != d or not x["r"]:
+                    continue
+                ticks = sum(s["ticks"] for s in x["r"]["shafts"])
+                if x["gaps"] == 0 and ticks > 0 and x["misses"] < 0.005 * ticks:
+                    ok.append(x)
             if not ok:
-                out.append(f"| {label} | {d} | none of the counts run | | |")
+                out.append(f"| {label} | {d} | none of the counts run | | | |")
                 continue
             best = max(ok, key=lambda x: x["n"])
             cap = best["n"] * 100.0 / best["cpu"] if best["cpu"] > 0 else float("nan")
-            out.append(f"| {label} | {d} | **{best['n']}** | {best['cpu']:.0f} % | {cap:.0f} |")
+            out.append(f"| {label} | {d} | **{best['n']}** | {best['misses']} ({best['misses'] / best['n']:.0f} "
+                       f"per shaft) | {best['cpu']:.0f} % | {cap:.0f} |")
     out.append("")
     # The daemon's own cost split (where it reports one).
     split_rows = [x for x in rows if x["r"] and "cost_split_us_per_twin_tick" in x["r"]]
