@@ -1,30 +1,50 @@
 #!/usr/bin/env bash
-# Twins per core: one hoist-twind process hosting N shafts (100 Hz, n = 50
-# modes each, every output on: cage state at 100 Hz, guide-rope shape at 5 Hz,
-# health at 1 Hz, alarms), the whole process pinned to ONE CPU, fed by
+# Twins per core: one hoist-twind process hosting N shafts (100 Hz, every
+# output on: cage state at 100 Hz, guide-rope shape at 5 Hz, health at 1 Hz,
+# alarms), the whole process pinned to ONE CPU, fed by
 # `hoist-replay --timing-test --shafts N` (N winder streams at 100 Hz, a hoist
-# moving the whole time) on another CPU.  For each N it records deadline
-# misses, tick lateness, step time and the CPU the process used, and writes
-# docs/multishaft-report.md with the largest N that ran without a miss.
+# moving the whole time) on another CPU.  For each setting (modes, static
+# correction), each N and each daemon binary it records deadline misses, tick
+# lateness, step time, the CPU the process used, inputs lost (sequence gaps,
+# and the kernel's drops on the daemon's input socket) and the daemon's own
+# cost split, and writes docs/multishaft-report.md.
 #
-#   bench/multishaft.sh [--counts "50 100 200 300"] [--seconds S] [--modes N] [--rate HZ]
-#                       [--max-step S] [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--out FILE] [--port P]
+#   bench/multishaft.sh [--counts "100 200 300"] [--seconds S] [--setting MODES:on|off ...]
+#                       [--daemon NAME=PATH[,key=value...] ...] [--feeder PATH] [--rate HZ] [--max-step S]
+#                       [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--feeder-rt] [--perf NAME]
+#                       [--same-url] [--out FILE] [--port P]
 #
-# Defaults: counts "100 200 300 400", 60 s each, n = 50, 100 Hz, [service]
-# max_step 0.01 s (one model step per tick, the paper's step: within 2 % of
-# the reference solution from a static start; the daemon's default 2.5 ms
-# substeps cost four steps per tick, --max-step 0.0025), daemon on
-# the last CPU with --mlockall --rt-priority 80 (reported, not fatal, when
-# refused), feeder on CPU 0, UDP multicast on loopback port 7880 (ttl=0).
+# --setting (repeatable; default 50:off and 25:on: the paper's n without the
+#   static correction, and the converged setting with it, issue 13): n modes
+#   and [model] static_correction.
+# --daemon (repeatable; default this=build/bin/hoist-twind): the binaries to
+#   compare, each run side by side (interleaved) for every setting and N; extra
+#   key=value pairs go into the [service] section of its configs (e.g.
+#   envelope_tolerance=0).  The feeder (--feeder PATH; default this build's
+#   hoist-replay) is the same for every daemon.
+# Defaults: counts "100 200 300 400", 60 s each, 100 Hz, [service] max_step
+# 0.01 s (one model step per tick), outputs to [service] lcm_url_out on port
+# P+1 (--same-url: on the input URL, as before issue 13), daemon on the last
+# CPU with --mlockall --rt-priority 80 (reported, not fatal, when refused),
+# feeder on CPU 0 (--feeder-rt: with SCHED_FIFO 50, so that a busy CPU 0 does
+# not make it late: a late feeder's bunched inputs fail the daemon's
+# consistency check and show up as rejected), UDP multicast on loopback port
+# P = 7880 (ttl=0).  --perf NAME: `perf record -e cpu-clock` on daemon NAME
+# for the middle half of each of its runs; the report lists its hottest symbols.
 set -euo pipefail
 orig_args="$*"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 counts="100 200 300 400"
 seconds=60
-modes=50
+settings=()
+daemons=()
+feeder="$here/build/bin/hoist-replay"
 rate=100
 max_step=0.01
 rt=1
+feeder_rt=0
+perf_name=""
+same_url=0
 ncpu=$(nproc)
 daemon_cpu=$((ncpu > 1 ? ncpu - 1 : 0))
 feeder_cpu=0
@@ -34,67 +54,126 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --counts) counts="$2"; shift 2 ;;
     --seconds) seconds="$2"; shift 2 ;;
-    --modes) modes="$2"; shift 2 ;;
+    --setting) settings+=("$2"); shift 2 ;;
+    --modes) settings+=("$2:on"); shift 2 ;;
+    --daemon) daemons+=("$2"); shift 2 ;;
+    --feeder) feeder="$2"; shift 2 ;;
     --rate) rate="$2"; shift 2 ;;
     --max-step) max_step="$2"; shift 2 ;;
     --daemon-cpu) daemon_cpu="$2"; shift 2 ;;
     --feeder-cpu) feeder_cpu="$2"; shift 2 ;;
     --no-rt) rt=0; shift ;;
+    --feeder-rt) feeder_rt=1; shift ;;
+    --perf) perf_name="$2"; shift 2 ;;
+    --same-url) same_url=1; shift ;;
     --out) out="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,33p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "multishaft.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
-bin="$here/build/bin"
-for b in hoist-twind hoist-replay; do
-  [[ -x "$bin/$b" ]] || { echo "multishaft.sh: $bin/$b not found; build first (scripts/setup.sh)" >&2; exit 2; }
+[[ ${#settings[@]} -eq 0 ]] && settings=("50:off" "25:on")
+[[ ${#daemons[@]} -eq 0 ]] && daemons=("this=$here/build/bin/hoist-twind")
+for s in "${settings[@]}"; do
+  [[ "$s" =~ ^[0-9]+:(on|off)$ ]] || { echo "multishaft.sh: --setting: MODES:on|off, got '$s'" >&2; exit 2; }
+done
+[[ -x "$feeder" ]] || { echo "multishaft.sh: $feeder not found; build first (scripts/setup.sh)" >&2; exit 2; }
+for d in "${daemons[@]}"; do
+  [[ "$d" == *=* ]] || { echo "multishaft.sh: --daemon: NAME=PATH[,key=value...], got '$d'" >&2; exit 2; }
+  p="${d#*=}"; p="${p%%,*}"
+  [[ -x "$p" ]] || { echo "multishaft.sh: --daemon: $p is not an executable" >&2; exit 2; }
 done
 url="udpm://239.255.76.67:$port?ttl=0"
+url_out="udpm://239.255.76.67:$((port + 1))?ttl=0"
 raw="$out.d"
 mkdir -p "$raw"
 rtargs=()
 [[ $rt -eq 1 ]] && rtargs=(--mlockall --rt-priority 80)
+outargs=()
+[[ $same_url -eq 0 ]] && outargs=(--lcm-url-out "$url_out")
 clk=$(getconf CLK_TCK)
 daemon_pid=""
 cleanup() { [[ -n "$daemon_pid" ]] && kill -TERM "$daemon_pid" 2>/dev/null || true; }
 trap cleanup EXIT INT TERM
 
 rows=()
-for N in $counts; do
-  cfgdir="$raw/configs-$N"
-  rm -rf "$cfgdir"; mkdir -p "$cfgdir"
-  cfgs=()
-  for ((i = 1; i <= N; i++)); do
-    printf '[model]\nmodes = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n' \
-      "$modes" "$rate" "$max_step" "$i" > "$cfgdir/shaft$i.toml"
-    cfgs+=(--config "$cfgdir/shaft$i.toml")
+for setting in "${settings[@]}"; do
+  modes="${setting%%:*}"
+  corr="${setting##*:}"
+  corr_toml=$([[ $corr == on ]] && echo true || echo false)
+  for N in $counts; do
+    for d in "${daemons[@]}"; do
+      name="${d%%=*}"
+      spec="${d#*=}"
+      bin="${spec%%,*}"
+      extra=""
+      if [[ "$spec" == *,* ]]; then
+        IFS=',' read -r -a kvs <<< "${spec#*,}"
+        for kv in "${kvs[@]}"; do extra+="${kv%%=*} = ${kv#*=}"$'\n'; done
+      fi
+      tag="n${modes}${corr}-N$N-$name"
+      cfgdir="$raw/configs-$tag"
+      rm -rf "$cfgdir"; mkdir -p "$cfgdir"
+      cfgs=()
+      outline=""
+      [[ $same_url -eq 0 ]] && outline="lcm_url_out = \"$url_out\""$'\n'
+      for ((i = 1; i <= N; i++)); do
+        printf '[model]\nmodes = %s\nstatic_correction = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n%s%s' \
+          "$modes" "$corr_toml" "$rate" "$max_step" "$i" "$outline" "$extra" > "$cfgdir/shaft$i.toml"
+        cfgs+=(--config "$cfgdir/shaft$i.toml")
+      done
+      echo "[multishaft] n = $modes (correction $corr), N = $N, daemon $name: daemon (all threads) on CPU $daemon_cpu, feeder on CPU $feeder_cpu, $seconds s ..." >&2
+      # --force: run even when the daemon's start-up measurement says the
+      # ticks will not fit (an overloaded count is a result too).
+      taskset -c "$daemon_cpu" "$bin" "${cfgs[@]}" --lcm-url "$url" --cpus "$daemon_cpu" "${rtargs[@]}" --force \
+        --report "$raw/$tag.json" --log-level warn 2> "$raw/$tag.daemon.log" &
+      daemon_pid=$!
+      sleep 3
+      if [[ ! -e "/proc/$daemon_pid/stat" ]]; then
+        echo "[multishaft] $tag: the daemon exited at start (see $raw/$tag.daemon.log)" >&2
+        wait "$daemon_pid" || true
+        daemon_pid=""
+        rm -rf "$cfgdir"
+        continue
+      fi
+      read -r -a st0 < <(cut -d' ' -f14,15 "/proc/$daemon_pid/stat")
+      steal0=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
+      t0=$(date +%s.%N)
+      set +e
+      perf_pid=""
+      if [[ -n "$perf_name" && "$name" == "$perf_name" ]] && command -v perf > /dev/null; then
+        (sleep "$(python3 -c "print($seconds / 4)")"
+         exec perf record -q -e cpu-clock -F 499 -p "$daemon_pid" -o "$raw/$tag.perf.data" -- sleep "$(python3 -c "print($seconds / 2)")") \
+          > /dev/null 2>&1 &
+        perf_pid=$!
+      fi
+      frt=()
+      [[ $feeder_rt -eq 1 ]] && frt=(chrt -f 50)
+      taskset -c "$feeder_cpu" "${frt[@]}" "$feeder" --timing-test --lcm-url "$url" "${outargs[@]}" --shafts "$N" --rate "$rate" \
+        --duration "$seconds" --max-misses 0 --quiet --report "$raw/$tag.timing.md" > "$raw/$tag.feeder.log"
+      verdict=$?
+      set -e
+      if [[ -n "$perf_pid" ]]; then
+        wait "$perf_pid" || true
+        perf report -i "$raw/$tag.perf.data" --stdio --no-children --sort symbol --percent-limit 1 2> /dev/null \
+          | grep -E '^ +[0-9.]+%' > "$raw/$tag.perf.txt" || true
+        rm -f "$raw/$tag.perf.data" "$raw/$tag.perf.data.old"
+      fi
+      read -r -a st1 < <(cut -d' ' -f14,15 "/proc/$daemon_pid/stat")
+      steal1=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
+      t1=$(date +%s.%N)
+      kill -TERM "$daemon_pid"
+      wait "$daemon_pid" || true
+      daemon_pid=""
+      cpu=$(python3 -c "print(f'{100.0 * ((${st1[0]} + ${st1[1]}) - (${st0[0]} + ${st0[1]})) / $clk / ($t1 - $t0):.0f}')")
+      steal=$(python3 -c "print(f'{($steal1 - $steal0) / $clk:.2f}')")
+      echo "[multishaft] $tag: timing test exit $verdict, daemon CPU $cpu %, steal $steal s" >&2
+      rm -rf "$cfgdir"
+      rows+=("$name" "$modes:$corr" "$N" "$raw/$tag.json" "$raw/$tag.timing.md" "$cpu/$steal")
+    done
   done
-  echo "[multishaft] N = $N: daemon (all threads) on CPU $daemon_cpu, feeder on CPU $feeder_cpu, $seconds s ..." >&2
-  taskset -c "$daemon_cpu" "$bin/hoist-twind" "${cfgs[@]}" --lcm-url "$url" --cpus "$daemon_cpu" "${rtargs[@]}" \
-    --report "$raw/N$N.json" --log-level warn 2> "$raw/N$N.daemon.log" &
-  daemon_pid=$!
-  sleep 3
-  read -r -a st0 < <(cut -d' ' -f14,15 "/proc/$daemon_pid/stat")
-  steal0=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
-  t0=$(date +%s.%N)
-  set +e
-  taskset -c "$feeder_cpu" "$bin/hoist-replay" --timing-test --lcm-url "$url" --shafts "$N" --rate "$rate" \
-    --duration "$seconds" --max-misses 0 --quiet --report "$raw/N$N.timing.md" > "$raw/N$N.feeder.log"
-  verdict=$?
-  set -e
-  read -r -a st1 < <(cut -d' ' -f14,15 "/proc/$daemon_pid/stat")
-  steal1=$(awk -v c="cpu$daemon_cpu" '$1 == c {print $9}' /proc/stat)
-  t1=$(date +%s.%N)
-  kill -TERM "$daemon_pid"
-  wait "$daemon_pid" || true
-  daemon_pid=""
-  cpu=$(python3 -c "print(f'{100.0 * ((${st1[0]} + ${st1[1]}) - (${st0[0]} + ${st0[1]})) / $clk / ($t1 - $t0):.0f}')")
-  steal=$(python3 -c "print(f'{($steal1 - $steal0) / $clk:.2f}')")
-  echo "[multishaft] N = $N: timing test exit $verdict, daemon CPU $cpu %, steal $steal s" >&2
-  rows+=("$N" "$raw/N$N.json" "$raw/N$N.timing.md" "$cpu/$steal")
 done
-python3 "$here/bench/multishaft_report.py" --max-step "$max_step" --command "bench/multishaft.sh $orig_args" --seconds "$seconds" \
-  --out-dir "$(dirname "$out")" "${rows[@]}" > "$out"
+python3 "$here/bench/multishaft_report.py" --max-step "$max_step" --command "bench/multishaft.sh $orig_args" \
+  --seconds "$seconds" --out-dir "$(dirname "$out")" --same-url "$same_url" --feeder-rt "$feeder_rt" "${rows[@]}" > "$out"
 echo "[multishaft] wrote $out" >&2
 cat "$out"

@@ -6,8 +6,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <linux/sock_diag.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 #include <sys/time.h>
 #include <unistd.h>
 
@@ -65,6 +67,14 @@ bool parseUdpmUrl(const std::string& url, UdpmUrl& out, std::string& why) {
         return false;
       }
       out.recv_buf_size = static_cast<int>(n);
+    } else if (kv.substr(0, eq) == "ttl") {
+      char* end = nullptr;
+      const long n = std::strtol(kv.c_str() + eq + 1, &end, 10);
+      if (!end || *end != '\0' || n < 0 || n > 255) {
+        why = "bad ttl in " + url;
+        return false;
+      }
+      out.ttl = static_cast<int>(n);
     }
   }
   return true;
@@ -74,19 +84,30 @@ UdpmReceiver::~UdpmReceiver() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool UdpmReceiver::open(const UdpmUrl& url, std::string& why) {
+bool UdpmReceiver::open(const UdpmUrl& url, std::string& why, int default_rcvbuf) {
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd_ < 0) {
     why = std::string("socket: ") + std::strerror(errno);
     return false;
   }
+  slots_.assign(static_cast<std::size_t>(kBatch) * kSlotBytes, 0);  // drain()'s batch buffers
   const int one = 1;
   ::setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
 #ifdef SO_REUSEPORT
   ::setsockopt(fd_, SOL_SOCKET, SO_REUSEPORT, &one, sizeof one);
 #endif
-  if (url.recv_buf_size > 0)
-    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &url.recv_buf_size, sizeof url.recv_buf_size);
+  const int want = url.recv_buf_size > 0 ? url.recv_buf_size : default_rcvbuf;
+  if (want > 0) {
+#ifdef SO_RCVBUFFORCE
+    if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &want, sizeof want) != 0)
+#endif
+      ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &want, sizeof want);
+  }
+  socklen_t optlen = sizeof rcvbuf_;
+  if (::getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf_, &optlen) != 0) rcvbuf_ = 0;
+#ifdef SO_RXQ_OVFL
+  ::setsockopt(fd_, SOL_SOCKET, SO_RXQ_OVFL, &one, sizeof one);
+#endif
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_addr.s_addr = htonl(INADDR_ANY);
@@ -105,8 +126,23 @@ bool UdpmReceiver::open(const UdpmUrl& url, std::string& why) {
   return true;
 }
 
+std::int64_t UdpmReceiver::refreshKernelDrops() {
+#if defined(SO_MEMINFO)
+  std::uint32_t mem[SK_MEMINFO_VARS] = {};
+  socklen_t len = sizeof mem;
+  if (fd_ >= 0 && ::getsockopt(fd_, SOL_SOCKET, SO_MEMINFO, mem, &len) == 0 &&
+      len >= (SK_MEMINFO_DROPS + 1) * sizeof(std::uint32_t))
+    kernel_drops_ = mem[SK_MEMINFO_DROPS];
+#endif
+  return kernel_drops_;
+}
+
 void UdpmReceiver::add(const std::string& channel, RawHandler handler) {
   routes_.push_back(Route{channel, std::move(handler)});
+  // Start-up only: rebuild the index (the vector may have moved the names).
+  index_.clear();
+  index_.reserve(routes_.size());
+  for (const Route& r : routes_) index_.emplace(std::string_view(r.channel), &r);
 }
 
 void UdpmReceiver::addMatching(std::function<bool(std::string_view)> match, RawHandler handler) {
@@ -115,61 +151,89 @@ void UdpmReceiver::addMatching(std::function<bool(std::string_view)> match, RawH
 }
 
 int UdpmReceiver::drain(int max) {
+  if (slots_.empty()) return 0;  // not open
   int n = 0;
-  for (; n < max; ++n) {
-    const ssize_t len = ::recv(fd_, buf_.data(), buf_.size(), 0);
-    if (len < 0) break;  // EAGAIN: nothing pending (or an error: try again next time)
-    ++received_;
-    const auto size = static_cast<std::size_t>(len);
-    if (size < 9) {
-      ++malformed_;
-      continue;
+  while (n < max) {
+    // recvmmsg: up to kBatch datagrams in one system call (system calls are
+    // what costs on a virtual machine), each with (SO_RXQ_OVFL) the socket's
+    // drop counter.
+    const int want = std::min(kBatch, max - n);
+    for (int i = 0; i < want; ++i) {
+      iov_[i] = iovec{slots_.data() + static_cast<std::size_t>(i) * kSlotBytes, kSlotBytes};
+      msghdr& mh = msgs_[i].msg_hdr;
+      mh = msghdr{};
+      mh.msg_iov = &iov_[i];
+      mh.msg_iovlen = 1;
+      mh.msg_control = control_[i].b;
+      mh.msg_controllen = sizeof control_[i].b;
+      msgs_[i].msg_len = 0;
     }
-    std::uint32_t magic = 0;
-    std::memcpy(&magic, buf_.data(), 4);
-    if (ntohl(magic) != kMagicShort) {
-      ++malformed_;  // fragments ("LC03") and foreign traffic
-      continue;
-    }
-    const char* name = reinterpret_cast<const char*>(buf_.data() + 8);
-    const std::size_t room = std::min(size - 8, kMaxChannel + 1);
-    const void* nul = std::memchr(name, '\0', room);
-    if (!nul) {
-      ++malformed_;
-      continue;
-    }
-    const std::size_t name_len = static_cast<const char*>(nul) - name;
-    const Route* route = nullptr;
-    for (const Route& r : routes_)
-      if (r.channel.size() == name_len && std::memcmp(r.channel.data(), name, name_len) == 0) {
-        route = &r;
-        break;
-      }
-    const MatchRoute* matched = nullptr;
-    if (!route)
-      for (const MatchRoute& m : matchers_)
-        if (m.match(std::string_view(name, name_len))) {
-          matched = &m;
-          break;
+    const int got = ::recvmmsg(fd_, msgs_.data(), static_cast<unsigned>(want), MSG_DONTWAIT, nullptr);
+    if (got <= 0) break;  // EAGAIN: nothing pending (or an error: try again next time)
+    for (int i = 0; i < got; ++i) {
+      msghdr& mh = msgs_[i].msg_hdr;
+#ifdef SO_RXQ_OVFL
+      for (cmsghdr* c = CMSG_FIRSTHDR(&mh); c; c = CMSG_NXTHDR(&mh, c))
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+          std::uint32_t drops = 0;
+          std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
+          kernel_drops_ = drops;
         }
-    if (!route && !matched) {
-      ++ignored_;
-      continue;
+#endif
+      dispatch(slots_.data() + static_cast<std::size_t>(i) * kSlotBytes, msgs_[i].msg_len,
+               (mh.msg_flags & MSG_TRUNC) != 0);
     }
-    lcm::ReceiveBuffer rb{};
-    rb.data = buf_.data() + 8 + name_len + 1;
-    rb.data_size = static_cast<std::uint32_t>(size - 8 - name_len - 1);
-    timeval tv{};
-    ::gettimeofday(&tv, nullptr);
-    rb.recv_utime = static_cast<std::int64_t>(tv.tv_sec) * 1000000 + tv.tv_usec;
-    if (route) {
-      route->handler(&rb, route->channel);
-    } else {
-      name_.assign(name, name_len);
-      matched->handler(&rb, name_);
-    }
+    n += got;
+    if (got < want) break;  // the queue is empty
   }
   return n;
+}
+
+void UdpmReceiver::dispatch(std::uint8_t* data, std::size_t size, bool truncated) {
+  ++received_;
+  if (size < 9 || truncated) {
+    ++malformed_;
+    return;
+  }
+  std::uint32_t magic = 0;
+  std::memcpy(&magic, data, 4);
+  if (ntohl(magic) != kMagicShort) {
+    ++malformed_;  // fragments ("LC03") and foreign traffic
+    return;
+  }
+  const char* name = reinterpret_cast<const char*>(data + 8);
+  const std::size_t room = std::min(size - 8, kMaxChannel + 1);
+  const void* nul = std::memchr(name, '\0', room);
+  if (!nul) {
+    ++malformed_;
+    return;
+  }
+  const std::size_t name_len = static_cast<const char*>(nul) - name;
+  const auto it = index_.find(std::string_view(name, name_len));
+  const Route* route = it == index_.end() ? nullptr : it->second;
+  const MatchRoute* matched = nullptr;
+  if (!route)
+    for (const MatchRoute& m : matchers_)
+      if (m.match(std::string_view(name, name_len))) {
+        matched = &m;
+        break;
+      }
+  if (!route && !matched) {
+    ++ignored_;
+    return;
+  }
+  lcm::ReceiveBuffer rb{};
+  rb.data = data + 8 + name_len + 1;
+  rb.data_size = static_cast<std::uint32_t>(size - 8 - name_len - 1);
+  timeval tv{};
+  ::gettimeofday(&tv, nullptr);
+  rb.recv_utime = static_cast<std::int64_t>(tv.tv_sec) * 1000000 + tv.tv_usec;
+  if (route) {
+    route->handler(&rb, route->channel);
+  } else {
+    name_.assign(name, name_len);  // capacity reserved by addMatching: no allocation
+    matched->handler(&rb, name_);
+  }
 }
 
 }  // namespace hoist::bus

@@ -27,6 +27,19 @@ namespace asio = boost::asio;
 using std::chrono::duration;
 using std::chrono::duration_cast;
 
+namespace {
+/// Steady-clock span in nanoseconds (the cost split).
+inline std::int64_t nanos(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
+}
+/// User + system CPU time of the whole process [ns].
+std::int64_t processCpuNanos() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return 0;
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+}  // namespace
+
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
       out_(std::move(log)),
@@ -94,7 +107,13 @@ bool Daemon::start() {
   std::string why;
   if (parseUdpmUrl(opt_.lcm_url, udpm, why)) {
     receiver_ = std::make_unique<UdpmReceiver>();
-    if (!receiver_->open(udpm, why)) {
+    // Without recv_buf_size in the URL the buffer holds 200 ms of every
+    // shaft's inputs (about 2 KiB of kernel memory per datagram on
+    // loopback), at least 1 MiB and at most 64 MiB.
+    double inputs_per_s = 0.0;
+    for (const auto& s : shafts_) inputs_per_s += s->config().service.rate;
+    const double want = std::clamp(0.2 * inputs_per_s * 2048.0, 1048576.0, 67108864.0);
+    if (!receiver_->open(udpm, why, static_cast<int>(want))) {
       out_->error("cannot open the LCM input socket for {}: {}", bus::describeLcmUrl(opt_.lcm_url), why);
       return false;
     }
@@ -103,9 +122,28 @@ bool Daemon::start() {
       s->setIgnoredCounter(&ignored_);
     }
     lcm_fd_.assign(receiver_->fd());
+    out_->info("input socket: receive buffer {} KiB granted ({} KiB asked{})", receiver_->rcvbuf() / 1024,
+               (udpm.recv_buf_size > 0 ? udpm.recv_buf_size : static_cast<int>(want)) / 1024,
+               udpm.recv_buf_size > 0 ? ", recv_buf_size of the URL" : "");
   } else {
     for (auto& s : shafts_) s->subscribe();
     lcm_fd_.assign(lcm_.getFileno());
+  }
+  // Outputs: our own publisher for udpm URLs (one sendmmsg per batch of the
+  // tick's cage/shape messages instead of one sendmsg each); else LCM's.
+  {
+    const std::string& out_url = lcm_out_ ? opt_.lcm_url_out : opt_.lcm_url;
+    UdpmUrl u;
+    std::string why_out;
+    if (parseUdpmUrl(out_url, u, why_out)) {
+      sender_ = std::make_unique<UdpmSender>();
+      if (sender_->open(u, why_out)) {
+        for (auto& s : shafts_) s->setSender(sender_.get());
+      } else {
+        out_->warn("own output socket for {} failed ({}); publishing through LCM", bus::describeLcmUrl(out_url), why_out);
+        sender_.reset();
+      }
+    }
   }
   armLcm();
   // [service] lcm_url_out elsewhere: the input socket cannot see a second
@@ -143,6 +181,7 @@ bool Daemon::start() {
   pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
   armSignals();
   start_ = Clock::now();
+  cpu0_ = processCpuNanos();
   const std::size_t n = shafts_.size();
   for (std::size_t i = 0; i < n; ++i) {
     const ServiceConfig& s = shafts_[i]->config().service;
@@ -203,8 +242,7 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
   }
   // Drain what is queued, bounded so the timers are never starved.
   if (receiver_) {
-    receiver_->drain(256);
-    ignored_ = receiver_->ignored() + receiver_->malformed();
+    drainInput();
   } else {
     for (int i = 0; i < 256; ++i)
       if (lcm_.handleTimeout(0) <= 0) break;
@@ -226,6 +264,20 @@ void Daemon::onOutReadable(const boost::system::error_code& ec) {
   // Mostly our own outputs come back here (loopback); bounded like the input.
   out_receiver_->drain(256);
   if (!stopping_) armOutWatch();
+}
+
+void Daemon::flushOutputs() {
+  if (!sender_ || sender_->queued() == 0) return;
+  const auto t0 = Clock::now();
+  sender_->flush();
+  ns_flush_ += nanos(Clock::now() - t0);
+}
+
+void Daemon::drainInput() {
+  const auto t0 = Clock::now();
+  receiver_->drain(256);
+  ignored_ = receiver_->ignored() + receiver_->malformed();
+  ns_receive_ += nanos(Clock::now() - t0);
 }
 
 // ---- timers ------------------------------------------------------------------
@@ -255,7 +307,22 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   // Lateness is measured against the deadline this tick was scheduled for
   // (g.k), so a tick that misses periods reports how late it really was.
   const auto deadline = start_ + g.k * g.period;
-  for (ShaftTwin* s : g.shafts) s->tick(k, deadline, skipped);
+  // Between shafts the input socket is drained every kDrainEvery shafts: a
+  // tick of hundreds of shafts takes milliseconds, during which the inputs
+  // of the next period arrive (issue 13: no input may be lost).  An empty
+  // socket costs one recvmsg.
+  // The outputs queued by the shafts go out at the same points.
+  const auto ns_rx0 = ns_receive_, ns_fl0 = ns_flush_;
+  std::size_t i = 0;
+  for (ShaftTwin* s : g.shafts) {
+    s->tick(k, deadline, skipped);
+    if (++i % kDrainEvery == 0) {
+      flushOutputs();
+      if (receiver_) drainInput();
+    }
+  }
+  flushOutputs();
+  ns_ticks_ += nanos(Clock::now() - now) - (ns_receive_ - ns_rx0) - (ns_flush_ - ns_fl0);
   if (opt_.duration > 0.0 && duration<double>(Clock::now() - start_).count() >= opt_.duration) {
     stop("--duration elapsed");
     return;
@@ -289,6 +356,7 @@ void Daemon::stop(const char* why) {
   stop_time_ = Clock::now();
   stop_reason_ = why;
   log_.info("stopping ({})", why);
+  flushOutputs();
   for (auto& s : shafts_) {
     s->publishHealth(true);
     s->logFinal();
@@ -382,6 +450,49 @@ bool Daemon::writeReport() const {
   j["stop_reason"] = stop_reason_;
   j["realtime"] = {{"memory_lock", rt_.mlockall}, {"scheduling", rt_.scheduling}, {"affinity", rt_.affinity}};
   j["log_lines_dropped"] = log_.dropped();
+  if (receiver_)
+    j["input_socket"] = {{"rcvbuf_bytes", receiver_->rcvbuf()},
+                         {"datagrams", receiver_->received()},
+                         {"kernel_drops", receiver_->refreshKernelDrops()},
+                         {"ignored", receiver_->ignored()},
+                         {"malformed", receiver_->malformed()}};
+  if (sender_) j["output_socket"] = {{"datagrams", sender_->sent()}, {"system_calls", sender_->systemCalls()}};
+  {
+    // Per twin and tick, in microseconds: where the process's CPU time went
+    // (issue 13).  model_step excludes the envelope; tick_other is the rest
+    // of each shaft's tick (alarms, health bookkeeping, histograms) and the
+    // loop around it; receive is every drain of the input socket;
+    // timer_and_rest is the process's CPU time (user + system, all threads)
+    // minus all of the above: timer wake-ups, Asio, the kernel's share of
+    // the work not inside those calls, the log thread.
+    std::int64_t model = 0, env = 0, publish = 0, tick = 0, shaft_ticks = 0, exact = 0, bounded = 0;
+    for (const auto& sp : shafts_) {
+      const ShaftRunStats st = sp->runStats();
+      model += st.ns_model;
+      env += st.ns_envelope;
+      publish += st.ns_publish;
+      tick += st.ns_tick;
+      shaft_ticks += st.ticks;
+      exact += st.envelope_exact;
+      bounded += st.envelope_bounded;
+    }
+    const double cpu = static_cast<double>(processCpuNanos() - cpu0_);
+    const double per = shaft_ticks > 0 ? 1e-3 / static_cast<double>(shaft_ticks) : 0.0;
+    const double other = static_cast<double>(ns_ticks_ - model - publish);
+    publish += ns_flush_;  // the batched sends (outside the shafts' ticks)
+    j["cost_split_us_per_twin_tick"] = {
+        {"twin_ticks", shaft_ticks},
+        {"model_step", per * static_cast<double>(model - env)},
+        {"envelope", per * static_cast<double>(env)},
+        {"publish", per * static_cast<double>(publish)},
+        {"receive", per * static_cast<double>(ns_receive_)},
+        {"tick_other", per * other},
+        {"timer_and_rest", per * (cpu - static_cast<double>(ns_ticks_ + ns_receive_ + ns_flush_))},
+        {"process_cpu", per * cpu},
+        {"envelope_exact", exact},
+        {"envelope_bounded", bounded}};
+    (void)tick;
+  }
   j["histogram_note"] =
       "times in microseconds; " + std::to_string(LatencyHistogram::kPerDecade) +
       " logarithmic bins per decade from 0.1 us, so quantiles are bin centres (about 1.2 % resolution); "

@@ -41,6 +41,7 @@
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
 #include "hoist/bus/udpm_receiver.hpp"
+#include "udpm_sender.hpp"
 
 namespace hoist::svc {
 
@@ -102,6 +103,8 @@ class Daemon {
   };
 
   void armLcm();
+  void drainInput();  ///< the own receive path: read what is queued (timed)
+  void flushOutputs();  ///< the own publisher: send what the tick queued (timed)
   void onLcmReadable(const boost::system::error_code& ec);
   void armOutWatch();
   void onOutReadable(const boost::system::error_code& ec);
@@ -121,6 +124,12 @@ class Daemon {
   lcm::LCM lcm_;
   std::unique_ptr<UdpmReceiver> receiver_;  ///< own receive path for udpm URLs (udpm_receiver.hpp); else LCM's
   std::int64_t ignored_ = 0;                 ///< receiver_->ignored(), mirrored for the health reports
+  static constexpr std::size_t kDrainEvery = 16;  ///< shafts stepped between two drains within a tick
+  // cost split (report): steady-clock ns in the ticks (without the drains
+  // inside them) and in the drains; process CPU time at start
+  std::int64_t ns_ticks_ = 0, ns_receive_ = 0, cpu0_ = 0;
+  std::unique_ptr<UdpmSender> sender_;      ///< own publisher for udpm output URLs (udpm_sender.hpp); else LCM's
+  std::int64_t ns_flush_ = 0;               ///< cost split: steady-clock ns in sender_->flush()
   std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
   /// Receive-only socket on the udpm lcm_url_out group: dispatches only our
   /// own HOIST_HEALTH channels (another instance_id there is a second

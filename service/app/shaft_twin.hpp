@@ -31,6 +31,7 @@
 #include "hoist/winder_t.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "hoist/bus/udpm_receiver.hpp"
+#include "udpm_sender.hpp"
 
 namespace hoist::svc {
 
@@ -55,6 +56,12 @@ struct ShaftRunStats {
   std::int64_t alarm_events = 0, model_faults = 0, publish_failures = 0, nonfinite_blocked = 0;
   const LatencyHistogram* step = nullptr;  ///< model step time [us]
   const LatencyHistogram* late = nullptr;  ///< tick lateness [us]
+  // Cost split, whole run [ns of steady clock] (issue 13): the model
+  // (core tick + housekeeping, the envelope included), of which the
+  // deflection envelope; publishing (encode + sendmsg of every output); the
+  // whole tick() call.
+  std::int64_t ns_model = 0, ns_envelope = 0, ns_publish = 0, ns_tick = 0;
+  std::int64_t envelope_exact = 0, envelope_bounded = 0;  ///< envelope evaluations
 };
 
 class ShaftTwin {
@@ -79,6 +86,9 @@ class ShaftTwin {
   /// on the output group through `router` (a receive-only socket there), so
   /// that a second publisher is detected there too.
   void watchOwnOutputs(InputRouter* router);
+  /// The daemon's own udpm publisher (udpm_sender.hpp), used instead of
+  /// LCM's publish when set (udpm output URLs).
+  void setSender(UdpmSender* s) { sender_ = s; }
   /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
   void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: wall times are measured from `start`; publishes a
@@ -113,19 +123,24 @@ class ShaftTwin {
   void logJunk(const std::string& what);
   std::int64_t rssKb() const;
   double wallNow() const;
-  void publishCage(std::int64_t utime);
-  void publishShape(std::int64_t utime);
+  // batch: queued on the daemon's UdpmSender (sent at its next flush, in the
+  // same tick); only for the tick's cage and shape, whose buffers are not
+  // touched again before then.
+  void publishCage(std::int64_t utime, bool batch = false);
+  void publishShape(std::int64_t utime, bool batch = false);
   void drainAlarmEvents();
-  bool publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len);
+  bool publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len, bool batch = false);
   template <class Msg>
-  bool encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf);
+  bool encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
+                        bool batch = false);
   void logReject(RejectReason r, const char* detail);
 
   TwinConfig cfg_;
   std::string label_;  ///< as given ("" for a daemon with one shaft)
   std::string tag_;    ///< log-line prefix: "[label] " or ""
   lcm::LCM& lcm_;
-  lcm::LCM& out_;  ///< publishes (lcm_url_out, or lcm_)
+  lcm::LCM& out_;  ///< publishes (lcm_url_out, or lcm_) unless sender_ is set
+  UdpmSender* sender_ = nullptr;
   std::int64_t instance_id_ = 0;
   RtLog& log_;
   TestHooks hooks_;
@@ -137,10 +152,11 @@ class ShaftTwin {
   double last_shape_t_ = -1e300;  ///< input clock: model time of the last shape message
   double last_health_wall_ = 0.0;
   std::int64_t ticks_ = 0, deadline_misses_ = 0;
+  std::int64_t ns_model_ = 0, ns_publish_ = 0, ns_tick_ = 0;  ///< cost split (ShaftRunStats)
 
   // statistics
   LatencyHistogram step_hist_, late_hist_;    // this health window
-  LatencyHistogram step_total_, late_total_;  // whole run (final report)
+  LatencyHistogram step_total_, late_total_;  // whole run (final report): the windows merged at each health report
   std::int64_t publish_failures_ = 0, nonfinite_blocked_ = 0, alarm_events_ = 0;
   // Extra HOIST_HEALTH reasons after the winder reasons (not in rejected_total,
   // which counts winder inputs): undecodable alarm commands, and exceptions

@@ -44,6 +44,7 @@ void ServiceConfig::validate() const {
   checkRange("max_step", max_step, 0.0, 10.0);
   checkRange("shape_points", shape_points, 2, 2001);
   checkRange("envelope_points", envelope_points, 2, 20001);
+  checkRange("envelope_tolerance", envelope_tolerance, 0.0, 0.05);
   checkRange("log_rate_limit", log_rate_limit, 1, 1000);
   checkRange("fault_hold", fault_hold, 0.0, 3600.0);
   checkRange("accel_tolerance", accel_tolerance, 0.0, 100.0, true);

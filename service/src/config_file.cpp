@@ -48,6 +48,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   sr.number("max_step", s.max_step);
   sr.integer("shape_points", s.shape_points);
   sr.integer("envelope_points", s.envelope_points);
+  sr.number("envelope_tolerance", s.envelope_tolerance);
   sr.integer("log_rate_limit", s.log_rate_limit);
   sr.number("fault_hold", s.fault_hold);
   sr.string("lcm_url_out", [&](const toml::node&, const std::string& v) { s.lcm_url_out = v; });
@@ -122,7 +123,7 @@ std::string toToml(const TwinConfig& c) {
      << "\nmax_time_step = " << Num{s.max_time_step} << "\nstale_timeout = " << Num{s.stale_timeout}
      << "\nstale_periods = " << Num{s.stale_periods} << "\nstale_min = " << Num{s.stale_min}
      << "\nmax_step = " << Num{s.max_step} << "\nshape_points = " << s.shape_points
-     << "\nenvelope_points = " << s.envelope_points << "\nlog_rate_limit = " << s.log_rate_limit
+     << "\nenvelope_points = " << s.envelope_points << "\nenvelope_tolerance = " << Num{s.envelope_tolerance} << "\nlog_rate_limit = " << s.log_rate_limit
      << "\nfault_hold = " << Num{s.fault_hold} << "\nlcm_url_out = \"" << s.lcm_url_out
      << "\"\naccel_tolerance = " << Num{s.accel_tolerance} << "\nvelocity_tolerance = " << Num{s.velocity_tolerance}
      << "\nconsistency_window = " << Num{s.consistency_window} << "\nplausible_factor = " << Num{s.plausible_factor}

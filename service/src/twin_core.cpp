@@ -2,6 +2,7 @@
 #include "hoist/service/twin_core.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -205,6 +206,7 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
       clock_(makeClock(clock)),
       solver_(solver ? std::move(solver) : defaultSolver(cfg)),
       envelope_(solver_->model(), cfg.service.envelope_points),
+      envelope_tol_(cfg.service.envelope_tolerance * cfg.alarms.guide_rope_gap),
       shape_(solver_->model(), cfg.service.shape_points),
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
@@ -316,7 +318,13 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
     }
     if (ok) {
       const CageResponse& r = solver_->response();
-      const double gdef = envelope_.evaluate(*solver_);
+      // The deflection alarm's envelope: exact, or a conservative bound
+      // within envelope_tol_ of it (service.envelope_tolerance).
+      const auto e0 = std::chrono::steady_clock::now();
+      double gdef = envelope_.evaluateBounded(*solver_, envelope_tol_);
+      // Never fault on a bound: look exactly first.
+      if (!(gdef <= bounds_.lateral) && !envelope_.lastExact()) gdef = envelope_.evaluate(*solver_);
+      envelope_ns_ += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - e0).count();
       out_.t = publishedTime(t);
       out_.kin = r.kin;
       out_.x_c = r.x_c;

@@ -26,7 +26,7 @@ TEST(NoAlloc, FastStepAndEnvelopeAllocateNothing) {
     p.Tb2 = 32000;  // distinct ropes: both modal bases in use
     auto model = std::make_shared<const ShaftModel>(p);
     FastSolver s(model);
-    GuideRopeEnvelope env(*model, 401);
+    GuideRopeEnvelope env(*model, 401), bounded(*model, 401);
     const HoistProfile prof = HoistProfile::trapezoid();
     s.initialize(0.0, prof.at(0.0));
     s.step(0.01, prof.at(0.01));  // first step may size nothing new, but allow it
@@ -37,7 +37,10 @@ TEST(NoAlloc, FastStepAndEnvelopeAllocateNothing) {
       const double t = k * 0.01;
       s.step(t, prof.at(t));
       acc += env.evaluate(s);
+      acc += bounded.evaluateBounded(s, 3e-4);  // issue 13: the bounded envelope, exact and bounded calls
     }
+    EXPECT_GT(bounded.boundedEvaluations(), 0) << "n = " << n;
+    EXPECT_GT(bounded.exactEvaluations(), 0) << "n = " << n;
     Eigen::internal::set_is_malloc_allowed(true);
     EXPECT_EQ(allocationCount() - before, 0) << "n = " << n;
     EXPECT_TRUE(std::isfinite(acc));

@@ -133,6 +133,17 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   DaemonOptions opt;
   opt.shafts = {shaftConfig(1000.0, 50, ""), shaftConfig(100.0, 20, "B/")};
   opt.labels = {"A", "B"};
+  // Issue 13: 15 more (unfed, default gaps) shafts at 100 Hz, so that the
+  // loop drains its input socket between shafts within a tick (every
+  // Daemon::kDrainEvery = 16 shafts) and the bounded envelope runs.
+  for (int i = 1; i <= 15; ++i) {
+    TwinConfig c;
+    c.shaft.n = 10;
+    c.service.rate = 100.0;
+    c.service.channel_prefix = "C" + std::to_string(i) + "/";
+    opt.shafts.push_back(c);
+    opt.labels.push_back("C" + std::to_string(i));
+  }
   opt.lcm_url = kUrl;
   Daemon d(std::move(opt), captureLogger(logs));
   ASSERT_TRUE(d.start());
@@ -150,14 +161,14 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
     }
   };
   loopFor(1.0s);  // warm-up: first input, re-initialization, first events, first health
-  const ShaftRunStats a0 = d.shaft(0).runStats(), b0 = d.shaft(1).runStats();
+  const ShaftRunStats a0 = d.shaft(0).runStats(), b0 = d.shaft(1).runStats(), c0 = d.shaft(2).runStats();
   long allocs = 0;
   {
     AllocationWatch watch;
     loopFor(3.3s);
     allocs = watch.count();
   }
-  const ShaftRunStats a1 = d.shaft(0).runStats(), b1 = d.shaft(1).runStats();
+  const ShaftRunStats a1 = d.shaft(0).runStats(), b1 = d.shaft(1).runStats(), c1 = d.shaft(2).runStats();
   feed.join();
   d.requestStop("test over");
   d.finish();
@@ -171,6 +182,10 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   EXPECT_GT(a1.alarm_events - a0.alarm_events, 4) << logs.str();
   EXPECT_GT(b1.alarm_events - b0.alarm_events, 4) << logs.str();
   EXPECT_EQ(a1.publish_failures, 0);
+  EXPECT_GT(c1.envelope_bounded - c0.envelope_bounded, 250) << "the bounded envelope ran in the window";
+  EXPECT_GT(a1.envelope_exact - a0.envelope_exact, 0);
+  EXPECT_GT(a1.ns_model - a0.ns_model, 0) << "cost split measured";
+  EXPECT_GT(a1.ns_publish - a0.ns_publish, 0);
   const std::string log = logs.str();
   EXPECT_NE(log.find("[A] ALARM INPUT_STALE"), std::string::npos) << log;
   EXPECT_NE(log.find("[B] alarm: INPUT_STALE WARNING cleared"), std::string::npos) << log;

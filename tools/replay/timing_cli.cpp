@@ -25,7 +25,7 @@ Timing test: how a user checks a deployment machine.
 Feeds the RUNNING hoist-twind at --rate Hz (1..1000, default 100) for --duration s (default 60) with
 the paper's trapezoid trip down and back up again, repeated, with the encoder length (the cage moves
 the whole time; seq contiguous from 0, utime = wall clock), and listens to its HOIST_HEALTH and
-HOIST_CAGE on the same --lcm-url and channel prefix.  Measured: deadline misses, tick lateness p99
+HOIST_CAGE on the same --lcm-url (or --lcm-url-out, the daemon's lcm_url_out) and channel prefix.  Measured: deadline misses, tick lateness p99
 (worst window) and max, model step time p99/max (from HOIST_HEALTH, as deltas over the test),
 rejected and lost inputs, model faults, degraded outputs; the end-to-end latency input -> first
 HOIST_CAGE answering it (input_seq) p50/p99/p99.9/max; the feeder's own lateness.  Budgets:
@@ -44,7 +44,8 @@ still reported).
 const std::vector<std::string>& timingOnlyOptions() {
   static const std::vector<std::string> o = {"--duration",        "--shafts",           "--max-late-p99-us",
                                              "--max-late-max-us", "--max-misses",       "--max-step-p99-us",
-                                             "--max-e2e-p99-us",  "--max-rejected",     "--report"};
+                                             "--max-e2e-p99-us",  "--max-rejected",     "--report",
+                                             "--lcm-url-out"};
   return o;
 }
 
@@ -66,6 +67,10 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   app.add_option("--rate", rate, "inputs per second per shaft (default 100)")
       ->check(numberIn(1.0, 1000.0, false, "in [1, 1000] Hz"));
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
+  std::string url_out;
+  app.add_option("--lcm-url-out", url_out,
+                 "where the daemon publishes (its [service] lcm_url_out): HOIST_HEALTH and HOIST_CAGE are read "
+                 "there; default: --lcm-url");
   auto* prefix_opt = app.add_option("--channel-prefix", prefixes,
                                     "prepended to HOIST_WINDER, HOIST_HEALTH, HOIST_CAGE; repeat it to test "
                                     "several shafts")
@@ -118,6 +123,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   o.budgets = budgets;
   o.report_path = report_path;
   o.lcm_url = url;
+  o.lcm_url_out = url_out;
   {
     // As typed: the alias shows "hoist-replay --timing-test ...".
     const std::string typed = commandLine(argc, argv);

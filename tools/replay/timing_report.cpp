@@ -236,6 +236,7 @@ std::string formatReport(const TimingResult& r, const TimingTestOptions& o, cons
   }
   out << " |\n";
   out << "| LCM | " << (o.lcm_url.empty() ? std::string("LCM default") : o.lcm_url) << " |\n";
+  if (!o.lcm_url_out.empty()) out << "| LCM, daemon outputs | " << o.lcm_url_out << " |\n";
   {
     std::string d;
     for (const auto& s : r.shafts)

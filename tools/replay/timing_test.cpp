@@ -364,9 +364,11 @@ int runTimingTest(const TimingTestOptions& o) {
     if (o.progress) std::cerr << "hoist-timing-test: " << s << "\n";
   };
 
-  lcm::LCM rx(o.lcm_url), tx(o.lcm_url);
+  const std::string& rx_url = o.lcm_url_out.empty() ? o.lcm_url : o.lcm_url_out;
+  lcm::LCM rx(rx_url), tx(o.lcm_url);
   if (!rx.good() || !tx.good()) {
-    std::cerr << "hoist-timing-test: cannot open LCM at " << hoist::bus::describeLcmUrl(o.lcm_url) << "\n";
+    std::cerr << "hoist-timing-test: cannot open LCM at " << hoist::bus::describeLcmUrl(rx.good() ? o.lcm_url : rx_url)
+              << "\n";
     return 1;
   }
   const RoundTrip trip(o.l0, o.travel, o.vmax, o.amax);

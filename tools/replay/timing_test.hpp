@@ -38,6 +38,7 @@ struct TimingTestOptions {
   Budgets budgets;
   std::string report_path;  ///< "" = none
   std::string lcm_url;      ///< resolved ("" = LCM default)
+  std::string lcm_url_out;  ///< the daemon's [service] lcm_url_out: its outputs are read there ("" = lcm_url)
   std::string command;      ///< the command line, for the report
   bool progress = false;    ///< one line per second on stderr
   bool quiet = false;

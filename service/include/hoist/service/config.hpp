@@ -47,6 +47,11 @@ struct ServiceConfig {
   double max_step = 0.0025;     ///< largest integration step: longer ticks/input intervals are substepped [s]; 0 = off (same default as hoist-sim)
   int shape_points = 101;       ///< depth samples in HOIST_GUIDE_SHAPE, [2, 2001]
   int envelope_points = 401;    ///< depth samples for the guide-rope deflection alarm, [2, 20001]
+  /// The deflection alarm's envelope may be a conservative bound at most
+  /// this fraction of alarms.guide_rope_gap above the exact one (evaluated
+  /// exactly only when the bound would drift further: issue 13); 0 = exact
+  /// every step, [0, 0.05].
+  double envelope_tolerance = 0.01;
   int log_rate_limit = 5;       ///< log lines per second per rejection reason, [1, 1000]
   double fault_hold = 1.0;      ///< outputs flagged degraded after a model re-init [s]
   /// Cross-sample consistency (docs/service.md): within a stream, the change

@@ -155,6 +155,12 @@ class TwinCore {
   /// read it from shape().depths()/y1()/y2().
   void evaluateShape() { shape_.evaluate(*solver_); }
   const GuideRopeEnvelope& shape() const { return shape_; }
+  /// The deflection alarm's envelope (service.envelope_tolerance: exact or
+  /// bounded evaluations, GuideRopeEnvelope::evaluateBounded).
+  const GuideRopeEnvelope& envelope() const { return envelope_; }
+  /// Time spent in the envelope (exact or bounded) since construction [ns]
+  /// (steady clock around each evaluation: the daemon's cost split).
+  std::int64_t envelopeNanos() const { return envelope_ns_; }
 
   const InputCounters& counters() const { return counters_; }
   const AlarmEngine& alarms() const { return alarms_; }
@@ -205,6 +211,8 @@ class TwinCore {
   std::unique_ptr<ClockPolicy> clock_;
   std::unique_ptr<Solver> solver_;
   GuideRopeEnvelope envelope_;
+  double envelope_tol_ = 0.0;  // [m]: service.envelope_tolerance x alarms.guide_rope_gap
+  std::int64_t envelope_ns_ = 0;
   GuideRopeEnvelope shape_;
   InputValidator validator_;
   AlarmEngine alarms_;

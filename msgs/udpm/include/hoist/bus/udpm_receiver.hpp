@@ -27,7 +27,15 @@
 //
 // Socket options as LCM's: SO_REUSEADDR (+ SO_REUSEPORT) so that other LCM
 // programs on the machine share the port, bound to INADDR_ANY:port, joined
-// to the group on INADDR_ANY; SO_RCVBUF from the URL's recv_buf_size.
+// to the group on INADDR_ANY; SO_RCVBUF from the URL's recv_buf_size, else
+// the caller's default (hoist-twind sizes it for 200 ms of its inputs: a
+// tick of many shafts must not overflow it, issue 13), asked for with
+// SO_RCVBUFFORCE first (root / CAP_NET_ADMIN may exceed net.core.rmem_max),
+// then SO_RCVBUF (capped at rmem_max by the kernel); rcvbuf() is what the
+// kernel granted.  SO_RXQ_OVFL makes the kernel report, with every
+// datagram, how many it dropped on this socket because the buffer was full:
+// kernelDrops() (the "inputs lost" that no sequence number can attribute to
+// a shaft when the lost datagram was someone else's).
 #pragma once
 
 #include <array>
@@ -36,6 +44,9 @@
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 #include <string_view>
+#include <sys/socket.h>
+#include <sys/uio.h>
+#include <unordered_map>
 #include <vector>
 
 namespace hoist::bus {
@@ -55,6 +66,7 @@ struct UdpmUrl {
   std::string group = "239.255.76.67";
   int port = 7667;
   int recv_buf_size = 0;  ///< bytes, 0 = the system default
+  int ttl = 0;            ///< multicast TTL (publishing), 0 = this machine only
 };
 bool parseUdpmUrl(const std::string& url, UdpmUrl& out, std::string& why);
 
@@ -66,15 +78,28 @@ class UdpmReceiver final : public InputRouter {
   UdpmReceiver& operator=(const UdpmReceiver&) = delete;
 
   /// Open the socket (non-blocking); false and `why` on failure.
-  bool open(const UdpmUrl& url, std::string& why);
+  /// `default_rcvbuf` [bytes] applies when the URL gives no recv_buf_size.
+  bool open(const UdpmUrl& url, std::string& why, int default_rcvbuf = 0);
+  /// The receive buffer the kernel granted [bytes] (getsockopt SO_RCVBUF).
+  int rcvbuf() const { return rcvbuf_; }
+  /// Datagrams the kernel dropped on this socket (buffer full), as last
+  /// reported by SO_RXQ_OVFL: each datagram carries the count at the time it
+  /// was queued, so drops show with the next datagram read after them.
+  std::int64_t kernelDrops() const { return kernel_drops_; }
+  /// Ask the kernel for the current drop count (SO_MEMINFO,
+  /// SK_MEMINFO_DROPS; not for the loop: a system call); updates and returns
+  /// kernelDrops().
+  std::int64_t refreshKernelDrops();
   int fd() const { return fd_; }
   void add(const std::string& channel, RawHandler handler) override;
   /// Every channel whose name satisfies `match` (checked after the exact
   /// names).  The handler's channel string is reused between calls.
   void addMatching(std::function<bool(std::string_view)> match, RawHandler handler);
-  /// Read and dispatch at most `max` datagrams; returns how many were read
-  /// (0: nothing pending).  No allocation.
+  /// Read and dispatch at most `max` datagrams, up to kBatch per system
+  /// call (recvmmsg); returns how many were read (0: nothing pending).  No
+  /// allocation (the batch buffers are allocated by open()).
   int drain(int max);
+  static constexpr int kBatch = 16;  ///< datagrams per recvmmsg
 
   std::int64_t received() const { return received_; }
   std::int64_t ignored() const { return ignored_; }      ///< datagrams on channels nobody subscribed
@@ -85,7 +110,11 @@ class UdpmReceiver final : public InputRouter {
     std::string channel;
     RawHandler handler;
   };
+  void dispatch(std::uint8_t* data, std::size_t size, bool truncated);
+  static constexpr std::size_t kSlotBytes = 65536;  ///< any UDP datagram fits
   int fd_ = -1;
+  int rcvbuf_ = 0;
+  std::int64_t kernel_drops_ = 0;
   std::vector<Route> routes_;
   struct MatchRoute {
     std::function<bool(std::string_view)> match;
@@ -93,7 +122,14 @@ class UdpmReceiver final : public InputRouter {
   };
   std::vector<MatchRoute> matchers_;
   std::string name_;  ///< the channel name for matched routes (capacity reserved)
-  std::array<std::uint8_t, 65536> buf_{};
+  std::unordered_map<std::string_view, const Route*> index_;  ///< exact channel name -> route
+  std::vector<std::uint8_t> slots_;                           ///< kBatch x kSlotBytes
+  std::array<mmsghdr, kBatch> msgs_{};
+  std::array<iovec, kBatch> iov_{};
+  struct alignas(cmsghdr) Control {
+    char b[CMSG_SPACE(sizeof(std::uint32_t))];
+  };
+  std::array<Control, kBatch> control_{};
   std::int64_t received_ = 0, ignored_ = 0, malformed_ = 0;
 };
 
