@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <linux/filter.h>
 #include <linux/sock_diag.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -122,6 +123,64 @@ bool UdpmReceiver::open(const UdpmUrl& url, std::string& why, int default_rcvbuf
   if (::setsockopt(fd_, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) < 0) {
     why = std::string("join ") + url.group + ": " + std::strerror(errno);
     return false;
+  }
+  return true;
+}
+
+bool UdpmReceiver::acceptOnlySuffix(std::string_view suffix, const std::vector<std::size_t>& prefix_lengths,
+                                    std::string& why) {
+  // Classic BPF on a UDP socket sees the datagram from its UDP header: the
+  // LCM header starts at offset 8, the channel name at 16.  For each prefix
+  // length P, compare the bytes suffix + NUL at 16 + P (4 at a time, then
+  // single bytes); any mismatch jumps to the next length, a full match
+  // accepts, and after the last length the datagram is dropped in the
+  // kernel.  A load past the end of a short datagram drops it too.
+  if (fd_ < 0) {
+    why = "not open";
+    return false;
+  }
+  std::string want(suffix);
+  want.push_back('\0');
+  std::vector<sock_filter> prog;
+  for (std::size_t P : prefix_lengths) {
+    if (P + want.size() > kMaxChannel + 1) continue;  // no valid channel that long
+    const std::size_t base = 16 + P;
+    // Build the block first, then fix its "mismatch" jumps to point past it.
+    std::vector<sock_filter> block;
+    std::vector<std::size_t> fixups;
+    std::size_t i = 0;
+    while (i < want.size()) {
+      const std::size_t left = want.size() - i;
+      if (left >= 4) {
+        std::uint32_t w = 0;
+        for (int k = 0; k < 4; ++k) w = (w << 8) | static_cast<std::uint8_t>(want[i + k]);
+        block.push_back(BPF_STMT(BPF_LD | BPF_W | BPF_ABS, static_cast<std::uint32_t>(base + i)));
+        block.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, w, 0, 0));
+        i += 4;
+      } else {
+        block.push_back(BPF_STMT(BPF_LD | BPF_B | BPF_ABS, static_cast<std::uint32_t>(base + i)));
+        block.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, static_cast<std::uint8_t>(want[i]), 0, 0));
+        i += 1;
+      }
+      fixups.push_back(block.size() - 1);
+    }
+    block.push_back(BPF_STMT(BPF_RET | BPF_K, 0xFFFFFFFFu));  // match: accept the whole datagram
+    for (std::size_t f : fixups) block[f].jf = static_cast<std::uint8_t>(block.size() - 1 - f);
+    prog.insert(prog.end(), block.begin(), block.end());
+  }
+  prog.push_back(BPF_STMT(BPF_RET | BPF_K, 0));  // no length matched: drop
+  if (prog.size() > BPF_MAXINSNS) {
+    why = "too many prefix lengths for a kernel filter";
+    return false;
+  }
+  sock_fprog fprog{static_cast<unsigned short>(prog.size()), prog.data()};
+  if (::setsockopt(fd_, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) {
+    why = std::string("SO_ATTACH_FILTER: ") + std::strerror(errno);
+    return false;
+  }
+  // Datagrams queued before the filter was attached: read and drop them.
+  std::uint8_t junk[16];
+  while (::recv(fd_, junk, sizeof junk, MSG_DONTWAIT) >= 0) {
   }
   return true;
 }

@@ -165,6 +165,16 @@ bool Daemon::start() {
         out_receiver_.reset();
       } else {
         for (auto& s : shafts_) s->watchOwnOutputs(out_receiver_.get());
+        // All our outputs arrive on that group: let the kernel drop all but
+        // the HOIST_HEALTH channels, so that the loop does not wake for its
+        // own cage and shape messages (the point of lcm_url_out, issue 13).
+        std::vector<std::size_t> lens;
+        for (auto& s : shafts_) {
+          const std::size_t P = s->channels().health.size() - bus::kChannelHealth.size();
+          if (std::find(lens.begin(), lens.end(), P) == lens.end()) lens.push_back(P);
+        }
+        if (!out_receiver_->acceptOnlySuffix(bus::kChannelHealth, lens, out_why))
+          out_->warn("no kernel filter on the output-URL watch ({}): it reads every output datagram", out_why);
         out_fd_.assign(out_receiver_->fd());
         armOutWatch();
       }

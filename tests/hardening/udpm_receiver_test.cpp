@@ -1,7 +1,7 @@
 // hoist/bus/udpm_receiver.hpp, the project's own udpm:// receive path (the
 // LCM 1.3.1 workaround of issue 12.3, used by hoist-twind, hoist-dash,
 // hoist-mqtt and hoist-monitor): URL parsing, exact and matching routes, and
-// what it drops.  Real multicast on loopback, port 7866 (the datagrams are
+// what it drops.  Real multicast on loopback, ports 7866 and 7877 (the datagrams are
 // LCM's own, sent by lcm::LCM::publish, and hand-made ones).
 #include <gtest/gtest.h>
 
@@ -104,4 +104,37 @@ TEST(UdpmReceiverTest, ExactAndMatchingRoutesOthersCountedNothingStored) {
   EXPECT_EQ(last_matched, "north/HOIST_ALARM");
   EXPECT_EQ(rx.ignored(), 1002);   // mineX1, HOIST_ALARM_ACK, 1000 spam names
   EXPECT_EQ(rx.malformed(), 3);
+}
+
+TEST(UdpmReceiverTest, KernelSuffixFilterQueuesOnlyTheWatchedChannels) {
+  // hoist-twind's watch of its own HOIST_HEALTH on lcm_url_out: the kernel
+  // must drop every other channel (its cage and shape outputs) before they
+  // reach the socket, and keep "<prefix>HOIST_HEALTH" for the prefix lengths
+  // given (here 0 and 6: "" and "north/").
+  const std::string url = hoist::test::urlFor(7877);
+  std::string why;
+  if (!hoist::test::loopbackMulticastWorks(url, why)) FAIL() << why << ".\n" << hoist::test::kMulticastHelp;
+  UdpmUrl u;
+  ASSERT_TRUE(hoist::bus::parseUdpmUrl(url, u, why));
+  UdpmReceiver rx;
+  ASSERT_TRUE(rx.open(u, why)) << why;
+  std::vector<std::string> got;
+  rx.addMatching([](std::string_view) { return true; },
+                 [&](const lcm::ReceiveBuffer*, const std::string& ch) { got.push_back(ch); });
+  ASSERT_TRUE(rx.acceptOnlySuffix("HOIST_HEALTH", {0, 6}, why)) << why;
+  lcm::LCM pub(url);
+  ASSERT_TRUE(pub.good());
+  const char payload[24] = {};
+  for (const char* ch : {"HOIST_CAGE", "HOIST_HEALTH", "north/HOIST_CAGE", "north/HOIST_HEALTH", "south/HOIST_HEALTH",
+                         "xyz/HOIST_HEALTH", "HOIST_HEALTHX", "north/HOIST_HEALTH_", "HOIST_HEALT"})
+    pub.publish(ch, payload, sizeof payload);
+  const auto until = std::chrono::steady_clock::now() + 300ms;
+  while (std::chrono::steady_clock::now() < until)
+    if (rx.drain(256) == 0) std::this_thread::sleep_for(1ms);
+  // "south/" has 6 bytes too: the kernel keeps it (same length); the exact
+  // routes of the daemon then tell it apart.  Everything else never arrives.
+  EXPECT_EQ(got, (std::vector<std::string>{"HOIST_HEALTH", "north/HOIST_HEALTH", "south/HOIST_HEALTH"}));
+  EXPECT_EQ(rx.received(), 3);
+  EXPECT_EQ(rx.ignored(), 0);
+  EXPECT_EQ(rx.malformed(), 0);
 }

@@ -99,6 +99,14 @@ class UdpmReceiver final : public InputRouter {
   /// call (recvmmsg); returns how many were read (0: nothing pending).  No
   /// allocation (the batch buffers are allocated by open()).
   int drain(int max);
+  /// Kernel-side filter (classic BPF, SO_ATTACH_FILTER), for a socket that
+  /// only needs a few channels of a busy group: the kernel queues only the
+  /// datagrams whose channel name is some prefix of one of `prefix_lengths`
+  /// bytes followed by `suffix`, and drops the rest before they cost a
+  /// wake-up or a read (hoist-twind's watch of its own HOIST_HEALTH on
+  /// lcm_url_out, where all its outputs arrive).  The routes still match the
+  /// exact names.  Start-up only (allocates); false and `why` on failure.
+  bool acceptOnlySuffix(std::string_view suffix, const std::vector<std::size_t>& prefix_lengths, std::string& why);
   static constexpr int kBatch = 16;  ///< datagrams per recvmmsg
 
   std::int64_t received() const { return received_; }
