@@ -18,15 +18,17 @@
 #   ropes' wave impedance in ~6 ms and sends sharp waves along the ropes.
 #   The uncorrected model does not converge as 1/n there (its modal rope is
 #   an effective mass ~2 rho2 L / n at a sleeve instead of the continuum's
-#   wave impedance): off n = 200 -> 400 -> 800 stays 3.5 -> 3.0 -> 2.0 %
-#   (nRMS, lambda) from the corrected runs, and Richardson makes lambda worse
+#   wave impedance): at 0.625 ms the uncorrected n = 200 / 400 runs are
+#   3.5 / 3.0 % (nRMS, lambda) from the corrected n = 400 run, at 2.5 ms the
+#   uncorrected n = 400 / 800 runs 3.1 / 2.0 % from the corrected n = 800
+#   run (slow convergence towards the corrected family), and Richardson makes lambda worse
 #   (2 y400 - y200: 4.6 % against 3.1 % for y400 alone; the test
 #   RichardsonDoesNotConvergeTheRestStartsSleeveForces shows it at n = 50/100).
 #   The previous rest.csv (Richardson of the uncorrected n = 200/400, 2.5 ms)
 #   was 4.6 % off in lambda.  The corrected family converges: n = 200 vs 400
 #   at 0.625 ms differ by 0.04 % (theta) / 0.7 % (lambda); 1.25 vs 0.625 ms at
-#   n = 400 by 0.07 % / 1.0 % (the step matters: the 6-ms twist); the
-#   residual uncertainty lies above 10 Hz, far above the n = 20 band.  The
+#   n = 400 by 0.07 % / 1.0 % (the step matters: the 6-ms twist); below the
+#   n = 20 band's top (3.1 Hz) both differences are under 0.1 %.  The
 #   uncorrected n = 400 run at 0.625 ms agrees in theta within its own static
 #   truncation error (1.3 %).  docs/model.md "Dynamics against a converged
 #   model" has the table; docs/figures/convergence/convergence.sh reproduces it.
