@@ -248,7 +248,7 @@ std::vector<double> lowPass(const std::vector<double>& x, double fc, double dt) 
   const double K = std::tan(std::numbers::pi * fc * dt), q = std::sqrt(2.0), nrm = 1.0 / (1.0 + q * K + K * K);
   const double b0 = K * K * nrm, b1 = 2 * b0, b2 = b0, a1 = 2 * (K * K - 1) * nrm, a2 = (1 - q * K + K * K) * nrm;
   const std::size_t pad = static_cast<std::size_t>(std::ceil(10.0 / (fc * dt)));  // 10 periods of fc
-  std::vector<double> y(pad, x.front() * 0.0);
+  std::vector<double> y(pad, 0.0);
   y.insert(y.end(), x.begin(), x.end());
   y.insert(y.end(), pad, x.back());
   auto pass = [&](auto first, auto last) {
@@ -276,6 +276,24 @@ double topModeFrequency(int n) {
   const double T0 = p.Tb1 + p.rho2 * p.g * p.L, T1 = p.Tb1;
   const double travel = 2.0 * std::sqrt(p.rho2) * (std::sqrt(T0) - std::sqrt(T1)) / (p.rho2 * p.g);
   return n / (2.0 * travel);
+}
+
+TEST(StaticCorrection, LowPassIsTheFilterItSays) {
+  // The band-limited comparisons rest on lowPass: zero phase, |H| =
+  // 1 / (1 + (f / fc)^4) (a sine keeps its phase; half amplitude at fc).
+  const double fc = 3.0, dt = 0.01;
+  for (double f : {0.3, 1.5, 3.0, 6.0, 15.0}) {
+    std::vector<double> x(6000);
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::sin(2 * std::numbers::pi * f * dt * static_cast<double>(i) + 0.3);
+    const auto y = lowPass(x, fc, dt);
+    // Away from the ends: y = H x with the prewarped (bilinear) response.
+    const double wd = std::tan(std::numbers::pi * f * dt) / std::tan(std::numbers::pi * fc * dt);
+    const double H = 1.0 / (1.0 + std::pow(wd, 4));
+    double worst = 0;
+    for (std::size_t i = 2000; i < 4000; ++i) worst = std::max(worst, std::abs(y[i] - H * x[i]));
+    EXPECT_LT(worst, 1e-6) << f << " Hz";
+    if (f == fc) EXPECT_NEAR(H, 0.5, 1e-12);
+  }
 }
 
 struct BandErrors {

@@ -24,7 +24,7 @@ plot "rest.csv" u 1:3 w l lw 2 lc rgb "black" t "converged", \
      "" u 1:11 w l lw 1.5 dt 2 lc rgb "gray50" t "converged, low-passed at f_{20}", \
      "" u 1:5 w l lw 1.5 lc rgb "red" t "n = 20, on", \
      "" u 1:9 w l lw 1 lc rgb "blue" t "n = 50, on"
-set title "lambda_1, 5-7 s: n = 20 follows the low-passed converged force; the content above f_{20} (3.3 % nRMS) is beyond any 20-mode rope"
+set title "lambda_1, 5-7 s: n = 20 follows the low-passed converged force; the content above f_{20} (3.2 % nRMS) is beyond any 20-mode rope"
 set xrange [5:7]
 plot "rest.csv" u 1:3 w l lw 2 lc rgb "black" t "converged", \
      "" u 1:11 w l lw 1.5 dt 2 lc rgb "gray50" t "converged, low-passed at f_{20}", \
