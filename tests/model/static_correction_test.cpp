@@ -292,7 +292,9 @@ TEST(StaticCorrection, LowPassIsTheFilterItSays) {
     double worst = 0;
     for (std::size_t i = 2000; i < 4000; ++i) worst = std::max(worst, std::abs(y[i] - H * x[i]));
     EXPECT_LT(worst, 1e-6) << f << " Hz";
-    if (f == fc) EXPECT_NEAR(H, 0.5, 1e-12);
+    if (f == fc) {
+      EXPECT_NEAR(H, 0.5, 1e-12);
+    }
   }
 }
 
