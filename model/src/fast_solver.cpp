@@ -112,6 +112,7 @@ void FastSolver::fillResidualFlexibility(double l) {
   const double Ta2 = model_->guideTension(2, a), Tb2 = model_->guideTension(2, b);
   Zd_ << 2.0 * std::sqrt(Ta1 * p.rho2), 2.0 * std::sqrt(Ta2 * p.rho2), 2.0 * std::sqrt(Tb2 * p.rho2),
       2.0 * std::sqrt(Tb1 * p.rho2);
+  Zd_ *= zscale_;
   R_.setZero();
   R_(0, 0) = G1(0) - g1.cwiseProduct(k1).dot(g1);
   R_(0, 3) = R_(3, 0) = G1(1) - g1.cwiseProduct(k1).dot(g4);
@@ -119,6 +120,11 @@ void FastSolver::fillResidualFlexibility(double l) {
   R_(1, 1) = G2(0) - g2.cwiseProduct(k2).dot(g2);
   R_(1, 2) = R_(2, 1) = G2(1) - g2.cwiseProduct(k2).dot(g3);
   R_(2, 2) = G2(2) - g3.cwiseProduct(k2).dot(g3);
+}
+
+void FastSolver::setResidualDampingScale(double s) {
+  if (!(s >= 0.0) || !std::isfinite(s)) throw std::invalid_argument("residual damping scale must be finite and >= 0");
+  zscale_ = s;
 }
 
 void FastSolver::fillConstraintRowDerivatives(double l) {

@@ -112,6 +112,12 @@ class FastSolver final : public Solver {
   /// and the spring (quasi-static) part of the sleeve forces, R^-1 (-G q).
   const Eigen::Vector4d& residualDamping() const { return Zd_; }
   const Eigen::Vector4d& residualSpringForces() const { return lamS_; }
+  /// Scales the sleeves' dashpot Z (default 1; 0 removes it, leaving the
+  /// residual springs alone).  A sensitivity knob for tests and studies
+  /// (docs/model.md: the response is insensitive to 0.25 Z .. 2 Z); takes
+  /// effect from the next step; no effect without the static correction.
+  void setResidualDampingScale(double s);
+  double residualDampingScale() const { return zscale_; }
 
  private:
   void fillConstraintRows(double l);                 // G_ (4 x N) at l
@@ -145,6 +151,7 @@ class FastSolver final : public Solver {
   Eigen::Matrix4d R_ = Eigen::Matrix4d::Zero();  // residual flexibility at the sleeves
   Eigen::Matrix4d Rc_ = Eigen::Matrix4d::Zero(); // step compliance (R^-1 + Z/h)^-1
   Eigen::Vector4d Zd_ = Eigen::Vector4d::Zero(); // wave impedance 2 sqrt(T rho2) at each sleeve
+  double zscale_ = 1.0;                           // setResidualDampingScale
   Eigen::Vector4d delta_ = Eigen::Vector4d::Zero();  // residual displacement -G x at the last step
   Eigen::Vector4d lamS_ = Eigen::Vector4d::Zero();   // spring part of lam: R lamS = delta
   VectorXd kinv_;                     // 1 / kappa (rope entries)
