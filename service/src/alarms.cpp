@@ -17,6 +17,8 @@ const char* toString(AlarmKind k) {
     case AlarmKind::ModelFault: return "MODEL_FAULT";
     case AlarmKind::ModelDomain: return "MODEL_DOMAIN";
     case AlarmKind::DuplicatePublisher: return "DUPLICATE_PUBLISHER";
+    case AlarmKind::PredictedClearance: return "PREDICTED_CLEARANCE";
+    case AlarmKind::PredictedSlack: return "PREDICTED_SLACK";
   }
   return "?";
 }
@@ -205,7 +207,8 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 
 namespace {
 // Slot layout: 0/1 CAGE_POS_Y W/C, 2/3 CAGE_NEG_Y W/C, 4/5 GUIDE_ROPE W/C,
-// 6 INPUT_STALE W, 7 MODEL_FAULT C, 8 MODEL_DOMAIN C, 9 DUPLICATE_PUBLISHER W.
+// 6 INPUT_STALE W, 7 MODEL_FAULT C, 8 MODEL_DOMAIN C, 9 DUPLICATE_PUBLISHER W,
+// 10 PREDICTED_CLEARANCE W, 11 PREDICTED_SLACK W.
 int slotOf(AlarmKind k, AlarmLevel l) {
   const int crit = l == AlarmLevel::Critical ? 1 : 0;
   switch (k) {
@@ -216,6 +219,8 @@ int slotOf(AlarmKind k, AlarmLevel l) {
     case AlarmKind::ModelFault: return l == AlarmLevel::Critical ? 7 : -1;
     case AlarmKind::ModelDomain: return l == AlarmLevel::Critical ? 8 : -1;
     case AlarmKind::DuplicatePublisher: return l == AlarmLevel::Warning ? 9 : -1;
+    case AlarmKind::PredictedClearance: return l == AlarmLevel::Warning ? 10 : -1;
+    case AlarmKind::PredictedSlack: return l == AlarmLevel::Warning ? 11 : -1;
   }
   return -1;
 }
@@ -249,6 +254,12 @@ AlarmEngine::AlarmEngine(const AlarmConfig& cfg) : cfg_(cfg) {
   alarms_[8].configure(AlarmKind::ModelDomain, AlarmLevel::Critical, flag);
   flag.latch = false;
   alarms_[9].configure(AlarmKind::DuplicatePublisher, AlarmLevel::Warning, flag);
+  // Predictions: raised with the forecast that predicts (no on-delay),
+  // cleared after off_delay without one, never latched.
+  AlarmSettings pred = flag;
+  pred.off_delay = cfg_.off_delay;
+  alarms_[10].configure(AlarmKind::PredictedClearance, AlarmLevel::Warning, pred);
+  alarms_[11].configure(AlarmKind::PredictedSlack, AlarmLevel::Warning, pred);
 }
 
 void AlarmEngine::updateClearance(double now, const Clearance& c, AlarmEvents& out) {
@@ -275,6 +286,17 @@ void AlarmEngine::setModelDomain(double now, bool outside, double l, double limi
 void AlarmEngine::setDuplicatePublisher(double now, bool seen, double other_id, AlarmEvents& out) {
   if (seen) alarms_[9].setDetail(other_id, 0.0);
   alarms_[9].update(now, seen ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setPredictedClearance(double now, bool predicted, double seconds, double horizon,
+                                        AlarmEvents& out) {
+  if (predicted) alarms_[10].setDetail(seconds, horizon);
+  alarms_[10].update(now, predicted ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out) {
+  if (predicted) alarms_[11].setDetail(seconds, horizon);
+  alarms_[11].update(now, predicted ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

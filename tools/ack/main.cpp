@@ -32,9 +32,9 @@ int main(int argc, char** argv) {
   double shelve = 0.0;
   bool unshelve = false;
   app.add_option("--kind", kind,
-                 "alarm kind: CAGE_POS_Y, CAGE_NEG_Y, GUIDE_ROPE, INPUT_STALE, MODEL_FAULT, MODEL_DOMAIN, DUPLICATE_PUBLISHER, or * for all")
+                 "alarm kind: CAGE_POS_Y, CAGE_NEG_Y, GUIDE_ROPE, INPUT_STALE, MODEL_FAULT, MODEL_DOMAIN, DUPLICATE_PUBLISHER, PREDICTED_CLEARANCE, PREDICTED_SLACK, or * for all")
       ->capture_default_str()
-      ->check(CLI::IsMember({"*", "CAGE_POS_Y", "CAGE_NEG_Y", "GUIDE_ROPE", "INPUT_STALE", "MODEL_FAULT", "MODEL_DOMAIN", "DUPLICATE_PUBLISHER"}));
+      ->check(CLI::IsMember({"*", "CAGE_POS_Y", "CAGE_NEG_Y", "GUIDE_ROPE", "INPUT_STALE", "MODEL_FAULT", "MODEL_DOMAIN", "DUPLICATE_PUBLISHER", "PREDICTED_CLEARANCE", "PREDICTED_SLACK"}));
   app.add_option("--level", level, "warning, critical or both")
       ->capture_default_str()
       ->check(CLI::IsMember({"warning", "critical", "both"}));

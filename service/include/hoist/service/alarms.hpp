@@ -17,7 +17,11 @@
 //     (critical_fraction * gap) alarm; INPUT_STALE is a WARNING, MODEL_FAULT a
 //     CRITICAL, MODEL_DOMAIN (rope length outside the model's valid range) a
 //     CRITICAL, DUPLICATE_PUBLISHER (another process publishes on this
-//     twin's output channels) a WARNING;
+//     twin's output channels) a WARNING; PREDICTED_CLEARANCE and
+//     PREDICTED_SLACK (issue 17: a look-ahead scenario crosses the CRITICAL
+//     clearance threshold / brings lambda_0 below the slack threshold within
+//     the forecast horizon) are WARNINGs, never latched, raised at once
+//     (no on-delay: the forecast itself is the early warning);
 //   * the condition comes on when value >= threshold has held for on_delay
 //     and goes off when value < threshold - deadband has held for off_delay
 //     (so a value hovering at the threshold cannot chatter);
@@ -45,9 +49,10 @@
 namespace hoist::svc {
 
 enum class AlarmKind : std::uint8_t {
-  CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher
+  CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher,
+  PredictedClearance, PredictedSlack
 };
-inline constexpr int kAlarmKinds = 7;
+inline constexpr int kAlarmKinds = 9;
 /// A re-shelve that moves the expiry by less than this [s] is not effective.
 inline constexpr double kReshelveResolution = 1.0;
 
@@ -199,7 +204,7 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 /// All alarms of the twin.
 class AlarmEngine {
  public:
-  static constexpr int kSlots = 10;
+  static constexpr int kSlots = 12;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
   const AlarmConfig& config() const { return cfg_; }
@@ -217,6 +222,12 @@ class AlarmEngine {
   /// MODEL_FAULT events report `value` against `limit` (e.g. an implausible
   /// output and its bound; 1/0 for a non-finite state).
   void setModelFaultDetail(double value, double limit) { alarms_[7].setDetail(value, limit); }
+  /// Look-ahead result (issue 17): `predicted` true while the latest
+  /// forecast has a scenario that crosses the threshold within the horizon;
+  /// `seconds` when (after the forecast's start), `horizon` the horizon
+  /// (reported as the event's value and threshold).
+  void setPredictedClearance(double now, bool predicted, double seconds, double horizon, AlarmEvents& out);
+  void setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out);
   /// Runs shelve expiry and re-announcement without a new value.
   void poll(double now, AlarmEvents& out);
 
