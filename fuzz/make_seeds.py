@@ -18,9 +18,16 @@ FMT = {"int8_t": ">b", "int16_t": ">h", "int32_t": ">i", "int64_t": ">q", "byte"
 
 
 def encode(st, count=0, text=b"", overrides=None):
-    """Encoding of `st` with every var count = `count`, strings = `text`.
-    overrides: member name -> raw bytes replacing that member's encoding."""
-    out = struct.pack(">q", g.fingerprint(st))
+    """Encoding of `st` with every var count = `count`, strings = `text`
+    (nested values too, without fingerprints as lcm-gen writes them).
+    overrides: member name -> raw bytes replacing that member's encoding
+    (top level), or (nested member name, index, inner member name) -> bytes
+    for a member of one nested element."""
+    return struct.pack(">q", g.fingerprint(st)) + body(st, count, text, overrides)
+
+
+def body(st, count=0, text=b"", overrides=None):
+    out = b""
     for m in st.members:
         if overrides and m.name in overrides:
             out += overrides[m.name]
@@ -30,8 +37,12 @@ def encode(st, count=0, text=b"", overrides=None):
             mode, size = m.dims[0]
             n = int(size) if mode == 0 else count
         is_count = any(x.dims and x.dims[0] == (1, m.name) for x in st.members)
-        for _ in range(n):
-            if m.type == "string":
+        for i in range(n):
+            if m.nested:
+                inner = {k[2]: v for k, v in (overrides or {}).items()
+                         if isinstance(k, tuple) and k[0] == m.name and k[1] == i}
+                out += body(m.struct, count, text, inner)
+            elif m.type == "string":
                 out += struct.pack(">i", len(text) + 1) + text + b"\0"
             elif is_count:
                 out += struct.pack(FMT[m.type], count)
@@ -65,9 +76,27 @@ def main():
                         st, overrides={m.name: struct.pack(">I", bad)})
             if m.dims and m.dims[0][0] == 1:
                 cname = m.dims[0][1]
+                cfmt = FMT[next(x.type for x in st.members if x.name == cname)]
                 for bad in (0x7FFFFFFF, -1, -0x80000000, 100001):
+                    bits = 8 * struct.calcsize(cfmt)
+                    v = ((bad + (1 << (bits - 1))) % (1 << bits)) - (1 << (bits - 1))  # wrap to the count's width
                     seeds[f"{st.name}_{cname}_{bad & 0xFFFFFFFF:x}"] = bytes([k]) + encode(
-                        st, overrides={cname: struct.pack(">i", bad)})
+                        st, overrides={cname: struct.pack(cfmt, v)})
+            if m.nested and m.dims:
+                # Bad counts and strings inside the second nested element
+                # (issue 17: forecast_t.scenarios[1].num_points, .name).
+                for x in m.struct.members:
+                    if x.dims and x.dims[0][0] == 1:
+                        cname = x.dims[0][1]
+                        cfmt = FMT[next(y.type for y in m.struct.members if y.name == cname)]
+                        for bad in (-1, 0x7FFF if cfmt != ">b" else 0x7F, 65):
+                            seeds[f"{st.name}_{m.name}1_{cname}_{bad & 0xFFFF:x}"] = bytes([k]) + encode(
+                                st, count=2, text=b"estop",
+                                overrides={(m.name, 1, cname): struct.pack(cfmt, bad)})
+                    if x.type == "string" and not x.dims:
+                        for bad in (0, 0x80000000):
+                            seeds[f"{st.name}_{m.name}1_{x.name}_len{bad:x}"] = bytes([k]) + encode(
+                                st, count=2, overrides={(m.name, 1, x.name): struct.pack(">I", bad)})
     for name, data in seeds.items():
         with open(os.path.join(mdir, name), "wb") as f:
             f.write(data)

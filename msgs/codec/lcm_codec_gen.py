@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """lcm_codec_gen.py -- generate the checked decoders and JSON codec of msgs/*.lcm.
 
-Reads the LCM type definitions (package, struct, primitive members, fixed and
-variable-length one-dimensional arrays, strings, consts) and writes
+Reads the LCM type definitions (package, struct, primitive members, members of
+another hoist type (nested structs), fixed and variable-length one-dimensional
+arrays of either, strings, consts) and writes
 
   OUT/include/hoist/msg/codec.hpp   the API (DecodeStatus, checkedDecode, toJson,
                                     fromJson, jsonSchema, TypeInfo, allTypes)
@@ -11,12 +12,19 @@ variable-length one-dimensional arrays, strings, consts) and writes
 
 The fingerprint of each type is computed here with LCM's rules (lcmgen.c:
 lcm_struct_hash + the rotation of _computeHash); tests/msgs checks that it equals
-lcm-gen's getHash() for every type.
+lcm-gen's getHash() for every type.  A nested type contributes its own hash
+(recursively, as lcm-gen's _computeHash); nested values carry no fingerprint
+of their own on the wire (lcm-gen's _encodeNoHash), so the outer fingerprint
+covers them.
 
 Annotations (comments in the .lcm file; they do not change the LCM semantics
 or the fingerprint):
   // @max COUNT N      the variable-length arrays sized by member COUNT hold at
-                       most N elements (default DEFAULT_MAX_COUNT)
+                       most N elements (default DEFAULT_MAX_COUNT); N may also
+                       name an integer const of the struct (@max num_points
+                       MAX_POINTS).  Without @max, a count member num_<x> takes
+                       the struct's const MAX_<X> when there is one (the
+                       "MAX_* constant" convention of forecast_t).
   // @maxlen MEMBER N  string MEMBER (or each element of a string array) holds
                        at most N bytes (default DEFAULT_MAX_STRING)
 
@@ -59,6 +67,11 @@ class Member:
         self.desc = desc
         self.max_count = None     # for var arrays
         self.max_len = DEFAULT_MAX_STRING
+        self.struct = None        # the Struct of a nested (non-primitive) member
+
+    @property
+    def nested(self):
+        return self.type not in PRIMITIVES
 
 
 class Struct:
@@ -138,7 +151,7 @@ def preceding_comment(line, comments, comment_only):
 
 def describe(first, last, comments, comment_only):
     def clean(text):
-        return re.sub(r"\s+", " ", re.sub(r"@max(len)?\s+\S+\s+\d+", "", text)).strip()
+        return re.sub(r"\s+", " ", re.sub(r"@max(len)?\s+\S+\s+\w+", "", text)).strip()
     trail = clean(" ".join(comments[k] for k in range(first, last + 1)
                            if k in comments and k not in comment_only))
     return trail or clean(preceding_comment(first, comments, comment_only))
@@ -149,8 +162,8 @@ def parse_file(path):
         text = f.read()
     toks, comments, comment_only = tokenize(text)
     for ln, c in comments.items():
-        if "@max" in c and not re.search(r"@max(len)?\s+[A-Za-z_]\w*\s+\d+", c):
-            raise GenError(f"{path}:{ln}: malformed annotation {c!r} (want '@max COUNT N' or '@maxlen MEMBER N')")
+        if "@max" in c and not re.search(r"@max\s+[A-Za-z_]\w*\s+(\d+|[A-Za-z_]\w*)|@maxlen\s+[A-Za-z_]\w*\s+\d+", c):
+            raise GenError(f"{path}:{ln}: malformed annotation {c!r} (want '@max COUNT N|CONST' or '@maxlen MEMBER N')")
     pos = 0
 
     def peek():
@@ -211,8 +224,8 @@ def parse_file(path):
                         raise GenError(f"{path}:{mln}: expected ',' or ';' after member {mname}")
             _, eln = take("}")
             for ln2 in range(sln, eln + 1):
-                for a in re.finditer(r"@max\s+([A-Za-z_]\w*)\s+(\d+)", comments.get(ln2, "")):
-                    st.max_annot[a.group(1)] = int(a.group(2))
+                for a in re.finditer(r"@max\s+([A-Za-z_]\w*)\s+(\d+|[A-Za-z_]\w*)", comments.get(ln2, "")):
+                    st.max_annot[a.group(1)] = a.group(2)
                 for a in re.finditer(r"@maxlen\s+([A-Za-z_]\w*)\s+(\d+)", comments.get(ln2, "")):
                     st.maxlen_annot[a.group(1)] = int(a.group(2))
             check_struct(st)
@@ -225,10 +238,28 @@ def parse_file(path):
 def check_struct(st):
     where = f"{st.path}: {st.full}"
     seen = {}
+    consts = {n: (t, v) for t, n, v in st.consts}
+
+    def maximum(count):
+        ann = st.max_annot.get(count)
+        if ann is None:
+            conv = "MAX_" + count[4:].upper() if count.startswith("num_") else None
+            if conv in consts:
+                ann = conv
+        if ann is None:
+            return DEFAULT_MAX_COUNT
+        if ann.isdigit():
+            return int(ann)
+        if ann not in consts or consts[ann][0] not in DIM_TYPES:
+            raise GenError(f"{where}: @max {count} {ann}: {ann!r} is not an integer const of the struct")
+        v = int(consts[ann][1], 0)
+        if v < 0:
+            raise GenError(f"{where}: const {ann} = {v} is not a valid maximum")
+        return v
+
     for m in st.members:
-        if m.type not in PRIMITIVES:
-            raise GenError(f"{where}.{m.name}: member type {m.type!r} is not a primitive; nested "
-                           "types are not supported by lcm_codec_gen.py yet (extend it)")
+        if m.type not in PRIMITIVES and not re.fullmatch(r"[A-Za-z_]\w*(\.[A-Za-z_]\w*)?", m.type):
+            raise GenError(f"{where}.{m.name}: bad member type {m.type!r}")
         if len(m.dims) > 1:
             raise GenError(f"{where}.{m.name}: multi-dimensional arrays are not supported by "
                            "lcm_codec_gen.py yet (extend it)")
@@ -238,7 +269,7 @@ def check_struct(st):
                 if cm is None or cm.type not in DIM_TYPES or cm.dims:
                     raise GenError(f"{where}.{m.name}: array size {size!r} is not an earlier "
                                    "integer member")
-                m.max_count = st.max_annot.get(size, DEFAULT_MAX_COUNT)
+                m.max_count = maximum(size)
         if m.type == "string":
             m.max_len = st.maxlen_annot.get(m.name, DEFAULT_MAX_STRING)
         seen[m.name] = m
@@ -274,7 +305,32 @@ def _hash_string(v, s):
     return v
 
 
-def fingerprint(st):
+def resolve(structs):
+    """Link each nested member to its Struct (same package unless qualified);
+    reject unknown and recursive types."""
+    by_name = {s.full: s for s in structs}
+    for st in structs:
+        for m in st.members:
+            if not m.nested:
+                continue
+            full = m.type if "." in m.type else (f"{st.package}.{m.type}" if st.package else m.type)
+            m.struct = by_name.get(full)
+            if m.struct is None:
+                raise GenError(f"{st.path}: {st.full}.{m.name}: unknown type {m.type!r} (not in the .lcm files given)")
+
+    def visit(st, stack):
+        if st in stack:
+            raise GenError(f"{st.path}: {st.full}: recursive type ({' -> '.join(x.full for x in stack + [st])}) "
+                           "is not supported")
+        for m in st.members:
+            if m.nested:
+                visit(m.struct, stack + [st])
+    for st in structs:
+        visit(st, [])
+
+
+def base_hash(st):
+    """lcmgen.c lcm_struct_hash: member names, primitive type names, dims."""
     v = 0x12345678
     for m in st.members:
         v = _hash_string(v, m.name)
@@ -284,33 +340,62 @@ def fingerprint(st):
         for mode, size in m.dims:
             v = _hash_update(v, mode)
             v = _hash_string(v, size)
-    u = v & M64
+    return v
+
+
+def fingerprint(st, parents=()):
+    """lcm-gen's getHash(): _computeHash = rotl1(base hash + the _computeHash
+    of every nested member's type), 0 for a type already on the stack."""
+    if st in parents:
+        return 0
+    u = base_hash(st) & M64
+    for m in st.members:
+        if m.nested:
+            u = (u + (fingerprint(m.struct, parents + (st,)) & M64)) & M64
     return _s64((u << 1) + ((u >> 63) & 1))
 
 
 # ---------------------------------------------------------------- sizes
 def elem_max(m):
+    if m.nested:
+        return body_max(m.struct)
     return 4 + m.max_len + 1 if m.type == "string" else PRIM_SIZE[m.type]
 
 
-def max_size(st):
-    total = 8
+def elem_min(m):
+    if m.nested:
+        return body_min(m.struct)
+    return 5 if m.type == "string" else PRIM_SIZE[m.type]
+
+
+def body_max(st):
+    """Largest encoding of st without its fingerprint (as nested), uncapped."""
+    total = 0
     for m in st.members:
         count = 1
         for mode, size in m.dims:
             count *= int(size) if mode == 0 else m.max_count
         total += count * elem_max(m)
-    return min(total, GLOBAL_MAX_SIZE)
+    return total
 
 
-def min_size(st):
-    total = 8
+def body_min(st):
+    """Smallest encoding of st without its fingerprint (as nested)."""
+    total = 0
     for m in st.members:
         count = 1
         for mode, size in m.dims:
             count *= int(size) if mode == 0 else 0
-        total += count * (5 if m.type == "string" else PRIM_SIZE[m.type])
+        total += count * elem_min(m)
     return total
+
+
+def max_size(st):
+    return min(8 + body_max(st), GLOBAL_MAX_SIZE)
+
+
+def min_size(st):
+    return 8 + body_min(st)
 
 
 # ---------------------------------------------------------------- schema
@@ -325,11 +410,11 @@ def scalar_schema(m):
     return {"type": "integer", "minimum": lo, "maximum": hi}
 
 
-def schema(st):
+def schema_obj(st, top):
     props = {}
     maxima = {m.dims[0][1]: m.max_count for m in st.members if m.dims and m.dims[0][0] == 1}
     for m in st.members:
-        s = scalar_schema(m)
+        s = schema_obj(m.struct, False) if m.nested else scalar_schema(m)
         if m.name in maxima:  # an array count: what checkedDecode accepts
             s["minimum"], s["maximum"] = 0, maxima[m.name]
         if m.dims:
@@ -344,24 +429,36 @@ def schema(st):
             desc = (desc + " " if desc else "") + "(null: not finite)"
         if m.dims and m.dims[0][0] == 1:
             desc = (desc + " " if desc else "") + f"(length: {m.dims[0][1]})"
-        if desc:
+        if desc and m.nested and not m.dims:
+            s = {**s, "description": desc}  # the member's, over the type's
+        elif desc:
             s = {"description": desc, **s}
         props[m.name] = s
-    out = {
-        "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "$id": f"urn:hoist-twin:msg:{st.full}",
+    out = {}
+    if top:
+        out["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+        out["$id"] = f"urn:hoist-twin:msg:{st.full}"
+    out.update({
         "title": st.full,
         "description": st.desc,
         "type": "object",
         "properties": props,
         "required": [m.name for m in st.members],
         "additionalProperties": False,
-        "x-lcm-fingerprint": f"0x{fingerprint(st) & M64:016x}",
-    }
+    })
+    # Nested values carry no fingerprint on the wire; the type's own is
+    # still given (it is what lcm-gen's getHash() returns for it).
+    out["x-lcm-fingerprint"] = f"0x{fingerprint(st) & M64:016x}"
     if st.consts:
         out["x-lcm-constants"] = {n: (float(v) if t in ("float", "double") else int(v, 0))
                                   for t, n, v in st.consts}
-    return json.dumps(out, indent=2)
+    return out
+
+
+def schema(st):
+    """JSON Schema of toJson(st): nested types are inlined (no $ref), so
+    every consumer (Foxglove, the dashboard page) reads it without resolving."""
+    return json.dumps(schema_obj(st, True), indent=2)
 
 
 # ---------------------------------------------------------------- C++
@@ -374,6 +471,17 @@ def cpp_walk(st):
     L.append("  if (!w.readInt(8, fp)) return DecodeStatus::truncated;")
     L.append(f"  if (fp != std::int64_t({fp}LL)) return DecodeStatus::bad_fingerprint;")
     L.append(f"  if (size > {max_size(st)}u) return DecodeStatus::too_large;")
+    L.append(f"  if (auto s = walkBody(w, static_cast<const {st.name}*>(nullptr)); s != DecodeStatus::ok) return s;")
+    L.append("  return w.left() == 0 ? DecodeStatus::ok : DecodeStatus::too_large;")
+    L.append("}")
+    return "\n".join(L)
+
+
+def cpp_walk_body(st):
+    """The members of st (no fingerprint): the whole message after its
+    fingerprint, or one nested value (lcm-gen's _decodeNoHash layout)."""
+    L = []
+    L.append(f"DecodeStatus walkBody(Walker& w, const {st.name}*) {{")
     counts = {m.dims[0][1] for m in st.members if m.dims and m.dims[0][0] == 1}
     for m in st.members:
         L.append(f"  // {m.type} {m.name}" + "".join(f"[{s}]" for _, s in m.dims))
@@ -383,6 +491,8 @@ def cpp_walk(st):
                 L.append(f"  if (!w.readInt({PRIM_SIZE[m.type]}, c_{m.name})) return DecodeStatus::truncated;")
             elif m.type == "string":
                 L.append(f"  if (auto s = w.string({m.max_len}); s != DecodeStatus::ok) return s;")
+            elif m.nested:
+                L.append(f"  if (auto s = walkBody(w, static_cast<const {m.struct.name}*>(nullptr)); s != DecodeStatus::ok) return s;")
             else:
                 L.append(f"  if (!w.skip({PRIM_SIZE[m.type]})) return DecodeStatus::truncated;")
             continue
@@ -396,9 +506,15 @@ def cpp_walk(st):
             L.append(f"  if (!w.fits(std::uint64_t({cnt}) * 5u)) return DecodeStatus::truncated;")
             L.append(f"  for (std::int64_t i = 0; i < std::int64_t({cnt}); ++i)")
             L.append(f"    if (auto s = w.string({m.max_len}); s != DecodeStatus::ok) return s;")
+        elif m.nested:
+            # count x smallest encoding of one element <= bytes remaining,
+            # before walking (and long before lcm-gen's decode allocates).
+            L.append(f"  if (!w.fits(std::uint64_t({cnt}) * {body_min(m.struct)}u)) return DecodeStatus::truncated;")
+            L.append(f"  for (std::int64_t i = 0; i < std::int64_t({cnt}); ++i)")
+            L.append(f"    if (auto s = walkBody(w, static_cast<const {m.struct.name}*>(nullptr)); s != DecodeStatus::ok) return s;")
         else:
             L.append(f"  if (!w.skip(std::uint64_t({cnt}) * {PRIM_SIZE[m.type]}u)) return DecodeStatus::truncated;")
-    L.append("  return w.left() == 0 ? DecodeStatus::ok : DecodeStatus::too_large;")
+    L.append("  return DecodeStatus::ok;")
     L.append("}")
     return "\n".join(L)
 
@@ -406,7 +522,9 @@ def cpp_walk(st):
 def cpp_to_json(st):
     L = [f"nlohmann::json toJson(const {st.name}& m) {{", "  nlohmann::json j = nlohmann::json::object();"]
     for m in st.members:
-        if m.type == "string":
+        if m.nested:
+            conv = "toJson({})"
+        elif m.type == "string":
             conv = "detail::utf8Safe({})"
         elif m.type == "boolean":
             conv = "bool({} != 0)"
@@ -439,6 +557,8 @@ def cpp_from_json(st):
          f"  {st.name} m{{}};"]
     for m in st.members:
         def get(src, dst, key):
+            if m.nested:
+                return f"detail::getNested({src}, {key}, {dst}, error)"
             if m.type == "string":
                 return f"detail::getString({src}, {key}, {m.max_len}, {dst}, error)"
             if m.type == "boolean":
@@ -482,7 +602,10 @@ HEADER = r'''// GENERATED by msgs/codec/lcm_codec_gen.py from msgs/*.lcm -- do n
 // fingerprint; every string length >= 1, <= the bytes remaining, <= the
 // member's cap, NUL-terminated, no NUL inside; every array count >= 0,
 // <= the member's maximum (the `// @max` annotations in the .lcm files) and
-// count x element size <= the bytes remaining; the total size <= the type's
+// count x element size <= the bytes remaining (nested values -- members of
+// another hoist type -- walked recursively with the same checks, count x the
+// nested type's smallest encoding <= the bytes remaining before any of them
+// is walked); the total size <= the type's
 // largest valid encoding, and no trailing bytes.  Only then does it run
 // lcm-gen's decode (inside try/catch).  Nothing is allocated from a count or
 // length that has not been validated.  This works around LCM 1.3.1's
@@ -740,6 +863,18 @@ bool checkArray(const nlohmann::json& a, const std::string& key, std::int64_t wa
   return true;
 }
 
+/// A nested value (a member of another hoist type): its own strict
+/// fromJson, the error prefixed with the member's key.
+template <class T>
+bool getNested(const nlohmann::json& v, const std::string& key, T& out, std::string& error) {
+  std::string sub;
+  if (!::hoist::msg::fromJson(v, out, sub)) {
+    error = "key '" + key + "': " + sub;
+    return false;
+  }
+  return true;
+}
+
 '''
 
 SOURCE_TAIL = r'''
@@ -846,6 +981,14 @@ def generate(structs, out):
                f"bool fromJson(const nlohmann::json&, {s.name}&, std::string& error);" for s in structs))
            .replace("@XMACRO@", " ".join(f"X({s.name})" for s in structs)))
     src = [SOURCE_HEAD]
+    src.append("namespace {")
+    for s in structs:
+        src.append(f"DecodeStatus walkBody(Walker& w, const {s.name}*);")
+    src.append("")
+    for s in structs:
+        src.append(cpp_walk_body(s))
+        src.append("")
+    src.append("}  // namespace\n")
     for s in structs:
         src.append(cpp_walk(s))
         src.append("")
@@ -900,6 +1043,7 @@ def load(files):
     structs = []
     for f in files:
         structs.extend(parse_file(f))
+    resolve(structs)
     return structs
 
 

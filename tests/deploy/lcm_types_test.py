@@ -121,28 +121,42 @@ def python(msgs, work):
     subprocess.run(["lcm-gen", "-p", "--ppath", out] + lcm_files(msgs), check=True)
     sys.path.insert(0, out)
     bad = 0
+    parsed = {}
     for f in lcm_files(msgs):
         pkg, struct, members = parse(f)
-        mod = importlib.import_module(f"{pkg}.{struct}")  # a keyword field fails right here (SyntaxError)
-        cls = getattr(mod, struct)
+        parsed[struct] = (pkg, members)
+
+    def build(struct):
+        """An instance of `struct` with every field filled (nested types
+        recursively, e.g. forecast_t.scenarios)."""
+        pkg, members = parsed[struct]
+        cls = getattr(importlib.import_module(f"{pkg}.{struct}"), struct)
         msg = cls()
         sizes = {}
         dim_names = {d for _, _, _, dims in members for d in dims if not d.isdigit()}
         for i, (kind, name, typ, dims) in enumerate(members):
             if kind != "field":
                 continue
+            nested = typ.split(".")[-1] if typ.split(".")[-1] in parsed else None
             if not dims:
-                value = 3 if name in dim_names else sample(typ, i)  # array sizes: small
+                value = build(nested)[1] if nested else (2 if name in dim_names else sample(typ, i))  # sizes: small
                 setattr(msg, name, value)
                 sizes[name] = value
             else:
                 n = int(dims[0]) if dims[0].isdigit() else sizes[dims[0]]
-                setattr(msg, name, [sample(typ, i)] * n)
+                setattr(msg, name, [build(nested)[1] for _ in range(n)] if nested else [sample(typ, i)] * n)
+        return cls, msg
+
+    for f in lcm_files(msgs):
+        pkg, struct, members = parse(f)
+        cls, msg = build(struct)  # a keyword field fails right here at import (SyntaxError)
         data = msg.encode()
         back = cls.decode(data)
-        same = all(getattr(back, n) == getattr(msg, n) or
-                   (isinstance(getattr(msg, n), list) and list(getattr(back, n)) == getattr(msg, n))
-                   for k, n, _, _ in members if k == "field")
+        prim = [(n, t) for k, n, t, _ in members if k == "field" and t.split(".")[-1] not in parsed]
+        same = back.encode() == data and all(
+            getattr(back, n) == getattr(msg, n) or
+            (isinstance(getattr(msg, n), list) and list(getattr(back, n)) == getattr(msg, n))
+            for n, _ in prim)
         print(("ok   " if same else "FAIL ") + f"python: import {pkg}.{struct}, encode {len(data)} bytes, decode"
               f" {'equal' if same else 'DIFFERENT'}; fingerprint {cls._get_packed_fingerprint().hex()}")
         bad += 0 if same else 1

@@ -69,12 +69,55 @@ alarm_ack_t sampleAck() {
   return k;
 }
 
+forecast_scenario_t sampleScenario(const char* name, int points) {
+  forecast_scenario_t s{};
+  s.name = name;
+  s.status = forecast_scenario_t::STATUS_OK;
+  s.horizon = 20.0;
+  s.t_reached = 20.0;
+  s.min_clearance = 0.031;
+  s.t_min_clearance = 4.25;
+  s.t_warning = 3.5;
+  s.t_critical = -1.0;
+  s.peak_y_c = 0.012;
+  s.peak_theta = 1.5e-3;
+  for (int k = 0; k < 4; ++k) s.peak_lambdas[k] = 100.0 * (k + 1);
+  s.lambda0_min = 2.5e3;
+  s.lambda0_max = 1.9e4;
+  s.num_points = static_cast<std::int16_t>(points);
+  for (int i = 0; i < points; ++i) {
+    s.series_t.push_back(20.0 * (i + 1) / points);
+    s.series_min_clearance.push_back(0.05 - 1e-3 * i);
+    s.series_lambda0_min.push_back(8e3 - i);
+    s.series_lambda0_max.push_back(9e3 + i);
+  }
+  return s;
+}
+
+forecast_t sampleForecast() {
+  forecast_t f{};
+  f.utime = 1700000000000002;
+  f.seq = 17;
+  f.instance_id = 99;
+  f.t_start = 20.0;
+  f.l = 150.0;
+  f.v = 10.0;
+  f.a = 0.0;
+  f.plan_seq = -1;
+  f.compute_time = 0.004;
+  f.num_scenarios = 2;
+  f.scenarios = {sampleScenario("estop", 3), sampleScenario("continue", 50)};
+  return f;
+}
+
 template <class T>
 T sample() {
   if constexpr (std::is_same_v<T, health_t>) return sampleHealth();
   else if constexpr (std::is_same_v<T, guide_shape_t>) return sampleShape(3);
   else if constexpr (std::is_same_v<T, alarm_t>) return sampleAlarm();
   else if constexpr (std::is_same_v<T, alarm_ack_t>) return sampleAck();
+  else if constexpr (std::is_same_v<T, forecast_scenario_t>) return sampleScenario("estop", 2);
+  else if constexpr (std::is_same_v<T, forecast_t>) return sampleForecast();
   else {
     T m{};
     return m;
@@ -156,7 +199,7 @@ TEST(Codec, EveryTypeFingerprintRoundTripTruncationSchema) {
 #define HOIST_CHECK_TYPE(T) checkType<T>(#T);
   HOIST_MSG_FOR_EACH_TYPE(HOIST_CHECK_TYPE)
 #undef HOIST_CHECK_TYPE
-  EXPECT_EQ(allTypes().size(), 7u);  // msgs/*.lcm
+  EXPECT_EQ(allTypes().size(), 9u);  // msgs/*.lcm
   for (const auto& t : allTypes()) EXPECT_EQ(findByName(t.name), &t);
   EXPECT_EQ(findByName("nope_t"), nullptr);
   const std::uint8_t junk[8] = {1, 2, 3, 4, 5, 6, 7, 8};
@@ -320,4 +363,224 @@ TEST(Codec, FromJsonArrays) {
   h["n_reasons"] = -1;
   health_t hh;
   EXPECT_FALSE(fromJson(h, hh, err));
+}
+
+// ---- nested types (issue 17: forecast_t holds forecast_scenario_t[]) ------
+
+namespace {
+
+// Offsets in sampleForecast()'s encoding.  forecast_t: fp 8, utime, seq,
+// instance_id, t_start, l, v, a, plan_seq, compute_time (9 x 8), then
+// num_scenarios (int8), then the scenarios WITHOUT fingerprints (lcm-gen's
+// _encodeNoHash).  forecast_scenario_t body: name (4 + len + 1), status (1),
+// horizon, t_reached, min_clearance, t_min_clearance, t_warning, t_critical,
+// peak_y_c, peak_theta (8 x 8), peak_lambdas (4 x 8), lambda0_min/max (16),
+// num_points (int16), then 4 x num_points doubles.
+constexpr std::size_t kNumScenariosAt = 8 + 9 * 8;
+constexpr std::size_t kFirstScenarioAt = kNumScenariosAt + 1;
+std::size_t numPointsAt(std::size_t scenario_at, std::size_t name_len) {
+  return scenario_at + 4 + name_len + 1 + 1 + 8 * 8 + 4 * 8 + 16;
+}
+void put16(Bytes& b, std::size_t at, std::int16_t v) {
+  b[at] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(v) >> 8);
+  b[at + 1] = static_cast<std::uint8_t>(static_cast<std::uint16_t>(v) & 0xff);
+}
+
+}  // namespace
+
+TEST(CodecNested, ForecastRoundTripAndLayout) {
+  const forecast_t f = sampleForecast();
+  const Bytes b = encode(f);
+  // The layout assumed by the attack tests below.
+  ASSERT_EQ(b[kNumScenariosAt], 2);
+  const std::size_t np = numPointsAt(kFirstScenarioAt, 5);  // "estop"
+  ASSERT_EQ(b[np], 0);
+  ASSERT_EQ(b[np + 1], 3);
+  forecast_t d;
+  ASSERT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::ok);
+  ASSERT_EQ(d.scenarios.size(), 2u);
+  EXPECT_EQ(d.scenarios[1].name, "continue");
+  EXPECT_EQ(d.scenarios[1].series_lambda0_max.size(), 50u);
+  const auto j = toJson(d);
+  EXPECT_EQ(j.at("scenarios").size(), 2u);
+  EXPECT_EQ(j.at("scenarios")[0].at("name"), "estop");
+  EXPECT_EQ(j.at("scenarios")[1].at("series_min_clearance").size(), 50u);
+  EXPECT_EQ(j.at("scenarios")[0].at("peak_lambdas")[3], 400.0);
+  EXPECT_EQ(j.at("scenarios")[0].at("t_critical"), -1.0);
+  // The largest valid forecast (8 scenarios of 64 points, long names) fits.
+  forecast_t big = f;
+  big.num_scenarios = forecast_t::MAX_SCENARIOS;
+  big.scenarios.assign(forecast_t::MAX_SCENARIOS,
+                       sampleScenario(std::string(4096, 'n').c_str(), forecast_scenario_t::MAX_POINTS));
+  const Bytes bb = encode(big);
+  const TypeInfo* info = findByName("forecast_t");
+  ASSERT_NE(info, nullptr);
+  EXPECT_EQ(bb.size(), info->max_size);
+  EXPECT_EQ(checkedDecode(bb.data(), bb.size(), d), DecodeStatus::ok);
+  // One more point in one scenario: bad_count (and the size cap holds).
+  big.scenarios[7] = sampleScenario("x", forecast_scenario_t::MAX_POINTS + 1);
+  const Bytes over = encode(big);
+  EXPECT_NE(checkedDecode(over.data(), over.size(), d), DecodeStatus::ok);
+}
+
+TEST(CodecNested, HugeNegativeAndLyingScenarioCounts) {
+  const Bytes good = encode(sampleForecast());
+  forecast_t d;
+  for (int n : {-1, -128, 9, 127}) {  // outside 0..MAX_SCENARIOS (8)
+    Bytes b = good;
+    b[kNumScenariosAt] = static_cast<std::uint8_t>(static_cast<std::int8_t>(n));
+    EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::bad_count) << n;
+  }
+  for (int n : {3, 8}) {  // plausible, but the bytes are not there
+    Bytes b = good;
+    b[kNumScenariosAt] = static_cast<std::uint8_t>(n);
+    const auto st = checkedDecode(b.data(), b.size(), d);
+    EXPECT_TRUE(st == DecodeStatus::truncated || st == DecodeStatus::bad_string) << n << " " << toString(st);
+  }
+  {  // count x smallest scenario encoding > bytes left: truncated before walking any
+    Bytes b(good.begin(), good.begin() + static_cast<long>(kFirstScenarioAt));
+    b[kNumScenariosAt] = 1;
+    EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::truncated);
+    b[kNumScenariosAt] = 0;
+    EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::ok);
+    EXPECT_TRUE(d.scenarios.empty());
+  }
+  {  // fewer scenarios than the bytes hold: trailing bytes
+    Bytes b = good;
+    b[kNumScenariosAt] = 1;
+    EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::too_large);
+  }
+}
+
+TEST(CodecNested, HugeNegativeAndLyingPointCountsInsideAScenario) {
+  const Bytes good = encode(sampleForecast());
+  const std::size_t np = numPointsAt(kFirstScenarioAt, 5);
+  forecast_t d;
+  for (std::int16_t n : {std::int16_t(-1), std::int16_t(INT16_MIN), std::int16_t(65), std::int16_t(INT16_MAX)}) {
+    Bytes b = good;
+    put16(b, np, n);
+    EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::bad_count) << n;
+  }
+  // 64 points claimed, 3 there: the rest of the message is read as points
+  // and the second scenario runs out (or bytes are missing).
+  Bytes b = good;
+  put16(b, np, 64);
+  EXPECT_NE(checkedDecode(b.data(), b.size(), d), DecodeStatus::ok);
+  // The second scenario's count, past the first scenario.
+  const std::size_t second = np + 2 + 4 * 3 * 8;
+  const std::size_t np2 = numPointsAt(second, 8);  // "continue"
+  ASSERT_EQ(b.size(), good.size());
+  ASSERT_EQ(good[np2 + 1], 50);
+  for (std::int16_t n : {std::int16_t(-2), std::int16_t(1000)}) {
+    Bytes c = good;
+    put16(c, np2, n);
+    EXPECT_EQ(checkedDecode(c.data(), c.size(), d), DecodeStatus::bad_count) << n;
+  }
+  Bytes c = good;
+  put16(c, np2, 51);
+  EXPECT_EQ(checkedDecode(c.data(), c.size(), d), DecodeStatus::truncated);
+  // Every truncation of a message with nested values is rejected.
+  for (std::size_t n = 0; n < good.size(); ++n)
+    EXPECT_NE(checkedDecode(good.data(), n, d), DecodeStatus::ok) << n;
+}
+
+TEST(CodecNested, NestedStringAttacks) {
+  const Bytes good = encode(sampleForecast());
+  forecast_t d;
+  for (std::uint32_t len : {0u, 0x80000000u, 0xFFFFFFFFu, 4098u}) {
+    Bytes b = good;
+    for (int i = 0; i < 4; ++i) b[kFirstScenarioAt + i] = static_cast<std::uint8_t>(len >> (8 * (3 - i)));
+    const auto st = checkedDecode(b.data(), b.size(), d);
+    EXPECT_TRUE(st == DecodeStatus::bad_string || st == DecodeStatus::truncated) << len << " " << toString(st);
+  }
+  Bytes b = good;
+  b[kFirstScenarioAt + 4 + 5] = 'x';  // "estop" loses its NUL
+  EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::bad_string);
+  b = good;
+  b[kFirstScenarioAt + 4 + 2] = 0;  // NUL inside "estop"
+  EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::bad_string);
+}
+
+// Nested values have no fingerprint of their own on the wire: the outer
+// fingerprint covers the nested type (lcm-gen adds the nested hash into it).
+// A scenario published alone, or a forecast with a stray fingerprint before
+// a scenario, is rejected.
+TEST(CodecNested, FingerprintsOfNestedTypes) {
+  EXPECT_EQ(findByName("forecast_t")->fingerprint, forecast_t::getHash());
+  EXPECT_EQ(findByName("forecast_scenario_t")->fingerprint, forecast_scenario_t::getHash());
+  const Bytes sc = encode(sampleScenario("estop", 2));
+  forecast_t d;
+  EXPECT_EQ(checkedDecode(sc.data(), sc.size(), d), DecodeStatus::bad_fingerprint);
+  forecast_scenario_t s;
+  const Bytes fb = encode(sampleForecast());
+  EXPECT_EQ(checkedDecode(fb.data(), fb.size(), s), DecodeStatus::bad_fingerprint);
+  // A "nested fingerprint" inserted before the first scenario: the name's
+  // length field then reads the fingerprint's first bytes.
+  forecast_t one = sampleForecast();
+  one.num_scenarios = 1;
+  one.scenarios.resize(1);
+  Bytes b = encode(one);
+  Bytes withfp(b.begin(), b.begin() + static_cast<long>(kFirstScenarioAt));
+  withfp.insert(withfp.end(), sc.begin(), sc.begin() + 8);
+  withfp.insert(withfp.end(), b.begin() + static_cast<long>(kFirstScenarioAt), b.end());
+  EXPECT_NE(checkedDecode(withfp.data(), withfp.size(), d), DecodeStatus::ok);
+  // The schema inlines the nested type and gives its fingerprint.
+  const auto sch = nlohmann::json::parse(jsonSchema<forecast_t>());
+  const auto& item = sch.at("properties").at("scenarios").at("items");
+  EXPECT_EQ(item.at("title"), "hoist.forecast_scenario_t");
+  EXPECT_EQ(item.at("additionalProperties"), false);
+  EXPECT_EQ(item.at("properties").at("num_points").at("maximum"), int(forecast_scenario_t::MAX_POINTS));
+  EXPECT_EQ(sch.at("properties").at("scenarios").at("maxItems"), int(forecast_t::MAX_SCENARIOS));
+  EXPECT_EQ(sch.at("properties").at("num_scenarios").at("maximum"), int(forecast_t::MAX_SCENARIOS));
+  EXPECT_EQ(item.at("x-lcm-constants").at("STATUS_LEFT_SHAFT"), 1);
+  std::set<std::string> keys, req;
+  const auto sj = toJson(sampleScenario("a", 1));
+  for (auto it = sj.begin(); it != sj.end(); ++it) keys.insert(it.key());
+  for (const auto& r : item.at("required")) req.insert(r.get<std::string>());
+  EXPECT_EQ(keys, req);
+}
+
+TEST(CodecNested, FromJsonNestedIsStrictAndNamesThePath) {
+  const auto good = toJson(sampleForecast());
+  forecast_t f;
+  std::string err;
+  ASSERT_TRUE(fromJson(good, f, err)) << err;
+  EXPECT_EQ(f.scenarios[1].name, "continue");
+  auto bad = good;
+  bad["scenarios"][1]["name"] = 5;
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("'scenarios[1]'"), std::string::npos) << err;
+  EXPECT_NE(err.find("'name'"), std::string::npos) << err;
+  bad = good;
+  bad["scenarios"][0].erase("t_critical");
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("'scenarios[0]'"), std::string::npos) << err;
+  EXPECT_NE(err.find("t_critical"), std::string::npos) << err;
+  bad = good;
+  bad["scenarios"][0]["extra"] = 1;
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("extra"), std::string::npos) << err;
+  bad = good;
+  bad["scenarios"][0]["series_t"].push_back(1.0);  // 4 values, num_points 3
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("series_t"), std::string::npos) << err;
+  bad = good;
+  bad["scenarios"][0]["num_points"] = 65;  // over MAX_POINTS even with 65 values
+  for (int i = 0; i < 62; ++i)
+    for (const char* k : {"series_t", "series_min_clearance", "series_lambda0_min", "series_lambda0_max"})
+      bad["scenarios"][0][k].push_back(0.0);
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("at most 64"), std::string::npos) << err;
+  bad = good;
+  bad["scenarios"].push_back(bad["scenarios"][0]);  // 3 elements, num_scenarios 2
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("'scenarios'"), std::string::npos) << err;
+  bad = good;
+  bad["scenarios"][0] = "estop";
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("'scenarios[0]'"), std::string::npos) << err;
+  bad = good;
+  bad["scenarios"][0]["peak_lambdas"].erase(0);
+  EXPECT_FALSE(fromJson(bad, f, err));
+  EXPECT_NE(err.find("peak_lambdas"), std::string::npos) << err;
 }
