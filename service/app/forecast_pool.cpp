@@ -30,7 +30,7 @@ ForecastJob::ForecastJob(std::shared_ptr<const ShaftModel> model, const TwinConf
       max_length_(cfg.shaft.maxRopeLength()),
       ws_(model, optionsFor(cfg)),
       in_(ForecastSnapshot(model->n())),
-      out_(resultPrototype())) {}
+      out_(resultPrototype()) {}
 
 void ForecastJob::compute(const ForecastSnapshot& s, ForecastResult& r) {
   const auto c0 = std::chrono::steady_clock::now();

@@ -18,7 +18,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
-#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/sinks/ringbuffer_sink.h>
 
 #include "daemon.hpp"
 #include "hoist/alarm_t.hpp"
@@ -39,8 +39,10 @@ using namespace std::chrono_literals;
 
 namespace {
 
-std::shared_ptr<spdlog::logger> captureLogger(std::ostringstream& os) {
-  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(os);
+/// The daemon's log lines, kept in a ring read under the sink's own mutex
+/// (the daemon's log writer thread fills it while the test reads).
+std::shared_ptr<spdlog::logger> captureLogger(std::shared_ptr<spdlog::sinks::ringbuffer_sink_mt>& sink) {
+  sink = std::make_shared<spdlog::sinks::ringbuffer_sink_mt>(20000);
   auto log = std::make_shared<spdlog::logger>("forecast-test", sink);
   log->set_level(spdlog::level::info);
   return log;
@@ -82,7 +84,7 @@ class Rig {
     opt.labels = std::move(labels);
     opt.lcm_url = url_;
     opt.hooks = hooks;
-    daemon_ = std::make_unique<Daemon>(std::move(opt), captureLogger(logs_));
+    daemon_ = std::make_unique<Daemon>(std::move(opt), captureLogger(sink_));
     listener_ = std::make_unique<Listener>(url_);
     pub_ = std::make_unique<lcm::LCM>(url_);
   }
@@ -139,12 +141,17 @@ class Rig {
   }
   Listener& listener() { return *listener_; }
   Daemon& daemon() { return *daemon_; }
-  std::string logs() const { return logs_.str(); }
+  std::string logs() const {
+    std::string all;
+    if (sink_)
+      for (const auto& line : sink_->last_formatted()) all += line;
+    return all;
+  }
 
  private:
   std::string url_;
   bool multicast_ = false;
-  std::ostringstream logs_;
+  std::shared_ptr<spdlog::sinks::ringbuffer_sink_mt> sink_;
   std::unique_ptr<Daemon> daemon_;
   std::unique_ptr<Listener> listener_;
   std::unique_ptr<lcm::LCM> pub_;
@@ -285,7 +292,7 @@ std::int64_t reasonCount(const health_t& h, const std::string& reason) {
 class ForecastExactness : public ::testing::Test {
  protected:
   static constexpr int kModes = 10;
-  static constexpr double kHorizon = 20.0;
+  static constexpr double kHorizon = 40.0;  // to the plan's end: cruise, S-stop at 300 m, rest
 
   /// Feeds the whole run once (shared by the tests of this suite).
   static void SetUpTestSuite() {
@@ -306,6 +313,8 @@ class ForecastExactness : public ::testing::Test {
       ASSERT_TRUE(rig.pumpUntil([&] { return rig.listener().count("HOIST_CAGE") >= want; }))
           << "no HOIST_CAGE for input " << k << "\n" << rig.logs();
     }
+    // The forecast at the last input comes after its HOIST_CAGE.
+    rig.pumpUntil([&] { return rig.listener().count("HOIST_FORECAST") >= 13; }, 20s);
     cage_ = rig.listener().decoded<cage_state_t>("HOIST_CAGE");
     forecasts_ = rig.listener().decoded<forecast_t>("HOIST_FORECAST");
     logs_ = rig.logs();
@@ -328,12 +337,12 @@ class ForecastExactness : public ::testing::Test {
 };
 
 TEST_F(ForecastExactness, ForecastsAtTheirInstantsDeterministically) {
-  // One forecast every 5 s of model time, each answering the input at that instant.
-  ASSERT_GE(forecasts_.size(), 9u) << logs_;
+  // One forecast every 5 s of model time (0 .. 60 s), each answering the input at that instant.
+  ASSERT_EQ(forecasts_.size(), 13u) << logs_;
   for (std::size_t i = 0; i < forecasts_.size(); ++i) {
     const forecast_t& f = forecasts_[i];
     EXPECT_NEAR(f.t_start, 5.0 * static_cast<double>(i), 1e-9);
-    EXPECT_EQ(f.utime, kUtime0 + 500000 * static_cast<std::int64_t>(i));
+    EXPECT_EQ(f.utime, kUtime0 + 5000000 * static_cast<std::int64_t>(i));
     EXPECT_EQ(f.seq, static_cast<std::int64_t>(i));
     ASSERT_EQ(f.num_scenarios, 2);
     EXPECT_EQ(f.scenarios[0].name, "estop");
@@ -350,19 +359,21 @@ TEST_F(ForecastExactness, ContinueAtT0EqualsTheTwinsLaterOutputs) {
   EXPECT_EQ(f->plan_seq, 1);
   const forecast_scenario_t* cont = scenario(*f, "continue");
   ASSERT_NE(cont, nullptr);
-  ASSERT_EQ(cont->status, forecast_scenario_t::STATUS_OK);
+  ASSERT_EQ(static_cast<int>(cont->status), 0);
   std::vector<cage_state_t> rows;
   for (const auto& c : cage_)
     if (c.t >= 20.0 - 1e-9 && c.t <= 20.0 + kHorizon + 1e-9) rows.push_back(c);
-  ASSERT_EQ(rows.size(), 2001u);
+  ASSERT_EQ(rows.size(), 4001u);
   const ForecastSummary twin = summarize(rows, 20.0, cfg_, cfg_.forecast.series_points);
   std::string what;
   const double d = worstDifference(*cont, twin, what);
   std::printf("continue forecast at t0 = 20 s vs the twin's outputs: largest relative difference %.3g (%s)\n", d,
               what.c_str());
   EXPECT_LE(d, 1e-9) << what;
-  // Not trivially equal: the scenario moves the cage 160 m and back to rest.
-  EXPECT_GT(twin.lambda0_max - twin.lambda0_min, 100.0);
+  // Not trivially equal: the scenario cruises, brakes along the S-curve to
+  // rest at 300 m (lambda_0 swings by the braking force), and rests.
+  EXPECT_GT(twin.lambda0_max - twin.lambda0_min, 500.0);
+  EXPECT_NEAR(rows.back().l, 300.0, 1e-9);
 }
 
 TEST_F(ForecastExactness, EstopAtT0EqualsHoistSimEstopAt) {
@@ -370,7 +381,7 @@ TEST_F(ForecastExactness, EstopAtT0EqualsHoistSimEstopAt) {
   ASSERT_NE(f, nullptr) << logs_;
   const forecast_scenario_t* es = scenario(*f, "estop");
   ASSERT_NE(es, nullptr);
-  ASSERT_EQ(es->status, forecast_scenario_t::STATUS_OK);
+  ASSERT_EQ(static_cast<int>(es->status), 0);
   const auto dir = testDir("forecast_estop");
   const std::string out = (dir / "estop.csv").string();
   const CapturedRun r = runCaptured(HOIST_SIM, {"--profile", "paper", "--modes", std::to_string(kModes), "--estop-at",
@@ -403,7 +414,7 @@ TEST_F(ForecastExactness, EstopAtT0EqualsHoistSimEstopAt) {
     th = std::max(th, std::abs(v[col["theta"]]));
     for (int i = 0; i < 4; ++i) lam[i] = std::max(lam[i], std::abs(v[col["lambda_" + std::to_string(i + 1)]]));
   }
-  ASSERT_EQ(n, 2001);
+  ASSERT_EQ(n, 4001);
   const double d = std::max({rel(l0min, es->lambda0_min), rel(l0max, es->lambda0_max), rel(yc, es->peak_y_c),
                              rel(th, es->peak_theta), rel(lam[0], es->peak_lambdas[0]),
                              rel(lam[1], es->peak_lambdas[1]), rel(lam[2], es->peak_lambdas[2]),
@@ -466,7 +477,7 @@ TEST(ForecastPlans, BadPlansAreRejectedEachWithItsCountedReason) {
   // The log says why, naming the numbers.
   const std::string logs = rig.logs();
   EXPECT_NE(logs.find("rejected trip plan (plan_target_outside_shaft)"), std::string::npos) << logs;
-  EXPECT_NE(logs.find("rejected trip plan (plan_wrong_direction)"), std::string::npos) << logs;
+  EXPECT_NE(logs.find("rejected trip plan (plan_not_finite): seq 11 target 300 m vmax nan"), std::string::npos) << logs;
   // The good plan is the one the forecasts follow.
   const auto fc = rig.listener().decoded<forecast_t>("HOIST_FORECAST");
   ASSERT_FALSE(fc.empty());
@@ -508,7 +519,7 @@ TEST(ForecastShafts, SeveralShaftsForecastOnTheOnePool) {
     for (const auto& f : fc) {
       ASSERT_EQ(f.num_scenarios, 2);
       for (const auto& s : f.scenarios) {
-        EXPECT_EQ(s.status, forecast_scenario_t::STATUS_OK);
+        EXPECT_EQ(static_cast<int>(s.status), 0);
         EXPECT_NEAR(s.t_reached, 2.0, 1e-9);
         EXPECT_GT(s.lambda0_min, 1000.0);
         EXPECT_EQ(s.num_points, 50);
@@ -521,7 +532,9 @@ TEST(ForecastShafts, SeveralShaftsForecastOnTheOnePool) {
   const auto h = rig.listener().decoded<health_t>("B/HOIST_HEALTH");
   ASSERT_FALSE(h.empty());
   EXPECT_GE(h.back().forecasts, 4);
-  EXPECT_GT(h.back().forecast_p99_us, 0.0);
+  double p99 = 0.0;  // per health window: 0 in the windows without a forecast
+  for (const auto& m : h) p99 = std::max(p99, m.forecast_p99_us);
+  EXPECT_GT(p99, 0.0);
   EXPECT_NE(rig.logs().find("look-ahead forecasts: 3 shaft(s) on one pool of 1 worker thread(s)"), std::string::npos)
       << rig.logs();
 }
@@ -564,7 +577,7 @@ TEST(ForecastFault, NoForecastFromADegradedStateAfterAModelFault) {
     if (it != degraded_at.end()) EXPECT_FALSE(it->second) << "forecast from a degraded state at t = " << f.t_start;
     EXPECT_FALSE(f.t_start >= fault_t && f.t_start < fault_t + c.service.fault_hold - 0.02)
         << "forecast at t = " << f.t_start << " inside the fault hold from " << fault_t;
-    for (const auto& s : f.scenarios) EXPECT_NE(s.status, forecast_scenario_t::STATUS_NON_FINITE);
+    for (const auto& s : f.scenarios) EXPECT_NE(static_cast<int>(s.status), 2);
     if (f.t_start > fault_t) ++after_fault;
   }
   EXPECT_GT(after_fault, 0) << "forecasts resume after the fault hold";
