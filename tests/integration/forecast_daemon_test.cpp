@@ -595,6 +595,10 @@ TEST(ForecastUsefulness, PredictedClearanceLeadsTheActualCriticalAlarm) {
   // announces on HOIST_TRIP_PLAN.  Near the bottom the cage's lean plus its
   // sway cross CRITICAL (an actual CAGE_* CRITICAL alarm at Tc); the
   // forecasts (1 Hz, 20-s horizon, n = 20) must say so at least 5 s earlier.
+#ifdef HOIST_SANITIZED
+  GTEST_SKIP() << "a measurement: 45 one-second forecasts run ~90x slower under the sanitizers; the threads it "
+                  "uses are exercised by the other tests here";
+#endif
   TwinConfig c = demoShaft(20, ClockMode::Input);
   c.forecast.rate = 1.0;
   c.forecast.horizon = 20.0;
