@@ -121,6 +121,11 @@ void ShaftModel::guideModeCurvatures(double eta, Eigen::Ref<VectorXd> out) const
   }
 }
 
+double ShaftModel::staticRopeForce(double l) const {
+  (void)l;  // independent of l in this model: see shaft_model.hpp
+  return p_.m * p_.g + p_.Fa;
+}
+
 double ShaftModel::guideTension(int r, double x) const {
   return (r == 1 ? p_.Tb1 : p_.Tb2) + p_.rho2 * p_.g * (p_.L - x);
 }

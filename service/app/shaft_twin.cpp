@@ -26,7 +26,8 @@ bool finiteAll(const hoist::cage_state_t& m) {
             std::isfinite(m.y_top) && std::isfinite(m.y_bottom) &&
             std::isfinite(m.guide_deflection) && std::isfinite(m.clearance_pos_y) &&
             std::isfinite(m.clearance_neg_y) && std::isfinite(m.clearance_guide) &&
-            std::isfinite(m.min_clearance);
+            std::isfinite(m.min_clearance) && std::isfinite(m.rope_slack_threshold) &&
+            std::isfinite(m.rope_overload_threshold);
   for (double v : m.lambdas) ok = ok && std::isfinite(v);
   return ok;
 }
@@ -120,7 +121,6 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
     fast_ = dynamic_cast<const FastSolver*>(&core_.solver());
     if (!fast_) throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
     fjob_ = std::make_unique<ForecastJob>(core_.solver().modelPtr(), cfg_);
-    slack_threshold_ = slackThreshold(cfg_);
     forecast_msg_.instance_id = instance_id_;
     forecast_msg_.num_scenarios = ForecastResult::kScenarios;
     forecast_msg_.scenarios.resize(ForecastResult::kScenarios);
@@ -467,6 +467,7 @@ void ShaftTwin::onForecastResult(const ForecastResult& r) {
   }
   const ForecastSummary* sc[ForecastResult::kScenarios];
   for (int i = 0; i < ForecastResult::kScenarios; ++i) sc[i] = &r.scenario[i];
+  slack_threshold_ = slackThreshold(cfg_, core_.solver().model(), r.kin.l);
   const ForecastVerdict v = judgeForecast(sc, ForecastResult::kScenarios, slack_threshold_);
   pred_clearance_scenario_ = v.clearance ? ForecastResult::kNames[v.clearance_scenario] : "";
   pred_slack_scenario_ = v.slack ? ForecastResult::kNames[v.slack_scenario] : "";

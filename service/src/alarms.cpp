@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,8 @@ const char* toString(AlarmKind k) {
     case AlarmKind::ModelFault: return "MODEL_FAULT";
     case AlarmKind::ModelDomain: return "MODEL_DOMAIN";
     case AlarmKind::DuplicatePublisher: return "DUPLICATE_PUBLISHER";
+    case AlarmKind::RopeSlack: return "ROPE_SLACK";
+    case AlarmKind::RopeOverload: return "ROPE_OVERLOAD";
     case AlarmKind::PredictedClearance: return "PREDICTED_CLEARANCE";
     case AlarmKind::PredictedSlack: return "PREDICTED_SLACK";
   }
@@ -76,6 +79,20 @@ void AlarmConfig::validate() const {
   nonneg("off_delay", off_delay);
   nonneg("reannounce", reannounce);
   positive("max_shelve", max_shelve);
+  positive("slack_fraction", slack_fraction);
+  if (!(slack_fraction < 1.0))
+    bad("slack_fraction", "must be below 1 (a fraction of the static rope force), got " + std::to_string(slack_fraction));
+  positive("overload_fraction", overload_fraction);
+  if (!(overload_fraction > 1.0) || overload_fraction > 100.0)
+    bad("overload_fraction", "must be in (1, 100] (a multiple of the static rope force), got " +
+                                 std::to_string(overload_fraction));
+  nonneg("force_deadband", force_deadband);
+  if (!(force_deadband < slack_fraction) || !(slack_fraction + force_deadband < 1.0))
+    bad("force_deadband", "must be below slack_fraction and 1 - slack_fraction (else ROPE_SLACK could not clear "
+                          "at the static force)");
+  if (!(force_deadband < overload_fraction - 1.0))
+    bad("force_deadband", "must be below overload_fraction - 1 (else ROPE_OVERLOAD could not clear at the static "
+                          "force)");
 }
 
 // ---- BinaryAlarm -------------------------------------------------------------
@@ -86,6 +103,8 @@ void BinaryAlarm::configure(AlarmKind kind, AlarmLevel level, const AlarmSetting
   s_ = s;
   cond_ = active_ = acked_ = shelved_ = announced_ = pending_valid_ = false;
   pending_since_ = shelved_until_ = last_announce_ = value_ = 0.0;
+  // A low alarm's "no value yet" must read as clear (poll() feeds value_ back).
+  if (s.low) value_ = std::numeric_limits<double>::max();
 }
 
 void BinaryAlarm::emit(AlarmEventType type, double now, AlarmEvents& out) {
@@ -126,9 +145,11 @@ void BinaryAlarm::update(double now, double value, AlarmEvents& out) {
   value_ = value;
   expireShelve(now, out);
 
-  // Debounce: deadband below the threshold, then the on/off delay.
-  const bool over = !std::isfinite(value) || value >= s_.threshold;
-  const bool under = std::isfinite(value) && value < s_.threshold - s_.deadband;
+  // Debounce: deadband below the threshold (above it for a low alarm),
+  // then the on/off delay.
+  const bool over = !std::isfinite(value) || (s_.low ? value <= s_.threshold : value >= s_.threshold);
+  const bool under = std::isfinite(value) &&
+                     (s_.low ? value > s_.threshold + s_.deadband : value < s_.threshold - s_.deadband);
   const bool want = cond_ ? !under : over;
   if (want != cond_) {
     if (!pending_valid_) {
@@ -208,7 +229,7 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 namespace {
 // Slot layout: 0/1 CAGE_POS_Y W/C, 2/3 CAGE_NEG_Y W/C, 4/5 GUIDE_ROPE W/C,
 // 6 INPUT_STALE W, 7 MODEL_FAULT C, 8 MODEL_DOMAIN C, 9 DUPLICATE_PUBLISHER W,
-// 10 PREDICTED_CLEARANCE W, 11 PREDICTED_SLACK W.
+// 10 ROPE_SLACK C, 11 ROPE_OVERLOAD C, 12 PREDICTED_CLEARANCE W, 13 PREDICTED_SLACK W.
 int slotOf(AlarmKind k, AlarmLevel l) {
   const int crit = l == AlarmLevel::Critical ? 1 : 0;
   switch (k) {
@@ -219,8 +240,10 @@ int slotOf(AlarmKind k, AlarmLevel l) {
     case AlarmKind::ModelFault: return l == AlarmLevel::Critical ? 7 : -1;
     case AlarmKind::ModelDomain: return l == AlarmLevel::Critical ? 8 : -1;
     case AlarmKind::DuplicatePublisher: return l == AlarmLevel::Warning ? 9 : -1;
-    case AlarmKind::PredictedClearance: return l == AlarmLevel::Warning ? 10 : -1;
-    case AlarmKind::PredictedSlack: return l == AlarmLevel::Warning ? 11 : -1;
+    case AlarmKind::RopeSlack: return l == AlarmLevel::Critical ? 10 : -1;
+    case AlarmKind::RopeOverload: return l == AlarmLevel::Critical ? 11 : -1;
+    case AlarmKind::PredictedClearance: return l == AlarmLevel::Warning ? 12 : -1;
+    case AlarmKind::PredictedSlack: return l == AlarmLevel::Warning ? 13 : -1;
   }
   return -1;
 }
@@ -254,13 +277,40 @@ AlarmEngine::AlarmEngine(const AlarmConfig& cfg) : cfg_(cfg) {
   alarms_[8].configure(AlarmKind::ModelDomain, AlarmLevel::Critical, flag);
   flag.latch = false;
   alarms_[9].configure(AlarmKind::DuplicatePublisher, AlarmLevel::Warning, flag);
+  // Rope force: thresholds follow the static force (updateRopeForce); until
+  // the first update they sit at the fractions of a unit force.
+  AlarmSettings rope;
+  rope.on_delay = cfg_.on_delay;
+  rope.off_delay = cfg_.off_delay;
+  rope.reannounce = cfg_.reannounce;
+  rope.latch = cfg_.latch_critical;
+  rope.low = true;
+  rope.threshold = cfg_.slack_fraction;
+  rope.deadband = cfg_.force_deadband;
+  alarms_[10].configure(AlarmKind::RopeSlack, AlarmLevel::Critical, rope);
+  rope.low = false;
+  rope.threshold = cfg_.overload_fraction;
+  alarms_[11].configure(AlarmKind::RopeOverload, AlarmLevel::Critical, rope);
   // Predictions: raised with the forecast that predicts (no on-delay),
   // cleared after off_delay without one, never latched.
   AlarmSettings pred = flag;
   pred.off_delay = cfg_.off_delay;
-  alarms_[10].configure(AlarmKind::PredictedClearance, AlarmLevel::Warning, pred);
-  alarms_[11].configure(AlarmKind::PredictedSlack, AlarmLevel::Warning, pred);
+  alarms_[12].configure(AlarmKind::PredictedClearance, AlarmLevel::Warning, pred);
+  alarms_[13].configure(AlarmKind::PredictedSlack, AlarmLevel::Warning, pred);
 }
+
+void AlarmEngine::updateRopeForce(double now, double lambda0, double static_force, AlarmEvents& out) {
+  if (std::isfinite(static_force) && static_force > 0.0) {
+    const double db = cfg_.force_deadband * static_force;
+    alarms_[10].setThreshold(cfg_.slack_fraction * static_force, db);
+    alarms_[11].setThreshold(cfg_.overload_fraction * static_force, db);
+  }
+  alarms_[10].update(now, lambda0, out);
+  alarms_[11].update(now, lambda0, out);
+}
+
+double AlarmEngine::ropeSlackThreshold() const { return alarms_[10].settings().threshold; }
+double AlarmEngine::ropeOverloadThreshold() const { return alarms_[11].settings().threshold; }
 
 void AlarmEngine::updateClearance(double now, const Clearance& c, AlarmEvents& out) {
   for (int i = 0; i < 2; ++i) {
@@ -290,13 +340,13 @@ void AlarmEngine::setDuplicatePublisher(double now, bool seen, double other_id, 
 
 void AlarmEngine::setPredictedClearance(double now, bool predicted, double seconds, double horizon,
                                         AlarmEvents& out) {
-  if (predicted) alarms_[10].setDetail(seconds, horizon);
-  alarms_[10].update(now, predicted ? 1.0 : 0.0, out);
+  if (predicted) alarms_[12].setDetail(seconds, horizon);
+  alarms_[12].update(now, predicted ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out) {
-  if (predicted) alarms_[11].setDetail(seconds, horizon);
-  alarms_[11].update(now, predicted ? 1.0 : 0.0, out);
+  if (predicted) alarms_[13].setDetail(seconds, horizon);
+  alarms_[13].update(now, predicted ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

@@ -77,6 +77,9 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   ar.number("reannounce", a.reannounce);
   ar.boolean("latch_critical", a.latch_critical);
   ar.number("max_shelve", a.max_shelve);
+  ar.number("slack_fraction", a.slack_fraction);
+  ar.number("overload_fraction", a.overload_fraction);
+  ar.number("force_deadband", a.force_deadband);
   ar.run();
   try {
     a.validate();
@@ -149,7 +152,9 @@ std::string toToml(const TwinConfig& c) {
      << "\ncritical_fraction = " << Num{a.critical_fraction} << "\ndeadband = " << Num{a.deadband}
      << "\non_delay = " << Num{a.on_delay} << "\noff_delay = " << Num{a.off_delay}
      << "\nreannounce = " << Num{a.reannounce} << "\nlatch_critical = "
-     << (a.latch_critical ? "true" : "false") << "\nmax_shelve = " << Num{a.max_shelve} << "\n";
+     << (a.latch_critical ? "true" : "false") << "\nmax_shelve = " << Num{a.max_shelve}
+     << "\nslack_fraction = " << Num{a.slack_fraction} << "\noverload_fraction = " << Num{a.overload_fraction}
+     << "\nforce_deadband = " << Num{a.force_deadband} << "\n";
   const ForecastConfig& f = c.forecast;
   os << "\n[forecast]\nenabled = " << (f.enabled ? "true" : "false") << "\nrate = " << Num{f.rate}
      << "\nhorizon = " << Num{f.horizon} << "\nestop_decel = " << Num{f.estop_decel}

@@ -43,9 +43,9 @@ PlanCheck checkPlan(const TripPlan& plan, double t, const Kinematics& k, const S
   return planProfile(t, k, plan, shaft.maxRopeLength(), scratch);
 }
 
-double staticRopeForce(const ShaftParams& p) { return p.m * p.g + p.Fa; }
-
-double slackThreshold(const TwinConfig& cfg) { return kSlackFraction * staticRopeForce(cfg.shaft); }
+double slackThreshold(const TwinConfig& cfg, const ShaftModel& model, double l) {
+  return cfg.alarms.slack_fraction * model.staticRopeForce(l);
+}
 
 ForecastVerdict judgeForecast(const ForecastSummary* const* scenarios, int n, double slack_threshold) {
   ForecastVerdict v;

@@ -27,6 +27,8 @@ void toCageMessage(const CageOutput& o, hoist::cage_state_t& m) {
   m.min_clearance = o.clearance.min_clearance;
   m.alarm_level = static_cast<int8_t>(o.alarm_level);
   m.degraded = o.degraded;
+  m.rope_slack_threshold = o.rope_slack_threshold;
+  m.rope_overload_threshold = o.rope_overload_threshold;
 }
 
 void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n) {
@@ -99,6 +101,19 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
                       "(limit %.3f m); holding the last valid state, outputs degraded%s",
                       kind, level, verb, e.value, ctx.range.lo, ctx.range.hi, e.threshold, state);
       break;
+    case AlarmKind::RopeSlack:
+    case AlarmKind::RopeOverload: {
+      const AlarmConfig dflt{};
+      const AlarmConfig& cfg = ctx.alarms ? *ctx.alarms : dflt;
+      const bool slack = e.kind == AlarmKind::RopeSlack;
+      const double frac = slack ? cfg.slack_fraction : cfg.overload_fraction;
+      std::snprintf(buf, n, "%s %s %s: hoisting-rope force lambda_0 %.0f N %s threshold %.0f N (%.3g x the static "
+                    "rope force %.0f N)%s",
+                    kind, level, verb, e.value, slack ? (e.value <= e.threshold ? "at or below" : "above")
+                                                      : (e.value >= e.threshold ? "at or above" : "below"),
+                    e.threshold, frac, frac > 0.0 ? e.threshold / frac : 0.0, state);
+      break;
+    }
     case AlarmKind::DuplicatePublisher:
       if (e.type == AlarmEventType::Clear)
         std::snprintf(buf, n, "%s %s cleared: no other publisher seen on this twin's output channels%s", kind,

@@ -342,6 +342,10 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
     if (ok) {
       alarms_.setModelFault(t, false, events_);
       alarms_.updateClearance(t, out_.clearance, events_);
+      // Rope force against the static force at this length (issue 17).
+      alarms_.updateRopeForce(t, out_.lambda[0], solver_->model().staticRopeForce(out_.kin.l), events_);
+      out_.rope_slack_threshold = alarms_.ropeSlackThreshold();
+      out_.rope_overload_threshold = alarms_.ropeOverloadThreshold();
       out_.alarm_level = alarms_.highestActive();
       out_.degraded = degradedNow();
       out_.input_seq = have_input_ ? last_.seq : -1;

@@ -10,6 +10,7 @@
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hub.hpp"
 #include "static_files.hpp"
@@ -297,6 +298,95 @@ TEST(ValidateAckTest, Fields) {
   EXPECT_EQ(validateAckFields("X", 1, 2, 600, "ann"), "");
   EXPECT_NE(validateAckFields("X", 1, 1, 0, ""), "");
   EXPECT_NE(validateAckFields("X", 1, 1, 0, "a\nb"), "");
+}
+
+}  // namespace
+}  // namespace hoist::dash
+
+// ---- issue 17: HOIST_FORECAST (forecast_t with nested scenarios) ---------------
+namespace hoist::dash {
+namespace {
+
+forecast_t sampleForecast() {
+  forecast_t f{};
+  f.utime = 1700000000000000;
+  f.seq = 1;
+  f.t_start = 20.0;
+  f.l = 150.0;
+  f.plan_seq = -1;
+  f.num_scenarios = 2;
+  f.scenarios.resize(2);
+  for (int k = 0; k < 2; ++k) {
+    auto& s = f.scenarios[static_cast<std::size_t>(k)];
+    s.name = k == 0 ? "estop" : "continue";
+    s.horizon = s.t_reached = 20.0;
+    s.min_clearance = 0.02 + 0.01 * k;
+    s.t_min_clearance = 3.0;
+    s.t_warning = k == 0 ? 1.5 : -1.0;
+    s.t_critical = k == 0 ? 2.5 : -1.0;
+    s.lambda0_min = 3000.0;
+    s.lambda0_max = 14000.0;
+    s.num_points = 50;
+    for (int i = 0; i < 50; ++i) {
+      s.series_t.push_back(0.4 * (i + 1));
+      s.series_min_clearance.push_back(0.05 - 0.0005 * i);
+      s.series_lambda0_min.push_back(8000.0 - 10.0 * i);
+      s.series_lambda0_max.push_back(9000.0 + 10.0 * i);
+    }
+  }
+  return f;
+}
+
+TEST_F(HubTest, ForecastIsAdvertisedWithItsNestedSchemaAndForwardedAsJson) {
+  Hub hub = make(false, {"north/"});
+  RecClient c;
+  hub.addClient(c);
+  // Advertised under its LCM channel name, schema hoist.forecast_t with the
+  // scenarios' schema inlined (no $ref for a client to resolve).
+  Json adv;
+  for (const auto& m : c.text)
+    if (m["op"] == "advertise")
+      for (const auto& ch : m["channels"])
+        if (ch["topic"] == "north/HOIST_FORECAST") adv = ch;
+  ASSERT_FALSE(adv.is_null());
+  EXPECT_EQ(adv["schemaName"], "hoist.forecast_t");
+  const Json schema = Json::parse(adv["schema"].get<std::string>());
+  const Json& item = schema["properties"]["scenarios"]["items"];
+  EXPECT_EQ(item["title"], "hoist.forecast_scenario_t");
+  for (const char* k : {"name", "min_clearance", "t_min_clearance", "t_warning", "t_critical", "series_t",
+                        "series_min_clearance", "series_lambda0_min", "series_lambda0_max"})
+    EXPECT_TRUE(item["properties"].contains(k)) << k;
+  EXPECT_EQ(schema["properties"]["scenarios"]["maxItems"], 8);
+
+  const auto id = channelId(c, "north/HOIST_FORECAST");
+  const auto bytes = encode(sampleForecast());
+  hub.onLcm("north/HOIST_FORECAST", bytes.data(), bytes.size());  // before any subscriber: kept as latest
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 7}, {"channelId", id}}}}}.dump());
+  ASSERT_EQ(c.data.size(), 1u) << "the latest forecast is sent on subscribe";
+  Json j = Json::parse(c.data[0].substr(13));
+  ASSERT_EQ(j["scenarios"].size(), 2u);
+  EXPECT_EQ(j["scenarios"][0]["name"], "estop");
+  EXPECT_DOUBLE_EQ(j["scenarios"][0]["t_critical"].get<double>(), 2.5);
+  EXPECT_DOUBLE_EQ(j["scenarios"][1]["t_critical"].get<double>(), -1.0);
+  EXPECT_EQ(j["scenarios"][1]["series_lambda0_max"].size(), 50u);
+  hub.onLcm("north/HOIST_FORECAST", bytes.data(), bytes.size());
+  EXPECT_EQ(c.data.size(), 2u);
+
+  // Hostile forecasts: a lying nested count, a truncation, a forecast on the
+  // wrong channel -- counted, never forwarded.
+  auto bad = bytes;
+  const std::size_t np = 8 + 9 * 8 + 1 + 4 + 6 + 1 + 8 * 8 + 4 * 8 + 16;  // scenarios[0].num_points
+  ASSERT_EQ(bad[np + 1], 50);
+  bad[np] = 0x7f;
+  hub.onLcm("north/HOIST_FORECAST", bad.data(), bad.size());
+  auto cut = bytes;
+  cut.resize(cut.size() - 3);
+  hub.onLcm("north/HOIST_FORECAST", cut.data(), cut.size());
+  hub.onLcm("north/HOIST_CAGE", bytes.data(), bytes.size());
+  EXPECT_EQ(c.data.size(), 2u);
+  EXPECT_EQ(hub.counter("lcm_rejected_decode_bad_count"), 1u);
+  EXPECT_EQ(hub.counter("lcm_rejected_decode_truncated"), 1u);
+  EXPECT_EQ(hub.counter("lcm_rejected_wrong_type"), 1u);
 }
 
 }  // namespace

@@ -8,7 +8,10 @@
 //   * hoist-monitor receives an alarm_t whose message carries terminal escape
 //     sequences, health_t with impossible counts and garbage: no control
 //     character reaches its output, the undecodable messages are counted, it
-//     says STALE when the daemon goes quiet, and it exits 0 with bounded memory.
+//     says STALE when the daemon goes quiet, and it exits 0 with bounded memory;
+//   * hoist-monitor shows HOIST_FORECAST (issue 17, port 7757): per scenario
+//     the worst clearance and the time to violation, scenario names
+//     terminal-safe, a forecast with a lying nested count dropped and counted.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -17,6 +20,7 @@
 #include "attack_bytes.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
 #include "run_util.hpp"
@@ -169,6 +173,65 @@ TEST_F(DecodeAttack, MonitorSanitizesStringsAndFlagsStaleData) {
   EXPECT_NE(text.find("FAKE: all clear"), std::string::npos) << text;  // shown, but inert
   EXPECT_NE(text.find("undecodable messages: 5"), std::string::npos) << text;
   EXPECT_NE(text.find("STALE: no HOIST_CAGE"), std::string::npos) << text;
+}
+
+TEST_F(DecodeAttack, MonitorShowsForecastWorstClearanceAndTimeToViolation) {
+  start(7757, "decode_attack_monitor_forecast");
+  const std::string out = (dir_ / "monitor.out").string();
+  Process mon({HOIST_MONITOR, "--lcm-url", url_, "--period", "0.25", "--duration", "2.5"}, out);
+  ASSERT_TRUE(mon.started());
+  listener_->pump(500ms);  // let it subscribe
+  hoist::cage_state_t cage{};
+  cage.t = 20.0;
+  cage.l = 150.0;
+  cage.min_clearance = 0.05;
+  listener_->lcm().publish("HOIST_CAGE", &cage);
+  hoist::forecast_t f{};
+  f.utime = 1;
+  f.seq = 1;
+  f.t_start = 20.0;
+  f.plan_seq = -1;
+  f.num_scenarios = 2;
+  f.scenarios.resize(2);
+  auto& e = f.scenarios[0];
+  e.name = "estop";
+  e.min_clearance = 0.0125;
+  e.t_min_clearance = 2.0;
+  e.t_warning = 1.5;
+  e.t_critical = 2.5;
+  e.lambda0_min = 2400.0;
+  auto& c = f.scenarios[1];
+  c.name = "cont\x1b[2Jinue";  // a name with an escape sequence
+  c.min_clearance = 0.040;
+  c.t_min_clearance = 6.0;
+  c.t_warning = -1.0;
+  c.t_critical = -1.0;
+  c.lambda0_min = 8100.0;
+  c.status = hoist::forecast_scenario_t::STATUS_LEFT_SHAFT;
+  c.t_reached = 12.5;
+  std::vector<std::uint8_t> b(static_cast<std::size_t>(f.getEncodedSize()));
+  f.encode(b.data(), 0, static_cast<int>(b.size()));
+  // First a lying copy: scenarios[0].num_points = 30000 (no points follow).
+  auto bad = b;
+  const std::size_t np = 8 + 9 * 8 + 1 + 4 + 6 + 1 + 112;
+  ASSERT_EQ(bad[np + 1], 0);
+  bad[np] = 0x75;
+  bad[np + 1] = 0x30;
+  publish("HOIST_FORECAST", bad);
+  publish("HOIST_FORECAST", b);
+  const int st = mon.wait(15s);
+  const std::string text = readFile(out);
+  EXPECT_EQ(st, 0) << text;
+  EXPECT_NE(text.find("forecast from t=20.00 s: estop: worst 12.5 mm at +2.00 s, CRITICAL in 2.50 s, "
+                      "WARNING in 1.50 s, F0 min 2.40 kN"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("| cont\\x1b[2Jinue: worst 40.0 mm at +6.00 s, CRITICAL none, WARNING none, F0 min 8.10 kN "
+                      "[stopped at +12.50 s: left the shaft]"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find('\x1b'), std::string::npos) << "an escape character reached the terminal:\n" << text;
+  EXPECT_NE(text.find("undecodable messages: 1"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -16,6 +16,8 @@
 
 #include "attack_bytes.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
+#include "hoist/trip_plan_t.hpp"
 #include "hoist/io/lcm_log.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
@@ -266,6 +268,102 @@ TEST(Log2Csv, FullDiskIsAnErrorNamingTheFile) {
   EXPECT_NE(out.find("HOIST_WINDER.csv"), std::string::npos) << out;
   EXPECT_NE(out.find("No space left on device"), std::string::npos) << out;
   EXPECT_EQ(out.find("600 rows"), std::string::npos) << out;
+}
+
+// Issue 17: HOIST_FORECAST (nested forecast_scenario_t) to CSV -- one row
+// per scenario in HOIST_FORECAST.csv, the series in HOIST_FORECAST.series.csv;
+// HOIST_TRIP_PLAN; HOIST_CAGE's appended threshold columns; a forecast with a
+// lying nested count is rejected by the checked decoder (exit 1, bad_count).
+TEST(Log2Csv, ForecastOneRowPerScenarioAndTheSeries) {
+  const auto d = workDir("forecast");
+  hoist::forecast_t f{};
+  f.utime = 1700000000000000;
+  f.seq = 3;
+  f.instance_id = 77;
+  f.t_start = 20.0;
+  f.l = 150.0;
+  f.v = 5.0;
+  f.plan_seq = 9;
+  f.compute_time = 0.012;
+  f.num_scenarios = 2;
+  f.scenarios.resize(2);
+  const char* names[] = {"estop", "con,\"tinue\""};
+  for (int k = 0; k < 2; ++k) {
+    auto& sc = f.scenarios[static_cast<std::size_t>(k)];
+    sc.name = names[k];
+    sc.horizon = sc.t_reached = 20.0;
+    sc.min_clearance = 0.05 - 0.01 * k;
+    sc.t_min_clearance = 4.0 + k;
+    sc.t_warning = k == 0 ? -1.0 : 2.5;
+    sc.t_critical = -1.0;
+    sc.peak_lambdas[3] = 31.25;
+    sc.lambda0_min = 2400.0;
+    sc.lambda0_max = 15000.0;
+    sc.num_points = static_cast<std::int16_t>(k == 0 ? 3 : 2);
+    for (int i = 0; i < sc.num_points; ++i) {
+      sc.series_t.push_back(i + 1.0);
+      sc.series_min_clearance.push_back(0.05);
+      sc.series_lambda0_min.push_back(8000.0);
+      sc.series_lambda0_max.push_back(9000.0 + i);
+    }
+  }
+  hoist::trip_plan_t plan{};
+  plan.utime = 5;
+  plan.seq = 9;
+  plan.target_length = 300.0;
+  plan.vmax = 5.0;
+  plan.amax = 1.0;
+  plan.jerk = 0.5;
+  hoist::cage_state_t cage{};
+  cage.rope_slack_threshold = 4424.0;
+  cage.rope_overload_threshold = 13272.0;
+  Bytes log;
+  auto add = [&](const Bytes& ev) { log.insert(log.end(), ev.begin(), ev.end()); };
+  add(atk::logEvent(0, 1000000, "HOIST_FORECAST", encode(f)));
+  add(atk::logEvent(1, 1000001, "HOIST_TRIP_PLAN", encode(plan)));
+  add(atk::logEvent(2, 1000002, "HOIST_CAGE", encode(cage)));
+  f.seq = 4;
+  add(atk::logEvent(3, 1000003, "HOIST_FORECAST", encode(f)));
+  writeBytes(d / "f.lcmlog", log);
+  auto res = runMeasured({HOIST_LOG2CSV, (d / "f.lcmlog").string(), "--out-dir", (d / "out").string()},
+                         (d / "f.log").string());
+  ASSERT_EQ(res.status, 0) << slurp(d / "f.log");
+  const std::string csv = slurp(d / "out" / "HOIST_FORECAST.csv");
+  EXPECT_EQ(csvRows(d / "out" / "HOIST_FORECAST.csv"), 4) << csv;  // 2 messages x 2 scenarios
+  EXPECT_EQ(csv.rfind("utime,seq,instance_id,t_start,l,v,a,plan_seq,compute_time,scenario,name,status,horizon,"
+                      "t_reached,min_clearance,t_min_clearance,t_warning,t_critical,peak_y_c,peak_theta,"
+                      "peak_lambda_1,peak_lambda_2,peak_lambda_3,peak_lambda_4,lambda0_min,lambda0_max,num_points\n",
+                      0),
+            0u)
+      << csv;
+  EXPECT_NE(csv.find("1700000000000000,3,77,20,150,5,0,9,0.012,0,\"estop\",0,20,20,0.050000000000000003,4,-1,-1,0,0,"
+                     "0,0,0,31.25,2400,15000,3\n"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",1,\"con,\"\"tinue\"\"\",0,20,20,"), std::string::npos) << csv;  // quoted name
+  const std::string series = slurp(d / "out" / "HOIST_FORECAST.series.csv");
+  EXPECT_EQ(csvRows(d / "out" / "HOIST_FORECAST.series.csv"), 10) << series;  // 2 x (3 + 2)
+  EXPECT_NE(series.find("utime,seq,scenario,name,i,t,min_clearance,lambda0_min,lambda0_max\n"), std::string::npos);
+  EXPECT_NE(series.find("1700000000000000,4,1,\"con,\"\"tinue\"\"\",1,2,0.050000000000000003,8000,9001\n"),
+            std::string::npos)
+      << series;
+  EXPECT_NE(slurp(d / "out" / "HOIST_TRIP_PLAN.csv").find("5,9,300,5,1,0.5\n"), std::string::npos);
+  const std::string c = slurp(d / "out" / "HOIST_CAGE.csv");
+  EXPECT_NE(c.find(",alarm_level,degraded,rope_slack_threshold,rope_overload_threshold\n"), std::string::npos) << c;
+  EXPECT_NE(c.find(",0,0,4424,13272\n"), std::string::npos) << c;
+
+  // A forecast whose second scenario claims 30000 points: bad_count, no row, exit 1.
+  Bytes b = encode(f);
+  const std::size_t np2 = 8 + 9 * 8 + 1 + (4 + 6 + 1 + 112 + 2 + 3 * 32) + 4 + 12 + 1 + 112;
+  ASSERT_EQ(b[np2 + 1], 2);
+  b[np2] = 0x75;
+  b[np2 + 1] = 0x30;
+  writeBytes(d / "bad.lcmlog", atk::logEvent(0, 0, "HOIST_FORECAST", b));
+  res = runMeasured({HOIST_LOG2CSV, (d / "bad.lcmlog").string(), "--out-dir", (d / "out2").string()},
+                    (d / "bad.log").string());
+  EXPECT_EQ(res.status, 1) << slurp(d / "bad.log");
+  EXPECT_NE(slurp(d / "bad.log").find("bad_count"), std::string::npos) << slurp(d / "bad.log");
+  EXPECT_FALSE(fs::exists(d / "out2" / "HOIST_FORECAST.csv"));
 }
 
 // hoist-replay --lcm-log: the same log classes (publishing to memq://).

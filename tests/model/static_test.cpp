@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include "hoist/fast_solver.hpp"
 #include "hoist/paper_solver.hpp"
@@ -170,3 +172,58 @@ TEST(Static, FastPathAccurateAtTheShaftEnds) {
 }
 
 }  // namespace
+
+// ShaftModel::staticRopeForce (the reference of ROPE_SLACK / ROPE_OVERLOAD,
+// issue 17) against the solver's static solve: lambda_0 = m g + Fa at every
+// length, for both methods and several shafts -- the rope's own weight
+// (rho1 g l) does not pass through g0.  Then a rest start settles to it, and
+// a constant deceleration shifts it by m a as the cage's equation says.
+TEST(Static, RopeForceEqualsTheStaticSolve) {
+  std::vector<ShaftParams> shafts(4);
+  shafts[1].m = 5000.0;  // a heavy cage, no eccentric load
+  shafts[1].Fa = 0.0;
+  shafts[2].rho1 = 12.0;  // a heavy rope: its weight must not appear
+  shafts[2].g = 9.79;
+  shafts[3].Fa = 4000.0;
+  shafts[3].n = 12;
+  for (std::size_t k = 0; k < shafts.size(); ++k) {
+    ShaftParams p = shafts[k];
+    auto model = std::make_shared<const ShaftModel>(p);
+    const double f = model->staticRopeForce(100.0);
+    EXPECT_NEAR(f, p.m * p.g + p.Fa, 1e-12 * f);
+    for (double l : {0.5, 50.0, 150.0, 300.0, p.maxRopeLength() - 0.5}) {
+      SCOPED_TRACE("shaft " + std::to_string(k) + ", l = " + std::to_string(l));
+      EXPECT_EQ(model->staticRopeForce(l), f);
+      for (bool corr : {true, false}) {
+        p.static_correction = corr;
+        EXPECT_NEAR(staticAt(p, l).lambda[0], f, 1e-9 * f) << "fast, static_correction " << corr;
+      }
+      p.static_correction = false;
+      if (l >= 50.0 && l <= 300.0) {  // the paper partition is ill-conditioned near the ends
+        EXPECT_NEAR(staticAt(p, l, Method::Paper).lambda[0], f, 1e-8 * f) << "paper";
+      }
+    }
+  }
+  // Dynamics agree: from rest (q = 0, the load applied as a step) lambda_0
+  // oscillates about the static force and the damped rope settles to it.
+  ShaftParams p;
+  p.u1 = 3000.0;  // 100x the paper's rope damping: settle within seconds
+  auto model = std::make_shared<const ShaftModel>(p);
+  auto s = makeSolver(Method::Fast, model);
+  const Kinematics rest{150.0, 0.0, 0.0};
+  s->initialize(0.0, rest, InitialState::Rest);
+  for (int i = 1; i <= 2000; ++i) s->step(i * 0.005, rest);
+  const double f = model->staticRopeForce(rest.l);
+  EXPECT_NEAR(s->response().lambda[0], f, 1e-4 * f);
+  // Constant a (no jerk after the start): lambda_0 -> Fa + m (g - a).
+  const double a = -2.0;  // descending and braking
+  s->initialize(0.0, {150.0, 3.0, a}, InitialState::Static);
+  double l = 150.0, v = 3.0;
+  for (int i = 1; i <= 1000; ++i) {
+    const double dt = 0.001;
+    l += v * dt + 0.5 * a * dt * dt;
+    v += a * dt;
+    s->step(i * dt, {l, v, a});
+  }
+  EXPECT_NEAR(s->response().lambda[0], p.Fa + p.m * (p.g - a), 2e-2 * f);
+}

@@ -17,6 +17,7 @@
 #include "lcm_fixtures.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
+#include "hoist/forecast_t.hpp"
 
 using namespace hoist::test;
 using json = nlohmann::json;
@@ -246,6 +247,36 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
   EXPECT_EQ((*health)["clock"], "wall");
   EXPECT_TRUE((*health)["reject_reason"].is_array());
 
+  // Forecast (issue 17): a forecast_t on north/HOIST_FORECAST (synthetic: the
+  // daemon's forecast worker is elsewhere) -> hoist/north/forecast as JSON
+  // with its nested scenarios, not retained.
+  {
+    hoist::forecast_t f{};
+    f.utime = 1;
+    f.seq = 5;
+    f.t_start = 20.0;
+    f.plan_seq = -1;
+    f.num_scenarios = 1;
+    f.scenarios.resize(1);
+    f.scenarios[0].name = "estop";
+    f.scenarios[0].min_clearance = 0.0125;
+    f.scenarios[0].t_critical = 2.5;
+    f.scenarios[0].t_warning = 1.5;
+    f.scenarios[0].num_points = 2;
+    f.scenarios[0].series_t = {10.0, 20.0};
+    f.scenarios[0].series_min_clearance = {0.02, 0.0125};
+    f.scenarios[0].series_lambda0_min = {8000.0, 2400.0};
+    f.scenarios[0].series_lambda0_max = {9000.0, 15000.0};
+    lcm.lcm().publish("north/HOIST_FORECAST", &f);
+  }
+  auto fc = early.waitJson("hoist/north/forecast", [](const json& j, bool) { return j.value("seq", -1) == 5; }, 5s);
+  ASSERT_TRUE(fc) << readFile(log("bridge.log"));
+  ASSERT_EQ((*fc)["scenarios"].size(), 1u);
+  EXPECT_EQ((*fc)["scenarios"][0]["name"], "estop");
+  EXPECT_DOUBLE_EQ((*fc)["scenarios"][0]["t_critical"].get<double>(), 2.5);
+  EXPECT_EQ((*fc)["scenarios"][0]["series_lambda0_max"].size(), 2u);
+  for (const auto& m : early.on("hoist/north/forecast")) EXPECT_FALSE(m.retain);
+
   // The alarm: CAGE_POS_Y WARNING active (demo.toml's 16 mm gap, ~11 mm lean).
   auto alarm = early.waitJson("hoist/north/alarm/CAGE_POS_Y", [](const json& j, bool) { return isWarningActive(j); }, 15s);
   ASSERT_TRUE(alarm) << readFile(log("bridge.log")) << readFile(log("twind.log"));
@@ -300,6 +331,7 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
   EXPECT_EQ(c["rejected_by_reason"]["bad_fields"], 1);
   EXPECT_EQ((*bh)["connection"]["state"], "connected");
   EXPECT_EQ((*bh)["lcm"]["decode_errors"], 0);
+  EXPECT_GE((*bh)["shafts"][0]["forecasts_in"].get<int>(), 1);
   lcm.pump(300ms);
   EXPECT_EQ(lcm.count("north/HOIST_ALARM_ACK"), acks_before) << "a rejected command reached LCM";
   const std::string blog = readFile(log("bridge.log"));

@@ -293,3 +293,132 @@ TEST(AlarmNames, RoundTrip) {
   }
   EXPECT_FALSE(parseAlarmKind("NOPE"));
 }
+
+// ---- issue 17: live rope-force alarms ----------------------------------------
+
+TEST(BinaryAlarm, LowAlarmRaisesAtOrBelowAndClearsAboveThresholdPlusDeadband) {
+  AlarmSettings s = settings(100.0, 10.0);
+  s.low = true;
+  BinaryAlarm a(AlarmKind::RopeSlack, AlarmLevel::Critical, s);
+  AlarmEvents ev;
+  a.update(0.0, 150.0, ev);
+  EXPECT_FALSE(a.active());
+  a.update(0.1, 100.0, ev);  // at the threshold: on
+  EXPECT_TRUE(a.active());
+  a.update(0.2, 109.0, ev);  // inside the deadband: stays
+  EXPECT_TRUE(a.active());
+  a.update(0.3, 110.5, ev);  // above threshold + deadband: off
+  EXPECT_FALSE(a.active());
+  EXPECT_EQ(count(ev, AlarmEventType::Raise), 1);
+  EXPECT_EQ(count(ev, AlarmEventType::Clear), 1);
+  a.update(0.4, std::numeric_limits<double>::quiet_NaN(), ev);  // fail safe
+  EXPECT_TRUE(a.active());
+  // Moving the threshold keeps the state: 105 is above 50 + 10 -> clears.
+  a.setThreshold(50.0, 10.0);
+  a.update(0.5, 105.0, ev);
+  EXPECT_FALSE(a.active());
+  EXPECT_EQ(a.settings().threshold, 50.0);
+}
+
+TEST(AlarmEngine, RopeSlackAndOverloadFollowTheStaticForce) {
+  AlarmConfig cfg;  // slack 0.5, overload 1.5, force_deadband 0.05, on 0.1 s, off 1 s
+  AlarmEngine eng(cfg);
+  AlarmEvents ev;
+  // No rope force yet: polling raises nothing (the slack alarm's "no value"
+  // is not a zero force).
+  eng.poll(0.0, ev);
+  eng.poll(5.0, ev);
+  EXPECT_TRUE(ev.empty());
+  EXPECT_EQ(eng.activeCount(), 0);
+  const double F = 800.0 * 9.81 + 1000.0;  // m g + Fa of the paper's shaft
+  double t = 10.0;
+  auto feed = [&](double lambda0, double seconds) {
+    for (double end = t + seconds; t < end - 1e-9; t += 0.01) eng.updateRopeForce(t, lambda0, F, ev);
+  };
+  feed(F, 1.0);
+  EXPECT_TRUE(ev.empty());
+  EXPECT_DOUBLE_EQ(eng.ropeSlackThreshold(), 0.5 * F);
+  EXPECT_DOUBLE_EQ(eng.ropeOverloadThreshold(), 1.5 * F);
+  // A dip shorter than on_delay: nothing.
+  feed(0.3 * F, 0.05);
+  feed(F, 0.5);
+  EXPECT_TRUE(ev.empty());
+  // A slack rope: CRITICAL after the on-delay, value and threshold in N.
+  feed(0.3 * F, 0.3);
+  const BinaryAlarm* slack = eng.find(AlarmKind::RopeSlack, AlarmLevel::Critical);
+  ASSERT_NE(slack, nullptr);
+  EXPECT_TRUE(slack->active());
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, AlarmKind::RopeSlack);
+  EXPECT_EQ(ev[0].level, AlarmLevel::Critical);
+  EXPECT_EQ(ev[0].type, AlarmEventType::Raise);
+  EXPECT_NEAR(ev[0].value, 0.3 * F, 1e-9);
+  EXPECT_NEAR(ev[0].threshold, 0.5 * F, 1e-9);
+  EXPECT_EQ(eng.highestActive(), AlarmLevel::Critical);
+  EXPECT_EQ(eng.find(AlarmKind::RopeSlack, AlarmLevel::Warning), nullptr);
+  ev.clear();
+  // Back inside the deadband (0.52 F < 0.55 F) for long: the condition holds.
+  feed(0.52 * F, 2.0);
+  EXPECT_TRUE(slack->condition());
+  // Above it for off_delay: condition gone, but latched until acknowledged.
+  feed(F, 1.5);
+  EXPECT_FALSE(slack->condition());
+  EXPECT_TRUE(slack->active());
+  EXPECT_TRUE(slack->latched());
+  EXPECT_EQ(eng.acknowledge(t, AlarmKind::RopeSlack, AlarmLevel::None, ev), 1);
+  EXPECT_FALSE(slack->active());
+  ev.clear();
+  // Overload.
+  feed(1.6 * F, 0.3);
+  const BinaryAlarm* over = eng.find(AlarmKind::RopeOverload, AlarmLevel::Critical);
+  ASSERT_NE(over, nullptr);
+  EXPECT_TRUE(over->active());
+  EXPECT_FALSE(slack->active());
+  ASSERT_GE(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, AlarmKind::RopeOverload);
+  EXPECT_NEAR(ev[0].threshold, 1.5 * F, 1e-9);
+  // Shelving works as for every alarm.
+  EXPECT_EQ(eng.shelve(t, AlarmKind::RopeOverload, AlarmLevel::Critical, 60.0, ev), 1);
+  EXPECT_EQ(eng.highestActive(), AlarmLevel::None);
+  // The thresholds follow the static force given (e.g. another length).
+  eng.updateRopeForce(t, F, 2.0 * F, ev);
+  EXPECT_DOUBLE_EQ(eng.ropeSlackThreshold(), F);
+  EXPECT_DOUBLE_EQ(eng.ropeOverloadThreshold(), 3.0 * F);
+  // A bad static force leaves them.
+  eng.updateRopeForce(t, F, std::numeric_limits<double>::quiet_NaN(), ev);
+  eng.updateRopeForce(t, F, -1.0, ev);
+  EXPECT_DOUBLE_EQ(eng.ropeSlackThreshold(), F);
+}
+
+TEST(AlarmConfig, RopeForceKeysNameTheKey) {
+  auto err = [](auto set) {
+    AlarmConfig c;
+    set(c);
+    try {
+      c.validate();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(err([](AlarmConfig& c) { c.slack_fraction = 0.0; }).find("alarms.slack_fraction"), std::string::npos);
+  EXPECT_NE(err([](AlarmConfig& c) { c.slack_fraction = 1.0; }).find("alarms.slack_fraction"), std::string::npos);
+  EXPECT_NE(err([&](AlarmConfig& c) { c.slack_fraction = nan; }).find("alarms.slack_fraction"), std::string::npos);
+  EXPECT_NE(err([](AlarmConfig& c) { c.overload_fraction = 1.0; }).find("alarms.overload_fraction"),
+            std::string::npos);
+  EXPECT_NE(err([](AlarmConfig& c) { c.overload_fraction = 101.0; }).find("alarms.overload_fraction"),
+            std::string::npos);
+  EXPECT_NE(err([](AlarmConfig& c) { c.force_deadband = -1e-3; }).find("alarms.force_deadband"), std::string::npos);
+  EXPECT_NE(err([](AlarmConfig& c) { c.force_deadband = 0.5; }).find("alarms.force_deadband"), std::string::npos);
+  EXPECT_NE(err([](AlarmConfig& c) {
+              c.overload_fraction = 1.04;
+            }).find("alarms.force_deadband"),
+            std::string::npos);  // 0.05 deadband cannot clear 1.04 x static
+  EXPECT_EQ(err([](AlarmConfig& c) {
+              c.slack_fraction = 0.2;
+              c.overload_fraction = 3.0;
+              c.force_deadband = 0.0;
+            }),
+            "(no error)");
+}

@@ -68,6 +68,9 @@ off_delay = 2.0
 reannounce = 0
 latch_critical = false
 max_shelve = 600
+slack_fraction = 0.3
+overload_fraction = 2.0
+force_deadband = 0.1
 )");
   EXPECT_EQ(c.service.rate, 200.0);
   EXPECT_EQ(c.service.cage_rate, 50.0);
@@ -78,6 +81,9 @@ max_shelve = 600
   EXPECT_EQ(c.alarms.gap_neg_y, 0.25);
   EXPECT_EQ(c.alarms.reannounce, 0.0);
   EXPECT_FALSE(c.alarms.latch_critical);
+  EXPECT_EQ(c.alarms.slack_fraction, 0.3);
+  EXPECT_EQ(c.alarms.overload_fraction, 2.0);
+  EXPECT_EQ(c.alarms.force_deadband, 0.1);
   EXPECT_EQ(c.alarms.max_shelve, 600.0);
 }
 
@@ -112,8 +118,14 @@ TEST(ServiceConfig, PrintedConfigParsesBack) {
   c.service.rate = 250.0;
   c.service.channel_prefix = "X_";
   c.alarms.deadband = 0.03;
+  c.alarms.slack_fraction = 0.25;
+  c.alarms.overload_fraction = 1.75;
+  c.alarms.force_deadband = 0.02;
   const std::string text = toToml(c);
   const TwinConfig d = parse(text);
+  EXPECT_EQ(d.alarms.slack_fraction, 0.25);
+  EXPECT_EQ(d.alarms.overload_fraction, 1.75);
+  EXPECT_EQ(d.alarms.force_deadband, 0.02);
   EXPECT_EQ(d.service.rate, 250.0);
   EXPECT_EQ(d.service.channel_prefix, "X_");
   EXPECT_EQ(d.alarms.deadband, 0.03);
@@ -191,4 +203,35 @@ TEST(ForecastConfig, BadValuesNameTheKeyAndLine) {
   expectKey("[forecast]\nworkers = 1.5\n", "forecast.workers: must be an integer");
   expectKey("[forecast]\nseries_points = 65\n", "forecast.series_points");
   expectKey("[forecast]\nhorizn = 20\n", "forecast.horizn");
+// Issue 17: the rope-force alarm keys are validated like every key; the
+// error names file:line and the key.
+TEST(ServiceConfig, RopeForceAlarmKeysAreValidated) {
+  const TwinConfig d = parse("");
+  EXPECT_EQ(d.alarms.slack_fraction, 0.5);
+  EXPECT_EQ(d.alarms.overload_fraction, 1.5);
+  EXPECT_EQ(d.alarms.force_deadband, 0.05);
+  struct Case {
+    const char* text;
+    const char* want;
+  };
+  const Case cases[] = {
+      {"[alarms]\nslack_fraction = 0.0\n", "test.toml:2: alarms.slack_fraction"},
+      {"[alarms]\nslack_fraction = 1.0\n", "test.toml:2: alarms.slack_fraction: must be below 1"},
+      {"[alarms]\nslack_fraction = -0.2\n", "alarms.slack_fraction"},
+      {"[alarms]\nslack_fraction = nan\n", "alarms.slack_fraction"},
+      {"[alarms]\nslack_fraction = \"half\"\n", "test.toml:2: alarms.slack_fraction: must be a number"},
+      {"[alarms]\n\noverload_fraction = 1.0\n", "test.toml:3: alarms.overload_fraction: must be in (1, 100]"},
+      {"[alarms]\noverload_fraction = 0.8\n", "alarms.overload_fraction"},
+      {"[alarms]\noverload_fraction = 1000\n", "alarms.overload_fraction"},
+      {"[alarms]\noverload_fraction = inf\n", "alarms.overload_fraction"},
+      {"[alarms]\nforce_deadband = -0.01\n", "test.toml:2: alarms.force_deadband"},
+      {"[alarms]\nforce_deadband = 0.5\n", "alarms.force_deadband: must be below slack_fraction"},
+      {"[alarms]\nslack_fraction = 0.9\nforce_deadband = 0.2\n", "alarms.force_deadband"},
+      {"[alarms]\noverload_fraction = 1.1\nforce_deadband = 0.2\n", "alarms.force_deadband: must be below overload_fraction - 1"},
+      {"[alarms]\nslack_fractoin = 0.4\n", "alarms.slack_fractoin"},
+  };
+  for (const Case& c : cases) {
+    const std::string e = errorOf(c.text);
+    EXPECT_NE(e.find(c.want), std::string::npos) << c.text << " -> " << e;
+  }
 }

@@ -135,10 +135,13 @@ TEST(ForecastVerdict, EarliestCrossingOfAnyFiniteScenario) {
   EXPECT_EQ(v.clearance_s, -1.0);
 }
 
-TEST(ForecastVerdict, SlackThresholdIsAFractionOfTheStaticRopeForce) {
+TEST(ForecastVerdict, SlackThresholdIsTheLiveRopeSlackAlarms) {
   TwinConfig c;
-  EXPECT_DOUBLE_EQ(staticRopeForce(c.shaft), 800.0 * 9.81 + 1000.0);
-  EXPECT_DOUBLE_EQ(slackThreshold(c), kSlackFraction * (800.0 * 9.81 + 1000.0));
+  c.shaft.n = 4;
+  c.alarms.slack_fraction = 0.4;
+  const ShaftModel model(c.shaft);
+  // ROPE_SLACK's threshold: slack_fraction x the static rope force m g + Fa.
+  EXPECT_NEAR(slackThreshold(c, model, 137.5), 0.4 * (800.0 * 9.81 + 1000.0), 1e-9);
 }
 
 TEST(PredictedAlarms, RaiseAtOnceClearAfterOffDelayNameScenarioAndSeconds) {

@@ -24,6 +24,8 @@ TEST(Messages, CageMappingCopiesEveryField) {
   o.alarm_level = AlarmLevel::Warning;
   o.degraded = true;
   o.input_seq = 42;
+  o.rope_slack_threshold = 4424.0;
+  o.rope_overload_threshold = 13272.0;
   hoist::cage_state_t m{};
   toCageMessage(o, m);
   EXPECT_EQ(m.input_seq, 42);
@@ -44,6 +46,35 @@ TEST(Messages, CageMappingCopiesEveryField) {
   EXPECT_EQ(m.min_clearance, o.clearance.min_clearance);
   EXPECT_EQ(m.alarm_level, 1);
   EXPECT_TRUE(m.degraded);
+  EXPECT_EQ(m.rope_slack_threshold, 4424.0);  // issue 17: appended fields
+  EXPECT_EQ(m.rope_overload_threshold, 13272.0);
+}
+
+TEST(Messages, RopeForceAlarmTextStatesForceThresholdAndStaticForce) {
+  AlarmConfig cfg;
+  AlarmTextContext ctx;
+  ctx.alarms = &cfg;
+  AlarmEvent e;
+  e.kind = AlarmKind::RopeSlack;
+  e.level = AlarmLevel::Critical;
+  e.type = AlarmEventType::Raise;
+  e.active = true;
+  e.value = 2400.0;
+  e.threshold = 4424.0;  // 0.5 x 8848 N
+  char buf[512];
+  describeAlarm(e, ctx, buf, sizeof buf);
+  std::string s(buf);
+  EXPECT_NE(s.find("ROPE_SLACK CRITICAL raised"), std::string::npos) << s;
+  EXPECT_NE(s.find("lambda_0 2400 N at or below threshold 4424 N (0.5 x the static rope force 8848 N)"),
+            std::string::npos) << s;
+  e.kind = AlarmKind::RopeOverload;
+  e.value = 15000.0;
+  e.threshold = 13272.0;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  s = buf;
+  EXPECT_NE(s.find("ROPE_OVERLOAD CRITICAL raised"), std::string::npos) << s;
+  EXPECT_NE(s.find("15000 N at or above threshold 13272 N (1.5 x the static rope force 8848 N)"), std::string::npos)
+      << s;
 }
 
 TEST(Messages, AlarmTextNamesWhatTheOperatorNeeds) {

@@ -3,6 +3,7 @@
 // model-fault recovery, clearance alarms.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -382,4 +383,96 @@ TEST(TwinCoreAlarms, TightGapRaisesAClearanceWarning) {
   EXPECT_LT(core.output().clearance.clearance_pos, 0.014 * 0.4);
   EXPECT_GT(core.output().clearance.clearance_pos, 0.014 * 0.1);
   EXPECT_NEAR(core.output().clearance.min_clearance, core.output().clearance.clearance_pos, 1e-15);
+}
+
+// ---- issue 17: live rope-force alarms through TwinCore ------------------------
+
+namespace {
+
+/// Feed `prof` at 100 Hz with encoder lengths; the rope-force alarm events seen.
+struct RopeRun {
+  int slack_raises = 0, overload_raises = 0;
+  double lambda0_min = 1e300, lambda0_max = -1e300;
+  double slack_thr = 0.0, overload_thr = 0.0;
+  double slack_t = -1.0;
+};
+RopeRun runRope(const TwinConfig& cfg, const HoistProfile& prof) {
+  TwinCore core(cfg, ClockMode::Input);
+  RopeRun r;
+  const long n = std::lround((prof.endTime() - prof.startTime()) / 0.01);
+  for (long k = 0; k <= n; ++k) {
+    const InputResult res = core.onInput(sampleAt(prof, k, 0.01, true), 0.0);
+    EXPECT_TRUE(res.accepted) << "k = " << k;
+    r.lambda0_min = std::min(r.lambda0_min, core.output().lambda[0]);
+    r.lambda0_max = std::max(r.lambda0_max, core.output().lambda[0]);
+    for (const AlarmEvent& e : core.events()) {
+      if (e.type != AlarmEventType::Raise) continue;
+      if (e.kind == AlarmKind::RopeSlack) {
+        ++r.slack_raises;
+        if (r.slack_t < 0) r.slack_t = e.t;
+        EXPECT_EQ(e.level, AlarmLevel::Critical);
+        EXPECT_LE(e.value, e.threshold);
+      }
+      if (e.kind == AlarmKind::RopeOverload) {
+        ++r.overload_raises;
+        EXPECT_GE(e.value, e.threshold);
+      }
+    }
+    core.clearEvents();
+  }
+  r.slack_thr = core.output().rope_slack_threshold;
+  r.overload_thr = core.output().rope_overload_threshold;
+  return r;
+}
+
+}  // namespace
+
+TEST(TwinCoreAlarms, EmergencyStopWhileHoistingSlackensTheRope) {
+  // Hoisting at 5 m/s (v < 0) from l = 300 m, e-stop at t = 2 s with 8 m/s^2:
+  // the cage goes on upward, lambda_0 -> Fa + m (g - 8) = 2.4 kN, below
+  // 0.5 x (m g + Fa) = 4.4 kN.
+  TwinConfig cfg = smallConfig();
+  const double F = cfg.shaft.m * cfg.shaft.g + cfg.shaft.Fa;
+  const RopeRun r = runRope(cfg, HoistProfile::emergencyStop(300.0, -5.0, 2.0, 8.0, 5.0, 0.01));
+  EXPECT_GE(r.slack_raises, 1);
+  EXPECT_EQ(r.overload_raises, 0);
+  EXPECT_LT(r.lambda0_min, 0.5 * F);
+  EXPECT_GT(r.slack_t, 2.0 + cfg.alarms.on_delay - 1e-9);  // after the stop began, debounced
+  EXPECT_LT(r.slack_t, 2.0 + 0.625);                         // during the 0.625 s stop
+  // The thresholds in the state (HOIST_CAGE.rope_slack_threshold, ...).
+  EXPECT_NEAR(r.slack_thr, 0.5 * F, 1e-9 * F);
+  EXPECT_NEAR(r.overload_thr, 1.5 * F, 1e-9 * F);
+  // A gentle stop (1 m/s^2) slackens nothing: lambda_0 stays near m (g - 1) + Fa.
+  const RopeRun g = runRope(cfg, HoistProfile::emergencyStop(300.0, -5.0, 2.0, 1.0, 8.0, 0.01));
+  EXPECT_EQ(g.slack_raises, 0);
+  EXPECT_EQ(g.overload_raises, 0);
+  EXPECT_GT(g.lambda0_min, 0.8 * F);
+}
+
+TEST(TwinCoreAlarms, EmergencyStopWhileDescendingOverloadsTheRope) {
+  // Descending at 5 m/s, e-stop with 8 m/s^2: lambda_0 -> Fa + m (g + 8) =
+  // 15.2 kN > 1.5 x 8.85 kN = 13.3 kN.
+  TwinConfig cfg = smallConfig();
+  const double F = cfg.shaft.m * cfg.shaft.g + cfg.shaft.Fa;
+  RopeRun r = runRope(cfg, HoistProfile::emergencyStop(100.0, 5.0, 2.0, 8.0, 5.0, 0.01));
+  EXPECT_GE(r.overload_raises, 1);
+  EXPECT_EQ(r.slack_raises, 0);
+  EXPECT_GT(r.lambda0_max, 1.5 * F);
+  // A higher overload_fraction (2.0 x = 17.7 kN) keeps it quiet, and the
+  // published threshold follows the configuration.
+  cfg.alarms.overload_fraction = 2.0;
+  r = runRope(cfg, HoistProfile::emergencyStop(100.0, 5.0, 2.0, 8.0, 5.0, 0.01));
+  EXPECT_EQ(r.overload_raises, 0);
+  EXPECT_NEAR(r.overload_thr, 2.0 * F, 1e-9 * F);
+}
+
+TEST(TwinCoreAlarms, ThePaperTripRaisesNoRopeForceAlarm) {
+  // The defaults must not fire on a normal trip (a = +-1 m/s^2).
+  TwinConfig cfg = smallConfig();
+  const double F = cfg.shaft.m * cfg.shaft.g + cfg.shaft.Fa;
+  const RopeRun r = runRope(cfg, HoistProfile::trapezoid(50.0, 5.0, 1.0, 250.0, 60.0, 0.01));
+  EXPECT_EQ(r.slack_raises, 0);
+  EXPECT_EQ(r.overload_raises, 0);
+  EXPECT_GT(r.lambda0_min, 0.75 * F);
+  EXPECT_LT(r.lambda0_max, 1.25 * F);
 }

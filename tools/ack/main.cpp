@@ -31,10 +31,17 @@ int main(int argc, char** argv) {
   std::string kind = "*", level = "both", user, url, prefix;
   double shelve = 0.0;
   bool unshelve = false;
-  app.add_option("--kind", kind,
-                 "alarm kind: CAGE_POS_Y, CAGE_NEG_Y, GUIDE_ROPE, INPUT_STALE, MODEL_FAULT, MODEL_DOMAIN, DUPLICATE_PUBLISHER, PREDICTED_CLEARANCE, PREDICTED_SLACK, or * for all")
+  // Every kind the daemon knows (hoist::svc::AlarmKind), so the list cannot
+  // fall behind the engine.
+  std::vector<std::string> kinds{"*"};
+  std::string kind_list;
+  for (int i = 0; i < hoist::svc::kAlarmKinds; ++i) {
+    kinds.emplace_back(hoist::svc::toString(static_cast<hoist::svc::AlarmKind>(i)));
+    kind_list += kinds.back() + ", ";
+  }
+  app.add_option("--kind", kind, "alarm kind: " + kind_list + "or * for all")
       ->capture_default_str()
-      ->check(CLI::IsMember({"*", "CAGE_POS_Y", "CAGE_NEG_Y", "GUIDE_ROPE", "INPUT_STALE", "MODEL_FAULT", "MODEL_DOMAIN", "DUPLICATE_PUBLISHER", "PREDICTED_CLEARANCE", "PREDICTED_SLACK"}));
+      ->check(CLI::IsMember(kinds));
   app.add_option("--level", level, "warning, critical or both")
       ->capture_default_str()
       ->check(CLI::IsMember({"warning", "critical", "both"}));

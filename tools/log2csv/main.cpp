@@ -19,7 +19,8 @@
 //                       hoist-sim's output), then utime,seq,input_seq,y_top,
 //                       y_bottom,guide_deflection,clearance_pos_y,
 //                       clearance_neg_y,clearance_guide,min_clearance,
-//                       alarm_level,degraded
+//                       alarm_level,degraded,rope_slack_threshold,
+//                       rope_overload_threshold (the last two: issue 17, appended)
 //   hoist.winder_t      utime,seq,v,a,has_length,length,log_utime
 //   hoist.guide_shape_t t,x,y1,y2,l,utime (one row per depth sample, like
 //                       hoist-sim --shape-out)
@@ -28,6 +29,16 @@
 //   hoist.alarm_ack_t   utime,kind,level,action,shelve_duration,user
 //   hoist.health_t      utime,uptime,t,clock,rate,window,ticks,steps,deadline_misses,
 //                       step_p50_us,...,degraded, then rejected_<reason> per reason
+//   hoist.forecast_t    one row per scenario: utime,seq,instance_id,t_start,l,v,a,
+//                       plan_seq,compute_time,scenario,name,status,horizon,t_reached,
+//                       min_clearance,t_min_clearance,t_warning,t_critical,peak_y_c,
+//                       peak_theta,peak_lambda_1..peak_lambda_4,lambda0_min,
+//                       lambda0_max,num_points (times of a scenario in s after
+//                       t_start, -1 = none within the horizon).  The decimated
+//                       series go to DIR/<CHANNEL>.series.csv, one row per
+//                       point: utime,seq,scenario,name,i,t,min_clearance,
+//                       lambda0_min,lambda0_max.
+//   hoist.trip_plan_t   utime,seq,target_length,vmax,amax,jerk
 // Exit status: 0 on success; 1 if the log cannot be read, a file cannot be
 // written to its last byte (the path and the errno text are printed), or --
 // unless --lenient -- the log had corrupt regions (bytes skipped, events
@@ -49,8 +60,10 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/trip_plan_t.hpp"
 #include "hoist/io/lcm_log.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
@@ -115,6 +128,8 @@ class Converter {
     if (name == "hoist.alarm_t") return alarm(ev);
     if (name == "hoist.alarm_ack_t") return ack(ev);
     if (name == "hoist.health_t") return health(ev);
+    if (name == "hoist.forecast_t") return forecast(ev);
+    if (name == "hoist.trip_plan_t") return plan(ev);
     ++unknown_[ev.channel];
     return false;
   }
@@ -159,9 +174,11 @@ class Converter {
   }
   static std::string fileName(const std::string& key) { return key + ".csv"; }
 
-  /// The writer for (channel, type), created with `header` on first use.
-  Writer* writer(const std::string& channel, const char* type, const std::string& header) {
-    std::string key = sanitize(channel);
+  /// The writer for (channel, type), created with `header` on first use
+  /// (`suffix`: a second file of the channel, DIR/<CHANNEL><suffix>.csv).
+  Writer* writer(const std::string& channel, const char* type, const std::string& header,
+                 const char* suffix = "") {
+    std::string key = sanitize(channel) + suffix;
     auto it = writers_.find(key);
     if (it != writers_.end() && it->second->type != type) {
       key += std::string(".") + type;
@@ -196,7 +213,8 @@ class Converter {
     Writer* w = writer(ev.channel, "cage_state_t",
                        "t,l,v,a,x_c,y_c,theta,lambda_0,lambda_1,lambda_2,lambda_3,lambda_4,utime,seq,"
                        "input_seq,y_top,y_bottom,guide_deflection,clearance_pos_y,clearance_neg_y,"
-                       "clearance_guide,min_clearance,alarm_level,degraded");
+                       "clearance_guide,min_clearance,alarm_level,degraded,rope_slack_threshold,"
+                       "rope_overload_threshold");
     std::ostringstream os;
     os << num(m.t) << ',' << num(m.l) << ',' << num(m.v) << ',' << num(m.a) << ',' << num(m.x_c)
        << ',' << num(m.y_c) << ',' << num(m.theta);
@@ -204,7 +222,62 @@ class Converter {
     os << ',' << m.utime << ',' << m.seq << ',' << m.input_seq << ',' << num(m.y_top) << ','
        << num(m.y_bottom) << ',' << num(m.guide_deflection) << ',' << num(m.clearance_pos_y) << ','
        << num(m.clearance_neg_y) << ',' << num(m.clearance_guide) << ',' << num(m.min_clearance)
-       << ',' << int(m.alarm_level) << ',' << int(m.degraded);
+       << ',' << int(m.alarm_level) << ',' << int(m.degraded) << ',' << num(m.rope_slack_threshold) << ','
+       << num(m.rope_overload_threshold);
+    w->write(os.str());
+    return true;
+  }
+
+  bool forecast(const Event& ev) {
+    hoist::forecast_t m{};
+    if (!decode(ev, m)) return false;
+    if (m.scenarios.empty()) return true;  // nothing to tabulate (counted as a message, no row)
+    Writer* w = writer(ev.channel, "forecast_t",
+                       "utime,seq,instance_id,t_start,l,v,a,plan_seq,compute_time,scenario,name,status,horizon,"
+                       "t_reached,min_clearance,t_min_clearance,t_warning,t_critical,peak_y_c,peak_theta,"
+                       "peak_lambda_1,peak_lambda_2,peak_lambda_3,peak_lambda_4,lambda0_min,lambda0_max,"
+                       "num_points");
+    --w->rows;  // rows counted per scenario below
+    bool any_points = false;
+    for (std::size_t i = 0; i < m.scenarios.size(); ++i) {
+      const auto& sc = m.scenarios[i];
+      std::ostringstream os;
+      os << m.utime << ',' << m.seq << ',' << m.instance_id << ',' << num(m.t_start) << ',' << num(m.l) << ','
+         << num(m.v) << ',' << num(m.a) << ',' << m.plan_seq << ',' << num(m.compute_time) << ',' << i << ','
+         << csvQuote(sc.name) << ',' << int(sc.status) << ',' << num(sc.horizon) << ',' << num(sc.t_reached)
+         << ',' << num(sc.min_clearance) << ',' << num(sc.t_min_clearance) << ',' << num(sc.t_warning) << ','
+         << num(sc.t_critical) << ',' << num(sc.peak_y_c) << ',' << num(sc.peak_theta);
+      for (double v : sc.peak_lambdas) os << ',' << num(v);
+      os << ',' << num(sc.lambda0_min) << ',' << num(sc.lambda0_max) << ',' << sc.num_points;
+      w->write(os.str());
+      ++w->rows;
+      any_points = any_points || sc.num_points > 0;
+    }
+    if (!any_points) return true;
+    Writer* s = writer(ev.channel, "forecast_t",
+                       "utime,seq,scenario,name,i,t,min_clearance,lambda0_min,lambda0_max", ".series");
+    --s->rows;
+    for (std::size_t i = 0; i < m.scenarios.size(); ++i) {
+      const auto& sc = m.scenarios[i];
+      for (std::size_t k = 0; k < sc.series_t.size(); ++k) {
+        std::ostringstream os;
+        os << m.utime << ',' << m.seq << ',' << i << ',' << csvQuote(sc.name) << ',' << k << ','
+           << num(sc.series_t[k]) << ',' << num(sc.series_min_clearance[k]) << ','
+           << num(sc.series_lambda0_min[k]) << ',' << num(sc.series_lambda0_max[k]);
+        s->write(os.str());
+        ++s->rows;
+      }
+    }
+    return true;
+  }
+
+  bool plan(const Event& ev) {
+    hoist::trip_plan_t m{};
+    if (!decode(ev, m)) return false;
+    Writer* w = writer(ev.channel, "trip_plan_t", "utime,seq,target_length,vmax,amax,jerk");
+    std::ostringstream os;
+    os << m.utime << ',' << m.seq << ',' << num(m.target_length) << ',' << num(m.vmax) << ',' << num(m.amax)
+       << ',' << num(m.jerk);
     w->write(os.str());
     return true;
   }

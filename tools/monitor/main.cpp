@@ -9,13 +9,25 @@
 // remaining clearance and the active alarms.  Alarm events are printed as
 // they arrive.  Stops on SIGINT/SIGTERM or after --duration.
 //
+// Look-ahead (issue 17): when the daemon publishes HOIST_FORECAST, each line
+// is followed by one "forecast" line for the shaft: the time the latest
+// forecast starts from and, per scenario, its worst (smallest) clearance and
+// when, and the time to violation -- seconds until the first CRITICAL and
+// WARNING threshold crossing ("none" within the horizon) -- and the
+// smallest hoisting-rope force; a scenario stopped early says why.  Run one
+// monitor per shaft (--channel-prefix).
+//
 // Hostile input (issue 12): every payload passes hoist::msg::checkedDecode
 // before it is decoded (undecodable ones are counted and shown), no exception
 // leaves an LCM callback, every string from the network is printed through
 // hoist::msg::terminalSafe (no control characters or escape sequences reach
 // the terminal), at most 64 active alarms are tracked, and when no HOIST_CAGE
 // or no HOIST_HEALTH arrived for more than --stale seconds (default 2) the
-// line says STALE with the age of the data.
+// line says STALE with the age of the data (the forecast line likewise, after
+// max(--stale, 3) seconds: forecasts come at about 1 Hz).  Scenario names
+// are network strings too (terminalSafe, at most 24 bytes shown), and at
+// most forecast_t.MAX_SCENARIOS scenarios are shown (the checked decoder
+// rejects more).
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <poll.h>
@@ -32,6 +44,7 @@
 
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
@@ -75,6 +88,15 @@ class Monitor {
         std::printf("  >> [t=%7.2f s] %s\n", m.t, hoist::msg::terminalSafe(m.message).c_str());
         std::fflush(stdout);
       }
+    });
+  }
+  void onForecast(const lcm::ReceiveBuffer* rb, const std::string&) {
+    guarded([&] {
+      hoist::forecast_t m;
+      if (!decode(rb, m)) return;
+      forecast_ = std::move(m);
+      have_forecast_ = true;
+      last_forecast_ = Clock::now();
     });
   }
   void onHealth(const lcm::ReceiveBuffer* rb, const std::string&) {
@@ -128,7 +150,44 @@ class Monitor {
     std::printf("%9.2f %9.2f %9.2f %+10.3f %+11.4f %10.1f %11.1f  %s%s%s\n", cage_.t, cage_.l, cage_.v,
                 cage_.y_c * 1e3, cage_.theta * 1e3, fmax, cage_.min_clearance * 1e3, alarms.c_str(),
                 stale.c_str(), bad.c_str());
+    if (have_forecast_) std::printf("%s\n", forecastLine(Clock::now()).c_str());
     std::fflush(stdout);
+  }
+
+  /// "  forecast from t=20.00 s: estop: worst 31.0 mm at +4.25 s, CRITICAL
+  /// none, WARNING in 3.50 s, F0 min 2.41 kN | continue: ..."
+  std::string forecastLine(Clock::time_point now) const {
+    auto secs = [](double t) -> std::string {
+      if (!(t >= 0.0)) return "none";  // -1 (or NaN): not within the horizon
+      char b[32];
+      std::snprintf(b, sizeof b, "in %.2f s", t);
+      return b;
+    };
+    char b[256];
+    std::snprintf(b, sizeof b, "  forecast from t=%.2f s:", forecast_.t_start);
+    std::string out = b;
+    if (forecast_.scenarios.empty()) out += " (no scenarios)";
+    for (std::size_t i = 0; i < forecast_.scenarios.size(); ++i) {
+      const auto& sc = forecast_.scenarios[i];
+      std::snprintf(b, sizeof b, "%s %s: worst %.1f mm at +%.2f s, CRITICAL %s, WARNING %s, F0 min %.2f kN",
+                    i == 0 ? "" : " |", hoist::msg::terminalSafe(sc.name, 24).c_str(), sc.min_clearance * 1e3,
+                    sc.t_min_clearance, secs(sc.t_critical).c_str(), secs(sc.t_warning).c_str(),
+                    sc.lambda0_min * 1e-3);
+      out += b;
+      if (sc.status != hoist::forecast_scenario_t::STATUS_OK) {
+        const char* why = sc.status == hoist::forecast_scenario_t::STATUS_LEFT_SHAFT ? "left the shaft"
+                          : sc.status == hoist::forecast_scenario_t::STATUS_NON_FINITE ? "non-finite state"
+                                                                                       : "unknown status";
+        std::snprintf(b, sizeof b, " [stopped at +%.2f s: %s]", sc.t_reached, why);
+        out += b;
+      }
+    }
+    const double age = std::chrono::duration<double>(now - last_forecast_).count();
+    if (age > std::max(stale_s_, 3.0)) {
+      std::snprintf(b, sizeof b, "  ** STALE: no HOIST_FORECAST for %.1f s **", age);
+      out += b;
+    }
+    return out;
   }
 
   std::string cage_channel_;
@@ -157,7 +216,9 @@ class Monitor {
   std::size_t active_overflow_ = 0;
   hoist::cage_state_t cage_{};
   hoist::health_t health_{};
-  bool have_cage_ = false, have_health_ = false;
+  hoist::forecast_t forecast_{};
+  Clock::time_point last_forecast_{};
+  bool have_cage_ = false, have_health_ = false, have_forecast_ = false;
   std::map<std::string, bool> active_;
   long lines_ = 0;
 };
@@ -167,7 +228,9 @@ class Monitor {
 int main(int argc, char** argv) {
   CLI::App app{
       "hoist-monitor: print the digital twin's cage state once a second (time, depth, speed,\n"
-      "sway, tilt, largest sleeve force, minimum clearance, active alarms) and every alarm event."};
+      "sway, tilt, largest sleeve force, minimum clearance, active alarms) and every alarm event;\n"
+      "with HOIST_FORECAST, per scenario the worst forecast clearance and the time to violation\n"
+      "(seconds to the first CRITICAL / WARNING crossing)."};
   app.name("hoist-monitor");  // usage lines name the program, not the path it was run by
   app.set_version_flag("--version", std::string("hoist-monitor ") + hoist::kVersionString);
   std::string url, prefix;
@@ -203,6 +266,7 @@ int main(int argc, char** argv) {
   lcm.subscribe(ch.cage, &Monitor::onCage, &mon);
   lcm.subscribe(ch.alarm, &Monitor::onAlarm, &mon);
   lcm.subscribe(ch.health, &Monitor::onHealth, &mon);
+  lcm.subscribe(ch.forecast, &Monitor::onForecast, &mon);
   struct sigaction sa {};
   sa.sa_handler = onSignal;
   sigaction(SIGINT, &sa, nullptr);

@@ -75,6 +75,25 @@ class ShaftModel {
   /// Static tension of guide rope r at depth x: T_br + rho2 g (L - x).
   double guideTension(int r, double x) const;
 
+  /// Static hoisting-rope force lambda_0 at rope length l [N]: the value of
+  /// lambda_0 (the force of the cage on the rope at g0 = u(l) - x_c, +x
+  /// down) in static equilibrium (v = a = 0), the reference of the
+  /// ROPE_SLACK / ROPE_OVERLOAD alarms.
+  ///
+  /// Derivation (MODEL.md, Eq. 15): the cage's longitudinal equation is
+  /// m x_c'' = Fa + m (g - a) - lambda_0 (the cage feels -lambda_0; the
+  /// eccentric load Fa acts on x_c as a weight).  At rest x_c'' = a = 0, so
+  /// lambda_0 = m g + Fa, whatever the rope's modes do (they only set x_c).
+  /// The rope's own weight rho1 g l does not pass through g0: u is measured
+  /// about the gravity-loaded state, and the rope above the cage carries its
+  /// weight itself (the sheave sees m g + Fa + rho1 g l; lambda_0 is the
+  /// force at the cage end).  So in this model the static force does not
+  /// depend on l; the argument keeps the API right for models where it does
+  /// (a tail rope, a cage-mounted rope weight).  Checked against the solver's
+  /// static start for both methods, every l and several shafts
+  /// (tests/model/static_test.cpp, Static.RopeForceEqualsTheStaticSolve).
+  double staticRopeForce(double l) const;
+
   // ---- exact statics of a guide rope (static correction) ------------------
   /// S_r(x) = Int_0^x ds / T_r(s) = ln(T_r(0)/T_r(x)) / (rho2 g)  (x / T_br if g = 0).
   double guideFlexibilityIntegral(int r, double x) const;

@@ -8,7 +8,8 @@
 // HOIST_CAGE (as lcm-logger recorded it) to display rounding; the daemon's
 // alarm appears in the list; Acknowledge publishes HOIST_ALARM_ACK (seen in
 // lcm-logger's log) and the alarm turns acknowledged; a --read-only server's
-// page shows no command buttons; STALE within 3 s after the daemon stops.
+// page shows no command buttons; a HOIST_FORECAST fills the forecast panel;
+// STALE within 3 s after the daemon stops.
 import fs from "node:fs";
 import path from "node:path";
 import puppeteer from "puppeteer-core";
@@ -94,12 +95,38 @@ console.log(`page shows after ${Date.now() - t0} ms:`, shown);
 // ~0.1 s on an idle machine; the bound allows for a loaded CI machine.
 check(shown.now_us - shown.utime < 2000e3, `displayed cage state is current (${((shown.now_us - shown.utime) / 1e3).toFixed(0)} ms old)`);
 
+// 8. HOIST_FORECAST (issue 17), from a synthetic publisher (the daemon's
+// forecast worker is built elsewhere): the forecast panel shows each
+// scenario's worst clearance and time to violation, draws both series, keeps
+// a hostile scenario name as text, and the lying message is dropped.
+if (!process.env.HOIST_FORECAST_PUB) fail("HOIST_FORECAST_PUB (tests/dash: hoist-test-forecast-pub) is not set");
+const fpub = start("forecast-pub", process.env.HOIST_FORECAST_PUB, [lcm, "", "40", "250"], dir);
+await page.waitForSelector('[data-shaft=""] [data-role=forecast]:not([hidden]) tr[data-scenario="estop"]', { timeout: 5000 });
+const fc = await page.evaluate(() => {
+  const box = document.querySelector('[data-shaft=""] [data-role=forecast]');
+  const rows = [...box.querySelectorAll("tr[data-scenario]")].map((r) => ({
+    name: r.dataset.scenario, worst: r.querySelector('[data-field="worst"]').textContent,
+    crit: r.querySelector('[data-field="t-critical"]').textContent, warn: r.querySelector('[data-field="t-warning"]').textContent }));
+  return { rows, imgs: box.querySelectorAll("img").length,
+           clr: Number(box.querySelector("[data-role=forecast-clearance]")?.dataset.points || 0),
+           l0: Number(box.querySelector("[data-role=forecast-lambda0]")?.dataset.points || 0),
+           from: box.querySelector('[data-field="forecast-from"]').textContent };
+});
+console.log("forecast panel:", JSON.stringify(fc));
+const est = fc.rows.find((r) => r.name === "estop");
+check(est && est.worst === "12.5 mm at +2.0 s" && est.crit === "2.5 s" && est.warn === "1.5 s",
+      `forecast panel: estop worst clearance 12.5 mm at +2.0 s, CRITICAL in 2.5 s, WARNING in 1.5 s (${JSON.stringify(est)})`);
+const other = fc.rows.find((r) => r.name !== "estop");
+check(fc.rows.length === 2 && other && other.name.startsWith("<img") && other.crit === "none" && other.warn === "none" && fc.imgs === 0,
+      "a hostile scenario name is shown as text (no element created), no violation shows 'none'");
+check(fc.clr === 70 && fc.l0 === 140, `both forecast series drawn (clearance ${fc.clr} points, lambda_0 ${fc.l0} min/max points)`);
 await page.select("#window", "10");  // the 10-s trend window for the screenshot
 await sleep(2500);
 await page.screenshot({ path: shot });
 console.log(`screenshot: ${shot}`);
 
 // 6. STALE within 3 s of the daemon stopping.
+await stop(fpub);
 await stop(twin.replay);
 const tStop = Date.now();
 await stop(twin.twind);
@@ -117,6 +144,8 @@ await stop(dash.proc);
 await stop(ro.proc);
 check(errors.length === 0, `no errors in the page's console (${errors.join(" | ")})`);
 check(dashStats.counters.commands_published === 1, `hoist-dash published exactly one command (${dashStats.counters.commands_published})`);
+check(dashStats.counters.lcm_rejected_decode_bad_count === 1,
+      `the forecast with a lying nested count was dropped by the checked decoder (${dashStats.counters.lcm_rejected_decode_bad_count})`);
 
 // 7. Against what lcm-logger recorded.
 const log = readLog(path.join(dir, "run.lcm"), dir);

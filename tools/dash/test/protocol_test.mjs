@@ -7,8 +7,10 @@
 // parseable JSON Schema naming the msgs/*.lcm fields), subscribes to
 // HOIST_CAGE, decodes >= 50 messages, and checks that their fields equal what
 // lcm-logger recorded in the same run (through hoist-log2csv, round-trip
-// exact doubles).  Also publishes one HOIST_ALARM_ACK as a client channel.
+// exact doubles).  Also publishes one HOIST_ALARM_ACK as a client channel, and
+// checks HOIST_FORECAST (nested forecast_scenario_t) end to end.
 import foxglove from "@foxglove/ws-protocol";
+import { spawnSync } from "node:child_process";
 import path from "node:path";
 import WebSocket from "ws";
 import { check, fail, lcmUrl, readLog, sleep, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
@@ -28,6 +30,8 @@ const channels = new Map();
 const decoded = [];
 const statuses = [];
 let cageSub = null;
+let fcSub = null;
+const forecasts = [];
 client.on("serverInfo", (i) => { info = i; });
 client.on("status", (s) => statuses.push(s));
 client.on("error", (e) => fail(`client error: ${e}`));
@@ -35,8 +39,11 @@ client.on("advertise", (chs) => {
   for (const ch of chs) channels.set(ch.topic, ch);
   const cage = channels.get("HOIST_CAGE");
   if (cage && cageSub === null) cageSub = client.subscribe(cage.id);
+  const fc = channels.get("HOIST_FORECAST");
+  if (fc && fcSub === null) fcSub = client.subscribe(fc.id);
 });
 client.on("message", ({ subscriptionId, data }) => {
+  if (subscriptionId === fcSub) forecasts.push(JSON.parse(new TextDecoder().decode(data)));
   if (subscriptionId !== cageSub) return;
   decoded.push(JSON.parse(new TextDecoder().decode(data)));
 });
@@ -51,6 +58,8 @@ const expect = {
   HOIST_ALARM: ["utime", "kind", "level", "event_type", "active", "acked", "shelved", "latched", "value", "threshold", "message", "user"],
   HOIST_ALARM_ACK: ["utime", "kind", "level", "action", "shelve_duration", "user"],
   HOIST_HEALTH: ["utime", "step_p50_us", "deadline_misses", "input_age", "rejected_total", "reject_reason", "rejected", "degraded"],
+  HOIST_FORECAST: ["utime", "seq", "instance_id", "t_start", "l", "v", "a", "plan_seq", "compute_time", "num_scenarios", "scenarios"],
+  HOIST_TRIP_PLAN: ["utime", "seq", "target_length", "vmax", "amax", "jerk"],
 };
 for (const [topic, fields] of Object.entries(expect)) {
   const ch = channels.get(topic);
@@ -60,6 +69,29 @@ for (const [topic, fields] of Object.entries(expect)) {
   const missing = fields.filter((f) => !props.includes(f));
   check(ch.encoding === "json" && missing.length === 0,
         `${topic}: encoding json, schema ${ch.schemaName} names the msgs/*.lcm fields (missing: ${missing.join(",") || "none"})`);
+}
+
+// HOIST_FORECAST: the nested scenario schema, then synthetic forecasts
+// (tests/dash/forecast_pub.cpp) decoded as JSON with their nested values.
+{
+  const item = JSON.parse(channels.get("HOIST_FORECAST").schema).properties.scenarios.items;
+  const want = ["name", "status", "horizon", "t_reached", "min_clearance", "t_min_clearance", "t_warning", "t_critical",
+                "peak_y_c", "peak_theta", "peak_lambdas", "lambda0_min", "lambda0_max", "num_points", "series_t",
+                "series_min_clearance", "series_lambda0_min", "series_lambda0_max"];
+  check(item.title === "hoist.forecast_scenario_t" && want.every((k) => item.properties[k]) && item.additionalProperties === false,
+        "HOIST_FORECAST schema inlines forecast_scenario_t with every field");
+  if (!process.env.HOIST_FORECAST_PUB) fail("HOIST_FORECAST_PUB (tests/dash: hoist-test-forecast-pub) is not set");
+  const pub = spawnSync(process.env.HOIST_FORECAST_PUB, [lcm, "", "3", "100"], { encoding: "utf8" });
+  check(pub.status === 0, `synthetic forecasts published (${pub.stdout.trim().split("\n").length} lines)`);
+  await waitFor(() => forecasts.length >= 3, 5000, "3 HOIST_FORECAST messages");
+  const f = forecasts[0];
+  const [e, o] = f.scenarios;
+  check(forecasts.length === 3 && f.seq === 0 && f.num_scenarios === 2 && e.name === "estop" && e.t_critical === 2.5 &&
+        e.t_warning === 1.5 && e.min_clearance === 0.0125 && e.series_t.length === 50 && e.series_lambda0_max.length === 50 &&
+        o.name === "<img src=x onerror=alert(1)>\u001b[2J" && o.t_critical === -1 && o.series_t.length === 20,
+        "forecasts arrive whole, nested scenarios and series intact; the lying one (num_points 30000) was dropped");
+  const st = await (await fetch(new URL("/api/stats", dash.url))).json();
+  check(st.counters.lcm_rejected_decode_bad_count === 1, `hoist-dash counted it (${JSON.stringify(st.counters)})`);
 }
 
 await waitFor(() => decoded.length >= 60, 10000, "60 HOIST_CAGE messages");

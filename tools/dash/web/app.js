@@ -169,7 +169,7 @@
     $("#tabs").append(tab);
     s = { prefix, root, banner, canvas, ro, alarmsBody, tab, lastMsg: -1e12, everData: false, cage: null, shape: null,
           health: null, alarms: new Map(), thr: {}, dirty: true, charts: [], data: null, gap: null };
-    s.data = { x: [], y_c: [], theta: [], l1: [], l2: [], l3: [], l4: [], l0: [], clr: [], warn: [], crit: [], v: [], l: [] };
+    s.data = { x: [], y_c: [], theta: [], l1: [], l2: [], l3: [], l4: [], l0: [], slk: [], ovl: [], clr: [], warn: [], crit: [], v: [], l: [] };
     makeCharts(s, trends);
     state.shafts.set(prefix, s);
     if (state.selected === null) select(prefix);
@@ -195,7 +195,7 @@
       ["sway y_c [mm]", [["y_c", "#60a5fa"]]],
       ["tilt θ [mrad]", [["theta", "#a78bfa"]]],
       ["guide-sleeve forces λ1..λ4 [N]", [["l1", "#f87171", "λ1"], ["l2", "#fbbf24", "λ2"], ["l3", "#34d399", "λ3"], ["l4", "#60a5fa", "λ4"]]],
-      ["hoisting-rope force λ0 [kN]", [["l0", "#e5e7eb", "λ0"]]],
+      ["hoisting-rope force λ0 [kN]", [["l0", "#e5e7eb", "λ0"], ["slk", "#ef4444", "ROPE_SLACK", [6, 4]], ["ovl", "#ef4444", "ROPE_OVERLOAD", [2, 4]]]],
       ["min clearance [mm]", [["clr", "#2fbf71", "min clearance"], ["warn", "#f0b429", "WARNING", [6, 4]], ["crit", "#ef4444", "CRITICAL", [6, 4]]]],
       ["speed v [m/s] and depth l [m]", [["v", "#93c5fd", "v"], ["l", "#fca5a5", "l", null, "l"]]],
     ];
@@ -231,7 +231,10 @@
   function cageVals(m, s) {
     const lam = m.lambdas || [NaN, NaN, NaN, NaN, NaN];
     const [w, c] = thresholds(s);
+    // The rope-force alarms' thresholds as the daemon publishes them (issue 17; absent from older daemons).
+    const kN = (x) => (typeof x === "number" && x > 0 ? x / 1e3 : NaN);
     return { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
+             slk: kN(m.rope_slack_threshold), ovl: kN(m.rope_overload_threshold),
              clr: m.min_clearance * 1e3, warn: w, crit: c, v: m.v, l: m.l };
   }
 
@@ -317,6 +320,7 @@
 
   function fmtVal(a) {
     if (a.kind === "INPUT_STALE" || a.kind === "MODEL_FAULT") return a.value >= 0.5 ? "on" : "off";
+    if (a.kind === "ROPE_SLACK" || a.kind === "ROPE_OVERLOAD") return `${(a.value / 1e3).toFixed(2)} kN / ${(a.threshold / 1e3).toFixed(2)} kN`;
     return `${(a.value * 1e3).toFixed(1)} mm / ${(a.threshold * 1e3).toFixed(1)} mm`;
   }
 
@@ -391,18 +395,95 @@
   }
 
   // ---- forecasts (only when HOIST_FORECAST publishes) -------------------------------
+  // Per scenario: worst clearance and when, time to violation (first CRITICAL
+  // and WARNING crossing, "none" within the horizon), the lambda_0 range; and
+  // the decimated series (min clearance, lambda_0 min..max) against the time
+  // ahead, with the live thresholds (clearance WARNING/CRITICAL, ROPE_SLACK /
+  // ROPE_OVERLOAD).  Every string from the network goes in as text.
+  const SCN_COLORS = ["#f87171", "#60a5fa", "#34d399", "#fbbf24", "#a78bfa", "#f472b6", "#22d3ee", "#a3e635"];
+  const STATUS = ["ok", "left the shaft", "non-finite"];
+  const ahead = (t) => (typeof t === "number" && t >= 0 ? `${t.toFixed(1)} s` : "none");
+
   function renderForecast(s) {
     const box = $("[data-role=forecast]", s.root);
     box.hidden = false;
     const body = $("[data-role=forecast-body]", s.root);
     body.textContent = "";
     const f = s.forecast;
-    const tbl = el("table");
-    for (const [k, v] of Object.entries(f)) {
-      if (k === "utime") continue;
-      tbl.append(el("tr", {}, el("th", {}, k), el("td", {}, Array.isArray(v) ? v.map((x) => typeof x === "number" ? x.toPrecision(4) : String(x)).join(", ") : String(v))));
-    }
+    const scns = Array.isArray(f.scenarios) ? f.scenarios.slice(0, 8) : [];
+    body.append(el("p", { class: "fc-note", "data-field": "forecast-from" },
+      `from t=${Number(f.t_start).toFixed(2)} s, l=${Number(f.l).toFixed(1)} m` +
+      (f.plan_seq >= 0 ? `, trip plan #${f.plan_seq}` : ", no trip plan") +
+      ` (${(Number(f.compute_time) * 1e3).toFixed(0)} ms)`));
+    const tbl = el("table", { class: "fc" }, el("thead", {}, el("tr", {},
+      ...["Scenario", "Worst clearance", "CRITICAL in", "WARNING in", "λ0 min…max [kN]"].map((h) => el("th", {}, h)))));
+    const tb = el("tbody");
+    scns.forEach((sc, i) => {
+      const crit = sc.t_critical >= 0, warn = sc.t_warning >= 0;
+      const tr = el("tr", { class: crit ? "lvl-2" : warn ? "lvl-1" : "", "data-scenario": String(sc.name),
+                            "data-t-critical": String(sc.t_critical), "data-t-warning": String(sc.t_warning) },
+        el("td", {}, el("span", { class: "swatch", style: `background:${SCN_COLORS[i]}` }), String(sc.name),
+           sc.status ? ` (stopped at ${Number(sc.t_reached).toFixed(1)} s: ${STATUS[sc.status] || "status " + sc.status})` : ""),
+        el("td", { "data-field": "worst" }, `${(sc.min_clearance * 1e3).toFixed(1)} mm at +${Number(sc.t_min_clearance).toFixed(1)} s`),
+        el("td", { "data-field": "t-critical", class: crit ? "lvl2" : "" }, ahead(sc.t_critical)),
+        el("td", { "data-field": "t-warning", class: warn ? "lvl1" : "" }, ahead(sc.t_warning)),
+        el("td", {}, `${(sc.lambda0_min / 1e3).toFixed(2)} … ${(sc.lambda0_max / 1e3).toFixed(2)}`));
+      tb.append(tr);
+    });
+    tbl.append(tb);
     body.append(tbl);
+    const [w, c] = thresholds(s);
+    const cage = s.cage || {};
+    body.append(fcPlot("min clearance [mm] vs time ahead [s]", scns, (sc) => [sc.series_min_clearance.map((v) => v * 1e3)],
+                       [[w, "#f0b429"], [c, "#ef4444"]], "clearance"));
+    body.append(fcPlot("hoisting-rope force λ0 [kN] (min…max) vs time ahead [s]", scns,
+                       (sc) => [sc.series_lambda0_min.map((v) => v / 1e3), sc.series_lambda0_max.map((v) => v / 1e3)],
+                       [[cage.rope_slack_threshold / 1e3, "#ef4444"], [cage.rope_overload_threshold / 1e3, "#ef4444"]], "lambda0"));
+  }
+
+  // A small line plot on a canvas: one colour per scenario, dashed threshold lines.
+  function fcPlot(title, scns, ys, thr, role) {
+    const W = 560, H = 180, ml = 44, mr = 8, mt = 8, mb = 20;
+    const cv = el("canvas", { class: "fcplot", width: String(W), height: String(H), "data-role": `forecast-${role}` });
+    const g = cv.getContext("2d");
+    let tmax = 0, lo = Infinity, hi = -Infinity, npts = 0;
+    for (const sc of scns) {
+      const t = sc.series_t || [];
+      if (t.length) tmax = Math.max(tmax, t[t.length - 1]);
+      for (const arr of ys(sc)) for (const v of arr) if (isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); npts++; }
+    }
+    for (const [v] of thr) if (isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    cv.dataset.points = String(npts);
+    if (!(tmax > 0) || !isFinite(lo)) return el("div", { class: "trend" }, el("h3", {}, title), el("p", { class: "empty" }, "no series"));
+    if (hi - lo < 1e-9) { hi += 1; lo -= 1; }
+    const pad = 0.05 * (hi - lo);
+    lo -= pad; hi += pad;
+    const X = (t) => ml + (W - ml - mr) * t / tmax, Y = (v) => mt + (H - mt - mb) * (hi - v) / (hi - lo);
+    g.font = "10px system-ui"; g.fillStyle = "#8a96a3"; g.strokeStyle = "#252c34";
+    for (let k = 0; k <= 4; k++) {
+      const v = lo + (hi - lo) * k / 4;
+      g.beginPath(); g.moveTo(ml, Y(v)); g.lineTo(W - mr, Y(v)); g.stroke();
+      g.fillText(v.toPrecision(3), 2, Y(v) + 3);
+    }
+    for (let k = 0; k <= 4; k++) g.fillText(`${(tmax * k / 4).toFixed(0)}`, X(tmax * k / 4) - 4, H - 6);
+    for (const [v, col] of thr) {
+      if (!isFinite(v)) continue;
+      g.strokeStyle = col; g.setLineDash([6, 4]); g.beginPath(); g.moveTo(ml, Y(v)); g.lineTo(W - mr, Y(v)); g.stroke();
+    }
+    g.setLineDash([]);
+    scns.forEach((sc, i) => {
+      const t = sc.series_t || [];
+      g.strokeStyle = SCN_COLORS[i]; g.lineWidth = 1.5;
+      for (const arr of ys(sc)) {
+        g.beginPath();
+        for (let k = 0; k < Math.min(t.length, arr.length); k++) {
+          if (!isFinite(arr[k])) continue;
+          k ? g.lineTo(X(t[k]), Y(arr[k])) : g.moveTo(X(t[k]), Y(arr[k]));
+        }
+        g.stroke();
+      }
+    });
+    return el("div", { class: "trend" }, el("h3", {}, title), cv);
   }
 
   // ---- shaft view -----------------------------------------------------------------

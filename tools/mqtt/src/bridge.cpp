@@ -24,6 +24,7 @@
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/mqtt/command.hpp"
 #include "hoist/mqtt/outbox.hpp"
@@ -39,6 +40,7 @@ using json = nlohmann::json;
 using hoist::bus::kChannelAlarm;
 using hoist::bus::kChannelAlarmAck;
 using hoist::bus::kChannelCage;
+using hoist::bus::kChannelForecast;
 using hoist::bus::kChannelHealth;
 constexpr int kMaxKindsPerShaft = 32;
 
@@ -111,13 +113,13 @@ struct Bridge::Impl {
   };
   struct Shaft {
     std::string prefix, name;
-    std::string t_cage, t_health, t_alarm, t_cmd;
+    std::string t_cage, t_health, t_alarm, t_cmd, t_forecast;
     bool subscribed = false;       // command topic subscribed on the current connection
     bool cage_new = false;
     hoist::cage_state_t cage{};
     std::map<std::string, AlarmState> alarms;  // by kind
     std::int64_t instance_id = 0;
-    std::uint64_t cage_in = 0, cage_out = 0, health_in = 0, alarms_in = 0, commands = 0;
+    std::uint64_t cage_in = 0, cage_out = 0, health_in = 0, alarms_in = 0, commands = 0, forecasts_in = 0;
     Clock::time_point last_health{};
   };
   std::map<std::string, Shaft> shafts;           // by prefix
@@ -174,9 +176,10 @@ struct Bridge::Impl {
 
     discover = cfg.channel_prefixes.empty();
     for (const auto& p : cfg.channel_prefixes) addShaft(p);
-    // One subscription for every shaft: ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM)" (LCM anchors it).
+    // One subscription for every shaft: ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM|HOIST_FORECAST)"
+    // (LCM anchors it).
     lcm.subscribe(".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" +
-                      std::string(kChannelAlarm) + ")",
+                      std::string(kChannelAlarm) + "|" + std::string(kChannelForecast) + ")",
                   &Impl::onLcm, this);
 
     mosq = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
@@ -237,9 +240,11 @@ struct Bridge::Impl {
     s.t_health = base + "health";
     s.t_alarm = base + "alarm/";
     s.t_cmd = base + "cmd/ack";
+    s.t_forecast = base + "forecast";
     auto [it, fresh] = shafts.emplace(prefix, std::move(s));
     cmd_topics[it->second.t_cmd] = prefix;
-    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM}} -> {}{{cage,health,alarm/<KIND>}}{}", it->second.name,
+    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST}} -> {}{{cage,health,alarm/<KIND>,forecast}}{}",
+                 it->second.name,
                  prefix, base,
                  cfg.commands ? ", " + it->second.t_cmd + " -> " + hoist::bus::channel(prefix, kChannelAlarmAck) : "");
     if (conn == Conn::Connected) subscribeCommands(it->second);
@@ -309,6 +314,16 @@ struct Bridge::Impl {
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
         if (st != hoist::msg::DecodeStatus::ok) return decodeError("alarm_t", st, channel);
         onAlarm(*s, m);
+      } else if (ends(kChannelForecast)) {
+        // Issue 17: the look-ahead forecast, as JSON (nested scenarios), at
+        // the daemon's rate (~1 Hz); queued like health (low rate).
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelForecast.size()));
+        if (!s) return void(++ignored_channels);
+        hoist::forecast_t m;
+        const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
+        if (st != hoist::msg::DecodeStatus::ok) return decodeError("forecast_t", st, channel);
+        ++s->forecasts_in;
+        publish({s->t_forecast, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
       }
     } catch (const std::exception& e) {  // nothing may escape an LCM callback
       ++decode_errors["exception"];
@@ -477,6 +492,7 @@ struct Bridge::Impl {
                     {"cage_in", s.cage_in},
                     {"cage_out", s.cage_out},
                     {"health_in", s.health_in},
+                    {"forecasts_in", s.forecasts_in},
                     {"alarm_events_in", s.alarms_in},
                     {"alarms_active", active},
                     {"commands", s.commands}});

@@ -17,14 +17,20 @@
 //     (critical_fraction * gap) alarm; INPUT_STALE is a WARNING, MODEL_FAULT a
 //     CRITICAL, MODEL_DOMAIN (rope length outside the model's valid range) a
 //     CRITICAL, DUPLICATE_PUBLISHER (another process publishes on this
-//     twin's output channels) a WARNING; PREDICTED_CLEARANCE and
-//     PREDICTED_SLACK (issue 17: a look-ahead scenario crosses the CRITICAL
-//     clearance threshold / brings lambda_0 below the slack threshold within
-//     the forecast horizon) are WARNINGs, never latched, raised at once
-//     (no on-delay: the forecast itself is the early warning);
+//     twin's output channels) a WARNING; ROPE_SLACK (lambda_0 at or below
+//     slack_fraction x the static rope force) and ROPE_OVERLOAD (at or above
+//     overload_fraction x it) are CRITICAL, their deadband force_deadband x
+//     the static force (ShaftModel::staticRopeForce);
+//     PREDICTED_CLEARANCE and PREDICTED_SLACK (issue 17: a look-ahead
+//     scenario crosses the CRITICAL clearance threshold / brings lambda_0
+//     below the slack threshold within the forecast horizon) are WARNINGs,
+//     never latched, raised at once (no on-delay: the forecast itself is the
+//     early warning);
 //   * the condition comes on when value >= threshold has held for on_delay
 //     and goes off when value < threshold - deadband has held for off_delay
-//     (so a value hovering at the threshold cannot chatter);
+//     (so a value hovering at the threshold cannot chatter); a low alarm
+//     (ROPE_SLACK) mirrors it: on at value <= threshold, off above
+//     threshold + deadband;
 //   * a CRITICAL alarm latches (with latch_critical): it stays active after
 //     its condition is gone until an operator acknowledges it;
 //   * an operator can shelve an alarm for a time (at most max_shelve): while
@@ -50,9 +56,10 @@ namespace hoist::svc {
 
 enum class AlarmKind : std::uint8_t {
   CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher,
-  PredictedClearance, PredictedSlack
+  RopeSlack, RopeOverload,  // issue 17: live rope-force alarms
+  PredictedClearance, PredictedSlack  // issue 17: look-ahead forecasts
 };
-inline constexpr int kAlarmKinds = 9;
+inline constexpr int kAlarmKinds = 11;
 /// A re-shelve that moves the expiry by less than this [s] is not effective.
 inline constexpr double kReshelveResolution = 1.0;
 
@@ -82,6 +89,14 @@ struct AlarmConfig {
   double reannounce = 10.0;        ///< re-announce active alarms every ... [s]; 0 = never
   bool latch_critical = true;      ///< CRITICAL stays active until acknowledged
   double max_shelve = 3600.0;      ///< longest shelve an operator may set [s]
+  /// Rope-force alarms (issue 17), as fractions of the static rope force at
+  /// the current length (ShaftModel::staticRopeForce, m g + Fa); see
+  /// docs/service.md for the defaults' reasons.
+  double slack_fraction = 0.5;     ///< ROPE_SLACK at lambda_0 <= fraction x static, in (0, 1)
+  double overload_fraction = 1.5;  ///< ROPE_OVERLOAD at lambda_0 >= fraction x static, in (1, 100]
+  /// Hysteresis of both, as a fraction of the static force, in [0, 1):
+  /// below slack_fraction and 1 - slack_fraction, and below overload_fraction - 1.
+  double force_deadband = 0.05;
 
   /// Throws std::invalid_argument("alarms.<key>: ...") for the first bad value.
   void validate() const;
@@ -90,6 +105,7 @@ struct AlarmConfig {
 /// Settings of one binary alarm.
 struct AlarmSettings {
   double threshold = 1.0;
+  bool low = false;        ///< a low alarm: on at value <= threshold, off above threshold + deadband
   double deadband = 0.0;   ///< absolute, in the value's unit
   double on_delay = 0.0;
   double off_delay = 0.0;
@@ -150,6 +166,12 @@ class BinaryAlarm {
     detail_value_ = value;
     detail_limit_ = limit;
   }
+  /// Move the threshold and deadband (e.g. with the rope length); the
+  /// condition's state and timers are kept.  No allocation.
+  void setThreshold(double threshold, double deadband) {
+    s_.threshold = threshold;
+    s_.deadband = deadband;
+  }
   /// Operator acknowledgement; false if there was nothing to acknowledge.
   bool acknowledge(double now, AlarmEvents& out);
   /// Shelve for `duration` seconds (> 0).  Re-shelving extends/shortens.
@@ -204,7 +226,7 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 /// All alarms of the twin.
 class AlarmEngine {
  public:
-  static constexpr int kSlots = 12;
+  static constexpr int kSlots = 14;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
   const AlarmConfig& config() const { return cfg_; }
@@ -219,6 +241,15 @@ class AlarmEngine {
   /// `seen` true while another publisher is seen on the output channels;
   /// `other_id` its instance id (reported as the event's value).
   void setDuplicatePublisher(double now, bool seen, double other_id, AlarmEvents& out);
+  /// ROPE_SLACK / ROPE_OVERLOAD: the hoisting-rope force `lambda0` [N]
+  /// against slack_fraction / overload_fraction x `static_force` [N] (the
+  /// static rope force at the current length).  A non-finite lambda0 counts
+  /// as in alarm (fail safe), a non-finite or non-positive static_force
+  /// leaves the thresholds as they were.
+  void updateRopeForce(double now, double lambda0, double static_force, AlarmEvents& out);
+  /// The thresholds in force [N] (HOIST_CAGE.rope_slack_threshold, _overload_threshold).
+  double ropeSlackThreshold() const;
+  double ropeOverloadThreshold() const;
   /// MODEL_FAULT events report `value` against `limit` (e.g. an implausible
   /// output and its bound; 1/0 for a non-finite state).
   void setModelFaultDetail(double value, double limit) { alarms_[7].setDetail(value, limit); }

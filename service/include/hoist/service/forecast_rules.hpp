@@ -8,6 +8,7 @@
 
 #include "hoist/forecast.hpp"
 #include "hoist/params.hpp"
+#include "hoist/shaft_model.hpp"
 #include "hoist/service/config.hpp"
 
 namespace hoist::svc {
@@ -37,14 +38,11 @@ PlanReject planReject(PlanError e);
 PlanCheck checkPlan(const TripPlan& plan, double t, const Kinematics& k, const ShaftParams& shaft,
                     MotionProfile& scratch);
 
-/// Static force of the hoisting rope on the cage, m g + Fa [N] (the cage's
-/// weight and its payload's: what lambda_0 reads at rest).
-double staticRopeForce(const ShaftParams& p);
-/// The slack threshold of PREDICTED_SLACK [N]: kSlackFraction x staticRopeForce.
-/// ONE place: ROPE_SLACK's [alarms] slack_fraction replaces kSlackFraction
-/// when it lands (the forecast then warns at the live alarm's level).
-inline constexpr double kSlackFraction = 0.5;
-double slackThreshold(const TwinConfig& cfg);
+/// The slack threshold of PREDICTED_SLACK [N]: the live ROPE_SLACK alarm's,
+/// [alarms] slack_fraction x ShaftModel::staticRopeForce(l) at the rope
+/// length l the forecast starts from (so the forecast warns of exactly what
+/// ROPE_SLACK would raise).
+double slackThreshold(const TwinConfig& cfg, const ShaftModel& model, double l);
 
 /// What one forecast predicts.  Times are seconds after the forecast's start.
 struct ForecastVerdict {

@@ -65,6 +65,10 @@ struct CageOutput {
   std::int64_t input_seq = -1;
   std::int64_t input_utime = 0;  ///< utime of the input the state answers (input clock)
   AlarmLevel alarm_level = AlarmLevel::None;
+  /// ROPE_SLACK / ROPE_OVERLOAD thresholds in force [N] (fractions of the
+  /// static rope force at kin.l); 0 before the first step.
+  double rope_slack_threshold = 0.0;
+  double rope_overload_threshold = 0.0;
 };
 
 /// What onInput()/tick() did.
