@@ -21,7 +21,7 @@ import subprocess
 import sys
 
 STATIC = 800.0 * 9.81 + 1000.0  # m g + Fa of the paper's shaft [N]
-SLACK_FRACTION = 0.5            # hoist::svc::kSlackFraction
+SLACK_FRACTION = 0.5            # [alarms] slack_fraction (default): ROPE_SLACK, PREDICTED_SLACK
 
 
 def run_table(binary, modes, every):

@@ -203,6 +203,8 @@ TEST(ForecastConfig, BadValuesNameTheKeyAndLine) {
   expectKey("[forecast]\nworkers = 1.5\n", "forecast.workers: must be an integer");
   expectKey("[forecast]\nseries_points = 65\n", "forecast.series_points");
   expectKey("[forecast]\nhorizn = 20\n", "forecast.horizn");
+}
+
 // Issue 17: the rope-force alarm keys are validated like every key; the
 // error names file:line and the key.
 TEST(ServiceConfig, RopeForceAlarmKeysAreValidated) {
