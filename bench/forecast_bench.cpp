@@ -66,6 +66,9 @@ BENCHMARK(BM_ForecastEstop)->Args({20, 25})->Args({50, 25})->Args({50, 100})->Un
 BENCHMARK(BM_ForecastEstop)->Args({200, 25})->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_ForecastContinue)->Args({20, 25})->Args({50, 25})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ForecastPlan)->Args({50, 25})->Unit(benchmark::kMillisecond);
+// The converged setting of issue 13 (n = 25, static correction on; helper conv).
+BENCHMARK(BM_ForecastEstop)->Args({25, 25})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForecastPlan)->Args({25, 25})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -22,7 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   hoist::ShaftParams p;
   try {
-    p = hoist::io::shaftParamsFromToml(tbl, "fuzz.toml", {"service", "alarms"});
+    p = hoist::io::shaftParamsFromToml(tbl, "fuzz.toml", {"service", "alarms", "forecast"});
   } catch (const std::exception& e) {
     if (!*e.what()) std::abort();
     return 0;

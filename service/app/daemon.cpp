@@ -75,10 +75,31 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     g->shafts.push_back(shafts_.back().get());
   }
   for (auto& g : groups_) g->shafts.shrink_to_fit();
+  // Look-ahead forecasts: one pool for the process; the forecasting shafts
+  // are staggered over the forecast period (shaft i of N at phase i / N).
+  std::vector<ShaftTwin*> fshafts;
+  int workers = 0;
+  for (auto& sp : shafts_)
+    if (sp->forecastJob()) {
+      fshafts.push_back(sp.get());
+      workers = std::max(workers, sp->config().forecast.workers);
+    }
+  if (!fshafts.empty()) pool_ = std::make_unique<ForecastPool>(workers);
+  for (std::size_t i = 0; i < fshafts.size(); ++i) {
+    ShaftTwin* s = fshafts[i];
+    const double phase = static_cast<double>(i) / static_cast<double>(fshafts.size());
+    if (s->config().service.clock == ClockMode::Wall) {
+      pool_->add(s->forecastJob());
+      s->setForecastPool(pool_.get(), phase);
+    } else {
+      s->setForecastPool(nullptr, phase);  // --clock input: synchronous, deterministic
+    }
+  }
 }
 
 Daemon::~Daemon() {
   stopWatchdog();
+  if (pool_) pool_->stop();
   // The descriptor belongs to LCM: never let Asio close it.
   if (lcm_fd_.is_open()) lcm_fd_.release();
   if (out_fd_.is_open()) out_fd_.release();  // out_receiver_ closes it
@@ -180,6 +201,11 @@ bool Daemon::start() {
       }
     }
   }
+  if (pool_ && !pool_->empty()) {
+    pool_->start();
+    out_->info("look-ahead forecasts: {} shaft(s) on one pool of {} worker thread(s)", pool_->jobs(),
+               pool_->workers());
+  }
   // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
   // never receives them.
   startWatchdog();
@@ -229,6 +255,7 @@ int Daemon::run() {
 bool Daemon::finish() {
   sd_notify(0, "STOPPING=1");
   stopWatchdog();
+  if (pool_) pool_->stop();
   log_.flush();
   const bool ok = writeReport();
   out_->info("hoist-twind stopped");

@@ -36,6 +36,7 @@
 #include <thread>
 #include <vector>
 
+#include "forecast_pool.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
@@ -141,6 +142,10 @@ class Daemon {
   boost::asio::signal_set signals_;
   std::vector<std::unique_ptr<ShaftTwin>> shafts_;
   std::vector<std::unique_ptr<RateGroup>> groups_;
+  /// The one forecast pool of the process (issue 17): serves every shaft with
+  /// [forecast] enabled and --clock wall.  Declared after shafts_ so that it
+  /// stops (joins its workers) before the jobs it serves are destroyed.
+  std::unique_ptr<ForecastPool> pool_;
   Clock::time_point start_{};
   Clock::time_point stop_time_{};
   RealtimeOutcome rt_;

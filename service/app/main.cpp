@@ -143,6 +143,12 @@ int main(int argc, char** argv) {
         throw std::invalid_argument(what);
       }
       cfg.shaft.validate();
+      // [forecast] against the effective [service] rate (--rate may have lowered it).
+      try {
+        cfg.forecast.validate(cfg.service.rate);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(where + ": " + e.what() + (rate > 0.0 ? " (with --rate)" : ""));
+      }
       if (!prefixes.insert(cfg.service.channel_prefix).second)
         throw std::invalid_argument(where + ": service.channel_prefix: \"" + cfg.service.channel_prefix +
                                     "\" is already used by another --config (each shaft needs its own)");

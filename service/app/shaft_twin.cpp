@@ -56,6 +56,25 @@ bool finiteAll(const hoist::health_t& m) {
          std::isfinite(m.late_p99_us) && std::isfinite(m.late_max_us) && std::isfinite(m.input_age);
 }
 
+bool finiteAll(const hoist::forecast_t& m) {
+  bool ok = std::isfinite(m.t_start) && std::isfinite(m.l) && std::isfinite(m.v) && std::isfinite(m.a) &&
+            std::isfinite(m.compute_time);
+  for (int i = 0; i < m.num_scenarios; ++i) {
+    const hoist::forecast_scenario_t& s = m.scenarios[static_cast<std::size_t>(i)];
+    ok = ok && std::isfinite(s.horizon) && std::isfinite(s.t_reached) && std::isfinite(s.min_clearance) &&
+         std::isfinite(s.t_min_clearance) && std::isfinite(s.t_warning) && std::isfinite(s.t_critical) &&
+         std::isfinite(s.peak_y_c) && std::isfinite(s.peak_theta) && std::isfinite(s.lambda0_min) &&
+         std::isfinite(s.lambda0_max);
+    for (double v : s.peak_lambdas) ok = ok && std::isfinite(v);
+    for (int k = 0; k < s.num_points; ++k) {
+      const auto j = static_cast<std::size_t>(k);
+      ok = ok && std::isfinite(s.series_t[j]) && std::isfinite(s.series_min_clearance[j]) &&
+           std::isfinite(s.series_lambda0_min[j]) && std::isfinite(s.series_lambda0_max[j]);
+    }
+  }
+  return ok;
+}
+
 int divider(double rate, double sub_rate) {
   if (!(sub_rate > 0.0)) return 1;
   return std::max(1, static_cast<int>(std::lround(rate / sub_rate)));
@@ -96,6 +115,31 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
     health_msg_.reject_reason[i] = toString(static_cast<RejectReason>(i));
   health_msg_.reject_reason[kRejectReasons] = "command_decode";
   health_msg_.reject_reason[kRejectReasons + 1] = "handler_exception";
+  for (int i = 0; i < kPlanRejectReasons; ++i)
+    health_msg_.reject_reason[kRejectReasons + 2 + i] = toString(static_cast<PlanReject>(i));
+
+  // Look-ahead forecasts: the job (workspace, mailboxes) and the message,
+  // sized once.  A non-finite scenario keeps its status in the message; the
+  // numbers of a scenario that stopped early cover [0, t_reached].
+  if (cfg_.forecast.enabled) {
+    cfg_.forecast.validate(s.rate);
+    fast_ = dynamic_cast<const FastSolver*>(&core_.solver());
+    if (!fast_) throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
+    fjob_ = std::make_unique<ForecastJob>(core_.solver().modelPtr(), cfg_);
+    forecast_msg_.instance_id = instance_id_;
+    forecast_msg_.num_scenarios = ForecastResult::kScenarios;
+    forecast_msg_.scenarios.resize(ForecastResult::kScenarios);
+    for (int i = 0; i < ForecastResult::kScenarios; ++i) {
+      hoist::forecast_scenario_t& m = forecast_msg_.scenarios[static_cast<std::size_t>(i)];
+      m.name = ForecastResult::kNames[i];
+      m.num_points = static_cast<int16_t>(cfg_.forecast.series_points);
+      m.series_t.assign(m.num_points, 0.0);
+      m.series_min_clearance.assign(m.num_points, 0.0);
+      m.series_lambda0_min.assign(m.num_points, 0.0);
+      m.series_lambda0_max.assign(m.num_points, 0.0);
+    }
+    forecast_buf_.resize(static_cast<std::size_t>(forecast_msg_.getEncodedSize()) + 64);
+  }
   alarm_msg_.kind.reserve(64);
   alarm_msg_.user.reserve(kUserMax + 4);
   cage_msg_.instance_id = instance_id_;
@@ -121,6 +165,8 @@ void ShaftTwin::subscribe(InputRouter* router) {
   if (router) {
     router->add(ch_.winder, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onWinder(rb, c); });
     router->add(ch_.ack, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onAck(rb, c); });
+    if (fjob_)
+      router->add(ch_.trip_plan, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onTripPlan(rb, c); });
     if (own_health)
       router->add(ch_.health, [this](const lcm::ReceiveBuffer* rb, const std::string& c) { onOwnHealth(rb, c); });
     return;
@@ -129,6 +175,7 @@ void ShaftTwin::subscribe(InputRouter* router) {
   // names (a prefix "mine.1/" must not match "mineX1/").
   lcm_.subscribe(regexEscape(ch_.winder), &ShaftTwin::onWinder, this);
   lcm_.subscribe(regexEscape(ch_.ack), &ShaftTwin::onAck, this);
+  if (fjob_) lcm_.subscribe(regexEscape(ch_.trip_plan), &ShaftTwin::onTripPlan, this);
   if (own_health) lcm_.subscribe(regexEscape(ch_.health), &ShaftTwin::onOwnHealth, this);
 }
 
@@ -162,7 +209,7 @@ void ShaftTwin::start(Clock::time_point start, double health_phase) {
   last_health_wall_ = -health_phase;
 }
 
-double ShaftTwin::wallNow() const { return duration<double>(Clock::now() - start_).count(); }
+double ShaftTwin::wallNow() const { return duration<double>(Clock::now() - start_ - sync_pause_).count(); }
 
 // ---- LCM input ---------------------------------------------------------------
 
@@ -236,6 +283,7 @@ void ShaftTwin::handleWinder(const lcm::ReceiveBuffer* rbuf) {
       last_shape_t_ = core_.modelTime();
       publishShape(s.utime);
     }
+    if (fjob_) maybeForecast(s.utime);
   }
   drainAlarmEvents();
 }
@@ -305,6 +353,176 @@ void ShaftTwin::logJunk(const std::string& what) {
   log_.warn("{}{}", tag_, what);
 }
 
+// ---- look-ahead forecasts (issue 17) ------------------------------------------------
+
+void ShaftTwin::setForecastPool(ForecastPool* pool, double phase) {
+  pool_ = pool;
+  forecast_phase_ = phase;
+  next_forecast_t_ = phase / cfg_.forecast.rate;
+}
+
+void ShaftTwin::onTripPlan(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  try {
+    handleTripPlan(rbuf);
+  } catch (const std::exception& e) {
+    handlerFailed(e.what(), "HOIST_TRIP_PLAN");
+  } catch (...) {
+    handlerFailed("unknown exception", "HOIST_TRIP_PLAN");
+  }
+}
+
+void ShaftTwin::rejectPlan(PlanReject r, const char* detail) {
+  ++plan_rejects_[static_cast<std::size_t>(r)];
+  std::int64_t suppressed = 0;
+  if (!reject_log_.allow(kLogPlan, wallNow(), suppressed)) return;
+  log_.warn("{}rejected trip plan ({}): {} [{} similar suppressed]", tag_, toString(r), detail, suppressed);
+}
+
+void ShaftTwin::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
+  // Every byte is validated before anything is decoded (checked decoder);
+  // trip_plan_t is flat (no string, no array): decoding allocates nothing.
+  const auto size = static_cast<std::size_t>(rbuf->data_size);
+  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, plan_in_); st != hoist::msg::DecodeStatus::ok) {
+    std::snprintf(text_, sizeof text_, "%zu bytes: %s", size, hoist::msg::toString(st));
+    rejectPlan(PlanReject::Decode, text_);
+    return;
+  }
+  const trip_plan_t& m = plan_in_;
+  if (have_plan_ && m.seq <= plan_seq_) {
+    std::snprintf(text_, sizeof text_, "seq %lld is not newer than the plan in force (seq %lld)",
+                  static_cast<long long>(m.seq), static_cast<long long>(plan_seq_));
+    rejectPlan(PlanReject::OldSeq, text_);
+    return;
+  }
+  const TripPlan p{m.target_length, m.vmax, m.amax, m.jerk};
+  const CageOutput& o = core_.output();
+  const PlanCheck pc = checkPlan(p, core_.modelTime(), o.kin, cfg_.shaft, plan_scratch_);
+  if (!pc.ok()) {
+    // describe() allocates: plans are rare, off the tick (as alarm commands).
+    const std::string why = describe(pc);
+    std::snprintf(text_, sizeof text_, "seq %lld target %g m vmax %g amax %g jerk %g at l = %.3f m, v = %.3f m/s, "
+                  "a = %.3f m/s^2: %s",
+                  static_cast<long long>(m.seq), m.target_length, m.vmax, m.amax, m.jerk, o.kin.l, o.kin.v, o.kin.a,
+                  why.c_str());
+    rejectPlan(planReject(pc.error), text_);
+    return;
+  }
+  const bool first = !have_plan_;
+  have_plan_ = true;
+  plan_ = p;
+  plan_seq_ = m.seq;
+  ++plans_accepted_;
+  if (first)
+    log_.info("{}trip plan accepted (seq {}): target {} m, vmax {} m/s, amax {} m/s^2, jerk {} m/s^3", tag_, m.seq,
+              m.target_length, m.vmax, m.amax, m.jerk);
+}
+
+void ShaftTwin::maybeForecast(std::int64_t utime) {
+  const double tp = core_.output().t;
+  const double period = 1.0 / cfg_.forecast.rate;
+  // The published time restarts at the first input (wall clock) or a new
+  // stream: re-align the schedule when it went back.
+  if (tp + period < next_forecast_t_) next_forecast_t_ = (std::floor(tp / period) + forecast_phase_) * period;
+  if (tp + 1e-9 < next_forecast_t_) return;
+  while (next_forecast_t_ <= tp + 1e-9) next_forecast_t_ += period;
+  if (core_.degraded() || !core_.solver().finite()) {
+    // A state just re-initialized after a fault, stale input, the domain
+    // edge, a limited catch-up: not a state to forecast from.  The
+    // predictions are withdrawn (MODEL_FAULT / INPUT_STALE / MODEL_DOMAIN
+    // say what is wrong).
+    ++forecasts_skipped_;
+    core_.setPredictions(false, 0.0, false, 0.0, cfg_.forecast.horizon);
+    return;
+  }
+  ForecastSnapshot& snap = fjob_->snapshotSlot();
+  fast_->saveState(snap.state);
+  snap.utime = utime;
+  snap.t_published = tp;
+  snap.has_plan = have_plan_;
+  snap.plan = plan_;
+  snap.plan_seq = plan_seq_;
+  if (core_.clock() == ClockMode::Input || !pool_) {
+    // Deterministic: the forecast runs here, at this instant, and its result
+    // is published before the next input is read.
+    const auto c0 = Clock::now();
+    const ForecastResult& r = fjob_->runNow();
+    sync_pause_ += Clock::now() - c0;
+    onForecastResult(r);
+    return;
+  }
+  if (fjob_->postSnapshot()) ++forecasts_dropped_;
+  pool_->notify();
+}
+
+void ShaftTwin::onForecastResult(const ForecastResult& r) {
+  if (r.failed) {
+    ++forecast_failures_;
+    return;
+  }
+  ++forecasts_;
+  const double us = r.compute_s * 1e6;
+  forecast_hist_.add(us);
+  forecast_total_.add(us);
+  if (r.plan_error != PlanError::None) {
+    // The plan was valid when it came, but no longer fits the motion (e.g.
+    // braking already, the target closer than the plan's stopping distance):
+    // "continue" used the no-plan rule.
+    ++plan_unusable_;
+    std::int64_t suppressed = 0;
+    if (reject_log_.allow(kLogPlan, wallNow(), suppressed))
+      log_.info("{}trip plan seq {} no longer fits the motion at t = {:.2f} s ({}): the continue scenario uses the "
+                "no-plan rule [{} similar suppressed]",
+                tag_, plan_seq_, r.t_published, hoist::toString(r.plan_error), suppressed);
+  }
+  const ForecastSummary* sc[ForecastResult::kScenarios];
+  for (int i = 0; i < ForecastResult::kScenarios; ++i) sc[i] = &r.scenario[i];
+  slack_threshold_ = slackThreshold(cfg_, core_.solver().model(), r.kin.l);
+  const ForecastVerdict v = judgeForecast(sc, ForecastResult::kScenarios, slack_threshold_);
+  pred_clearance_scenario_ = v.clearance ? ForecastResult::kNames[v.clearance_scenario] : "";
+  pred_slack_scenario_ = v.slack ? ForecastResult::kNames[v.slack_scenario] : "";
+  core_.setPredictions(v.clearance, v.clearance_s, v.slack, v.slack_s, cfg_.forecast.horizon);
+  publishForecast(r);
+  drainAlarmEvents();
+}
+
+void ShaftTwin::publishForecast(const ForecastResult& r) {
+  forecast_t& m = forecast_msg_;
+  m.utime = r.utime;
+  m.seq = forecast_seq_++;
+  m.t_start = r.t_published;
+  m.l = r.kin.l;
+  m.v = r.kin.v;
+  m.a = r.kin.a;
+  m.plan_seq = r.plan_seq;
+  m.compute_time = r.compute_s;
+  for (int i = 0; i < ForecastResult::kScenarios; ++i) {
+    const ForecastSummary& f = r.scenario[i];
+    forecast_scenario_t& s = m.scenarios[static_cast<std::size_t>(i)];
+    s.status = static_cast<int8_t>(f.status);
+    s.horizon = f.horizon;
+    s.t_reached = f.t_reached;
+    s.min_clearance = f.min_clearance;
+    s.t_min_clearance = f.t_min_clearance;
+    s.t_warning = f.t_warning;
+    s.t_critical = f.t_critical;
+    s.peak_y_c = f.peak_y_c;
+    s.peak_theta = f.peak_theta;
+    for (int k = 0; k < 4; ++k) s.peak_lambdas[k] = f.peak_lambda[static_cast<std::size_t>(k)];
+    s.lambda0_min = f.lambda0_min;
+    s.lambda0_max = f.lambda0_max;
+    const int np = std::clamp(f.series_count, 0, static_cast<int>(s.series_t.size()));
+    s.num_points = static_cast<int16_t>(np);
+    for (int k = 0; k < np; ++k) {
+      const auto j = static_cast<std::size_t>(k);
+      s.series_t[j] = f.series_t[j];
+      s.series_min_clearance[j] = f.series_min_clearance[j];
+      s.series_lambda0_min[j] = f.series_lambda0_min[j];
+      s.series_lambda0_max[j] = f.series_lambda0_max[j];
+    }
+  }
+  encodeAndPublish(ch_.forecast, m, forecast_buf_);
+}
+
 // ---- the tick ------------------------------------------------------------------
 
 void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped) {
@@ -314,7 +532,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   ++ticks_;
   deadline_misses_ += skipped;
   commands_this_tick_ = 0;
-  const double wall = duration<double>(now - start_).count();
+  const double wall = duration<double>(now - start_ - sync_pause_).count();
   if (hooks_.inject_fault_at >= 0.0 && !fault_injected_ && wall >= hooks_.inject_fault_at) {
     fault_injected_ = true;
     log_.warn("{}test: injecting a model fault (non-finite state) at wall time {:.3f} s", tag_, wall);
@@ -339,12 +557,17 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
                   "crossed with longer substeps, output flagged degraded [{} similar suppressed]",
                   tag_, cfg_.service.max_catchup_periods, suppressed);
     }
+    if (fjob_) {
+      // Results of earlier snapshots (the worker posts them when done).
+      if (const ForecastResult* fr = fjob_->takeResult()) onForecastResult(*fr);
+    }
     if (r.stepped && core_.hasInput()) {
       const auto p0 = Clock::now();
       const std::int64_t utime = bus::wallUtime();
       if (k % cage_div_ == 0) publishCage(utime, true);
       if (cfg_.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime, true);
       ns_publish_ += nanos(Clock::now() - p0);
+      if (fjob_) maybeForecast(utime);
     }
   } else {
     core_.housekeeping(wall);
@@ -438,6 +661,9 @@ void ShaftTwin::drainAlarmEvents() {
   ctx.range = core_.validRange();
   ctx.fault_what = core_.lastFaultWhat();
   ctx.requested_shelve = cmd_requested_shelve_;
+  ctx.predicted_clearance_scenario = pred_clearance_scenario_;
+  ctx.predicted_slack_scenario = pred_slack_scenario_;
+  ctx.slack_threshold = slack_threshold_;
   alarm_msg_.user.assign(cmd_user_);  // who caused these events ("" for the twin itself)
   for (const AlarmEvent& e : ev) {
     describeAlarm(e, ctx, text_, sizeof text_);
@@ -496,6 +722,18 @@ void ShaftTwin::publishHealth(bool final_report) {
   for (int i = 0; i < kRejectReasons; ++i) health_msg_.rejected[i] = c.rejected[i];
   health_msg_.rejected[kRejectReasons] = command_decode_rejects_;
   health_msg_.rejected[kRejectReasons + 1] = handler_exceptions_;
+  std::int64_t plans_rejected = 0;
+  for (int i = 0; i < kPlanRejectReasons; ++i) {
+    health_msg_.rejected[kRejectReasons + 2 + i] = plan_rejects_[static_cast<std::size_t>(i)];
+    plans_rejected += plan_rejects_[static_cast<std::size_t>(i)];
+  }
+  health_msg_.forecast_p50_us = forecast_hist_.count() > 0 ? forecast_hist_.quantile(0.5) : 0.0;
+  health_msg_.forecast_p99_us = forecast_hist_.count() > 0 ? forecast_hist_.quantile(0.99) : 0.0;
+  health_msg_.forecasts = forecasts_;
+  health_msg_.forecasts_dropped = forecasts_dropped_;
+  health_msg_.forecasts_skipped = forecasts_skipped_;
+  health_msg_.plans_accepted = plans_accepted_;
+  health_msg_.plans_rejected = plans_rejected;
   health_msg_.alarms_active = al.activeCount();
   health_msg_.alarms_unacked = al.unackedCount();
   health_msg_.alarms_shelved = al.shelvedCount();
@@ -527,6 +765,7 @@ void ShaftTwin::publishHealth(bool final_report) {
   late_total_.merge(late_hist_);
   step_hist_.reset();
   late_hist_.reset();
+  forecast_hist_.reset();
   last_health_wall_ = wall;
 }
 
@@ -547,6 +786,17 @@ void ShaftTwin::logFinal() {
     if (c.rejected[i] > 0) log_.info("{}  rejected {}: {}", tag_, toString(static_cast<RejectReason>(i)), c.rejected[i]);
   if (command_decode_rejects_ > 0) log_.info("{}  rejected alarm commands (command_decode): {}", tag_, command_decode_rejects_);
   if (handler_exceptions_ > 0) log_.info("{}  exceptions caught in LCM handlers: {}", tag_, handler_exceptions_);
+  if (fjob_) {
+    log_.info("{}forecasts: {} done (compute p50/p99/max {:.1f}/{:.1f}/{:.1f} ms), {} dropped (worker late), {} skipped "
+              "(degraded), {} failed; trip plans accepted {}, no longer fitting the motion {}",
+              tag_, forecasts_, forecast_total_.quantile(0.5) / 1e3, forecast_total_.quantile(0.99) / 1e3,
+              forecast_total_.max() / 1e3, forecasts_dropped_, forecasts_skipped_, forecast_failures_, plans_accepted_,
+              plan_unusable_);
+    for (int i = 0; i < kPlanRejectReasons; ++i)
+      if (plan_rejects_[static_cast<std::size_t>(i)] > 0)
+        log_.info("{}  rejected trip plans {}: {}", tag_, toString(static_cast<PlanReject>(i)),
+                  plan_rejects_[static_cast<std::size_t>(i)]);
+  }
 }
 
 std::int64_t ShaftTwin::rssKb() const {
@@ -584,6 +834,12 @@ ShaftRunStats ShaftTwin::runStats() const {
   s.ns_tick = ns_tick_;
   s.envelope_exact = core_.envelope().exactEvaluations();
   s.envelope_bounded = core_.envelope().boundedEvaluations();
+  s.forecasts = forecasts_;
+  s.forecasts_dropped = forecasts_dropped_;
+  s.forecasts_skipped = forecasts_skipped_;
+  s.plans_accepted = plans_accepted_;
+  for (auto n : plan_rejects_) s.plans_rejected += n;
+  s.forecast = &forecast_total_;
   return s;
 }
 

@@ -14,14 +14,21 @@
 // daemon_no_alloc_test.cpp checks the whole loop with a counting allocator.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 #include <vector>
 
+#include <memory>
+
+#include "forecast_pool.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
+#include "hoist/service/forecast_rules.hpp"
+#include "hoist/trip_plan_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/bus/channels.hpp"
@@ -54,6 +61,8 @@ struct ShaftRunStats {
   std::int64_t ticks = 0, steps = 0, deadline_misses = 0;
   std::int64_t accepted = 0, rejected = 0, seq_gaps = 0;
   std::int64_t alarm_events = 0, model_faults = 0, publish_failures = 0, nonfinite_blocked = 0;
+  std::int64_t forecasts = 0, forecasts_dropped = 0, forecasts_skipped = 0, plans_accepted = 0, plans_rejected = 0;
+  const LatencyHistogram* forecast = nullptr;  ///< forecast compute time [us]
   const LatencyHistogram* step = nullptr;  ///< model step time [us]
   const LatencyHistogram* late = nullptr;  ///< tick lateness [us]
   // Cost split, whole run [ns of steady clock] (issue 13): the model
@@ -89,6 +98,13 @@ class ShaftTwin {
   /// The daemon's own udpm publisher (udpm_sender.hpp), used instead of
   /// LCM's publish when set (udpm output URLs).
   void setSender(UdpmSender* s) { sender_ = s; }
+  /// [forecast] enabled: this shaft's forecast job (nullptr when off).  The
+  /// daemon adds it to its one ForecastPool (wall clock) and passes the pool
+  /// here; with --clock input the shaft runs its forecasts itself.  `phase`
+  /// in [0, 1): this shaft forecasts at published times (k + phase) / rate
+  /// (the shafts of one daemon are staggered).
+  ForecastJob* forecastJob() { return fjob_.get(); }
+  void setForecastPool(ForecastPool* pool, double phase);
   /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
   void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: wall times are measured from `start`; publishes a
@@ -116,6 +132,15 @@ class ShaftTwin {
   // "handler_exception" in HOIST_HEALTH and logged, rate-limited).
   void onWinder(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void onAck(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void onTripPlan(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void handleTripPlan(const lcm::ReceiveBuffer* rbuf);
+  void rejectPlan(PlanReject r, const char* detail);
+  /// After a model step: at a forecast instant, hand a snapshot over (wall
+  /// clock) or forecast now (input clock).
+  void maybeForecast(std::int64_t utime);
+  /// A result came back: publish forecast_t, feed PREDICTED_* alarms.
+  void onForecastResult(const ForecastResult& r);
+  void publishForecast(const ForecastResult& r);
   void handleWinder(const lcm::ReceiveBuffer* rbuf);
   void handleAck(const lcm::ReceiveBuffer* rbuf);
   void handlerFailed(const char* what, const char* channel);
@@ -148,6 +173,10 @@ class ShaftTwin {
   TwinCore core_;
 
   Clock::time_point start_{};
+  /// --clock input: wall time spent in synchronous forecasts, not counted as
+  /// time passing for this shaft's staleness and health windows (the inputs
+  /// wait in the socket meanwhile; they are not late).
+  Clock::duration sync_pause_{};
   int cage_div_ = 1, shape_div_ = 1;
   double last_shape_t_ = -1e300;  ///< input clock: model time of the last shape message
   double last_health_wall_ = 0.0;
@@ -161,7 +190,7 @@ class ShaftTwin {
   // Extra HOIST_HEALTH reasons after the winder reasons (not in rejected_total,
   // which counts winder inputs): undecodable alarm commands, and exceptions
   // caught in an LCM callback.
-  static constexpr int kExtraReasons = 2;
+  static constexpr int kExtraReasons = 2 + kPlanRejectReasons;
   std::int64_t command_decode_rejects_ = 0, handler_exceptions_ = 0;
   std::int64_t publish_attempts_ = 0;
   bool fault_injected_ = false;
@@ -171,7 +200,8 @@ class ShaftTwin {
   static constexpr int kLogJunkCommand = kRejectReasons + 1;  ///< invalid/ineffective/dropped commands
   static constexpr int kLogCatchup = kRejectReasons + 2;      ///< limited catch-up
   static constexpr int kLogHandlerException = kRejectReasons + 3;  ///< exceptions caught in LCM handlers
-  static constexpr int kLogKeys = kRejectReasons + 4;
+  static constexpr int kLogPlan = kRejectReasons + 4;  ///< rejected trip plans, unusable plans
+  static constexpr int kLogKeys = kRejectReasons + 5;
   LogRateLimiter<kLogKeys> reject_log_{5};
   static constexpr std::size_t kUserMax = 64;  ///< operator names are cut to this (printable) length
   int commands_this_tick_ = 0;
@@ -183,13 +213,35 @@ class ShaftTwin {
   int statm_fd_ = -1;
   const std::int64_t* ignored_counter_ = nullptr;
 
+  // look-ahead forecasts (issue 17)
+  std::unique_ptr<ForecastJob> fjob_;
+  ForecastPool* pool_ = nullptr;
+  double forecast_phase_ = 0.0;
+  double next_forecast_t_ = 0.0;      ///< published time of the next forecast instant
+  const FastSolver* fast_ = nullptr;  ///< the twin's solver, for saveState
+  double slack_threshold_ = 0.0;      ///< PREDICTED_SLACK [N]
+  const char* pred_clearance_scenario_ = "";
+  const char* pred_slack_scenario_ = "";
+  std::int64_t forecasts_ = 0, forecasts_dropped_ = 0, forecasts_skipped_ = 0, forecast_failures_ = 0;
+  std::int64_t forecast_seq_ = 0, plan_unusable_ = 0;
+  LatencyHistogram forecast_hist_, forecast_total_;  ///< compute time [us]: window, whole run
+  // trip plans: the latest accepted one
+  bool have_plan_ = false;
+  TripPlan plan_;
+  std::int64_t plan_seq_ = -1;
+  std::int64_t plans_accepted_ = 0;
+  std::array<std::int64_t, kPlanRejectReasons> plan_rejects_{};
+  MotionProfile plan_scratch_;
+  hoist::trip_plan_t plan_in_;
+
   // preallocated messages and encode buffers
   hoist::winder_t winder_in_;
   hoist::cage_state_t cage_msg_;
   hoist::guide_shape_t shape_msg_;
   hoist::alarm_t alarm_msg_;
   hoist::health_t health_msg_;
-  std::vector<std::uint8_t> cage_buf_, shape_buf_, alarm_buf_, health_buf_;
+  hoist::forecast_t forecast_msg_;
+  std::vector<std::uint8_t> cage_buf_, shape_buf_, alarm_buf_, health_buf_, forecast_buf_;
   char text_[256];
 };
 

@@ -20,6 +20,8 @@ const char* toString(AlarmKind k) {
     case AlarmKind::DuplicatePublisher: return "DUPLICATE_PUBLISHER";
     case AlarmKind::RopeSlack: return "ROPE_SLACK";
     case AlarmKind::RopeOverload: return "ROPE_OVERLOAD";
+    case AlarmKind::PredictedClearance: return "PREDICTED_CLEARANCE";
+    case AlarmKind::PredictedSlack: return "PREDICTED_SLACK";
   }
   return "?";
 }
@@ -227,7 +229,7 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 namespace {
 // Slot layout: 0/1 CAGE_POS_Y W/C, 2/3 CAGE_NEG_Y W/C, 4/5 GUIDE_ROPE W/C,
 // 6 INPUT_STALE W, 7 MODEL_FAULT C, 8 MODEL_DOMAIN C, 9 DUPLICATE_PUBLISHER W,
-// 10 ROPE_SLACK C, 11 ROPE_OVERLOAD C.
+// 10 ROPE_SLACK C, 11 ROPE_OVERLOAD C, 12 PREDICTED_CLEARANCE W, 13 PREDICTED_SLACK W.
 int slotOf(AlarmKind k, AlarmLevel l) {
   const int crit = l == AlarmLevel::Critical ? 1 : 0;
   switch (k) {
@@ -240,6 +242,8 @@ int slotOf(AlarmKind k, AlarmLevel l) {
     case AlarmKind::DuplicatePublisher: return l == AlarmLevel::Warning ? 9 : -1;
     case AlarmKind::RopeSlack: return l == AlarmLevel::Critical ? 10 : -1;
     case AlarmKind::RopeOverload: return l == AlarmLevel::Critical ? 11 : -1;
+    case AlarmKind::PredictedClearance: return l == AlarmLevel::Warning ? 12 : -1;
+    case AlarmKind::PredictedSlack: return l == AlarmLevel::Warning ? 13 : -1;
   }
   return -1;
 }
@@ -287,6 +291,12 @@ AlarmEngine::AlarmEngine(const AlarmConfig& cfg) : cfg_(cfg) {
   rope.low = false;
   rope.threshold = cfg_.overload_fraction;
   alarms_[11].configure(AlarmKind::RopeOverload, AlarmLevel::Critical, rope);
+  // Predictions: raised with the forecast that predicts (no on-delay),
+  // cleared after off_delay without one, never latched.
+  AlarmSettings pred = flag;
+  pred.off_delay = cfg_.off_delay;
+  alarms_[12].configure(AlarmKind::PredictedClearance, AlarmLevel::Warning, pred);
+  alarms_[13].configure(AlarmKind::PredictedSlack, AlarmLevel::Warning, pred);
 }
 
 void AlarmEngine::updateRopeForce(double now, double lambda0, double static_force, AlarmEvents& out) {
@@ -326,6 +336,17 @@ void AlarmEngine::setModelDomain(double now, bool outside, double l, double limi
 void AlarmEngine::setDuplicatePublisher(double now, bool seen, double other_id, AlarmEvents& out) {
   if (seen) alarms_[9].setDetail(other_id, 0.0);
   alarms_[9].update(now, seen ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setPredictedClearance(double now, bool predicted, double seconds, double horizon,
+                                        AlarmEvents& out) {
+  if (predicted) alarms_[12].setDetail(seconds, horizon);
+  alarms_[12].update(now, predicted ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out) {
+  if (predicted) alarms_[13].setDetail(seconds, horizon);
+  alarms_[13].update(now, predicted ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

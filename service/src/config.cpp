@@ -19,11 +19,12 @@ namespace {
   throw std::invalid_argument(key + ": " + why);
 }
 
-void checkRange(const char* key, double v, double lo, double hi, bool lo_open = false) {
+void checkRange(const char* key, double v, double lo, double hi, bool lo_open = false,
+                const char* section = "service.") {
   if (!std::isfinite(v) || v > hi || (lo_open ? !(v > lo) : v < lo)) {
     std::ostringstream os;
     os << "must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], got " << v;
-    bad(std::string("service.") + key, os.str());
+    bad(std::string(section) + key, os.str());
   }
 }
 
@@ -74,6 +75,28 @@ void ServiceConfig::validate() const {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == '/'))
       bad("service.channel_prefix", "may contain only letters, digits and _ - . /");
   if (channel_prefix.size() > 64) bad("service.channel_prefix", "at most 64 characters");
+}
+
+void ForecastConfig::validate(double service_rate) const {
+  const char* f = "forecast.";
+  checkRange("rate", rate, 0.0, 10.0, true, f);
+  if (std::isfinite(service_rate) && service_rate > 0.0 && rate > service_rate) {
+    std::ostringstream os;
+    os << "must be <= service.rate = " << service_rate << " Hz, got " << rate;
+    bad("forecast.rate", os.str());
+  }
+  checkRange("horizon", horizon, 0.0, 600.0, true, f);
+  if (std::isfinite(service_rate) && service_rate > 0.0 && horizon < 1.0 / service_rate) {
+    std::ostringstream os;
+    os << "must be at least one step (1 / service.rate = " << 1.0 / service_rate << " s), got " << horizon;
+    bad("forecast.horizon", os.str());
+  }
+  checkRange("estop_decel", estop_decel, 0.0, 50.0, true, f);
+  checkRange("estop_jerk", estop_jerk, 0.0, 1000.0, true, f);
+  checkRange("vmax", vmax, 0.0, 100.0, true, f);
+  checkRange("amax", amax, 0.0, 50.0, true, f);
+  checkRange("workers", workers, 1, 16, false, f);
+  checkRange("series_points", series_points, 1, 64, false, f);
 }
 
 }  // namespace hoist::svc

@@ -87,12 +87,30 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   } catch (const std::invalid_argument& e) {
     rethrowWithPosition(e, source, ar);
   }
+
+  ForecastConfig& f = cfg.forecast;
+  SectionReader fr(tbl, "forecast", source);
+  fr.boolean("enabled", f.enabled);
+  fr.number("rate", f.rate);
+  fr.number("horizon", f.horizon);
+  fr.number("estop_decel", f.estop_decel);
+  fr.number("estop_jerk", f.estop_jerk);
+  fr.number("vmax", f.vmax);
+  fr.number("amax", f.amax);
+  fr.integer("workers", f.workers);
+  fr.integer("series_points", f.series_points);
+  fr.run();
+  try {
+    f.validate(s.rate);
+  } catch (const std::invalid_argument& e) {
+    rethrowWithPosition(e, source, fr);
+  }
 }
 
 TwinConfig loadTwinConfig(const std::string& path) {
   const toml::table tbl = hoist::io::loadTomlFile(path);
   TwinConfig cfg;
-  cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, {"service", "alarms"});
+  cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, {"service", "alarms", "forecast"});
   parseServiceSections(tbl, path, cfg);
   return cfg;
 }
@@ -138,6 +156,11 @@ std::string toToml(const TwinConfig& c) {
      << (a.latch_critical ? "true" : "false") << "\nmax_shelve = " << Num{a.max_shelve}
      << "\nslack_fraction = " << Num{a.slack_fraction} << "\noverload_fraction = " << Num{a.overload_fraction}
      << "\nforce_deadband = " << Num{a.force_deadband} << "\n";
+  const ForecastConfig& f = c.forecast;
+  os << "\n[forecast]\nenabled = " << (f.enabled ? "true" : "false") << "\nrate = " << Num{f.rate}
+     << "\nhorizon = " << Num{f.horizon} << "\nestop_decel = " << Num{f.estop_decel}
+     << "\nestop_jerk = " << Num{f.estop_jerk} << "\nvmax = " << Num{f.vmax} << "\namax = " << Num{f.amax}
+     << "\nworkers = " << f.workers << "\nseries_points = " << f.series_points << "\n";
   return os.str();
 }
 

@@ -124,6 +124,25 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
                       "channels; its states interleave with ours (same channel_prefix twice?)%s",
                       kind, level, verb, e.value, state);
       break;
+    case AlarmKind::PredictedClearance:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: no forecast scenario crosses the CRITICAL clearance threshold within "
+                      "the horizon%s", kind, level, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: forecast scenario '%s' crosses the CRITICAL clearance threshold in %.1f s "
+                      "(horizon %.0f s)%s",
+                      kind, level, verb, ctx.predicted_clearance_scenario, e.value, e.threshold, state);
+      break;
+    case AlarmKind::PredictedSlack:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: no forecast scenario brings the hoisting-rope force below the slack "
+                      "threshold within the horizon%s", kind, level, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: forecast scenario '%s' brings the hoisting-rope force lambda_0 below the "
+                      "slack threshold %.0f N within %.1f s (horizon %.0f s)%s",
+                      kind, level, verb, ctx.predicted_slack_scenario, ctx.slack_threshold, e.value, e.threshold,
+                      state);
+      break;
   }
 }
 

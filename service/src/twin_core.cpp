@@ -295,6 +295,12 @@ void TwinCore::setDuplicatePublisher(bool seen, double other_id) {
   out_.alarm_level = alarms_.highestActive();
 }
 
+void TwinCore::setPredictions(bool clearance, double clearance_s, bool slack, double slack_s, double horizon) {
+  alarms_.setPredictedClearance(t_, clearance, clearance_s, horizon, events_);
+  alarms_.setPredictedSlack(t_, slack, slack_s, horizon, events_);
+  out_.alarm_level = alarms_.highestActive();
+}
+
 bool TwinCore::finishStep(double t, bool allow_fault_check) {
   (void)allow_fault_check;
   const double h = cfg_.shaft.h;

@@ -159,6 +159,52 @@ TEST(ServiceConfig, DaemonReadsTheStaticCorrection) {
   EXPECT_TRUE(TwinConfig{}.shaft.static_correction);
 }
 
+TEST(ForecastConfig, DefaultsReadAndPrinted) {
+  TwinConfig c = parse("");
+  EXPECT_FALSE(c.forecast.enabled);
+  EXPECT_EQ(c.forecast.rate, 1.0);
+  EXPECT_EQ(c.forecast.horizon, 20.0);
+  EXPECT_EQ(c.forecast.workers, 1);
+  c = parse("[forecast]\nenabled = true\nrate = 0.5\nhorizon = 12.5\nestop_decel = 2.5\nestop_jerk = 8\n"
+            "vmax = 12\namax = 0.8\nworkers = 2\nseries_points = 40\n");
+  EXPECT_TRUE(c.forecast.enabled);
+  EXPECT_EQ(c.forecast.rate, 0.5);
+  EXPECT_EQ(c.forecast.horizon, 12.5);
+  EXPECT_EQ(c.forecast.estop_decel, 2.5);
+  EXPECT_EQ(c.forecast.estop_jerk, 8.0);
+  EXPECT_EQ(c.forecast.vmax, 12.0);
+  EXPECT_EQ(c.forecast.amax, 0.8);
+  EXPECT_EQ(c.forecast.workers, 2);
+  EXPECT_EQ(c.forecast.series_points, 40);
+  const TwinConfig d = parse(toToml(c));
+  EXPECT_TRUE(d.forecast.enabled);
+  EXPECT_EQ(d.forecast.horizon, 12.5);
+  EXPECT_EQ(d.forecast.amax, 0.8);
+  EXPECT_EQ(d.forecast.series_points, 40);
+}
+
+TEST(ForecastConfig, BadValuesNameTheKeyAndLine) {
+  auto expectKey = [](const std::string& text, const std::string& what) {
+    const std::string e = errorOf(text);
+    EXPECT_NE(e.find(what), std::string::npos) << text << " -> " << e;
+  };
+  expectKey("[forecast]\nenabled = 1\n", "test.toml:2: forecast.enabled");
+  expectKey("[forecast]\nrate = 0\n", "test.toml:2: forecast.rate");
+  expectKey("[forecast]\nrate = nan\n", "forecast.rate");
+  expectKey("[service]\nrate = 5\n[forecast]\nrate = 8\n", "forecast.rate: must be <= service.rate");
+  expectKey("[forecast]\n\nhorizon = -1\n", "test.toml:3: forecast.horizon");
+  expectKey("[forecast]\nhorizon = 0.001\n", "forecast.horizon: must be at least one step");
+  expectKey("[forecast]\nhorizon = inf\n", "forecast.horizon");
+  expectKey("[forecast]\nestop_decel = 0\n", "forecast.estop_decel");
+  expectKey("[forecast]\nestop_jerk = -3\n", "forecast.estop_jerk");
+  expectKey("[forecast]\nvmax = 0\n", "forecast.vmax");
+  expectKey("[forecast]\namax = \"fast\"\n", "forecast.amax: must be a number");
+  expectKey("[forecast]\nworkers = 0\n", "forecast.workers");
+  expectKey("[forecast]\nworkers = 1.5\n", "forecast.workers: must be an integer");
+  expectKey("[forecast]\nseries_points = 65\n", "forecast.series_points");
+  expectKey("[forecast]\nhorizn = 20\n", "forecast.horizn");
+}
+
 // Issue 17: the rope-force alarm keys are validated like every key; the
 // error names file:line and the key.
 TEST(ServiceConfig, RopeForceAlarmKeysAreValidated) {

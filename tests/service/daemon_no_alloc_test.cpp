@@ -8,7 +8,11 @@
 // shafts (1 kHz n = 50, and 100 Hz n = 20 on prefix "B/"), fed by a winder
 // stream over real UDP multicast (loopback, ttl=0) that moves the cage (the
 // clearance alarms raise and clear) and pauses (INPUT_STALE raises and
-// clears), so every event path runs inside the watched window.
+// clears), so every event path runs inside the watched window.  Both shafts
+// run look-ahead forecasts (issue 17): the loop saves the solver state into
+// the preallocated mailbox slot and hands it to the worker pool, takes the
+// results, publishes HOIST_FORECAST and feeds PREDICTED_* alarms; trip plans
+// arrive on HOIST_TRIP_PLAN -- all inside the watched window.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -21,6 +25,7 @@
 
 #include "daemon.hpp"
 #include "hoist/profile.hpp"
+#include "hoist/trip_plan_t.hpp"
 #include "hoist/winder_t.hpp"
 
 #include "limit_malloc.hpp"
@@ -58,6 +63,9 @@ TwinConfig shaftConfig(double rate, int n, const std::string& prefix) {
   c.alarms.off_delay = 0.0;
   c.alarms.reannounce = 0.5;
   c.alarms.latch_critical = false;
+  c.forecast.enabled = true;
+  c.forecast.rate = 5.0;
+  c.forecast.horizon = 0.5;
   return c;
 }
 
@@ -89,6 +97,17 @@ class Feeder {
       lcm_.publish("HOIST_WINDER", &m);
       lcm_.publish("B/HOIST_WINDER", &m);
       sent_ = seq;
+      if (k % 100 == 50) {  // a trip plan every 0.1 s (it fits the motion: accepted)
+        trip_plan_t p{};
+        p.utime = m.utime;
+        p.seq = k;
+        p.target_length = 300.0;
+        p.vmax = 5.0;
+        p.amax = 1.5;
+        p.jerk = 100.0;
+        lcm_.publish("HOIST_TRIP_PLAN", &p);
+        lcm_.publish("B/HOIST_TRIP_PLAN", &p);
+      }
     }
   }
   std::int64_t sent() const { return sent_; }
@@ -186,6 +205,11 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   EXPECT_GT(a1.envelope_exact - a0.envelope_exact, 0);
   EXPECT_GT(a1.ns_model - a0.ns_model, 0) << "cost split measured";
   EXPECT_GT(a1.ns_publish - a0.ns_publish, 0);
+  // Forecasts ran and came back through the loop in the window (5 Hz).
+  EXPECT_GE(a1.forecasts - a0.forecasts, 8) << logs.str();
+  EXPECT_GE(b1.forecasts - b0.forecasts, 8) << logs.str();
+  EXPECT_GE(a1.plans_accepted - a0.plans_accepted, 20);
+  EXPECT_EQ(a1.plans_rejected, 0);
   const std::string log = logs.str();
   EXPECT_NE(log.find("[A] ALARM INPUT_STALE"), std::string::npos) << log;
   EXPECT_NE(log.find("[B] alarm: INPUT_STALE WARNING cleared"), std::string::npos) << log;

@@ -240,7 +240,7 @@ int main(int argc, char** argv) {
     try {
       if (!config_path.empty())
         l0 = hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(config_path), config_path,
-                                            {"service", "alarms"}).l0;
+                                            {"service", "alarms", "forecast"}).l0;
     } catch (const std::exception& e) {
       std::cerr << "hoist-replay: " << e.what() << "\n";
       return 2;

@@ -137,7 +137,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
     // 250 m, staying 10 % clear of the bottom (else upward).
     try {
       const hoist::ShaftParams p = hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(config_path), config_path,
-                                                                  {"service", "alarms"});
+                                                                  {"service", "alarms", "forecast"});
       o.l0 = p.l0;
       const double lmax = p.L - 2.0 * p.h;
       const double down = 0.9 * lmax - p.l0, up = p.l0 - 0.1 * lmax;

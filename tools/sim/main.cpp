@@ -228,7 +228,7 @@ int run(const Options& o) {
   hoist::ShaftParams p;
   // A daemon configuration (shaft + [service]/[alarms]) is accepted as well;
   // hoist-twind validates those sections.
-  if (!o.config.empty()) p = hoist::io::loadShaftConfig(o.config, {"service", "alarms"});
+  if (!o.config.empty()) p = hoist::io::loadShaftConfig(o.config, {"service", "alarms", "forecast"});
   if (o.modes != 0) p.n = o.modes;
   if (!o.initial.empty() && o.initial != "config") p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
   if (o.rho_inf >= 0.0) p.rho_inf = o.rho_inf;

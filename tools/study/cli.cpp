@@ -113,7 +113,7 @@ namespace {
 ShaftParams studyLoadConfig(const std::string& path) {
   try {
     // A daemon configuration is a shaft file plus [service]/[alarms]: accept it.
-    return hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(path), path, {"service", "alarms"});
+    return hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(path), path, {"service", "alarms", "forecast"});
   } catch (const std::exception& e) {
     throw UsageError(std::string("--config: ") + e.what());
   }

@@ -21,6 +21,11 @@
 //     slack_fraction x the static rope force) and ROPE_OVERLOAD (at or above
 //     overload_fraction x it) are CRITICAL, their deadband force_deadband x
 //     the static force (ShaftModel::staticRopeForce);
+//     PREDICTED_CLEARANCE and PREDICTED_SLACK (issue 17: a look-ahead
+//     scenario crosses the CRITICAL clearance threshold / brings lambda_0
+//     below the slack threshold within the forecast horizon) are WARNINGs,
+//     never latched, raised at once (no on-delay: the forecast itself is the
+//     early warning);
 //   * the condition comes on when value >= threshold has held for on_delay
 //     and goes off when value < threshold - deadband has held for off_delay
 //     (so a value hovering at the threshold cannot chatter); a low alarm
@@ -51,9 +56,10 @@ namespace hoist::svc {
 
 enum class AlarmKind : std::uint8_t {
   CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher,
-  RopeSlack, RopeOverload  // issue 17: live rope-force alarms
+  RopeSlack, RopeOverload,  // issue 17: live rope-force alarms
+  PredictedClearance, PredictedSlack  // issue 17: look-ahead forecasts
 };
-inline constexpr int kAlarmKinds = 9;
+inline constexpr int kAlarmKinds = 11;
 /// A re-shelve that moves the expiry by less than this [s] is not effective.
 inline constexpr double kReshelveResolution = 1.0;
 
@@ -220,7 +226,7 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 /// All alarms of the twin.
 class AlarmEngine {
  public:
-  static constexpr int kSlots = 12;
+  static constexpr int kSlots = 14;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
   const AlarmConfig& config() const { return cfg_; }
@@ -247,6 +253,12 @@ class AlarmEngine {
   /// MODEL_FAULT events report `value` against `limit` (e.g. an implausible
   /// output and its bound; 1/0 for a non-finite state).
   void setModelFaultDetail(double value, double limit) { alarms_[7].setDetail(value, limit); }
+  /// Look-ahead result (issue 17): `predicted` true while the latest
+  /// forecast has a scenario that crosses the threshold within the horizon;
+  /// `seconds` when (after the forecast's start), `horizon` the horizon
+  /// (reported as the event's value and threshold).
+  void setPredictedClearance(double now, bool predicted, double seconds, double horizon, AlarmEvents& out);
+  void setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out);
   /// Runs shelve expiry and re-announcement without a new value.
   void poll(double now, AlarmEvents& out);
 

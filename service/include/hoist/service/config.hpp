@@ -75,10 +75,32 @@ struct ServiceConfig {
   void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
 };
 
+/// The [forecast] section: look-ahead forecasts (issue 17, docs/lookahead.md).
+/// Off by default: a forecast costs CPU in proportion to modes x horizon x
+/// rate (about 13 % of one core per shaft at n = 50 with the defaults below,
+/// far more at the converged n), which a deployment must budget for before
+/// switching it on; the live twin's real-time budget is unchanged while it is off.
+struct ForecastConfig {
+  bool enabled = false;       ///< run forecasts and publish HOIST_FORECAST
+  double rate = 1.0;          ///< forecasts per second, (0, 10] Hz and <= service.rate
+  double horizon = 20.0;      ///< how far ahead each scenario is integrated [s], [1/service.rate, 600]
+  double estop_decel = 3.0;   ///< emergency-stop deceleration of the winder [m/s^2], (0, 50]
+  double estop_jerk = 10.0;   ///< rate at which the e-stop deceleration builds up [m/s^3], (0, 1000]
+  double vmax = 5.0;          ///< the winder's normal speed limit (no-plan rule) [m/s], (0, 100]
+  double amax = 1.0;          ///< the winder's normal acceleration limit (no-plan rule) [m/s^2], (0, 50]
+  int workers = 1;            ///< forecast threads per process, shared by all shafts, [1, 16]
+  int series_points = 50;     ///< points of the decimated series in forecast_t, [1, 64]
+
+  /// Throws std::invalid_argument "forecast.<key>: why"; `service_rate` is
+  /// the shaft's [service] rate (the forecast's output step is 1 / it).
+  void validate(double service_rate) const;
+};
+
 struct TwinConfig {
   ShaftParams shaft;
   ServiceConfig service;
   AlarmConfig alarms;
+  ForecastConfig forecast;
 };
 
 }  // namespace hoist::svc

@@ -29,6 +29,11 @@ struct AlarmTextContext {
   const char* fault_what = "";     ///< MODEL_FAULT: "non-finite" or the implausible quantity
   double requested_shelve = 0.0;   ///< SHELVE events: the duration the operator asked for [s]
   double published_t = 0.0;        ///< unused by the text; kept with the event
+  /// PREDICTED_CLEARANCE / PREDICTED_SLACK: the scenario that predicts it
+  /// ("estop", "continue"; static strings) and the slack threshold [N].
+  const char* predicted_clearance_scenario = "";
+  const char* predicted_slack_scenario = "";
+  double slack_threshold = 0.0;
 };
 
 /// A readable one-line description of an alarm event into buf[0..n)
