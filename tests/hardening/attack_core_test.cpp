@@ -319,8 +319,18 @@ TEST(Budget, StartUpMeasurementScalesWithTheModel) {
   TwinConfig big = smallConfig();
   big.shaft.n = 200;
   big.service.rate = 1000.0;
-  const TickBudget a = measureTickBudget(small, 50, 0.2);
-  const TickBudget b = measureTickBudget(big, 50, 0.2);
+  // A shared machine only ever adds time: keep the fastest of three
+  // measurements of each, so that one preempted run cannot invert them.
+  auto fastest = [](const TwinConfig& c) {
+    TickBudget best = measureTickBudget(c, 50, 0.2);
+    for (int i = 0; i < 2; ++i) {
+      const TickBudget m = measureTickBudget(c, 50, 0.2);
+      if (m.tick_us < best.tick_us) best = m;
+    }
+    return best;
+  };
+  const TickBudget a = fastest(small);
+  const TickBudget b = fastest(big);
   EXPECT_GE(a.ticks, 3);
   EXPECT_GT(a.tick_us, 0.0);
   EXPECT_DOUBLE_EQ(b.period_us, 1000.0);

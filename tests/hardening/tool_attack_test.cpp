@@ -21,14 +21,6 @@ using namespace hoist::test;
 
 namespace {
 
-long vmRssKb(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  return 0;
-}
-
 struct Tool {
   std::string name;
   std::unique_ptr<Process> p;

@@ -295,16 +295,7 @@ TEST_F(SimCli, HugeTEndIsRefusedNamingTheOptionNotBadAlloc) {
   EXPECT_NE(r.output.find("--t-end"), std::string::npos) << r.output;
 }
 
-namespace {
-/// VmRSS of a running process [KiB], 0 if unknown.
-long vmRssKb(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  return 0;
-}
-}  // namespace
+using hoist::test::vmRssKb;
 
 // Issue 12.6: a long run (1e8 rows, to /dev/null) states its estimated rows,
 // size and time before it starts, and its memory stays flat while it runs

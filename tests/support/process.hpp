@@ -25,6 +25,15 @@ extern char** environ;
 
 namespace hoist::test {
 
+/// VmRSS of a running process [KiB] (/proc/PID/status), 0 if unknown.
+inline long vmRssKb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(in, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
 using namespace std::chrono_literals;
 
 /// A child process; killed (SIGKILL) if still running when destroyed.
