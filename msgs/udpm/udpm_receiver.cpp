@@ -1,6 +1,8 @@
 // The project's own udpm receive path: see hoist/bus/udpm_receiver.hpp.
 #include "hoist/bus/udpm_receiver.hpp"
 
+#include "hoist/bus/lcm_util.hpp"
+
 #include <arpa/inet.h>
 #include <cerrno>
 #include <cstdlib>
@@ -293,6 +295,20 @@ void UdpmReceiver::dispatch(std::uint8_t* data, std::size_t size, bool truncated
     name_.assign(name, name_len);  // capacity reserved by addMatching: no allocation
     matched->handler(&rb, name_);
   }
+}
+
+std::unique_ptr<UdpmReceiver> openUdpmReceiver(const std::string& url, std::string& why) {
+  UdpmUrl u;
+  if (!parseUdpmUrl(url, u, why)) {
+    why.clear();
+    return nullptr;
+  }
+  auto rx = std::make_unique<UdpmReceiver>();
+  if (!rx->open(u, why)) {
+    why = "cannot open the LCM receive socket for " + describeLcmUrl(url) + ": " + why;
+    return nullptr;
+  }
+  return rx;
 }
 
 }  // namespace hoist::bus

@@ -168,17 +168,14 @@ int main(int argc, char** argv) {
   // sender cycling names would grow this process without bound;
   // hoist/bus/udpm_receiver.hpp).  LCM then only publishes.  Other
   // providers: LCM's receive path.
-  std::unique_ptr<hoist::bus::UdpmReceiver> rx;
+  std::string rx_why;
+  std::unique_ptr<hoist::bus::UdpmReceiver> rx = hoist::bus::openUdpmReceiver(url, rx_why);
+  if (!rx_why.empty()) {
+    std::fprintf(stderr, "hoist-dash: %s\n", rx_why.c_str());
+    return 1;
+  }
   {
-    hoist::bus::UdpmUrl udpm;
-    std::string why;
-    if (hoist::bus::parseUdpmUrl(url, udpm, why)) {
-      rx = std::make_unique<hoist::bus::UdpmReceiver>();
-      if (!rx->open(udpm, why)) {
-        std::fprintf(stderr, "hoist-dash: cannot open the LCM receive socket for %s: %s\n",
-                     hoist::bus::describeLcmUrl(url).c_str(), why.c_str());
-        return 1;
-      }
+    if (rx) {
       // LCM's ".*HOIST_.*" (anchored): any name containing HOIST_.
       rx->addMatching([](std::string_view n) { return n.find("HOIST_") != std::string_view::npos; },
                       [&pump](const lcm::ReceiveBuffer* rb, const std::string& ch) { pump.onMessage(rb, ch); });

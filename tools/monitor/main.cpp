@@ -269,17 +269,14 @@ int main(int argc, char** argv) {
   // stored per channel name (hoist/bus/udpm_receiver.hpp); else LCM's, with
   // literal names: subscribe() takes a regular expression, and a prefix
   // "mine.1/" must not show the shaft "mineX1/".
-  std::unique_ptr<hoist::bus::UdpmReceiver> rx;
+  std::string rx_why;
+  std::unique_ptr<hoist::bus::UdpmReceiver> rx = hoist::bus::openUdpmReceiver(url, rx_why);
+  if (!rx_why.empty()) {
+    std::fprintf(stderr, "hoist-monitor: %s\n", rx_why.c_str());
+    return 1;
+  }
   {
-    hoist::bus::UdpmUrl udpm;
-    std::string why;
-    if (hoist::bus::parseUdpmUrl(url, udpm, why)) {
-      rx = std::make_unique<hoist::bus::UdpmReceiver>();
-      if (!rx->open(udpm, why)) {
-        std::fprintf(stderr, "hoist-monitor: cannot open the LCM receive socket for %s: %s\n",
-                     hoist::bus::describeLcmUrl(url).c_str(), why.c_str());
-        return 1;
-      }
+    if (rx) {
       rx->add(ch.cage, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onCage(rb, c); });
       rx->add(ch.alarm, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onAlarm(rb, c); });
       rx->add(ch.health, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onHealth(rb, c); });

@@ -181,13 +181,10 @@ struct Bridge::Impl {
 
     discover = cfg.channel_prefixes.empty();
     for (const auto& p : cfg.channel_prefixes) addShaft(p);
-    hoist::bus::UdpmUrl udpm;
     std::string why;
-    if (hoist::bus::parseUdpmUrl(lcm_url, udpm, why)) {
-      rx = std::make_unique<hoist::bus::UdpmReceiver>();
-      if (!rx->open(udpm, why))
-        throw std::runtime_error("cannot open the LCM receive socket for " + hoist::bus::describeLcmUrl(lcm_url) +
-                                 ": " + why);
+    rx = hoist::bus::openUdpmReceiver(lcm_url, why);
+    if (!why.empty()) throw std::runtime_error(why);
+    if (rx) {
       rx->addMatching(
           [](std::string_view n) {
             auto ends = [&](std::string_view suffix) {

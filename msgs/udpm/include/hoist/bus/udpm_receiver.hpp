@@ -41,6 +41,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 #include <string_view>
@@ -140,5 +141,11 @@ class UdpmReceiver final : public InputRouter {
   std::array<Control, kBatch> control_{};
   std::int64_t received_ = 0, ignored_ = 0, malformed_ = 0;
 };
+
+/// The tools' receive path for `url`: an opened UdpmReceiver for udpm://
+/// (and LCM's default); nullptr with `why` empty for other providers (use
+/// LCM's subscribe); nullptr with `why` set when the socket cannot be opened
+/// (the message names the URL).
+std::unique_ptr<UdpmReceiver> openUdpmReceiver(const std::string& url, std::string& why);
 
 }  // namespace hoist::bus
