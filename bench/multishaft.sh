@@ -12,7 +12,7 @@
 #   bench/multishaft.sh [--counts "100 200 300"] [--seconds S] [--setting MODES:on|off ...]
 #                       [--daemon NAME=PATH[,key=value...] ...] [--feeder PATH] [--rate HZ] [--max-step S]
 #                       [--daemon-cpu C] [--feeder-cpu C] [--no-rt] [--feeder-rt] [--perf NAME]
-#                       [--same-url] [--out FILE] [--port P]
+#                       [--same-url] [--no-watch] [--out FILE] [--port P]
 #
 # --setting (repeatable; default 50:off and 25:on: the paper's n without the
 #   static correction, and the converged setting with it, issue 13): n modes
@@ -31,6 +31,10 @@
 # consistency check and show up as rejected), UDP multicast on loopback port
 # P = 7880 (ttl=0).  --perf NAME: `perf record -e cpu-clock` on daemon NAME
 # for the middle half of each of its runs; the report lists its hottest symbols.
+# Every run also has a bare-machine watcher on the daemon's CPU
+# (build/bin/hoist-wakeup-latency at the same rate, SCHED_FIFO 90, no work):
+# the deadlines the machine itself missed during that very run, i.e. the
+# platform's stalls that no daemon can avoid (--no-watch: without it).
 set -euo pipefail
 orig_args="$*"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -45,6 +49,7 @@ rt=1
 feeder_rt=0
 perf_name=""
 same_url=0
+watch=1
 ncpu=$(nproc)
 daemon_cpu=$((ncpu > 1 ? ncpu - 1 : 0))
 feeder_cpu=0
@@ -66,9 +71,10 @@ while [[ $# -gt 0 ]]; do
     --feeder-rt) feeder_rt=1; shift ;;
     --perf) perf_name="$2"; shift 2 ;;
     --same-url) same_url=1; shift ;;
+    --no-watch) watch=0; shift ;;
     --out) out="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,33p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,37p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "multishaft.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -77,6 +83,10 @@ done
 for s in "${settings[@]}"; do
   [[ "$s" =~ ^[0-9]+:(on|off)$ ]] || { echo "multishaft.sh: --setting: MODES:on|off, got '$s'" >&2; exit 2; }
 done
+watcher="$here/build/bin/hoist-wakeup-latency"
+if [[ $watch -eq 1 && ! -x "$watcher" ]]; then
+  echo "multishaft.sh: $watcher not found (build the bench targets, or --no-watch)" >&2; exit 2
+fi
 [[ -x "$feeder" ]] || { echo "multishaft.sh: $feeder not found; build first (scripts/setup.sh)" >&2; exit 2; }
 for d in "${daemons[@]}"; do
   [[ "$d" == *=* ]] || { echo "multishaft.sh: --daemon: NAME=PATH[,key=value...], got '$d'" >&2; exit 2; }
@@ -147,11 +157,21 @@ for setting in "${settings[@]}"; do
           > /dev/null 2>&1 &
         perf_pid=$!
       fi
+      watch_pid=""
+      rm -f "$raw/$tag.bare.json"
+      if [[ $watch -eq 1 ]]; then
+        wrt=()
+        [[ $rt -eq 1 ]] && wrt=(--mlockall --rt-priority 90)
+        taskset -c "$daemon_cpu" "$watcher" --rate "$rate" --seconds "$seconds" --cpus "$daemon_cpu" "${wrt[@]}" \
+          > "$raw/$tag.bare.json" 2> /dev/null &
+        watch_pid=$!
+      fi
       frt=()
       [[ $feeder_rt -eq 1 ]] && frt=(chrt -f 50)
       taskset -c "$feeder_cpu" "${frt[@]}" "$feeder" --timing-test --lcm-url "$url" "${outargs[@]}" --shafts "$N" --rate "$rate" \
         --duration "$seconds" --max-misses 0 --quiet --report "$raw/$tag.timing.md" > "$raw/$tag.feeder.log"
       verdict=$?
+      [[ -n "$watch_pid" ]] && { wait "$watch_pid" || true; }
       set -e
       if [[ -n "$perf_pid" ]]; then
         wait "$perf_pid" || true

@@ -21,6 +21,12 @@ PHASES = [("model_step", "model step"), ("envelope", "envelope"), ("publish", "L
           ("receive", "LCM receive"), ("tick_other", "rest of the tick"), ("timer_and_rest", "timer, kernel, rest")]
 
 
+def bare_cell(b):
+    if not b:
+        return "—"
+    return f"{b.get('deadline_misses', '?')} / {fmt_us(b.get('late_us', {}).get('max', float('nan')))}"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--command", default="")
@@ -42,7 +48,12 @@ def main():
         except (OSError, ValueError):
             r = None
         cpu, _, steal = cpu_steal.partition("/")
-        rows.append(dict(name=name, setting=setting, n=int(n), r=r, md=md, cpu=float(cpu), steal=steal))
+        try:   # the bare-machine watcher of that run (hoist-wakeup-latency on the daemon's CPU)
+            with open(md.replace(".timing.md", ".bare.json")) as f:
+                bare = json.load(f)
+        except (OSError, ValueError):
+            bare = None
+        rows.append(dict(name=name, setting=setting, n=int(n), r=r, md=md, cpu=float(cpu), steal=steal, bare=bare))
     first = next((x["r"] for x in rows if x["r"]), {})
     daemons = list(dict.fromkeys(x["name"] for x in rows))
     out = ["# Twins per core", ""]
@@ -66,13 +77,14 @@ def main():
                "shafts stepped before it in the same tick.")
     out.append("")
     out.append("| setting | twins | daemon | deadline misses | worst lateness p99 / max | step p50 / p99 | CPU used "
-               "| steal | inputs lost (seq. gaps) | of which rejected | kernel drops | timing test |")
-    out.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
+               "| steal | inputs lost (seq. gaps) | of which rejected | kernel drops | bare machine: misses / max late "
+               "| timing test |")
+    out.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for x in rows:
         r = x["r"]
         setting = f"n = {x['setting'].replace(':', ', correction ')}"
         if not r:
-            out.append(f"| {setting} | {x['n']} | {x['name']} | (no report) | | | {x['cpu']:.0f} % | {x['steal']} s | | | | |")
+            out.append(f"| {setting} | {x['n']} | {x['name']} | (no report) | | | {x['cpu']:.0f} % | {x['steal']} s | | | | | |")
             continue
         sh = r["shafts"]
         x["misses"] = sum(s["deadline_misses"] for s in sh)
@@ -86,7 +98,7 @@ def main():
         sp99 = max(s["step_us"]["p99"] for s in sh)
         out.append(f"| {setting} | {x['n']} | {x['name']} | **{x['misses']}** | {fmt_us(lp99)} / {fmt_us(lmax)} | "
                    f"{fmt_us(sp50)} / {fmt_us(sp99)} | {x['cpu']:.0f} % | {x['steal'] or '?'} s | **{x['gaps']}** | {rejected} | "
-                   f"{'—' if drops is None else drops} | {verdict(x['md'])} "
+                   f"{'—' if drops is None else drops} | {bare_cell(x['bare'])} | {verdict(x['md'])} "
                    f"([report]({os.path.relpath(x['md'], a.out_dir)})) |")
     out.append("")
     out.append("\"CPU used\": the process's user + system time over the run (100 % = the whole core); \"steal\": "
@@ -95,7 +107,10 @@ def main():
                "the consistency check when a late feeder bunches its inputs, also leaves a gap: \"of which "
                "rejected\"); \"kernel drops\": "
                "datagrams the kernel dropped on the daemon's input socket because its buffer was full "
-               "(SO_RXQ_OVFL; — where the daemon does not report it).")
+               "(SO_RXQ_OVFL; — where the daemon does not report it); \"bare machine\": a watcher thread on the "
+               "daemon's CPU during the same run (`hoist-wakeup-latency`, same rate, SCHED_FIFO 90, no work): the "
+               "ticks the machine itself woke up more than a period late, and its worst wake-up lateness.  A "
+               "platform stall of more than a period makes every hosted shaft miss that tick (N misses per stall).")
     out.append("")
     # Summary: per setting and daemon, the largest count that keeps up.
     out.append("## Twins per core")
@@ -124,8 +139,9 @@ def main():
                 continue
             best = max(ok, key=lambda x: x["n"])
             cap = best["n"] * 100.0 / best["cpu"] if best["cpu"] > 0 else float("nan")
+            bm = best["bare"].get("deadline_misses", "?") if best["bare"] else "—"
             out.append(f"| {label} | {d} | **{best['n']}** | {best['misses']} ({best['misses'] / best['n']:.0f} "
-                       f"per shaft) | {best['cpu']:.0f} % | {cap:.0f} |")
+                       f"per shaft; bare machine in that run: {bm}) | {best['cpu']:.0f} % | {cap:.0f} |")
     out.append("")
     # The daemon's own cost split (where it reports one).
     split_rows = [x for x in rows if x["r"] and "cost_split_us_per_twin_tick" in x["r"]]
