@@ -1,6 +1,7 @@
 #include "hoist/io/checked_file.hpp"
 
 #include <cerrno>
+#include <cstdarg>
 #include <cstring>
 #include <utility>
 
@@ -49,6 +50,18 @@ void CheckedFile::write(std::string_view s) {
   errno = 0;
   if (!s.empty() && std::fwrite(s.data(), 1, s.size(), f_) != s.size()) fail("write failed", errno);
   bytes_ += s.size();
+}
+
+void CheckedFile::printf(const char* fmt, ...) {
+  if (f_ == nullptr) fail("write after close", EBADF);
+  std::va_list ap;
+  va_start(ap, fmt);
+  errno = 0;
+  const int n = std::vfprintf(f_, fmt, ap);
+  const int err = errno;
+  va_end(ap);
+  if (n < 0) fail("write failed", err);
+  bytes_ += static_cast<std::uint64_t>(n);
 }
 
 void CheckedFile::close() {

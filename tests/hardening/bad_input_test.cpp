@@ -90,11 +90,11 @@ TEST_P(BadConfig, RejectedWithKeyAndLine) {
     FAIL() << c.name << ": accepted";
   } catch (const hoist::io::ConfigError& e) {
     EXPECT_EQ(e.key(), c.key) << e.what();
-    if (c.line > 0) EXPECT_EQ(e.line(), c.line) << e.what();
+    if (c.line > 0) { EXPECT_EQ(e.line(), c.line) << e.what(); }
     const std::string what = e.what();
     EXPECT_EQ(what.rfind("shaft.toml", 0), 0u) << what;  // names the file
-    if (*c.key) EXPECT_NE(what.find(c.key), std::string::npos) << what;
-    if (c.line > 0) EXPECT_NE(what.find("shaft.toml:" + std::to_string(c.line) + ":"), std::string::npos) << what;
+    if (*c.key) { EXPECT_NE(what.find(c.key), std::string::npos) << what; }
+    if (c.line > 0) { EXPECT_NE(what.find("shaft.toml:" + std::to_string(c.line) + ":"), std::string::npos) << what; }
     EXPECT_GT(e.message().size(), 5u) << what;
   }
 }
@@ -172,10 +172,10 @@ TEST_P(BadProfile, RejectedWithColumnAndLine) {
     FAIL() << c.name << ": accepted";
   } catch (const hoist::io::ProfileError& e) {
     EXPECT_EQ(e.key(), c.key) << e.what();
-    if (c.line > 0) EXPECT_EQ(e.line(), c.line) << e.what();
+    if (c.line > 0) { EXPECT_EQ(e.line(), c.line) << e.what(); }
     const std::string what = e.what();
     EXPECT_EQ(what.rfind("trip.csv", 0), 0u) << what;
-    if (c.line > 0) EXPECT_NE(what.find("trip.csv:" + std::to_string(c.line) + ":"), std::string::npos) << what;
+    if (c.line > 0) { EXPECT_NE(what.find("trip.csv:" + std::to_string(c.line) + ":"), std::string::npos) << what; }
   }
 }
 
@@ -238,14 +238,14 @@ TEST(ToolsExitStatus, BadConfigsGiveStatus2NamingTheKey) {
 #ifdef HOIST_SIM
     const ToolRun sim = run(HOIST_SIM, {"--config", cfg, "--profile", "rest:t_end=0.1", "--out", (dir / "o.csv").string()});
     EXPECT_EQ(sim.status, 2) << what << sim.output;
-    if (*c.key) EXPECT_NE(sim.output.find(c.key), std::string::npos) << what << sim.output;
+    if (*c.key) { EXPECT_NE(sim.output.find(c.key), std::string::npos) << what << sim.output; }
 #endif
     const ToolRun rep = run(HOIST_REPLAY, {"--config", cfg, "--profile", "rest:t_end=0.1", "--lcm-url", kUrl, "-q"});
     EXPECT_EQ(rep.status, 2) << what << rep.output;
-    if (*c.key) EXPECT_NE(rep.output.find(c.key), std::string::npos) << what << rep.output;
+    if (*c.key) { EXPECT_NE(rep.output.find(c.key), std::string::npos) << what << rep.output; }
     const ToolRun twind = run(HOIST_TWIND, {"--config", cfg, "--lcm-url", kUrl, "--duration", "0.1"});
     EXPECT_EQ(twind.status, 2) << what << twind.output;
-    if (*c.key) EXPECT_NE(twind.output.find(c.key), std::string::npos) << what << twind.output;
+    if (*c.key) { EXPECT_NE(twind.output.find(c.key), std::string::npos) << what << twind.output; }
     ++n;
   }
   EXPECT_GE(n, 25);
@@ -294,6 +294,29 @@ TEST(ToolsExitStatus, CrlfBomProfileIsAcceptedByTheTools) {
 #endif
   const ToolRun rep = run(HOIST_REPLAY, {"--profile", csv, "--lcm-url", kUrl, "-q", "--speed", "0"});
   EXPECT_EQ(rep.status, 0) << rep.output;
+}
+
+// Issue 12 section 6: every file hoist-study writes (a run's CSV, the
+// summary, the shapes, a gnuplot script) is checked to its last byte; a full
+// disk gives exit status 1 naming the file, never a silent short file.
+TEST(ToolsExitStatus, StudyOnAFullDiskExitsOneNamingTheFile) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  for (const char* file : {"runs/run1.csv", "summary.csv", "shapes.csv", "fig03_cage.gp"}) {
+    const auto dir = workDir(std::string("study_full_") + fs::path(file).stem().string());
+    fs::create_directories(dir / "response" / "runs");
+    fs::create_symlink("/dev/full", dir / "response" / file);
+    const ToolRun st = run(HOIST_STUDY, {"response", "--out-dir", dir.string(), "--modes", "5", "--no-plots",
+                                         "--profile", "rest:t_end=1", "-j", "1"});
+    EXPECT_EQ(st.status, 1) << file << ": " << st.output;
+    EXPECT_NE(st.output.find((dir / "response" / file).string()), std::string::npos) << st.output;
+    EXPECT_NE(st.output.find("No space left on device"), std::string::npos) << st.output;
+  }
+  // The same command onto a disk with room succeeds (the test can fail).
+  const auto ok = workDir("study_room");
+  const ToolRun st = run(HOIST_STUDY, {"response", "--out-dir", ok.string(), "--modes", "5", "--no-plots",
+                                       "--profile", "rest:t_end=1", "-j", "1"});
+  EXPECT_EQ(st.status, 0) << st.output;
+  EXPECT_GT(fs::file_size(ok / "response" / "runs" / "run1.csv"), 100u);
 }
 
 }  // namespace

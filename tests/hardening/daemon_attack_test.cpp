@@ -36,12 +36,6 @@ hoist::winder_t winder(std::int64_t seq, std::int64_t utime, double v, double le
   return m;
 }
 
-std::int64_t reason(const hoist::health_t& h, const std::string& r) {
-  for (int i = 0; i < h.n_reasons; ++i)
-    if (h.reject_reason[i] == r) return h.rejected[i];
-  return -1;
-}
-
 class DaemonAttack : public ::testing::Test {
  protected:
   void start(int port, const std::string& name, const std::string& prefix = "") {

@@ -282,7 +282,7 @@ TEST(Staleness, InputClockKeepsTheConfiguredTimeout) {
     for (const AlarmEvent& e : h.core.events())
       if (e.kind == AlarmKind::InputStale && e.type == AlarmEventType::Raise) raised_at = wall;
     h.core.clearEvents();
-    if (raised_at < 0) ASSERT_FALSE(h.core.stale()) << "stale after " << wall - last << " s";
+    if (raised_at < 0) { ASSERT_FALSE(h.core.stale()) << "stale after " << wall - last << " s"; }
   }
   ASSERT_GT(raised_at, 0.0) << "INPUT_STALE never raised";
   EXPECT_NEAR(raised_at - last, timeout, 0.0015);

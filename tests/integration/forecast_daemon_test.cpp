@@ -579,7 +579,7 @@ TEST(ForecastFault, NoForecastFromADegradedStateAfterAModelFault) {
   for (const auto& f : fc) {
     // Every forecast starts from a state the twin published as trustworthy.
     auto it = degraded_at.find(f.utime);
-    if (it != degraded_at.end()) EXPECT_FALSE(it->second) << "forecast from a degraded state at t = " << f.t_start;
+    if (it != degraded_at.end()) { EXPECT_FALSE(it->second) << "forecast from a degraded state at t = " << f.t_start; }
     EXPECT_FALSE(f.t_start >= fault_t && f.t_start < fault_t + c.service.fault_hold - 0.02)
         << "forecast at t = " << f.t_start << " inside the fault hold from " << fault_t;
     for (const auto& s : f.scenarios) EXPECT_NE(static_cast<int>(s.status), 2);

@@ -100,7 +100,7 @@ TEST(Reference, PaperMethodFirstSeconds) {
   // paths agree with each other, dynamics_test).
   const Errors e = compare("c1-paper", InitialState::Static, 0.01, 0.0, Method::Paper, 3.0);
   for (int c = 1; c < 8; ++c)
-    if (c != 3) EXPECT_LT(e.nrms[c], 0.02) << kCols[c];
+    if (c != 3) { EXPECT_LT(e.nrms[c], 0.02) << kCols[c]; }
 }
 
 TEST(Reference, GuideRopeShapes) {

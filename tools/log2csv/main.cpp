@@ -54,6 +54,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -64,6 +65,7 @@
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/trip_plan_t.hpp"
+#include "hoist/io/checked_file.hpp"
 #include "hoist/io/lcm_log.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
@@ -89,28 +91,43 @@ std::string csvQuote(const std::string& s) {
 
 using Event = hoist::io::LcmLogEvent;
 
-/// One output file, written through stdio so that every error -- on a write,
-/// the final fflush or fclose -- is seen with its errno.
+/// One output file (hoist::io::CheckedFile: every write, the final fflush and
+/// fclose checked).  The first failure is kept and the file dropped, so that
+/// the other channels are still converted and the summary names every failure.
 struct Writer {
-  std::FILE* f = nullptr;
+  std::optional<hoist::io::CheckedFile> f;
   std::string path;
   std::string type;
   long rows = 0;
-  int err = 0;  ///< first errno seen (0: none)
-  void write(const std::string& line) {
-    if (f == nullptr || err != 0) return;
-    if (std::fwrite(line.data(), 1, line.size(), f) != line.size() || std::fputc('\n', f) == EOF)
-      err = errno ? errno : EIO;
+  std::string error;  ///< the first failure, with the path and errno text ("": none)
+  void open() {
+    try {
+      f.emplace(path);
+    } catch (const hoist::io::WriteError& e) {
+      error = e.what();
+    }
   }
-  /// Flush and close; false (err set) if any byte did not reach the file.
+  void write(const std::string& line) {
+    if (!f) return;
+    try {
+      f->write(line);
+      f->write("\n");
+    } catch (const hoist::io::WriteError& e) {
+      error = e.what();
+      f.reset();
+    }
+  }
+  /// Flush and close; false (error set) if any byte did not reach the file.
   bool close() {
-    if (f == nullptr) return err == 0;
-    errno = 0;
-    if (std::fflush(f) != 0 && err == 0) err = errno ? errno : EIO;
-    if (std::ferror(f) && err == 0) err = EIO;
-    if (std::fclose(f) != 0 && err == 0) err = errno ? errno : EIO;
-    f = nullptr;
-    return err == 0;
+    if (f) {
+      try {
+        f->close();
+      } catch (const hoist::io::WriteError& e) {
+        error = e.what();
+      }
+      f.reset();
+    }
+    return error.empty();
   }
 };
 
@@ -139,7 +156,7 @@ class Converter {
   bool finish(std::ostream& os) {
     for (auto& [key, w] : writers_) {
       if (!w->close()) {
-        os << "hoist-log2csv: error: writing " << w->path << " failed: " << std::strerror(w->err) << "\n";
+        os << "hoist-log2csv: error: " << w->error << "\n";
         failed_ = true;
       } else {
         os << "hoist-log2csv: " << w->rows << " rows of hoist." << w->type << " -> " << w->path << "\n";
@@ -188,8 +205,7 @@ class Converter {
       auto w = std::make_unique<Writer>();
       w->type = type;
       w->path = (dir_ / fileName(key)).string();
-      w->f = std::fopen(w->path.c_str(), "w");
-      if (w->f == nullptr) w->err = errno ? errno : EIO;
+      w->open();
       w->write(header);
       it = writers_.emplace(key, std::move(w)).first;
     }

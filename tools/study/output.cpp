@@ -1,5 +1,7 @@
 #include "output.hpp"
 
+#include "hoist/io/checked_file.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,31 +19,6 @@
 namespace hoist::study::out {
 namespace {
 
-struct FileCloser {
-  void operator()(std::FILE* f) const {
-    if (f) std::fclose(f);
-  }
-};
-using File = std::unique_ptr<std::FILE, FileCloser>;
-
-File openOut(const std::string& path) {
-  File f(std::fopen(path.c_str(), "w"));
-  if (!f) throw std::runtime_error(path + ": cannot open for writing: " + std::strerror(errno));
-  return f;
-}
-
-/// Every byte checked: the last fflush, the error flag and fclose (a full
-/// disk shows here), with the errno text.
-void finish(File& f, const std::string& path) {
-  errno = 0;
-  int err = 0;
-  if (std::fflush(f.get()) != 0) err = errno ? errno : EIO;
-  if (err == 0 && std::ferror(f.get())) err = EIO;
-  errno = 0;
-  if (std::fclose(f.release()) != 0 && err == 0) err = errno ? errno : EIO;
-  if (err != 0) throw std::runtime_error(path + ": write failed: " + std::strerror(err));
-}
-
 std::string csvQuote(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string q = "\"";
@@ -58,29 +35,29 @@ std::string gpQuote(const std::string& s) {  // single-quoted gnuplot string
 }  // namespace
 
 void writeTraceCsv(const std::string& path, const Trace& tr) {
-  File f = openOut(path);
-  std::fprintf(f.get(), "t,l,v,a,x_c,y_c,theta,lambda_0,lambda_1,lambda_2,lambda_3,lambda_4\n");
+  io::CheckedFile f(path);
+  f.printf("t,l,v,a,x_c,y_c,theta,lambda_0,lambda_1,lambda_2,lambda_3,lambda_4\n");
   for (std::size_t i = 0; i < tr.size(); ++i)
-    std::fprintf(f.get(), "%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", tr.t[i],
+    f.printf("%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", tr.t[i],
                  tr.l[i], tr.v[i], tr.a[i], tr.x_c[i], tr.y_c[i], tr.theta[i], tr.lambda[0][i],
                  tr.lambda[1][i], tr.lambda[2][i], tr.lambda[3][i], tr.lambda[4][i]);
-  finish(f, path);
+  f.close();
 }
 
 void writeShapesCsv(const std::string& path, const std::vector<Shape>& shapes) {
-  File f = openOut(path);
-  std::fprintf(f.get(), "t,x,y1,y2\n");
+  io::CheckedFile f(path);
+  f.printf("t,x,y1,y2\n");
   for (const auto& s : shapes) {
     for (std::size_t i = 0; i < s.x.size(); ++i)
-      std::fprintf(f.get(), "%.6g,%.9g,%.9g,%.9g\n", s.t, s.x[i], s.y1[i], s.y2[i]);
+      f.printf("%.6g,%.9g,%.9g,%.9g\n", s.t, s.x[i], s.y1[i], s.y2[i]);
   }
-  finish(f, path);
+  f.close();
 }
 
 void writeSummaryCsv(const std::string& path, const Study& study, const std::vector<RunResult>& runs,
                      const std::vector<MetricSet>& metrics) {
-  File f = openOut(path);
-  std::fprintf(f.get(), "run,label,key,value,Tb1,Tb2,m,J,Fa,b,n,initial,status");
+  io::CheckedFile f(path);
+  f.printf("run,label,key,value,Tb1,Tb2,m,J,Fa,b,n,initial,status");
   const MetricSet* first = nullptr;
   for (const auto& m : metrics)
     if (!m.items().empty()) {
@@ -88,63 +65,62 @@ void writeSummaryCsv(const std::string& path, const Study& study, const std::vec
       break;
     }
   if (first)
-    for (const auto& kv : first->items()) std::fprintf(f.get(), ",%s", kv.first.c_str());
-  std::fprintf(f.get(), "\n");
+    for (const auto& kv : first->items()) f.printf(",%s", kv.first.c_str());
+  f.printf("\n");
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const auto& r = runs[i];
     const auto& p = r.spec.params;
-    std::fprintf(f.get(), "%zu,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%s,%s", i + 1,
+    f.printf("%zu,%s,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%s,%s", i + 1,
                  csvQuote(r.spec.label).c_str(), csvQuote(study.key).c_str(), r.spec.value, p.Tb1,
                  p.Tb2, p.m, p.J, p.Fa, p.b, p.n, toString(p.initial),
                  r.ok() ? "ok" : csvQuote("failed: " + r.error).c_str());
     if (first)
       for (const auto& kv : first->items())
-        std::fprintf(f.get(), ",%.9g", metrics[i].has(kv.first) ? metrics[i].get(kv.first) : std::nan(""));
-    std::fprintf(f.get(), "\n");
+        f.printf(",%.9g", metrics[i].has(kv.first) ? metrics[i].get(kv.first) : std::nan(""));
+    f.printf("\n");
   }
-  finish(f, path);
+  f.close();
 }
 
 void writeAdvisorCsv(const std::string& path, const std::vector<AdvisorPoint>& pts) {
-  File f = openOut(path);
-  std::fprintf(f.get(), "total,split,Tb1,Tb2,peak_excursion,peak_sleeve_force,peak_y_c,peak_theta,feasible\n");
+  io::CheckedFile f(path);
+  f.printf("total,split,Tb1,Tb2,peak_excursion,peak_sleeve_force,peak_y_c,peak_theta,feasible\n");
   for (const auto& p : pts)
-    std::fprintf(f.get(), "%.9g,%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", p.total, p.split,
+    f.printf("%.9g,%.6g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", p.total, p.split,
                  p.split * p.total, (1.0 - p.split) * p.total, p.peaks.excursion, p.peaks.sleeve_force,
                  p.peaks.y_c, p.peaks.theta, p.feasible ? 1 : 0);
-  finish(f, path);
+  f.close();
 }
 
 void writeGnuplotScript(const std::string& dir, const Figure& fig) {
   const std::string path = (std::filesystem::path(dir) / (fig.name + ".gp")).string();
-  File f = openOut(path);
-  std::FILE* o = f.get();
+  io::CheckedFile f(path);
   const int rows = static_cast<int>((fig.panels.size() + static_cast<std::size_t>(fig.cols) - 1) /
                                     static_cast<std::size_t>(fig.cols));
-  std::fprintf(o, "# %s\n# Written by hoist-study; re-render with:  cd %s && gnuplot %s.gp\n",
+  f.printf("# %s\n# Written by hoist-study; re-render with:  cd %s && gnuplot %s.gp\n",
                fig.title.c_str(), dir.c_str(), fig.name.c_str());
-  std::fprintf(o,
+  f.printf(
                "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
                "  set terminal pngcairo size %d,%d font ',9' linewidth 1.2\n"
                "} else {\n  set terminal png size %d,%d\n}\nset termoption noenhanced\n",
                fig.width, fig.height, fig.width, fig.height);
-  std::fprintf(o, "set output %s\nset datafile separator ','\nset grid\nset key %s samplen 2\n",
+  f.printf("set output %s\nset datafile separator ','\nset grid\nset key %s samplen 2\n",
                gpQuote(fig.name + ".png").c_str(), fig.key.c_str());
-  std::fprintf(o, "set multiplot layout %d,%d title %s\n", rows, fig.cols, gpQuote(fig.title).c_str());
+  f.printf("set multiplot layout %d,%d title %s\n", rows, fig.cols, gpQuote(fig.title).c_str());
   for (const auto& p : fig.panels) {
-    std::fprintf(o, "set xlabel %s\nset ylabel %s\n", gpQuote(p.xlabel).c_str(), gpQuote(p.ylabel).c_str());
-    if (!p.extra.empty()) std::fprintf(o, "%s\n", p.extra.c_str());
-    std::fprintf(o, "plot ");
+    f.printf("set xlabel %s\nset ylabel %s\n", gpQuote(p.xlabel).c_str(), gpQuote(p.ylabel).c_str());
+    if (!p.extra.empty()) f.printf("%s\n", p.extra.c_str());
+    f.printf("plot ");
     for (std::size_t i = 0; i < p.series.size(); ++i) {
       const auto& s = p.series[i];
-      std::fprintf(o, "%s%s using %s with %s title %s", i ? ", \\\n     " : "", gpQuote(s.file).c_str(),
+      f.printf("%s%s using %s with %s title %s", i ? ", \\\n     " : "", gpQuote(s.file).c_str(),
                    s.using_.c_str(), s.style.c_str(), gpQuote(s.title).c_str());
     }
-    std::fprintf(o, "\n");
-    if (!p.extra.empty()) std::fprintf(o, "unset logscale; unset arrow; unset label; set autoscale\n");
+    f.printf("\n");
+    if (!p.extra.empty()) f.printf("unset logscale; unset arrow; unset label; set autoscale\n");
   }
-  std::fprintf(o, "unset multiplot\n");
-  finish(f, path);
+  f.printf("unset multiplot\n");
+  f.close();
 }
 
 std::string findGnuplot() {

@@ -43,6 +43,8 @@ class CheckedFile {
   bool isOpen() const { return f_ != nullptr; }
   /// Appends `s`; throws WriteError on the first failure.
   void write(std::string_view s);
+  /// Appends printf-formatted text (vfprintf, checked); throws WriteError.
+  void printf(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
   /// fflush + ferror + fclose, each checked; throws WriteError.
   void close();
   const std::string& path() const { return path_; }
