@@ -297,14 +297,14 @@ void UdpmReceiver::dispatch(std::uint8_t* data, std::size_t size, bool truncated
   }
 }
 
-std::unique_ptr<UdpmReceiver> openUdpmReceiver(const std::string& url, std::string& why) {
+std::unique_ptr<UdpmReceiver> openUdpmReceiver(const std::string& url, std::string& why, int default_rcvbuf) {
   UdpmUrl u;
   if (!parseUdpmUrl(url, u, why)) {
     why.clear();
     return nullptr;
   }
   auto rx = std::make_unique<UdpmReceiver>();
-  if (!rx->open(u, why)) {
+  if (!rx->open(u, why, default_rcvbuf)) {
     why = "cannot open the LCM receive socket for " + describeLcmUrl(url) + ": " + why;
     return nullptr;
   }

@@ -1,7 +1,8 @@
 // Issue 12.3 for the tools that subscribe to LCM (UDP multicast on loopback,
 // port 7864): LCM 1.3.1 keeps a handler-table entry for every channel name
 // it ever receives and never frees it (about 11 MB per 100 000 names), so a
-// sender cycling names grew hoist-dash, hoist-mqtt and hoist-monitor (and
+// sender cycling names grew hoist-dash, hoist-mqtt, hoist-monitor and
+// hoist-timing-test's listener (and
 // the daemon, fixed before: DaemonAttack.MillionDistinctChannelNamesKeepMemoryFlat)
 // without bound.  They now read udpm:// through hoist/bus/udpm_receiver.hpp,
 // which stores nothing per name: 300 000 distinct names, RSS growth < 2 MB
@@ -39,6 +40,9 @@ TEST_F(ToolAttack, ChannelNameSpamKeepsToolMemoryFlat) {
     ASSERT_TRUE(tools.back().p->started()) << name;
   };
   add("hoist-monitor", {HOIST_MONITOR, "--lcm-url", url_, "--period", "0.5", "--duration", "30"});
+  // Waiting for a daemon's first HOIST_HEALTH (none comes) the whole time.
+  add("hoist-timing-test", {HOIST_TIMING_TEST, "--lcm-url", url_, "--shafts", "2", "--health-timeout", "60",
+                            "--duration", "1", "-q"});
 #ifdef HOIST_DASH
   add("hoist-dash", {HOIST_DASH, "--lcm-url", url_, "--port", "0"});
 #endif

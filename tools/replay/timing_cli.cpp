@@ -35,7 +35,7 @@ HOIST_CAGE answering it (input_seq) p50/p99/p99.9/max; the feeder's own lateness
 counts summed, latencies worst case).  Prints a Markdown summary (--report FILE writes it too; its
 first line is VERDICT: PASS|FAIL|INCONCLUSIVE); progress once a second on a terminal (not with -q).
 Exit status: 0 PASS; 1 FAIL, or INCONCLUSIVE when the feeder itself was late (p99 over one period),
-or no HOIST_HEALTH within 5 s; 2 bad options; 128+signal after Ctrl-C (the shortened run is
+or no HOIST_HEALTH within --health-timeout (default 5 s); 2 bad options; 128+signal after Ctrl-C (the shortened run is
 still reported).
 )";
 
@@ -45,7 +45,7 @@ const std::vector<std::string>& timingOnlyOptions() {
   static const std::vector<std::string> o = {"--duration",        "--shafts",           "--max-late-p99-us",
                                              "--max-late-max-us", "--max-misses",       "--max-step-p99-us",
                                              "--max-e2e-p99-us",  "--max-rejected",     "--report",
-                                             "--lcm-url-out"};
+                                             "--lcm-url-out",     "--health-timeout"};
   return o;
 }
 
@@ -59,7 +59,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   app.set_version_flag("--version", program + " " + hoist::kVersionString);
   std::string url, config_path, report_path;
   std::vector<std::string> prefixes;
-  double rate = 100.0, duration = 60.0;
+  double rate = 100.0, duration = 60.0, health_timeout = 5.0;
   bool quiet = false;
   int shafts = 0;
   Budgets budgets;
@@ -81,6 +81,9 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   app.add_flag("-q,--quiet", quiet, "no progress display");
   app.add_option("--duration", duration, "how long to feed [s] (default 60)")
       ->check(numberIn(0.0, 7 * 86400.0, true, "> 0 and at most 604800 s"));
+  app.add_option("--health-timeout", health_timeout,
+                 "how long to wait for every shaft's first HOIST_HEALTH before feeding [s] (default 5)")
+      ->check(numberIn(0.0, 3600.0, true, "> 0 and at most 3600 s"));
   app.add_option("--shafts", shafts, "shafts with prefixes shaft1/ .. shaftN/ (1..1000)")
       ->check(numberIn(1, 1000, false, "in [1, 1000]"))
       ->excludes(prefix_opt);
@@ -104,6 +107,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   }
   o.rate = rate;
   o.duration = duration;
+  o.health_timeout = health_timeout;
   if (shafts > 0) {
     o.prefixes.clear();
     for (int i = 1; i <= shafts; ++i) o.prefixes.push_back("shaft" + std::to_string(i) + "/");

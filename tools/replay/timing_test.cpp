@@ -1,8 +1,13 @@
 // hoist-replay --timing-test: feeder, listener and the run (see timing_test.hpp).
 //
 // Threads: the feeder (own LCM instance, publish only, absolute schedule on
-// CLOCK_MONOTONIC, signals blocked) and the main thread (listener LCM
-// instance: HOIST_HEALTH and HOIST_CAGE of every prefix, progress, signals).
+// CLOCK_MONOTONIC, signals blocked) and the main thread (the listener:
+// HOIST_HEALTH and HOIST_CAGE of every prefix, progress, signals).  The
+// listener receives udpm:// through hoist::bus::UdpmReceiver (exact channel
+// names, nothing stored per name: a sender cycling through channel names
+// cannot grow it, unlike LCM 1.3.1's receive path), with an 8 MiB socket
+// buffer for the outputs of hundreds of shafts; other LCM providers through
+// LCM's subscribe.
 // They share only atomics: the per-shaft rings of publish times (indexed by
 // seq) and the sent counters; the feeder's lateness histogram is read after
 // the join.
@@ -23,7 +28,10 @@
 #include <lcm/lcm-cpp.hpp>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <thread>
+
+#include <poll.h>
 
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
@@ -31,6 +39,7 @@
 #include "hoist/msg/codec.hpp"
 #include "hoist/profile.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/bus/udpm_receiver.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/winder_t.hpp"
 #include "timing_test.hpp"
@@ -365,12 +374,29 @@ int runTimingTest(const TimingTestOptions& o) {
   };
 
   const std::string& rx_url = o.lcm_url_out.empty() ? o.lcm_url : o.lcm_url_out;
-  lcm::LCM rx(rx_url), tx(o.lcm_url);
-  if (!rx.good() || !tx.good()) {
-    std::cerr << "hoist-timing-test: cannot open LCM at " << hoist::bus::describeLcmUrl(rx.good() ? o.lcm_url : rx_url)
-              << "\n";
+  std::string rx_why;
+  std::unique_ptr<hoist::bus::UdpmReceiver> urx = hoist::bus::openUdpmReceiver(rx_url, rx_why, 8 << 20);
+  if (!rx_why.empty()) {
+    std::cerr << "hoist-timing-test: " << rx_why << "\n";
     return 1;
   }
+  std::optional<lcm::LCM> lrx;  // other providers than udpm://
+  if (!urx) lrx.emplace(rx_url);
+  lcm::LCM tx(o.lcm_url);
+  if ((lrx && !lrx->good()) || !tx.good()) {
+    std::cerr << "hoist-timing-test: cannot open LCM at "
+              << hoist::bus::describeLcmUrl(lrx && !lrx->good() ? rx_url : o.lcm_url) << "\n";
+    return 1;
+  }
+  // Wait up to `ms` for datagrams and dispatch what arrived.
+  auto receive = [&](int ms) {
+    if (lrx) {
+      lrx->handleTimeout(ms);
+      return;
+    }
+    pollfd p{urx->fd(), POLLIN, 0};
+    if (::poll(&p, 1, ms) > 0) urx->drain(4096);
+  };
   const RoundTrip trip(o.l0, o.travel, o.vmax, o.amax);
 
   Run run(o);
@@ -387,8 +413,16 @@ int runTimingTest(const TimingTestOptions& o) {
     run.shafts.push_back(std::move(s));
   }
   for (auto& s : run.shafts) {
-    rx.subscribe(hoist::bus::regexEscape(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth)), &Shaft::onHealth, s.get());
-    rx.subscribe(hoist::bus::regexEscape(hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage)), &Shaft::onCage, s.get());
+    const std::string health = hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth);
+    const std::string cage = hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage);
+    if (urx) {
+      Shaft* sh = s.get();
+      urx->add(health, [sh](const lcm::ReceiveBuffer* rb, const std::string& c) { sh->onHealth(rb, c); });
+      urx->add(cage, [sh](const lcm::ReceiveBuffer* rb, const std::string& c) { sh->onCage(rb, c); });
+    } else {
+      lrx->subscribe(hoist::bus::regexEscape(health), &Shaft::onHealth, s.get());
+      lrx->subscribe(hoist::bus::regexEscape(cage), &Shaft::onCage, s.get());
+    }
   }
 
   struct sigaction sa {};
@@ -432,7 +466,7 @@ int runTimingTest(const TimingTestOptions& o) {
   };
   {
     const std::int64_t end = monotonicNs() + std::llround(o.health_timeout * 1e9);
-    while (!allHeard() && monotonicNs() < end && !g_signal.load()) rx.handleTimeout(50);
+    while (!allHeard() && monotonicNs() < end && !g_signal.load()) receive(50);
   }
   if (g_signal.load()) {
     std::cerr << "hoist-timing-test: stopped before the timing test started\n";
@@ -483,7 +517,7 @@ int runTimingTest(const TimingTestOptions& o) {
   const std::int64_t t0 = monotonicNs();
   std::int64_t next_progress = t0 + 1'000'000'000;
   while (!feeder.done.load()) {
-    rx.handleTimeout(20);
+    receive(20);
     if (g_signal.load()) feeder.stop.store(true);
     if (o.progress && monotonicNs() >= next_progress) {
       next_progress += 1'000'000'000;
@@ -516,7 +550,7 @@ int runTimingTest(const TimingTestOptions& o) {
   };
   {
     const std::int64_t end = monotonicNs() + std::llround(wait_s * 1e9);
-    while (!allFinal() && monotonicNs() < end && g_signal_count.load() < 2) rx.handleTimeout(50);
+    while (!allFinal() && monotonicNs() < end && g_signal_count.load() < 2) receive(50);
   }
   run.phase = Phase::Done;
 

@@ -1,7 +1,7 @@
 // hoist/bus/udpm_receiver.hpp -- the project's own receive path for LCM's
 // UDP multicast transport (udpm://), in place of LCM 1.3.1's: hoist-twind
-// (inputs, and its own outputs on lcm_url_out), hoist-dash, hoist-mqtt and
-// hoist-monitor.  Target hoist_lcm_udpm (msgs/CMakeLists.txt; not installed).
+// (inputs, and its own outputs on lcm_url_out), hoist-dash, hoist-mqtt,
+// hoist-monitor and hoist-timing-test's listener.  Target hoist_lcm_udpm (msgs/CMakeLists.txt; not installed).
 //
 // Why: LCM 1.3.1 keeps, per lcm_t, a hash table entry (channel name string +
 // handler array) for EVERY channel name it has ever received on the group,
@@ -145,7 +145,7 @@ class UdpmReceiver final : public InputRouter {
 /// The tools' receive path for `url`: an opened UdpmReceiver for udpm://
 /// (and LCM's default); nullptr with `why` empty for other providers (use
 /// LCM's subscribe); nullptr with `why` set when the socket cannot be opened
-/// (the message names the URL).
-std::unique_ptr<UdpmReceiver> openUdpmReceiver(const std::string& url, std::string& why);
+/// (the message names the URL).  `default_rcvbuf` [bytes]: as open()'s.
+std::unique_ptr<UdpmReceiver> openUdpmReceiver(const std::string& url, std::string& why, int default_rcvbuf = 0);
 
 }  // namespace hoist::bus
