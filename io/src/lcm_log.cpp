@@ -114,7 +114,9 @@ void LcmLogReader::closeRegion(std::uint64_t at, const LcmLogEvent* next) {
   // skipped (each event takes >= 29 bytes), else at least one.
   std::uint64_t lost = 1;
   if (next != nullptr && have_last_num_ && next->eventnum > last_num_) {
-    const auto gap = static_cast<std::uint64_t>(next->eventnum - last_num_) - 1;
+    // In unsigned arithmetic: the numbers come from the file, and their
+    // signed difference can overflow (fuzz_lcmlog: INT64_MIN + 1, then 5).
+    const std::uint64_t gap = static_cast<std::uint64_t>(next->eventnum) - static_cast<std::uint64_t>(last_num_) - 1;
     if (gap >= 1 && gap <= skipped / (kHeader + 1) + 1) lost = gap;
   }
   stats_.events_lost += lost;

@@ -195,6 +195,32 @@ TEST(LcmLogReader, CorruptedEventInTheMiddleResynchronises) {
   EXPECT_EQ(r.stats.bytes_skipped, 3 + ev_size - 7);
 }
 
+// fuzz_lcmlog's finding: event numbers are the file's, any int64.  A jump
+// from INT64_MIN + 1 to 5 across a corrupted region overflowed the signed
+// gap (undefined behaviour; UBSan in the sanitizer pass); now one event lost.
+TEST(LcmLogReader, ExtremeEventNumbersAcrossACorruptedRegion) {
+  const auto d = workDir("eventnum");
+  for (const auto& [a, b] : std::vector<std::pair<std::int64_t, std::int64_t>>{
+           {INT64_MIN + 1, 5}, {-5, INT64_MAX}, {INT64_MIN, INT64_MAX}, {INT64_MAX - 1, INT64_MAX}}) {
+    Bytes log = atk::logEvent(a, 1000000, "HOIST_WINDER", winderBytes(0));
+    // A corrupted event between them (its data length points past the file).
+    const Bytes junk = atk::logEvent(7, 1005000, "HOIST_WINDER", winderBytes(7), 0x7fffffff);
+    log.insert(log.end(), junk.begin(), junk.end());
+    const Bytes ev = atk::logEvent(b, 1010000, "HOIST_WINDER", winderBytes(1));
+    log.insert(log.end(), ev.begin(), ev.end());
+    writeBytes(d / "n.lcmlog", log);
+    const auto r = readAll(d / "n.lcmlog");
+    ASSERT_TRUE(r.ok) << a << " " << b;
+    ASSERT_EQ(r.events.size(), 2u) << a << " " << b;
+    EXPECT_EQ(r.events[0].eventnum, a);
+    EXPECT_EQ(r.events[1].eventnum, b);
+    EXPECT_EQ(r.stats.regions, 1u);
+    EXPECT_EQ(r.stats.bytes_skipped, junk.size());
+    // A gap of numbers that the skipped bytes cannot hold (or none): one event lost.
+    EXPECT_EQ(r.stats.events_lost, 1u) << a << " " << b;
+  }
+}
+
 // A sync word inside a payload is not taken for an event.
 TEST(LcmLogReader, SyncWordInsidePayload) {
   const auto d = workDir("syncdata");
