@@ -185,6 +185,24 @@ for setting in "${settings[@]}"; do
       kill -TERM "$daemon_pid"
       wait "$daemon_pid" || true
       daemon_pid=""
+      # The report's per-shaft histograms (bins) make it megabytes at
+      # hundreds of shafts; the summary does not read them: keep it compact.
+      python3 - "$raw/$tag.json" <<'PY' || true
+import json, sys
+p = sys.argv[1]
+try:
+    r = json.load(open(p))
+except (OSError, ValueError):
+    sys.exit(0)
+def strip(o):
+    if isinstance(o, dict):
+        o.pop("bins", None)
+        for v in o.values(): strip(v)
+    elif isinstance(o, list):
+        for v in o: strip(v)
+strip(r)
+json.dump(r, open(p, "w"), separators=(",", ":"))
+PY
       cpu=$(python3 -c "print(f'{100.0 * ((${st1[0]} + ${st1[1]}) - (${st0[0]} + ${st0[1]})) / $clk / ($t1 - $t0):.0f}')")
       steal=$(python3 -c "print(f'{($steal1 - $steal0) / $clk:.2f}')")
       echo "[multishaft] $tag: timing test exit $verdict, daemon CPU $cpu %, steal $steal s" >&2
