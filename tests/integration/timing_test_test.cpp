@@ -190,8 +190,17 @@ TEST_F(TimingTest, TwoShaftsAreFedAndReportedPerShaft) {
   stopDaemon(*d1, "twind1.log");
   stopDaemon(*d2, "twind2.log");
   const std::string r = readFile(report);
-  EXPECT_EQ(rc, 0) << out;
-  EXPECT_EQ(firstLine(r), "VERDICT: PASS") << r;
+  // PASS, or INCONCLUSIVE when (and only when) this loaded 2-core machine
+  // made the test's own feeder late (ctest runs two tests at once; seen
+  // once: feeder p99 11.9 ms at 100 Hz): the per-shaft report is still
+  // checked.  A FAIL verdict, or INCONCLUSIVE for another reason, fails.
+  if (firstLine(r) == "VERDICT: INCONCLUSIVE" && r.find("The feeder itself was late") != std::string::npos) {
+    EXPECT_EQ(rc, 1) << out;
+  } else {
+    EXPECT_EQ(rc, 0) << out;
+    EXPECT_EQ(firstLine(r), "VERDICT: PASS") << r;
+  }
+  EXPECT_NE(r.find("| inputs sent / accepted / lost |"), std::string::npos) << r;
   EXPECT_NE(r.find("## Per shaft"), std::string::npos) << r;
   EXPECT_NE(r.find("| \"shaft1/\" | "), std::string::npos) << r;
   EXPECT_NE(r.find("| \"shaft2/\" | "), std::string::npos) << r;
