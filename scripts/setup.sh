@@ -39,7 +39,8 @@ required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
 # Java bindings let lcm-spy decode the hoist channels (jchart2d draws its
 # plots; xvfb lets the test open its window headless); clang gives the
 # fuzzers; dpkg-dev gives dpkg-shlibdeps for the .deb (cpack -G DEB).
-optional=(liblcm-java default-jdk-headless libjchart2d-java xvfb clang libclang-rt-14-dev dpkg-dev)
+# ccache keeps recompiles (the sanitizer builds, CI's clean clone) cheap.
+optional=(ccache liblcm-java default-jdk-headless libjchart2d-java xvfb clang libclang-rt-14-dev dpkg-dev)
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 missing=()
 for p in "${required[@]}"; do installed "$p" || missing+=("$p"); done
@@ -121,8 +122,16 @@ fi
 if [[ $do_build -eq 1 ]]; then
   jobs="${JOBS:-$(nproc)}"
   say "configuring $build_dir ($build_type)"
+  launcher=""
+  if command -v ccache >/dev/null 2>&1; then
+    # Paths under the checkout are hashed relative to it, so a clone in
+    # another folder (CI) reuses this machine's cache.
+    ccache --max-size=8G >/dev/null 2>&1 || true
+    launcher="-DCMAKE_CXX_COMPILER_LAUNCHER=env;CCACHE_BASEDIR=$here;CCACHE_NOHASHDIR=1;ccache"
+    say "compiler cache: ccache (CCACHE_BASEDIR=$here)"
+  fi
   # shellcheck disable=SC2086
-  cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" $cmake_args >"$build_dir.configure.log" 2>&1 ||
+  cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" $launcher $cmake_args >"$build_dir.configure.log" 2>&1 ||
     { cat "$build_dir.configure.log"; exit 1; }
   say "building with $jobs jobs (log: $build_dir.build.log)"
   if ! cmake --build "$build_dir" -j"$jobs" >"$build_dir.build.log" 2>&1; then
