@@ -11,8 +11,8 @@ namespace {
 constexpr int kMaxSweeps = 12;
 }  // namespace
 
-FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model)
-    : Solver(std::move(model)), ga_(model_->params().rho_inf) {
+FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model, Forcing forcing)
+    : Solver(std::move(model)), ga_(model_->params().rho_inf), forcing_(forcing) {
   const ShaftParams& p = model_->params();
   n_ = p.n;
   N_ = 2 * n_ + 2;
@@ -180,6 +180,10 @@ void FastSolver::longitudinalLoads(const Kinematics& k) {
   const ShaftParams& p = model_->params();
   const auto& H = model_->hoistingRope();
   // F0 + u * F(x_c): hoisting-rope load plus the cage load carried through x_c = u.q0
+  if (forcing_ == Forcing::LoadOnly) {
+    F0_ = p.Fa * u_;
+    return;
+  }
   const double Fxc = p.Fa + p.m * (p.g - k.a);
   F0_ = (-p.rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
 }
@@ -192,9 +196,12 @@ void FastSolver::updateResponse(double t, const Kinematics& k) {
   resp_.y_c = x_(N_ - 2);
   resp_.theta = x_(N_ - 1);
   const double xcdd = u_.dot(ydd_);
-  lambda0_ = p.Fa + p.m * (p.g - k.a) - p.m * xcdd;
+  lambda0_ = forcing_ == Forcing::LoadOnly ? p.Fa - p.m * xcdd : p.Fa + p.m * (p.g - k.a) - p.m * xcdd;
   resp_.lambda[0] = lambda0_;
   for (int i = 0; i < 4; ++i) resp_.lambda[i + 1] = lam_(i);
+  resp_.x_c_ddot = xcdd;
+  resp_.y_c_ddot = xdd_(N_ - 2);
+  resp_.theta_dot = xd_(N_ - 1);
 }
 
 // When the winder already moves at t = 0 (v != 0), zero velocities violate the

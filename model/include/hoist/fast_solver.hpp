@@ -67,9 +67,19 @@ struct FastSolverState {
   int modes() const { return static_cast<int>(y.size()); }
 };
 
+/// What drives the solver.  The model is linear in its loads for given
+/// kinematics, so the response to the eccentric load alone is the exact
+/// derivative of every output with respect to Fa (longitudinal subsystem) and
+/// to the moment Fa b (lateral subsystem): the load estimator's sensitivities.
+enum class Forcing {
+  Full,      ///< Eq. (17): gravity, the rope's and cage's inertia and the eccentric load
+  LoadOnly,  ///< only the eccentric load: F(x_c) = Fa, F(theta) = Fa b; lambda_0 = Fa - m x_c''
+};
+
 class FastSolver final : public Solver {
  public:
-  explicit FastSolver(std::shared_ptr<const ShaftModel> model);
+  explicit FastSolver(std::shared_ptr<const ShaftModel> model, Forcing forcing = Forcing::Full);
+  Forcing forcing() const { return forcing_; }
 
   void initialize(double t0, const Kinematics& k0, InitialState init) override;
   using Solver::initialize;
@@ -167,6 +177,7 @@ class FastSolver final : public Solver {
   int last_iters_ = 0;
   long fallbacks_ = 0;
   bool fused_ = true;
+  Forcing forcing_ = Forcing::Full;
   double lambda0_ = 0.0;
 
   CageResponse resp_;

@@ -61,6 +61,11 @@ struct CageResponse {
   double y_c = 0.0;      ///< cage lateral displacement [m]
   double theta = 0.0;    ///< cage rotation [rad]
   std::array<double, 5> lambda{};  ///< lambda_0 (hoisting rope) .. lambda_4 (sleeves) [N]
+  // Rates of the cage coordinates at t (what a cage IMU sees; hoist/load_estimator.hpp).
+  // Filled by FastSolver; the paper path leaves them 0.
+  double x_c_ddot = 0.0;    ///< cage longitudinal acceleration about the static state [m/s^2]
+  double y_c_ddot = 0.0;    ///< cage lateral acceleration [m/s^2]
+  double theta_dot = 0.0;   ///< tilt rate [rad/s]
 };
 
 /// Point loads whose exact static deflection (the Green's function of each

@@ -1,0 +1,457 @@
+#include "hoist/load_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hoist {
+
+namespace {
+
+/// Standard normal quantile (Acklam's rational approximation, |rel. error| < 1.2e-9).
+double normalQuantile(double p) {
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  const double lo = 0.02425, hi = 1.0 - lo;
+  if (p <= 0.0) return -INFINITY;
+  if (p >= 1.0) return INFINITY;
+  if (p < lo) {
+    const double q = std::sqrt(-2.0 * std::log(p));
+    return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  }
+  if (p > hi) {
+    const double q = std::sqrt(-2.0 * std::log(1.0 - p));
+    return -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  }
+  const double q = p - 0.5, r = q * q;
+  return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+         (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+}
+
+constexpr double kMaxSpecificForce = 100.0;  // |f_y| [m/s^2] a cage IMU can report
+constexpr double kMaxRate = 20.0;            // |omega| [rad/s]
+constexpr double kMaxRopeLoad = 1.0e8;       // |rope_load| [N]
+constexpr int kImuAccel = 0, kImuRate = 1, kRope = 2;
+constexpr double kEnvelopeTime = 3.0;        // memory of the oscillation envelopes [s]
+
+void requirePositive(double v, const char* key) {
+  if (!(std::isfinite(v) && v > 0.0)) throw std::invalid_argument(std::string(key) + ": must be > 0");
+}
+void requireNonNegative(double v, const char* key) {
+  if (!(std::isfinite(v) && v >= 0.0)) throw std::invalid_argument(std::string(key) + ": must be >= 0");
+}
+
+}  // namespace
+
+SensorValues sensorModel(const CageResponse& r, double g) {
+  return {r.y_c_ddot + (g - r.kin.a) * r.theta, r.theta_dot, r.lambda[0]};
+}
+
+double chiSquareQuantile(double p, double dof) {
+  if (!(dof > 0.0)) return 0.0;
+  const double z = normalQuantile(p);
+  const double c = 2.0 / (9.0 * dof);
+  const double w = 1.0 - c + z * std::sqrt(c);
+  return w > 0.0 ? dof * w * w * w : 0.0;
+}
+
+void EstimatorSettings::validate() const {
+  requirePositive(noise.imu_accel, "sensors.imu_accel_noise");
+  requirePositive(noise.imu_rate, "sensors.imu_rate_noise");
+  requirePositive(noise.rope_load, "sensors.rope_load_noise");
+  requireNonNegative(fa_walk, "estimator.fa_walk");
+  requireNonNegative(moment_walk, "estimator.moment_walk");
+  requireNonNegative(moving_walk_scale, "estimator.moving_walk_scale");
+  requireNonNegative(rest_speed, "estimator.rest_speed");
+  requirePositive(fa_sigma0, "estimator.fa_sigma0");
+  requirePositive(moment_sigma0, "estimator.moment_sigma0");
+  requireNonNegative(model_error, "estimator.model_error");
+  if (!(gate_sigma >= 3.0 && gate_sigma <= 1e6)) throw std::invalid_argument("estimator.gate_sigma: must be in [3, 1e6]");
+  if (gate_reset < 1 || gate_reset > 100000) throw std::invalid_argument("estimator.gate_reset: must be in [1, 100000]");
+  if (!(nis_window >= 0.1 && nis_window <= 600.0))
+    throw std::invalid_argument("estimator.nis_window: must be in [0.1, 600] s");
+  if (!(nis_alpha > 0.0 && nis_alpha < 0.5)) throw std::invalid_argument("estimator.nis_alpha: must be in (0, 0.5)");
+  requirePositive(drift_sigma, "estimator.drift_sigma");
+  if (!(min_window_fill >= 0.0 && min_window_fill <= 1.0))
+    throw std::invalid_argument("estimator.min_window_fill: must be in [0, 1]");
+  requirePositive(sensor_timeout, "estimator.sensor_timeout");
+  if (max_rate < 1 || max_rate > 100000) throw std::invalid_argument("estimator.max_rate: must be in [1, 100000] Hz");
+  if (nis_window * max_rate > 5.0e6)
+    throw std::invalid_argument("estimator.nis_window: nis_window * max_rate must stay below 5e6 entries");
+}
+
+LoadEstimator::LoadEstimator(const ShaftParams& twin, const EstimatorSettings& settings)
+    : twin_(twin), set_(settings) {
+  set_.validate();
+  twin_.validate();
+  ShaftParams unit = twin_;
+  unit.Fa = 1.0;
+  unit.b = 1.0;
+  sens_ = std::make_unique<FastSolver>(std::make_shared<const ShaftModel>(unit), Forcing::LoadOnly);
+  Fa_c_ = twin_.Fa;
+  M_c_ = twin_.Fa * twin_.b;
+  const auto cap = static_cast<std::size_t>(std::ceil(set_.nis_window * set_.max_rate)) + 2;
+  ring_t_.assign(cap, 0.0);
+  ring_nis_.assign(cap, 0.0);
+  ring_dof_.assign(cap, 0);
+}
+
+void LoadEstimator::initialize(double t0, const Kinematics& k0) {
+  sens_->initialize(t0, k0, twin_.initial);
+  t_ = t0;
+  kin_ = k0;
+  Fa_ = Fa_c_;
+  PFa_ = set_.fa_sigma0 * set_.fa_sigma0;
+  M_ = M_c_;
+  PM_ = set_.moment_sigma0 * set_.moment_sigma0;
+  run_fa_ = run_m_ = 0;
+  env_fy_ = env_om_ = env_rope_ = 0.0;
+  env_t_ = t0;
+  tick_nis_ = 0.0;
+  tick_dof_ = 0;
+  for (int i = 0; i < 3; ++i) {
+    last_upd_[i] = -1e300;
+    seen_[i] = false;
+  }
+  head_ = count_ = 0;
+  win_nis_ = 0.0;
+  win_dof_ = 0;
+  first_t_ = t0;
+  have_update_ = false;
+  was_moving_ = false;
+  trip_drift_ = 0.0;
+  nis_flag_ = drift_flag_ = false;
+  counts_ = {};
+  est_ = {};
+  twin_resp_ = sens_->response();
+  predict(twin_resp_);
+}
+
+bool LoadEstimator::moving() const {
+  return std::abs(kin_.v) > set_.rest_speed || std::abs(kin_.a) > set_.rest_speed;
+}
+
+void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
+  const double t0 = t_, h = t1 - t0;
+  const Kinematics k0 = kin_;
+  const int n = std::max(1, substeps);
+  for (int j = 1; j < n; ++j) {
+    const double u = static_cast<double>(j) / n;
+    sens_->step(t0 + u * h, interpolate(k0, k1, h, u));
+  }
+  sens_->step(t1, k1);
+  t_ = t1;
+  kin_ = k1;
+  // Random walk of the loads over the interval (slower while the cage moves).
+  const double scale = moving() ? set_.moving_walk_scale : 1.0;
+  const double qfa = set_.fa_walk * scale, qm = set_.moment_walk * scale;
+  PFa_ += qfa * qfa * h;
+  PM_ += qm * qm * h;
+  trip_QFa_ += qfa * qfa * h;
+  trip_QM_ += qm * qm * h;
+}
+
+void LoadEstimator::predict(const CageResponse& twin) {
+  twin_resp_ = twin;
+  const CageResponse& s = sens_->response();
+  const double dFa = Fa_ - Fa_c_, dM = M_ - M_c_;
+  // The sensor model is linear: the sensitivities read through it (the
+  // sensitivity solver's own a-term is the twin's: same kinematics).
+  const SensorValues zt = sensorModel(twin, twin_.g), zs = sensorModel(s, twin_.g);
+  h_fy_ = zs.f_y;
+  h_om_ = zs.omega;
+  h_rope_ = zs.rope_load;
+  pred_fy_ = zt.f_y + dM * h_fy_;
+  pred_om_ = zt.omega + dM * h_om_;
+  pred_rope_ = zt.rope_load + dFa * h_rope_;
+  // Envelopes (peak hold, decaying over kEnvelopeTime) of the predicted
+  // oscillations: a model a few per cent off in frequency is off by up to
+  // twice their amplitude a few cycles later, also at a zero crossing.
+  const double dt = std::max(twin.t - env_t_, 0.0);
+  env_t_ = twin.t;
+  const double decay = std::exp(-dt / kEnvelopeTime);
+  const double yddot = twin.y_c_ddot + dM * s.y_c_ddot;
+  env_fy_ = std::max(std::abs(yddot), env_fy_ * decay);
+  env_om_ = std::max(std::abs(pred_om_), env_om_ * decay);
+  env_rope_ = std::max(std::abs(pred_rope_ - (twin_.m * twin_.g + Fa_)), env_rope_ * decay);
+  tick_nis_ = 0.0;
+  tick_dof_ = 0;
+}
+
+bool LoadEstimator::updateImu(double f_y, double omega) { return updateLateral(f_y, omega, 3u); }
+bool LoadEstimator::updateImuAccel(double f_y) { return updateLateral(f_y, 0.0, 1u); }
+bool LoadEstimator::updateImuRate(double omega) { return updateLateral(0.0, omega, 2u); }
+
+bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
+  const bool use_a = which & 1u, use_w = which & 2u;
+  if ((use_a && !(std::isfinite(f_y) && std::abs(f_y) <= kMaxSpecificForce)) ||
+      (use_w && !(std::isfinite(omega) && std::abs(omega) <= kMaxRate))) {
+    ++counts_.implausible;
+    return false;
+  }
+  const double eps = set_.model_error;
+  const double ea = eps * (std::abs(pred_fy_) + env_fy_), ew = eps * env_om_;
+  const double ra = set_.noise.imu_accel * set_.noise.imu_accel + ea * ea;
+  const double rw = set_.noise.imu_rate * set_.noise.imu_rate + ew * ew;
+  // Innovation, its covariance S = H P H^T + R (1 or 2 rows), in closed form.
+  Eigen::Vector2d H(use_a ? h_fy_ : 0.0, use_w ? h_om_ : 0.0);
+  Eigen::Vector2d nu(use_a ? f_y - pred_fy_ : 0.0, use_w ? omega - pred_om_ : 0.0);
+  auto covariance = [&](double P) {
+    Eigen::Matrix2d S = P * H * H.transpose();
+    S(0, 0) += use_a ? ra : 1.0;
+    S(1, 1) += use_w ? rw : 1.0;
+    // an unused row has H = 0 and nu = 0: it adds nothing to K or the NIS
+    return S;
+  };
+  Eigen::Matrix2d S = covariance(PM_);
+  const bool gated = (use_a && std::abs(nu(0)) > set_.gate_sigma * std::sqrt(S(0, 0))) ||
+                     (use_w && std::abs(nu(1)) > set_.gate_sigma * std::sqrt(S(1, 1)));
+  if (gated) {
+    if (++run_m_ < set_.gate_reset) {
+      ++counts_.gated;
+      return false;
+    }
+    reopen(PM_, set_.moment_sigma0);
+    S = covariance(PM_);
+  }
+  run_m_ = 0;
+  const Eigen::Matrix2d Si = S.inverse();
+  const Eigen::RowVector2d K = PM_ * H.transpose() * Si;
+  M_ += K * nu;
+  PM_ = std::max(PM_ - (K * S * K.transpose())(0, 0), 0.0);
+  const int dof = (use_a ? 1 : 0) + (use_w ? 1 : 0);
+  tick_nis_ += nu.dot(Si * nu);
+  tick_dof_ += dof;
+  ++counts_.accepted;
+  if (use_a) {
+    last_upd_[kImuAccel] = t_;
+    seen_[kImuAccel] = true;
+  }
+  if (use_w) {
+    last_upd_[kImuRate] = t_;
+    seen_[kImuRate] = true;
+  }
+  // The other channel's prediction follows the new moment.
+  const double dM = K * nu;
+  pred_fy_ += dM * h_fy_;
+  pred_om_ += dM * h_om_;
+  return true;
+}
+
+void LoadEstimator::reopen(double& P, double sigma0) {
+  P = std::max(P, sigma0 * sigma0);
+  ++counts_.load_changes;
+  // A load cannot change while the cage moves: a change then is evidence of mismatch.
+  if (moving()) trip_drift_ = std::max(trip_drift_, set_.drift_sigma + 1.0);
+}
+
+bool LoadEstimator::updateRopeLoad(double force) {
+  if (!(std::isfinite(force) && std::abs(force) <= kMaxRopeLoad)) {
+    ++counts_.implausible;
+    return false;
+  }
+  const double eps = set_.model_error;
+  // The dynamic part of lambda_0 and the cage's inertia m a: the rope's
+  // high modes, which n modes do not carry, scale with them.
+  const double dyn = env_rope_ + twin_.m * std::abs(kin_.a);
+  const double R = set_.noise.rope_load * set_.noise.rope_load + (eps * dyn) * (eps * dyn);
+  const double nu = force - pred_rope_;
+  double S = h_rope_ * h_rope_ * PFa_ + R;
+  if (std::abs(nu) > set_.gate_sigma * std::sqrt(S)) {
+    if (++run_fa_ < set_.gate_reset) {
+      ++counts_.gated;
+      return false;
+    }
+    reopen(PFa_, set_.fa_sigma0);
+    S = h_rope_ * h_rope_ * PFa_ + R;
+  }
+  run_fa_ = 0;
+  const double K = PFa_ * h_rope_ / S;
+  Fa_ += K * nu;
+  PFa_ = std::max(PFa_ - K * K * S, 0.0);
+  tick_nis_ += nu * nu / S;
+  tick_dof_ += 1;
+  ++counts_.accepted;
+  last_upd_[kRope] = t_;
+  seen_[kRope] = true;
+  pred_rope_ += K * nu * h_rope_;
+  return true;
+}
+
+void LoadEstimator::pushNis(double nis, int dof) {
+  const std::size_t cap = ring_t_.size();
+  if (count_ == cap) {  // full: the oldest entry leaves early (the window is shorter than asked)
+    const std::size_t tail = (head_ + cap - count_) % cap;
+    win_nis_ -= ring_nis_[tail];
+    win_dof_ -= ring_dof_[tail];
+    --count_;
+  }
+  ring_t_[head_] = t_;
+  ring_nis_[head_] = nis;
+  ring_dof_[head_] = dof;
+  head_ = (head_ + 1) % cap;
+  ++count_;
+  win_nis_ += nis;
+  win_dof_ += dof;
+}
+
+const LoadEstimate& LoadEstimator::finish() {
+  if (tick_dof_ > 0) {
+    if (!have_update_) {
+      have_update_ = true;
+      first_t_ = t_;
+    }
+    pushNis(tick_nis_, tick_dof_);
+  }
+  // Entries older than the window leave it.
+  const std::size_t cap = ring_t_.size();
+  while (count_ > 0) {
+    const std::size_t tail = (head_ + cap - count_) % cap;
+    if (ring_t_[tail] > t_ - set_.nis_window) break;
+    win_nis_ -= ring_nis_[tail];
+    win_dof_ -= ring_dof_[tail];
+    --count_;
+  }
+  if (count_ == 0) {  // no round-off residue in an empty window
+    win_nis_ = 0.0;
+    win_dof_ = 0;
+  }
+
+  // Drift of the loads during a trip (the cage moving).
+  const bool mov = moving();
+  if (mov && !was_moving_) {
+    trip_Fa0_ = Fa_;
+    trip_PFa0_ = PFa_;
+    trip_M0_ = M_;
+    trip_PM0_ = PM_;
+    trip_QFa_ = trip_QM_ = 0.0;
+    trip_drift_ = 0.0;
+    drift_flag_ = false;
+  }
+  was_moving_ = mov;
+  if (mov) {
+    // With a right model, x - x0 has variance P0 - P (the information gained)
+    // plus the random walk's variance added since the trip began.
+    auto drift = [](double x, double x0, double P, double P0, double Q) {
+      const double var = std::max(P0 - P, 0.0) + Q + 1e-12 * (P0 + 1.0);
+      return std::abs(x - x0) / std::sqrt(var);
+    };
+    if (seen_[kRope]) trip_drift_ = std::max(trip_drift_, drift(Fa_, trip_Fa0_, PFa_, trip_PFa0_, trip_QFa_));
+    if (seen_[kImuAccel] || seen_[kImuRate])
+      trip_drift_ = std::max(trip_drift_, drift(M_, trip_M0_, PM_, trip_PM0_, trip_QM_));
+    if (trip_drift_ > set_.drift_sigma) drift_flag_ = true;
+  }
+
+  LoadEstimate& e = est_;
+  e.t = t_;
+  e.kin = kin_;
+  e.nis = tick_nis_;
+  e.nis_window = win_nis_;
+  e.nis_dof = win_dof_;
+  if (win_dof_ > 0) {
+    e.nis_lower = chiSquareQuantile(0.025, win_dof_);
+    e.nis_upper = chiSquareQuantile(0.975, win_dof_);
+    e.nis_bound = chiSquareQuantile(1.0 - set_.nis_alpha, win_dof_);
+  } else {
+    e.nis_lower = e.nis_upper = e.nis_bound = 0.0;
+  }
+  const bool filled = have_update_ && t_ - first_t_ >= set_.min_window_fill * set_.nis_window;
+  if (filled && win_dof_ > 0 && win_nis_ > e.nis_bound) nis_flag_ = true;
+  else if (nis_flag_ && (win_dof_ == 0 || win_nis_ < e.nis_upper)) nis_flag_ = false;  // hysteresis
+  e.nis_exceeded = nis_flag_;
+  e.drift = trip_drift_;
+  e.drift_exceeded = drift_flag_;
+  e.mismatch = nis_flag_ || drift_flag_;
+
+  e.sensors = 0;
+  const unsigned bits[3] = {kSensorImuAccel, kSensorImuRate, kSensorRopeLoad};
+  for (int i = 0; i < 3; ++i)
+    if (t_ - last_upd_[i] <= set_.sensor_timeout) e.sensors |= bits[i];
+  e.fa_observed = seen_[kRope];
+  e.moment_observed = seen_[kImuAccel] || seen_[kImuRate];
+
+  const double sFa = std::sqrt(PFa_), sM = std::sqrt(PM_);
+  e.Fa = Fa_;
+  e.sigma_Fa = sFa;
+  e.moment = M_;
+  e.sigma_moment = sM;
+  if (e.fa_observed && e.moment_observed && std::abs(Fa_) > 3.0 * sFa) {
+    e.b = M_ / Fa_;
+    e.sigma_b = std::sqrt(PM_ + e.b * e.b * PFa_) / std::abs(Fa_);
+  } else {
+    e.b = 0.0;
+    e.sigma_b = -1.0;
+  }
+
+  // The state the estimated load implies, and its sigma (load + model error).
+  const CageResponse& tw = twin_resp_;
+  const CageResponse& s = sens_->response();
+  const double dFa = Fa_ - Fa_c_, dM = M_ - M_c_, eps = set_.model_error;
+  auto lateral = [&](double open, double sens, double& value, double& sigma) {
+    value = open + dM * sens;
+    sigma = std::hypot(sens * sM, eps * value);
+  };
+  e.x_c = tw.x_c + dFa * s.x_c;
+  e.sigma_x_c = std::hypot(s.x_c * sFa, eps * e.x_c);
+  lateral(tw.y_c, s.y_c, e.y_c, e.sigma_y_c);
+  lateral(tw.theta, s.theta, e.theta, e.sigma_theta);
+  e.lambda[0] = tw.lambda[0] + dFa * s.lambda[0];
+  e.sigma_lambda[0] = std::hypot(s.lambda[0] * sFa, eps * (e.lambda[0] - (twin_.m * twin_.g + Fa_)));
+  for (int i = 1; i < 5; ++i) lateral(tw.lambda[i], s.lambda[i], e.lambda[i], e.sigma_lambda[i]);
+  e.theta_open = tw.theta;
+  return e;
+}
+
+}  // namespace hoist
+
+namespace hoist {
+
+void estimateRecorded(const ShaftParams& twin, const EstimatorSettings& settings, double max_step,
+                      const std::vector<MeasurementSample>& samples,
+                      const std::function<void(const LoadEstimate&, const EstimatorCounters&)>& sink,
+                      const std::function<void(double)>& progress) {
+  if (samples.empty()) return;
+  auto model = std::make_shared<const ShaftModel>(twin);
+  FastSolver solver(model);
+  LoadEstimator est(twin, settings);
+  auto apply = [&](const MeasurementSample& m) {
+    est.predict(solver.response());
+    const bool a = m.present & kSensorImuAccel, w = m.present & kSensorImuRate;
+    if (a && w) est.updateImu(m.z.f_y, m.z.omega);
+    else if (a) est.updateImuAccel(m.z.f_y);
+    else if (w) est.updateImuRate(m.z.omega);
+    if (m.present & kSensorRopeLoad) est.updateRopeLoad(m.z.rope_load);
+    sink(est.finish(), est.counters());
+  };
+  const MeasurementSample& first = samples.front();
+  solver.initialize(first.t, first.k, twin.initial);
+  est.initialize(first.t, first.k);
+  apply(first);
+  const std::size_t every = std::max<std::size_t>(1, samples.size() / 100);
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    const MeasurementSample& prev = samples[i - 1];
+    const MeasurementSample& m = samples[i];
+    const double h = m.t - prev.t;
+    const int n = h > 0.0 ? substepCount(h, max_step) : 1;
+    for (int j = 1; j < n; ++j) {
+      const double u = static_cast<double>(j) / n;
+      solver.step(prev.t + u * h, interpolate(prev.k, m.k, h, u));
+    }
+    solver.step(m.t, m.k);
+    est.advance(m.t, m.k, n);
+    apply(m);
+    if (progress && i % every == 0) progress(static_cast<double>(i) / samples.size());
+  }
+  if (progress) progress(1.0);
+}
+
+}  // namespace hoist
