@@ -215,14 +215,16 @@ TEST(LoadEstimator, TripDownHeavierLoadNearerTheAxis) {
   const EstRun run = estimate(config(), tr.meas);
   expectAccurate(tr, run, "down, Fa 1500 b 0.6");
   EXPECT_NEAR(run.est.back().b, 0.6, 0.05 * 0.6);
-  for (const LoadEstimate& e : run.est) ASSERT_FALSE(e.mismatch) << "at t = " << e.t;
+  for (const LoadEstimate& e : run.est)
+    ASSERT_FALSE(e.mismatch) << "at t = " << e.t << " NIS " << e.nis_window << " (bound " << e.nis_bound << ", dof "
+                             << e.nis_dof << ") drift " << e.drift;
 }
 
 // DISABLED: accurate (Fa 0.7 %, M 2.4 %, theta nRMS 1.7 %), but after the stop
 // the residual rope bounce of the n = 100 truth raises a false MODEL_MISMATCH
 // at rest (t = 50 s); the model-error allowance of oscillations at rest is
 // still to be tuned.
-TEST(LoadEstimator, DISABLED_TripUpLighterLoadOnTheOtherSide) {
+TEST(LoadEstimator, TripUpLighterLoadOnTheOtherSide) {
   const SensorNoise noise;
   // 250 m -> 50 m: hoisting (v < 0).
   const HoistProfile prof = HoistProfile::trapezoid(250.0, 5.0, 1.0, -200.0, 55.0);
@@ -230,7 +232,9 @@ TEST(LoadEstimator, DISABLED_TripUpLighterLoadOnTheOtherSide) {
   const EstRun run = estimate(config(), tr.meas);
   dump(tr, run);
   expectAccurate(tr, run, "up, Fa 600 b -0.8");
-  for (const LoadEstimate& e : run.est) ASSERT_FALSE(e.mismatch) << "at t = " << e.t;
+  for (const LoadEstimate& e : run.est)
+    ASSERT_FALSE(e.mismatch) << "at t = " << e.t << " NIS " << e.nis_window << " (bound " << e.nis_bound << ", dof "
+                             << e.nis_dof << ") drift " << e.drift;
 }
 
 TEST(LoadEstimator, FollowsALoadStepAtRestWithinFiveSeconds) {
@@ -259,10 +263,10 @@ TEST(LoadEstimator, FollowsALoadStepAtRestWithinFiveSeconds) {
 // DISABLED: MODEL_MISMATCH stays down, but only 8-9 of 12 windows lie inside
 // the two-sided 95 % bounds (the model-error allowance makes the NIS too
 // small in quiet windows): the allowance is to be made adaptive.
-TEST(LoadEstimator, DISABLED_ConsistentWhenTheModelIsRight) {
+TEST(LoadEstimator, ConsistentWhenTheModelIsRight) {
   const SensorNoise noise;
   for (unsigned seed : {21u, 22u}) {
-    Truth tr = makeTruth(config(), HoistProfile::trapezoid(), {1300.0, -0.7}, 100, noise, seed);
+    Truth tr = makeTruth(config(), HoistProfile::trapezoid(), {1300.0, -0.7}, 200, noise, seed);
     const EstRun run = estimate(config(), tr.meas);
     int windows = 0, inside = 0;
     double next = 5.0;
@@ -271,6 +275,8 @@ TEST(LoadEstimator, DISABLED_ConsistentWhenTheModelIsRight) {
                                << e.nis_bound << " drift " << e.drift;
       if (e.t + 1e-9 >= next) {
         ++windows;
+        std::printf("  window to t = %.1f: NIS %.0f in [%.0f, %.0f], dof %d\n", e.t, e.nis_window, e.nis_lower,
+                    e.nis_upper, e.nis_dof);
         if (e.nis_window >= e.nis_lower && e.nis_window <= e.nis_upper) ++inside;
         next += 5.0;
       }
@@ -285,18 +291,19 @@ TEST(LoadEstimator, DISABLED_ConsistentWhenTheModelIsRight) {
 // DISABLED: with both preloads 30 % low the estimate of M absorbs most of the
 // stiffer-than-real model (M over-estimated, NIS and drift under their
 // bounds): the mismatch test needs a sharper statistic.
-TEST(LoadEstimator, DISABLED_WeakPreloadsRaiseModelMismatch) {
+TEST(LoadEstimator, WeakPreloadsRaiseModelMismatch) {
   const SensorNoise noise;
   ShaftParams shaft = config();
   shaft.Tb1 = shaft.Tb2 = 0.7 * 30000.0;
   Truth tr = makeTruth(shaft, HoistProfile::trapezoid(), {1500.0, 0.6}, 100, noise, 31);
   const EstRun run = estimate(config(), tr.meas);
-  double first = -1.0;
-  for (const LoadEstimate& e : run.est)
-    if (e.mismatch) {
-      first = e.t;
-      break;
-    }
+  double first = -1.0, dmax = 0.0, rmax = 0.0;
+  for (const LoadEstimate& e : run.est) {
+    dmax = std::max(dmax, e.drift);
+    if (e.nis_dof > 0) rmax = std::max(rmax, e.nis_window / e.nis_dof);
+    if (e.mismatch && first < 0.0) first = e.t;
+  }
+  std::printf("[ weak preloads ] largest drift %.2f sigma, largest NIS/dof %.2f\n", dmax, rmax);
   ASSERT_GE(first, 0.0) << "MODEL_MISMATCH never rose";
   EXPECT_LT(first, 55.0) << "it must rise during the trip";
   std::printf("[ weak preloads ] MODEL_MISMATCH at t = %.2f s into the trip\n", first);
@@ -319,7 +326,9 @@ TEST(LoadEstimator, SensorFaults) {
   EXPECT_EQ(during.sensors & kSensorImuAccel, 0u);
   EXPECT_NE(before.sensors & kSensorImuAccel, 0u);
   expectAccurate(tr, run, "IMU drop-out and a spike");
-  for (const LoadEstimate& e : run.est) ASSERT_FALSE(e.mismatch) << "at t = " << e.t;
+  for (const LoadEstimate& e : run.est)
+    ASSERT_FALSE(e.mismatch) << "at t = " << e.t << " NIS " << e.nis_window << " (bound " << e.nis_bound << ", dof "
+                             << e.nis_dof << ") drift " << e.drift;
 }
 
 // What each sensor makes observable.
@@ -409,13 +418,13 @@ TEST(LoadEstimator, ChiSquareQuantiles) {
 TEST(LoadEstimatorDebug, ChannelNis) {
   if (!std::getenv("HOIST_EST_DEBUG")) GTEST_SKIP();
   const SensorNoise noise;
-  Truth tr = makeTruth(config(), HoistProfile::trapezoid(), {1300.0, -0.7}, 100, noise, 21);
+  Truth tr = makeTruth(config(), HoistProfile::trapezoid(250.0, 5.0, 1.0, -200.0, 55.0), {600.0, -0.8}, 100, noise, 12);
   for (unsigned bits : {unsigned(kSensorRopeLoad), unsigned(kSensorImuAccel), unsigned(kSensorImuRate)}) {
     std::vector<MeasurementSample> m = tr.meas;
     for (auto& s : m) s.present &= bits;
     const EstRun run = estimate(config(), m);
     for (const LoadEstimate& e : run.est)
-      if (std::fmod(e.t + 1e-9, 2.5) < 0.01)
+      if (std::fmod(e.t + 1e-9, 1.0) < 0.01 && (e.t > 36))
         std::printf("bits %u t %.2f nisw %.0f dof %d bound %.0f drift %.2f\n", bits, e.t, e.nis_window, e.nis_dof,
                     e.nis_bound, e.drift);
   }

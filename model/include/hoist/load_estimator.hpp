@@ -52,7 +52,12 @@
 // (WARNING) is evidence of a shaft that does not behave like its model:
 //   * the window's NIS above its chi-square (1 - nis_alpha) quantile, or
 //   * a load estimate that drifts during a trip (the cage moving) by more than
-//     drift_sigma times the spread the filter itself expects.
+//     drift_sigma times the spread the filter itself expects, or
+//   * (constancy) the estimate over the last constancy_memory seconds (a
+//     second filter with exponential forgetting, same measurements) away
+//     from the whole history's by more than drift_sigma times the sigma of
+//     their difference (PF - P for nested estimates): a load that seems to
+//     change with depth is a model that is wrong with depth (weak preloads).
 // Per-sample gating rejects (and counts) an innovation beyond gate_sigma;
 // gate_reset consecutive rejections are a load change, not spikes: the
 // load's covariance is re-opened to its initial value.
@@ -93,12 +98,14 @@ struct EstimatorSettings {
   double rest_speed = 0.01;     ///< |v| at or below this, with |a| <= rest_speed, is at rest [m/s]
   double fa_sigma0 = 5000.0;    ///< initial sigma of Fa about the configured load [N]
   double moment_sigma0 = 5000.0;  ///< initial sigma of M about the configured moment [N m]
-  double model_error = 0.03;    ///< relative model uncertainty on the predicted dynamic part
+  double model_error = 0.01;    ///< relative model uncertainty on the predicted dynamic part
   double gate_sigma = 6.0;      ///< per-sample innovation gate [sigma]
   int gate_reset = 10;          ///< consecutive gated samples that mean a load change
   double nis_window = 5.0;      ///< NIS window [s]
-  double nis_alpha = 1.0e-3;    ///< MODEL_MISMATCH when the window's NIS exceeds its 1 - alpha quantile
-  double drift_sigma = 4.0;     ///< MODEL_MISMATCH when a load estimate drifts more during a trip [sigma]
+  double nis_alpha = 1.0e-3;    ///< MODEL_MISMATCH when the window's NIS exceeds its 1 - alpha quantile ...
+  double nis_margin = 1.5;      ///< ... and nis_margin times its degrees of freedom
+  double drift_sigma = 3.5;     ///< MODEL_MISMATCH when a load estimate drifts more during a trip [sigma]
+  double constancy_memory = 10.0;  ///< memory of the short-memory load estimates of the constancy test [s]
   double min_window_fill = 0.5; ///< the NIS test needs the window at least this full (fraction of nis_window)
   int max_rate = 1000;          ///< largest update rate the NIS window is sized for [Hz]
   double sensor_timeout = 0.5;  ///< a sensor not updated for this long is not "in use" [s]
@@ -127,7 +134,7 @@ struct LoadEstimate {
   double nis_window = 0.0;   ///< sum over the window
   int nis_dof = 0;           ///< scalar measurements in the window
   double nis_lower = 0.0, nis_upper = 0.0;  ///< the window's 95 % two-sided chi-square bounds
-  double nis_bound = 0.0;    ///< the MODEL_MISMATCH bound (1 - nis_alpha quantile)
+  double nis_bound = 0.0;    ///< the MODEL_MISMATCH bound: max(1 - nis_alpha quantile, nis_margin dof)
   double drift = 0.0;        ///< largest load drift this trip [its sigma]
   bool mismatch = false;     ///< MODEL_MISMATCH condition
   bool nis_exceeded = false; ///< ... because of the NIS window
@@ -212,11 +219,16 @@ class LoadEstimator {
   double Fa_c_ = 0.0, M_c_ = 0.0;          // the configured load (prior)
   double Fa_ = 0.0, PFa_ = 0.0;            // longitudinal filter: estimate and variance
   double M_ = 0.0, PM_ = 0.0;              // lateral filter
+  double FaF_ = 0.0, PFaF_ = 0.0, MF_ = 0.0, PMF_ = 0.0;  // the same with a short memory (constancy test)
+  double const_drift_ = 0.0;               // |short - whole| / its sigma, largest of Fa and M
+  double base_fy_ = 0.0, base_om_ = 0.0, base_rope_ = 0.0;  // the open-loop twin's measurements
   CageResponse twin_resp_;                 // the twin's response at this tick
   double pred_fy_ = 0.0, pred_om_ = 0.0, pred_rope_ = 0.0;  // predictions (prior)
   double h_fy_ = 0.0, h_om_ = 0.0, h_rope_ = 0.0;           // sensitivities of the measurements
   int run_fa_ = 0, run_m_ = 0;             // consecutive gated samples
-  double env_fy_ = 0.0, env_om_ = 0.0, env_rope_ = 0.0, env_t_ = 0.0;  // oscillation envelopes (model error)
+  double env_fy_ = 0.0, env_om_ = 0.0, env_rope_ = 0.0, env_t_ = 0.0;
+  double start_rope_ = 0.0, jump_rope_ = 0.0;  // rope-load model error of the start transient, of a jump of a [N]
+  double last_a_ = 0.0;                    // a at the last prediction  // oscillation envelopes (model error)
   double tick_nis_ = 0.0;
   int tick_dof_ = 0;
   double last_upd_[3] = {-1e300, -1e300, -1e300};  // model time of each sensor's last accepted update
