@@ -5,6 +5,7 @@
 
 #include "hoist/fast_solver.hpp"
 #include "hoist/forecast.hpp"
+#include "hoist/load_estimator.hpp"
 #include "hoist/scenario.hpp"
 #include "hoist/simulator.hpp"
 
@@ -130,4 +131,34 @@ TEST(NoAlloc, CounterSeesAllocations) {
   const long mid = allocationCount();
   FastSolver s(model);  // sizes its workspace in the library
   EXPECT_GT(allocationCount() - mid, 10);
+}
+
+TEST(NoAlloc, LoadEstimatorTickAllocatesNothing) {
+  // The estimator's per-tick path (the daemon calls it in its loop): the
+  // sensitivity step, prediction, updates and the NIS window.
+  ShaftParams p;
+  p.n = 25;
+  auto model = std::make_shared<const ShaftModel>(p);
+  FastSolver twin(model);
+  LoadEstimator est(p, EstimatorSettings{});
+  const HoistProfile prof = HoistProfile::trapezoid();
+  twin.initialize(0.0, prof.at(0.0));
+  est.initialize(0.0, prof.at(0.0));
+  const long before = allocationCount();
+  Eigen::internal::set_is_malloc_allowed(false);
+  double acc = 0.0;
+  for (int k = 1; k <= 3000; ++k) {
+    const double t = k * 0.01;
+    twin.step(t, prof.at(t));
+    est.advance(t, prof.at(t), 1);
+    est.predict(twin.response());
+    est.updateImu(0.007, 1e-5);
+    if (k % 2) est.updateImuAccel(0.007);
+    est.updateRopeLoad(8800.0 + (k % 7));
+    acc += est.finish().nis_window;
+    if (k == 1500) est.initialize(t, prof.at(t));  // a new stream
+  }
+  Eigen::internal::set_is_malloc_allowed(true);
+  EXPECT_EQ(allocationCount() - before, 0);
+  EXPECT_TRUE(std::isfinite(acc));
 }
