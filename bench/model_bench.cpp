@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "hoist/fast_solver.hpp"
+#include "hoist/load_estimator.hpp"
 #include "hoist/simulator.hpp"
 
 namespace {
@@ -87,6 +88,47 @@ void BM_FastStepLongitudinalFused(benchmark::State& state) {
   state.counters["fused"] = static_cast<double>(state.range(1));
 }
 BENCHMARK(BM_FastStepLongitudinalFused)->ArgsProduct({{20, 50, 200}, {0, 1}})->Unit(benchmark::kMicrosecond);
+
+/// One daemon tick of the twin alone (0) and of the twin with the load
+/// estimator (1): the sensitivity step, the prediction, an IMU and a rope-load
+/// update and the NIS window; side by side at n.
+void BM_TwinTickWithEstimator(benchmark::State& state) {
+  ShaftParams p;
+  p.n = static_cast<int>(state.range(0));
+  const bool with = state.range(1) != 0;
+  auto model = std::make_shared<const ShaftModel>(p);
+  FastSolver s(model);
+  LoadEstimator est(p, EstimatorSettings{});
+  const HoistProfile prof = HoistProfile::trapezoid();
+  const double dt = 0.01;
+  s.initialize(0.0, prof.at(0.0));
+  est.initialize(0.0, prof.at(0.0));
+  long k = 0;
+  for (auto _ : state) {
+    ++k;
+    if (k * dt > 55.0) {
+      state.PauseTiming();
+      k = 1;
+      s.initialize(0.0, prof.at(0.0));
+      est.initialize(0.0, prof.at(0.0));
+      state.ResumeTiming();
+    }
+    const double t = k * dt;
+    const Kinematics kin = prof.at(t);
+    s.step(t, kin);
+    if (with) {
+      est.advance(t, kin, 1);
+      est.predict(s.response());
+      est.updateImu(0.0074, 1e-5);
+      est.updateRopeLoad(8848.0);
+      benchmark::DoNotOptimize(est.finish().theta);
+    }
+    benchmark::DoNotOptimize(s.response().lambda[1]);
+  }
+  state.counters["n"] = p.n;
+  state.counters["estimator"] = with ? 1 : 0;
+}
+BENCHMARK(BM_TwinTickWithEstimator)->ArgsProduct({{25, 50}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(BM_FastStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Arg(400)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PaperStep)->Arg(10)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kMicrosecond)->MinTime(0.5);
