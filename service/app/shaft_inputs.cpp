@@ -8,7 +8,7 @@
 #include "forecast_scheduler.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
-#include "hoist/service/alarm_command.hpp"
+#include "hoist/contract/alarm_command.hpp"
 #include "hoist/service/messages.hpp"
 #include "hoist/service/winder_decode.hpp"
 
