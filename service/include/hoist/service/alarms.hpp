@@ -218,6 +218,8 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 /// All alarms of the twin.
 class AlarmEngine {
  public:
+  /// The number of binary alarms; which ones, in which order, is the slot
+  /// table in alarms.cpp (kSlotTable).
   static constexpr int kSlots = 14;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
@@ -244,7 +246,7 @@ class AlarmEngine {
   double ropeOverloadThreshold() const;
   /// MODEL_FAULT events report `value` against `limit` (e.g. an implausible
   /// output and its bound; 1/0 for a non-finite state).
-  void setModelFaultDetail(double value, double limit) { alarms_[7].setDetail(value, limit); }
+  void setModelFaultDetail(double value, double limit);
   /// Look-ahead result (issue 17): `predicted` true while the latest
   /// forecast has a scenario that crosses the threshold within the horizon;
   /// `seconds` when (after the forecast's start), `horizon` the horizon
