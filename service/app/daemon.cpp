@@ -2,23 +2,18 @@
 #include "daemon.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
-#include <ctime>
-#include <fstream>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <systemd/sd-daemon.h>
 #include <thread>
 #include <random>
-#include <sstream>
 #include <unistd.h>
 
 #include "hoist/bus/lcm_util.hpp"
-#include "hoist/io/checked_file.hpp"
+#include "hoist/rt/clock.hpp"
+#include "run_report.hpp"
 #include "hoist/version.hpp"
 
 namespace hoist::svc {
@@ -27,18 +22,8 @@ namespace asio = boost::asio;
 using std::chrono::duration;
 using std::chrono::duration_cast;
 
-namespace {
-/// Steady-clock span in nanoseconds (the cost split).
-inline std::int64_t nanos(std::chrono::steady_clock::duration d) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
-}
-/// User + system CPU time of the whole process [ns].
-std::int64_t processCpuNanos() {
-  timespec ts{};
-  if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0) return 0;
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
-}  // namespace
+using rt::nanos;
+using rt::processCpuNanos;
 
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
@@ -107,6 +92,25 @@ Daemon::~Daemon() {
 }
 
 bool Daemon::start() {
+  if (!checkLcm()) return false;
+  applyRealtimeSettings();
+  if (!openInput()) return false;
+  openOutput();
+  armLcm();
+  watchOutputGroup();
+  startForecasts();
+  // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
+  // never receives them.
+  startWatchdog();
+  unblockStopSignals();
+  armSignals();
+  startSchedules();
+  logStarted();
+  started_ = true;
+  return true;
+}
+
+bool Daemon::checkLcm() {
   if (!lcm_.good()) {
     out_->error("cannot open LCM at {}; for multicast on one machine see docs/service.md "
                 "(ip link set lo multicast on; ip route add 224.0.0.0/4 dev lo)",
@@ -117,59 +121,69 @@ bool Daemon::start() {
     out_->error("cannot open the LCM output URL {} ([service] lcm_url_out)", bus::describeLcmUrl(opt_.lcm_url_out));
     return false;
   }
+  return true;
+}
+
+void Daemon::applyRealtimeSettings() {
   rt_ = applyRealtime(opt_.realtime);
   (rt_.all_granted ? out_->info("real-time settings: {}", rt_.summary())
                    : out_->warn("real-time settings: {} (running without them)", rt_.summary()));
+}
+
+bool Daemon::openInput() {
   // udpm:// (and LCM's default): our own receive path, which dispatches only
   // the subscribed channels by exact name and stores nothing per channel
   // name seen (LCM 1.3.1 would; udpm_receiver.hpp).  Other providers go
   // through LCM (literal names, regex-escaped).
   UdpmUrl udpm;
   std::string why;
-  if (parseUdpmUrl(opt_.lcm_url, udpm, why)) {
-    receiver_ = std::make_unique<UdpmReceiver>();
-    // Without recv_buf_size in the URL the buffer holds 200 ms of every
-    // shaft's inputs (about 2 KiB of kernel memory per datagram on
-    // loopback), at least 1 MiB and at most 64 MiB.
-    double inputs_per_s = 0.0;
-    for (const auto& s : shafts_) inputs_per_s += s->config().service.rate;
-    const double want = std::clamp(0.2 * inputs_per_s * 2048.0, 1048576.0, 67108864.0);
-    if (!receiver_->open(udpm, why, static_cast<int>(want))) {
-      out_->error("cannot open the LCM input socket for {}: {}", bus::describeLcmUrl(opt_.lcm_url), why);
-      return false;
-    }
-    for (auto& s : shafts_) {
-      s->subscribe(receiver_.get());
-      s->setIgnoredCounter(&ignored_);
-    }
-    lcm_fd_.assign(receiver_->fd());
-    out_->info("input socket: receive buffer {} KiB granted ({} KiB asked{})", receiver_->rcvbuf() / 1024,
-               (udpm.recv_buf_size > 0 ? udpm.recv_buf_size : static_cast<int>(want)) / 1024,
-               udpm.recv_buf_size > 0 ? ", recv_buf_size of the URL" : "");
-  } else {
+  if (!parseUdpmUrl(opt_.lcm_url, udpm, why)) {
     for (auto& s : shafts_) s->subscribe();
     lcm_fd_.assign(lcm_.getFileno());
+    return true;
   }
-  // Outputs: our own publisher for udpm URLs (one sendmmsg per batch of the
-  // tick's cage/shape messages instead of one sendmsg each); else LCM's.
-  {
-    const std::string& out_url = lcm_out_ ? opt_.lcm_url_out : opt_.lcm_url;
-    UdpmUrl u;
-    std::string why_out;
-    if (parseUdpmUrl(out_url, u, why_out)) {
-      sender_ = std::make_unique<UdpmSender>();
-      if (sender_->open(u, why_out)) {
-        for (auto& s : shafts_) s->setSender(sender_.get());
-      } else {
-        out_->warn("own output socket for {} failed ({}); publishing through LCM", bus::describeLcmUrl(out_url), why_out);
-        sender_.reset();
-      }
-    }
+  receiver_ = std::make_unique<UdpmReceiver>();
+  // Without recv_buf_size in the URL the buffer holds 200 ms of every
+  // shaft's inputs (about 2 KiB of kernel memory per datagram on
+  // loopback), at least 1 MiB and at most 64 MiB.
+  double inputs_per_s = 0.0;
+  for (const auto& s : shafts_) inputs_per_s += s->config().service.rate;
+  const double want = std::clamp(0.2 * inputs_per_s * 2048.0, 1048576.0, 67108864.0);
+  if (!receiver_->open(udpm, why, static_cast<int>(want))) {
+    out_->error("cannot open the LCM input socket for {}: {}", bus::describeLcmUrl(opt_.lcm_url), why);
+    return false;
   }
-  armLcm();
+  for (auto& s : shafts_) {
+    s->subscribe(receiver_.get());
+    s->setIgnoredCounter(&ignored_);
+  }
+  lcm_fd_.assign(receiver_->fd());
+  out_->info("input socket: receive buffer {} KiB granted ({} KiB asked{})", receiver_->rcvbuf() / 1024,
+             (udpm.recv_buf_size > 0 ? udpm.recv_buf_size : static_cast<int>(want)) / 1024,
+             udpm.recv_buf_size > 0 ? ", recv_buf_size of the URL" : "");
+  return true;
+}
+
+void Daemon::openOutput() {
+  // Our own publisher for udpm URLs (one sendmmsg per batch of the tick's
+  // cage/shape messages instead of one sendmsg each); else LCM's.
+  const std::string& out_url = lcm_out_ ? opt_.lcm_url_out : opt_.lcm_url;
+  UdpmUrl u;
+  std::string why_out;
+  if (!parseUdpmUrl(out_url, u, why_out)) return;
+  sender_ = std::make_unique<UdpmSender>();
+  if (sender_->open(u, why_out)) {
+    for (auto& s : shafts_) s->setSender(sender_.get());
+  } else {
+    out_->warn("own output socket for {} failed ({}); publishing through LCM", bus::describeLcmUrl(out_url), why_out);
+    sender_.reset();
+  }
+}
+
+void Daemon::watchOutputGroup() {
   // [service] lcm_url_out elsewhere: the input socket cannot see a second
   // publisher of our outputs, so a receive-only socket on the output group
-  // watches our own HOIST_HEALTH channels (issue 12.5).
+  // watches our own HOIST_HEALTH channels.
   if (lcm_out_) {
     UdpmUrl out_udpm;
     std::string out_why;
@@ -201,21 +215,25 @@ bool Daemon::start() {
       }
     }
   }
-  if (pool_ && !pool_->empty()) {
-    pool_->start();
-    out_->info("look-ahead forecasts: {} shaft(s) on one pool of {} worker thread(s)", pool_->jobs(),
-               pool_->workers());
-  }
-  // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
-  // never receives them.
-  startWatchdog();
+}
+
+void Daemon::startForecasts() {
+  if (!pool_ || pool_->empty()) return;
+  pool_->start();
+  out_->info("look-ahead forecasts: {} shaft(s) on one pool of {} worker thread(s)", pool_->jobs(),
+             pool_->workers());
+}
+
+void Daemon::unblockStopSignals() {
   // The stop signals are handled on this (the loop) thread; hoist-twind's
   // main() blocks them before any helper thread exists (see main.cpp).
   sigset_t stop_signals;
   sigemptyset(&stop_signals);
   for (int sig : {SIGINT, SIGTERM, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) sigaddset(&stop_signals, sig);
   pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
-  armSignals();
+}
+
+void Daemon::startSchedules() {
   start_ = Clock::now();
   cpu0_ = processCpuNanos();
   const std::size_t n = shafts_.size();
@@ -227,6 +245,10 @@ bool Daemon::start() {
     g->k = 1;
     armTimer(*g);
   }
+}
+
+void Daemon::logStarted() {
+  const std::size_t n = shafts_.size();
   for (const auto& sp : shafts_) {
     const ShaftTwin& s = *sp;
     const TwinConfig& c = s.config();
@@ -239,8 +261,6 @@ bool Daemon::start() {
                s.channels().health, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
   }
   if (n > 1) out_->info("hoist-twind started: {} shafts on one loop, {} schedule(s)", n, groups_.size());
-  started_ = true;
-  return true;
 }
 
 int Daemon::run() {
@@ -456,127 +476,24 @@ void Daemon::watchdogMain(std::chrono::microseconds interval) {
   }
 }
 
-// ---- the run report ------------------------------------------------------------
-
-namespace {
-nlohmann::ordered_json histogramJson(const LatencyHistogram& h) {
-  nlohmann::ordered_json bins = nlohmann::ordered_json::array();
-  for (int b = 0; b < LatencyHistogram::kBins; ++b)
-    if (h.binCount(b) != 0) bins.push_back({LatencyHistogram::binLowerUs(b), h.binCount(b)});
-  return {{"count", h.count()}, {"p50", h.quantile(0.5)},     {"p99", h.quantile(0.99)},
-          {"p999", h.quantile(0.999)}, {"max", h.max()}, {"bins", std::move(bins)}};
-}
-}  // namespace
+// ---- the run report (run_report.hpp) --------------------------------------------
 
 bool Daemon::writeReport() const {
   if (opt_.report_path.empty()) return true;
-  char host[256] = "";
-  gethostname(host, sizeof host - 1);
-  const std::time_t now = std::time(nullptr);
-  char date[64];
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  const double ran = started_ ? duration<double>((stopping_ ? stop_time_ : Clock::now()) - start_).count() : 0.0;
-  nlohmann::ordered_json j;
-  j["tool"] = "hoist-twind";
-  j["version"] = hoist::kVersionString;
-  j["command"] = opt_.command_line;
-  j["host"] = host;
-  j["date"] = date;
-  j["cpus_online"] = sysconf(_SC_NPROCESSORS_ONLN);
-  j["duration_s"] = ran;
-  j["stop_reason"] = stop_reason_;
-  j["realtime"] = {{"memory_lock", rt_.mlockall}, {"scheduling", rt_.scheduling}, {"affinity", rt_.affinity}};
-  j["log_lines_dropped"] = log_.dropped();
-  if (receiver_)
-    j["input_socket"] = {{"rcvbuf_bytes", receiver_->rcvbuf()},
-                         {"datagrams", receiver_->received()},
-                         {"kernel_drops", receiver_->refreshKernelDrops()},
-                         {"ignored", receiver_->ignored()},
-                         {"malformed", receiver_->malformed()}};
-  if (sender_) j["output_socket"] = {{"datagrams", sender_->sent()}, {"system_calls", sender_->systemCalls()}};
-  {
-    // Per twin and tick, in microseconds: where the process's CPU time went
-    // (issue 13).  model_step excludes the envelope; tick_other is the rest
-    // of each shaft's tick (alarms, health bookkeeping, histograms) and the
-    // loop around it; receive is every drain of the input socket;
-    // timer_and_rest is the process's CPU time (user + system, all threads)
-    // minus all of the above: timer wake-ups, Asio, the kernel's share of
-    // the work not inside those calls, the log thread.
-    std::int64_t model = 0, env = 0, publish = 0, tick = 0, shaft_ticks = 0, exact = 0, bounded = 0;
-    for (const auto& sp : shafts_) {
-      const ShaftRunStats st = sp->runStats();
-      model += st.ns_model;
-      env += st.ns_envelope;
-      publish += st.ns_publish;
-      tick += st.ns_tick;
-      shaft_ticks += st.ticks;
-      exact += st.envelope_exact;
-      bounded += st.envelope_bounded;
-    }
-    const double cpu = static_cast<double>(processCpuNanos() - cpu0_);
-    const double per = shaft_ticks > 0 ? 1e-3 / static_cast<double>(shaft_ticks) : 0.0;
-    const double other = static_cast<double>(ns_ticks_ - model - publish);
-    publish += ns_flush_;  // the batched sends (outside the shafts' ticks)
-    j["cost_split_us_per_twin_tick"] = {
-        {"twin_ticks", shaft_ticks},
-        {"model_step", per * static_cast<double>(model - env)},
-        {"envelope", per * static_cast<double>(env)},
-        {"publish", per * static_cast<double>(publish)},
-        {"receive", per * static_cast<double>(ns_receive_)},
-        {"tick_other", per * other},
-        {"timer_and_rest", per * (cpu - static_cast<double>(ns_ticks_ + ns_receive_ + ns_flush_))},
-        {"process_cpu", per * cpu},
-        {"envelope_exact", exact},
-        {"envelope_bounded", bounded}};
-    (void)tick;
-  }
-  j["histogram_note"] =
-      "times in microseconds; " + std::to_string(LatencyHistogram::kPerDecade) +
-      " logarithmic bins per decade from 0.1 us, so quantiles are bin centres (about 1.2 % resolution); "
-      "bins are [lower edge, count]";
-  nlohmann::ordered_json shafts = nlohmann::ordered_json::array();
-  for (const auto& sp : shafts_) {
-    const ShaftRunStats s = sp->runStats();
-    const TwinConfig& c = sp->config();
-    nlohmann::ordered_json o;
-    o["label"] = s.label;
-    o["channel_prefix"] = c.service.channel_prefix;
-    o["clock"] = toString(c.service.clock);
-    o["rate_hz"] = c.service.rate;
-    o["modes"] = c.shaft.n;
-    o["ticks"] = s.ticks;
-    o["steps"] = s.steps;
-    o["deadline_misses"] = s.deadline_misses;
-    o["inputs_accepted"] = s.accepted;
-    o["inputs_rejected"] = s.rejected;
-    o["sequence_gaps"] = s.seq_gaps;
-    o["alarm_events"] = s.alarm_events;
-    o["model_faults"] = s.model_faults;
-    o["publish_failures"] = s.publish_failures;
-    o["nonfinite_withheld"] = s.nonfinite_blocked;
-    o["step_us"] = histogramJson(*s.step);
-    o["late_us"] = histogramJson(*s.late);
-    shafts.push_back(std::move(o));
-  }
-  j["shafts"] = std::move(shafts);
-  const std::string tmp = opt_.report_path + ".tmp";
-  try {
-    // Every byte checked, with the errno text (hoist/io/checked_file.hpp).
-    hoist::io::CheckedFile f(tmp, "--report");
-    // Invalid UTF-8 (a path or host name) is replaced, never a throw at stop.
-    f.write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
-    f.close();
-  } catch (const hoist::io::WriteError& e) {
-    out_->error("cannot write the run report: {}", e.what());
-    std::remove(tmp.c_str());
-    return false;
-  }
-  if (std::rename(tmp.c_str(), opt_.report_path.c_str()) != 0) {
-    out_->error("cannot write the run report {}: rename from {}: {}", opt_.report_path, tmp, std::strerror(errno));
-    return false;
-  }
-  out_->info("run report written to {}", opt_.report_path);
-  return true;
+  RunFacts f;
+  f.command_line = opt_.command_line;
+  f.duration_s = started_ ? duration<double>((stopping_ ? stop_time_ : Clock::now()) - start_).count() : 0.0;
+  f.stop_reason = stop_reason_;
+  f.realtime = rt_;
+  f.log_lines_dropped = static_cast<std::int64_t>(log_.dropped());
+  f.receiver = receiver_.get();
+  f.sender = sender_.get();
+  f.ns_ticks = ns_ticks_;
+  f.ns_receive = ns_receive_;
+  f.ns_flush = ns_flush_;
+  f.cpu_ns = processCpuNanos() - cpu0_;
+  for (const auto& sp : shafts_) f.shafts.push_back(sp.get());
+  return writeRunReport(opt_.report_path, f, *out_);
 }
 
 }  // namespace hoist::svc

@@ -103,6 +103,17 @@ class Daemon {
     std::unique_ptr<boost::asio::steady_timer> timer;
   };
 
+  // start(), step by step
+  bool checkLcm();               ///< the LCM instances opened
+  void applyRealtimeSettings();  ///< mlockall / SCHED_FIFO / affinity as asked, reported
+  bool openInput();              ///< own udpm receive path (or LCM's); shafts subscribed
+  void openOutput();             ///< own udpm publisher for udpm output URLs
+  void watchOutputGroup();       ///< lcm_url_out elsewhere: watch our own HOIST_HEALTH there
+  void startForecasts();         ///< the forecast pool's workers
+  void unblockStopSignals();     ///< the stop signals, handled on the loop thread
+  void startSchedules();         ///< the clock starts; shafts announce themselves; timers armed
+  void logStarted();             ///< one start line per shaft
+
   void armLcm();
   void drainInput();  ///< the own receive path: read what is queued (timed)
   void flushOutputs();  ///< the own publisher: send what the tick queued (timed)

@@ -30,7 +30,7 @@
 
 #include "hoist/forecast.hpp"
 #include "hoist/service/config.hpp"
-#include "hoist/service/latest_mailbox.hpp"
+#include "hoist/rt/latest_mailbox.hpp"
 
 namespace hoist::svc {
 
@@ -92,8 +92,8 @@ class ForecastJob {
   double max_length_;
   ForecastWorkspace ws_;
   MotionProfile plan_profile_;
-  LatestMailbox<ForecastSnapshot> in_;
-  LatestMailbox<ForecastResult> out_;
+  rt::LatestMailbox<ForecastSnapshot> in_;
+  rt::LatestMailbox<ForecastResult> out_;
   std::atomic<bool> busy_{false};
   ForecastResult direct_result_;  ///< --clock input: runNow()'s result
 };

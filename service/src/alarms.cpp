@@ -9,52 +9,6 @@
 
 namespace hoist::svc {
 
-const char* toString(AlarmKind k) {
-  switch (k) {
-    case AlarmKind::CagePosY: return "CAGE_POS_Y";
-    case AlarmKind::CageNegY: return "CAGE_NEG_Y";
-    case AlarmKind::GuideRope: return "GUIDE_ROPE";
-    case AlarmKind::InputStale: return "INPUT_STALE";
-    case AlarmKind::ModelFault: return "MODEL_FAULT";
-    case AlarmKind::ModelDomain: return "MODEL_DOMAIN";
-    case AlarmKind::DuplicatePublisher: return "DUPLICATE_PUBLISHER";
-    case AlarmKind::RopeSlack: return "ROPE_SLACK";
-    case AlarmKind::RopeOverload: return "ROPE_OVERLOAD";
-    case AlarmKind::PredictedClearance: return "PREDICTED_CLEARANCE";
-    case AlarmKind::PredictedSlack: return "PREDICTED_SLACK";
-  }
-  return "?";
-}
-
-const char* toString(AlarmLevel l) {
-  switch (l) {
-    case AlarmLevel::None: return "NONE";
-    case AlarmLevel::Warning: return "WARNING";
-    case AlarmLevel::Critical: return "CRITICAL";
-  }
-  return "?";
-}
-
-const char* toString(AlarmEventType e) {
-  switch (e) {
-    case AlarmEventType::Raise: return "RAISE";
-    case AlarmEventType::Clear: return "CLEAR";
-    case AlarmEventType::Ack: return "ACK";
-    case AlarmEventType::Shelve: return "SHELVE";
-    case AlarmEventType::Unshelve: return "UNSHELVE";
-    case AlarmEventType::Reannounce: return "REANNOUNCE";
-  }
-  return "?";
-}
-
-std::optional<AlarmKind> parseAlarmKind(std::string_view s) {
-  for (int i = 0; i < kAlarmKinds; ++i) {
-    const auto k = static_cast<AlarmKind>(i);
-    if (s == toString(k)) return k;
-  }
-  return std::nullopt;
-}
-
 void AlarmConfig::validate() const {
   auto bad = [](const char* key, const std::string& why) {
     throw std::invalid_argument(std::string("alarms.") + key + ": " + why);
@@ -227,126 +181,192 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 // ---- AlarmEngine -------------------------------------------------------------
 
 namespace {
-// Slot layout: 0/1 CAGE_POS_Y W/C, 2/3 CAGE_NEG_Y W/C, 4/5 GUIDE_ROPE W/C,
-// 6 INPUT_STALE W, 7 MODEL_FAULT C, 8 MODEL_DOMAIN C, 9 DUPLICATE_PUBLISHER W,
-// 10 ROPE_SLACK C, 11 ROPE_OVERLOAD C, 12 PREDICTED_CLEARANCE W, 13 PREDICTED_SLACK W.
-int slotOf(AlarmKind k, AlarmLevel l) {
-  const int crit = l == AlarmLevel::Critical ? 1 : 0;
-  switch (k) {
-    case AlarmKind::CagePosY: return 0 + crit;
-    case AlarmKind::CageNegY: return 2 + crit;
-    case AlarmKind::GuideRope: return 4 + crit;
-    case AlarmKind::InputStale: return l == AlarmLevel::Warning ? 6 : -1;
-    case AlarmKind::ModelFault: return l == AlarmLevel::Critical ? 7 : -1;
-    case AlarmKind::ModelDomain: return l == AlarmLevel::Critical ? 8 : -1;
-    case AlarmKind::DuplicatePublisher: return l == AlarmLevel::Warning ? 9 : -1;
-    case AlarmKind::RopeSlack: return l == AlarmLevel::Critical ? 10 : -1;
-    case AlarmKind::RopeOverload: return l == AlarmLevel::Critical ? 11 : -1;
-    case AlarmKind::PredictedClearance: return l == AlarmLevel::Warning ? 12 : -1;
-    case AlarmKind::PredictedSlack: return l == AlarmLevel::Warning ? 13 : -1;
-  }
+
+/// How a slot's settings follow from the [alarms] section.
+enum class Rule : std::uint8_t {
+  Clearance,    ///< excursion against warning_/critical_fraction x its gap, deadband x gap, on/off delay;
+                ///< the CRITICAL one latches with latch_critical
+  Flag,         ///< a 0/1 condition (threshold 0.5), no delays, never latched
+  FaultFlag,    ///< a flag that always latches (a model fault is an instant)
+  LatchedFlag,  ///< a flag that latches with latch_critical
+  RopeLow,      ///< lambda_0 at or below slack_fraction x the static force (low alarm), force_deadband
+  RopeHigh,     ///< lambda_0 at or above overload_fraction x the static force, force_deadband
+  Prediction,   ///< a flag raised at once with the forecast, cleared after off_delay, never latched
+};
+
+/// One binary alarm of the engine; its slot is its row.
+struct SlotRow {
+  AlarmKind kind;
+  AlarmLevel level;
+  Rule rule;
+  double AlarmConfig::*gap;  ///< Rule::Clearance: the gap it is a fraction of; else nullptr
+};
+
+/// The alarm slots: the one place that says which (kind, level) alarms exist,
+/// in the order of AlarmEngine::alarms().  A new alarm is one row here (and
+/// its kind in hoist/contract/alarm_vocabulary.hpp, its setter below).
+constexpr std::array<SlotRow, AlarmEngine::kSlots> kSlotTable{{
+    {AlarmKind::CagePosY, AlarmLevel::Warning, Rule::Clearance, &AlarmConfig::gap_pos_y},
+    {AlarmKind::CagePosY, AlarmLevel::Critical, Rule::Clearance, &AlarmConfig::gap_pos_y},
+    {AlarmKind::CageNegY, AlarmLevel::Warning, Rule::Clearance, &AlarmConfig::gap_neg_y},
+    {AlarmKind::CageNegY, AlarmLevel::Critical, Rule::Clearance, &AlarmConfig::gap_neg_y},
+    {AlarmKind::GuideRope, AlarmLevel::Warning, Rule::Clearance, &AlarmConfig::guide_rope_gap},
+    {AlarmKind::GuideRope, AlarmLevel::Critical, Rule::Clearance, &AlarmConfig::guide_rope_gap},
+    {AlarmKind::InputStale, AlarmLevel::Warning, Rule::Flag, nullptr},
+    {AlarmKind::ModelFault, AlarmLevel::Critical, Rule::FaultFlag, nullptr},
+    {AlarmKind::ModelDomain, AlarmLevel::Critical, Rule::LatchedFlag, nullptr},
+    {AlarmKind::DuplicatePublisher, AlarmLevel::Warning, Rule::Flag, nullptr},
+    {AlarmKind::RopeSlack, AlarmLevel::Critical, Rule::RopeLow, nullptr},
+    {AlarmKind::RopeOverload, AlarmLevel::Critical, Rule::RopeHigh, nullptr},
+    {AlarmKind::PredictedClearance, AlarmLevel::Warning, Rule::Prediction, nullptr},
+    {AlarmKind::PredictedSlack, AlarmLevel::Warning, Rule::Prediction, nullptr},
+}};
+
+/// The slot of (kind, level), or -1 if there is no such alarm.
+constexpr int slotOf(AlarmKind k, AlarmLevel l) {
+  for (std::size_t i = 0; i < kSlotTable.size(); ++i)
+    if (kSlotTable[i].kind == k && kSlotTable[i].level == l) return static_cast<int>(i);
   return -1;
 }
+
+/// The table is whole: every kind has an alarm, no (kind, level) twice, a
+/// gap exactly for the clearance rows.
+constexpr bool slotTableIsWhole() {
+  for (int k = 0; k < kAlarmKinds; ++k) {
+    const auto kind = static_cast<AlarmKind>(k);
+    if (slotOf(kind, AlarmLevel::Warning) < 0 && slotOf(kind, AlarmLevel::Critical) < 0) return false;
+  }
+  for (std::size_t i = 0; i < kSlotTable.size(); ++i) {
+    if (slotOf(kSlotTable[i].kind, kSlotTable[i].level) != static_cast<int>(i)) return false;
+    if (kSlotTable[i].level == AlarmLevel::None) return false;
+    if ((kSlotTable[i].rule == Rule::Clearance) != (kSlotTable[i].gap != nullptr)) return false;
+  }
+  return true;
+}
+static_assert(slotTableIsWhole(), "kSlotTable: every alarm kind once per level, a gap exactly for clearance rows");
+
+/// The slot of an alarm the engine sets by name (checked at compile time).
+constexpr int slot(AlarmKind k, AlarmLevel l) {
+  const int s = slotOf(k, l);
+  return s >= 0 ? s : throw "no such alarm in kSlotTable";
+}
+constexpr int kInputStale = slot(AlarmKind::InputStale, AlarmLevel::Warning);
+constexpr int kModelFault = slot(AlarmKind::ModelFault, AlarmLevel::Critical);
+constexpr int kModelDomain = slot(AlarmKind::ModelDomain, AlarmLevel::Critical);
+constexpr int kDuplicatePublisher = slot(AlarmKind::DuplicatePublisher, AlarmLevel::Warning);
+constexpr int kRopeSlack = slot(AlarmKind::RopeSlack, AlarmLevel::Critical);
+constexpr int kRopeOverload = slot(AlarmKind::RopeOverload, AlarmLevel::Critical);
+constexpr int kPredictedClearance = slot(AlarmKind::PredictedClearance, AlarmLevel::Warning);
+constexpr int kPredictedSlack = slot(AlarmKind::PredictedSlack, AlarmLevel::Warning);
+
+/// The settings of `row` under `cfg`.
+AlarmSettings settingsOf(const SlotRow& row, const AlarmConfig& cfg) {
+  AlarmSettings s;
+  s.reannounce = cfg.reannounce;
+  switch (row.rule) {
+    case Rule::Clearance: {
+      const double gap = cfg.*row.gap;
+      const bool critical = row.level == AlarmLevel::Critical;
+      s.threshold = (critical ? cfg.critical_fraction : cfg.warning_fraction) * gap;
+      s.deadband = cfg.deadband * gap;
+      s.on_delay = cfg.on_delay;
+      s.off_delay = cfg.off_delay;
+      s.latch = critical && cfg.latch_critical;
+      break;
+    }
+    case Rule::Flag: s.threshold = 0.5; break;
+    case Rule::FaultFlag:
+      s.threshold = 0.5;
+      s.latch = true;
+      break;
+    case Rule::LatchedFlag:
+      s.threshold = 0.5;
+      s.latch = cfg.latch_critical;
+      break;
+    case Rule::RopeLow:
+    case Rule::RopeHigh:
+      // Thresholds follow the static force (updateRopeForce); until the
+      // first update they sit at the fractions of a unit force.
+      s.on_delay = cfg.on_delay;
+      s.off_delay = cfg.off_delay;
+      s.latch = cfg.latch_critical;
+      s.low = row.rule == Rule::RopeLow;
+      s.threshold = s.low ? cfg.slack_fraction : cfg.overload_fraction;
+      s.deadband = cfg.force_deadband;
+      break;
+    case Rule::Prediction:
+      // Raised with the forecast that predicts (no on-delay), cleared after
+      // off_delay without one, never latched.
+      s.threshold = 0.5;
+      s.off_delay = cfg.off_delay;
+      break;
+  }
+  return s;
+}
+
 }  // namespace
 
 AlarmEngine::AlarmEngine(const AlarmConfig& cfg) : cfg_(cfg) {
   cfg_.validate();
-  auto clearanceAlarm = [&](AlarmKind k, double gap) {
-    AlarmSettings w;
-    w.threshold = cfg_.warning_fraction * gap;
-    w.deadband = cfg_.deadband * gap;
-    w.on_delay = cfg_.on_delay;
-    w.off_delay = cfg_.off_delay;
-    w.reannounce = cfg_.reannounce;
-    AlarmSettings c = w;
-    c.threshold = cfg_.critical_fraction * gap;
-    c.latch = cfg_.latch_critical;
-    alarms_[slotOf(k, AlarmLevel::Warning)].configure(k, AlarmLevel::Warning, w);
-    alarms_[slotOf(k, AlarmLevel::Critical)].configure(k, AlarmLevel::Critical, c);
-  };
-  clearanceAlarm(AlarmKind::CagePosY, cfg_.gap_pos_y);
-  clearanceAlarm(AlarmKind::CageNegY, cfg_.gap_neg_y);
-  clearanceAlarm(AlarmKind::GuideRope, cfg_.guide_rope_gap);
-  AlarmSettings flag;
-  flag.threshold = 0.5;
-  flag.reannounce = cfg_.reannounce;
-  alarms_[6].configure(AlarmKind::InputStale, AlarmLevel::Warning, flag);
-  flag.latch = true;  // a model fault is an instant: keep it until acknowledged
-  alarms_[7].configure(AlarmKind::ModelFault, AlarmLevel::Critical, flag);
-  flag.latch = cfg_.latch_critical;
-  alarms_[8].configure(AlarmKind::ModelDomain, AlarmLevel::Critical, flag);
-  flag.latch = false;
-  alarms_[9].configure(AlarmKind::DuplicatePublisher, AlarmLevel::Warning, flag);
-  // Rope force: thresholds follow the static force (updateRopeForce); until
-  // the first update they sit at the fractions of a unit force.
-  AlarmSettings rope;
-  rope.on_delay = cfg_.on_delay;
-  rope.off_delay = cfg_.off_delay;
-  rope.reannounce = cfg_.reannounce;
-  rope.latch = cfg_.latch_critical;
-  rope.low = true;
-  rope.threshold = cfg_.slack_fraction;
-  rope.deadband = cfg_.force_deadband;
-  alarms_[10].configure(AlarmKind::RopeSlack, AlarmLevel::Critical, rope);
-  rope.low = false;
-  rope.threshold = cfg_.overload_fraction;
-  alarms_[11].configure(AlarmKind::RopeOverload, AlarmLevel::Critical, rope);
-  // Predictions: raised with the forecast that predicts (no on-delay),
-  // cleared after off_delay without one, never latched.
-  AlarmSettings pred = flag;
-  pred.off_delay = cfg_.off_delay;
-  alarms_[12].configure(AlarmKind::PredictedClearance, AlarmLevel::Warning, pred);
-  alarms_[13].configure(AlarmKind::PredictedSlack, AlarmLevel::Warning, pred);
+  for (std::size_t i = 0; i < kSlotTable.size(); ++i)
+    alarms_[i].configure(kSlotTable[i].kind, kSlotTable[i].level, settingsOf(kSlotTable[i], cfg_));
 }
+
+void AlarmEngine::setModelFaultDetail(double value, double limit) { alarms_[kModelFault].setDetail(value, limit); }
 
 void AlarmEngine::updateRopeForce(double now, double lambda0, double static_force, AlarmEvents& out) {
   if (std::isfinite(static_force) && static_force > 0.0) {
     const double db = cfg_.force_deadband * static_force;
-    alarms_[10].setThreshold(cfg_.slack_fraction * static_force, db);
-    alarms_[11].setThreshold(cfg_.overload_fraction * static_force, db);
+    alarms_[kRopeSlack].setThreshold(cfg_.slack_fraction * static_force, db);
+    alarms_[kRopeOverload].setThreshold(cfg_.overload_fraction * static_force, db);
   }
-  alarms_[10].update(now, lambda0, out);
-  alarms_[11].update(now, lambda0, out);
+  alarms_[kRopeSlack].update(now, lambda0, out);
+  alarms_[kRopeOverload].update(now, lambda0, out);
 }
 
-double AlarmEngine::ropeSlackThreshold() const { return alarms_[10].settings().threshold; }
-double AlarmEngine::ropeOverloadThreshold() const { return alarms_[11].settings().threshold; }
+double AlarmEngine::ropeSlackThreshold() const { return alarms_[kRopeSlack].settings().threshold; }
+double AlarmEngine::ropeOverloadThreshold() const { return alarms_[kRopeOverload].settings().threshold; }
 
 void AlarmEngine::updateClearance(double now, const Clearance& c, AlarmEvents& out) {
-  for (int i = 0; i < 2; ++i) {
-    alarms_[0 + i].update(now, c.excursion_pos, out);
-    alarms_[2 + i].update(now, c.excursion_neg, out);
-    alarms_[4 + i].update(now, c.guide_deflection, out);
-  }
+  // The WARNING alarms first, then the CRITICAL ones (the order of their events).
+  for (const AlarmLevel level : {AlarmLevel::Warning, AlarmLevel::Critical})
+    for (std::size_t i = 0; i < kSlotTable.size(); ++i) {
+      const SlotRow& row = kSlotTable[i];
+      if (row.rule != Rule::Clearance || row.level != level) continue;
+      const double value = row.kind == AlarmKind::CagePosY   ? c.excursion_pos
+                           : row.kind == AlarmKind::CageNegY ? c.excursion_neg
+                                                             : c.guide_deflection;
+      alarms_[i].update(now, value, out);
+    }
 }
 
 void AlarmEngine::setInputStale(double now, bool stale, AlarmEvents& out) {
-  alarms_[6].update(now, stale ? 1.0 : 0.0, out);
+  alarms_[kInputStale].update(now, stale ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::setModelFault(double now, bool fault, AlarmEvents& out) {
-  alarms_[7].update(now, fault ? 1.0 : 0.0, out);
+  alarms_[kModelFault].update(now, fault ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::setModelDomain(double now, bool outside, double l, double limit, AlarmEvents& out) {
-  if (outside) alarms_[8].setDetail(l, limit);
-  alarms_[8].update(now, outside ? 1.0 : 0.0, out);
+  if (outside) alarms_[kModelDomain].setDetail(l, limit);
+  alarms_[kModelDomain].update(now, outside ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::setDuplicatePublisher(double now, bool seen, double other_id, AlarmEvents& out) {
-  if (seen) alarms_[9].setDetail(other_id, 0.0);
-  alarms_[9].update(now, seen ? 1.0 : 0.0, out);
+  if (seen) alarms_[kDuplicatePublisher].setDetail(other_id, 0.0);
+  alarms_[kDuplicatePublisher].update(now, seen ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::setPredictedClearance(double now, bool predicted, double seconds, double horizon,
                                         AlarmEvents& out) {
-  if (predicted) alarms_[12].setDetail(seconds, horizon);
-  alarms_[12].update(now, predicted ? 1.0 : 0.0, out);
+  if (predicted) alarms_[kPredictedClearance].setDetail(seconds, horizon);
+  alarms_[kPredictedClearance].update(now, predicted ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out) {
-  if (predicted) alarms_[13].setDetail(seconds, horizon);
-  alarms_[13].update(now, predicted ? 1.0 : 0.0, out);
+  if (predicted) alarms_[kPredictedSlack].setDetail(seconds, horizon);
+  alarms_[kPredictedSlack].update(now, predicted ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

@@ -4,7 +4,12 @@
 #      INTERFACE_LINK_LIBRARIES, '|'-separated, read at configure time);
 #   2. nothing under service/ or io/ includes a header from tools/: no include
 #      path naming tools/, and no include that resolves only to a header under
-#      tools/ (e.g. "hoist/study/sweep.hpp" or "timing_report.hpp").
+#      tools/ (e.g. "hoist/study/sweep.hpp" or "timing_report.hpp");
+#   3. nothing under tools/ includes a header from service/: no include path
+#      into service/ ("../../service/app/daemon.hpp"), and no include that
+#      resolves only to a header under service/ (e.g. "hoist/service/alarms.hpp"
+#      or "shaft_twin.hpp").  What the tools share with the daemon is the
+#      contract in msgs/contract.
 # Also: model/ includes only its own headers and system/Eigen headers.
 #   cmake -DROOT=<source dir> -DMODEL_LINKS='Eigen3::Eigen' -P check_layers.cmake
 # Prints "LAYER VIOLATION: ..." for each broken rule and fails.
@@ -89,6 +94,51 @@ foreach(layer service io)
   endforeach()
 endforeach()
 
+# ---- rule 3: tools/ includes nothing from service/ --------------------------
+file(GLOB_RECURSE _svc_headers LIST_DIRECTORIES false RELATIVE "${ROOT}/service"
+     "${ROOT}/service/*.hpp" "${ROOT}/service/*.h")
+set(_svc_names "")
+foreach(h IN LISTS _svc_headers)
+  get_filename_component(_name "${h}" NAME)
+  list(APPEND _svc_names "${_name}")
+  if(h MATCHES "^include/(.+)$")                # service/include/hoist/service/...
+    list(APPEND _svc_names "${CMAKE_MATCH_1}")
+  endif()
+  if(h MATCHES "^[^/]+/(.+)$")                  # relative to service/<x>/
+    list(APPEND _svc_names "${CMAKE_MATCH_1}")
+  endif()
+endforeach()
+list(REMOVE_DUPLICATES _svc_names)
+# Include directories a tools/ file may legitimately reach: every layer's
+# include folder except service's, and the tools' own folders.
+file(GLOB _tool_dirs LIST_DIRECTORIES true "${ROOT}/*/include" "${ROOT}/msgs/*/include" "${ROOT}/tools/*"
+     "${ROOT}/tools/*/include" "${ROOT}/tools/*/src")
+list(FILTER _tool_dirs EXCLUDE REGEX "^${ROOT}/service/")
+file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/tools/*.hpp" "${ROOT}/tools/*.h" "${ROOT}/tools/*.cpp")
+foreach(f IN LISTS _files)
+  file(RELATIVE_PATH _rel "${ROOT}" "${f}")
+  get_filename_component(_dir "${f}" DIRECTORY)
+  _includes("${f}" _incs)
+  foreach(inc IN LISTS _incs)
+    if(inc MATCHES "(^|\\.\\./)service/")
+      _violation("${_rel} includes \"${inc}\" (a path into service/)")
+      continue()
+    endif()
+    if(NOT inc IN_LIST _svc_names)
+      continue()
+    endif()
+    set(_found FALSE)
+    foreach(d IN LISTS _tool_dirs _dir)
+      if(EXISTS "${d}/${inc}")
+        set(_found TRUE)
+      endif()
+    endforeach()
+    if(NOT _found)
+      _violation("${_rel} includes \"${inc}\", a header of service/")
+    endif()
+  endforeach()
+endforeach()
+
 # ---- model/ includes only itself (and Eigen / the standard library) --------
 file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/model/*.hpp" "${ROOT}/model/*.cpp")
 foreach(f IN LISTS _files)
@@ -105,4 +155,4 @@ endforeach()
 if(_violations GREATER 0)
   message(FATAL_ERROR "check_layers: ${_violations} layer violation(s); see README.md, Development")
 endif()
-message("check_layers: OK (hoist_model links: ${MODEL_LINKS}; no tools/ header in service/ or io/)")
+message("check_layers: OK (hoist_model links: ${MODEL_LINKS}; no tools/ header in service/ or io/; no service/ header in tools/)")

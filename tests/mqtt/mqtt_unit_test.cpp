@@ -12,7 +12,7 @@
 #include "hoist/mqtt/command.hpp"
 #include "hoist/mqtt/config.hpp"
 #include "hoist/mqtt/outbox.hpp"
-#include "hoist/service/alarm_command.hpp"
+#include "hoist/contract/alarm_command.hpp"
 
 using namespace hoist::mqtt;
 
@@ -242,21 +242,21 @@ TEST(MqttCommand, RejectsBadPayloadsByReason) {
 }
 
 TEST(MqttCommand, SameValidationAsTheDaemon) {
-  // The bridge and hoist-twind share hoist::svc::validateAlarmCommand.
-  hoist::svc::AlarmCommand c;
-  EXPECT_EQ(hoist::svc::validateAlarmCommand("GUIDE_ROPE", 2, 2, 30.0, c), hoist::svc::CommandError::None);
-  EXPECT_EQ(c.action, hoist::svc::AlarmAction::Shelve);
+  // The bridge and hoist-twind share hoist::contract::validateAlarmCommand.
+  hoist::contract::AlarmCommand c;
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("GUIDE_ROPE", 2, 2, 30.0, c), hoist::contract::CommandError::None);
+  EXPECT_EQ(c.action, hoist::contract::AlarmAction::Shelve);
   ASSERT_TRUE(c.kind.has_value());
-  EXPECT_EQ(*c.kind, hoist::svc::AlarmKind::GuideRope);
-  EXPECT_EQ(c.level, hoist::svc::AlarmLevel::Critical);
-  EXPECT_EQ(hoist::svc::validateAlarmCommand("*", 0, 1, 0.0, c), hoist::svc::CommandError::None);
+  EXPECT_EQ(*c.kind, hoist::contract::AlarmKind::GuideRope);
+  EXPECT_EQ(c.level, hoist::contract::AlarmLevel::Critical);
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("*", 0, 1, 0.0, c), hoist::contract::CommandError::None);
   EXPECT_FALSE(c.kind.has_value());
-  EXPECT_EQ(hoist::svc::validateAlarmCommand("X", 0, 1, 0.0, c), hoist::svc::CommandError::UnknownKind);
-  EXPECT_EQ(hoist::svc::validateAlarmCommand("", -1, 1, 0.0, c), hoist::svc::CommandError::BadLevel);
-  EXPECT_EQ(hoist::svc::validateAlarmCommand("", 0, 0, 0.0, c), hoist::svc::CommandError::BadAction);
-  EXPECT_EQ(hoist::svc::validateAlarmCommand("", 0, 2, std::nan(""), c),
-            hoist::svc::CommandError::BadShelveDuration);
-  for (int i = 0; i < hoist::svc::kCommandErrors; ++i)
-    EXPECT_STRNE(hoist::svc::toString(static_cast<hoist::svc::CommandError>(i)), "?");
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("X", 0, 1, 0.0, c), hoist::contract::CommandError::UnknownKind);
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", -1, 1, 0.0, c), hoist::contract::CommandError::BadLevel);
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 0, 0.0, c), hoist::contract::CommandError::BadAction);
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 2, std::nan(""), c),
+            hoist::contract::CommandError::BadShelveDuration);
+  for (int i = 0; i < hoist::contract::kCommandErrors; ++i)
+    EXPECT_STRNE(hoist::contract::toString(static_cast<hoist::contract::CommandError>(i)), "?");
   for (int i = 0; i < kCommandRejects; ++i) EXPECT_STRNE(toString(static_cast<CommandReject>(i)), "?");
 }

@@ -422,3 +422,52 @@ TEST(AlarmConfig, RopeForceKeysNameTheKey) {
             }),
             "(no error)");
 }
+
+// The alarm slots come from one table (alarms.cpp, kSlotTable): every
+// (kind, level) alarm exists once, carries its own kind and level, and gets
+// the settings its rule gives it under the [alarms] section.
+TEST(AlarmEngine, SlotTableGivesEachAlarmItsKindLevelAndSettings) {
+  AlarmConfig cfg;
+  cfg.gap_pos_y = 0.2;
+  cfg.gap_neg_y = 0.25;
+  cfg.guide_rope_gap = 0.4;
+  cfg.latch_critical = false;
+  cfg.off_delay = 0.7;
+  const AlarmEngine eng(cfg);
+  int found = 0;
+  for (int k = 0; k < kAlarmKinds; ++k)
+    for (const AlarmLevel l : {AlarmLevel::Warning, AlarmLevel::Critical})
+      if (const BinaryAlarm* a = eng.find(static_cast<AlarmKind>(k), l)) {
+        ++found;
+        EXPECT_EQ(a->kind(), static_cast<AlarmKind>(k));
+        EXPECT_EQ(a->level(), l);
+      }
+  EXPECT_EQ(found, AlarmEngine::kSlots);
+  // Which alarms exist (the documented layout).
+  const std::pair<AlarmKind, AlarmLevel> expected[] = {
+      {AlarmKind::CagePosY, AlarmLevel::Warning},        {AlarmKind::CagePosY, AlarmLevel::Critical},
+      {AlarmKind::CageNegY, AlarmLevel::Warning},        {AlarmKind::CageNegY, AlarmLevel::Critical},
+      {AlarmKind::GuideRope, AlarmLevel::Warning},       {AlarmKind::GuideRope, AlarmLevel::Critical},
+      {AlarmKind::InputStale, AlarmLevel::Warning},      {AlarmKind::ModelFault, AlarmLevel::Critical},
+      {AlarmKind::ModelDomain, AlarmLevel::Critical},    {AlarmKind::DuplicatePublisher, AlarmLevel::Warning},
+      {AlarmKind::RopeSlack, AlarmLevel::Critical},      {AlarmKind::RopeOverload, AlarmLevel::Critical},
+      {AlarmKind::PredictedClearance, AlarmLevel::Warning}, {AlarmKind::PredictedSlack, AlarmLevel::Warning}};
+  for (const auto& [k, l] : expected) EXPECT_NE(eng.find(k, l), nullptr) << toString(k) << "/" << toString(l);
+  // Settings by rule.
+  const AlarmSettings& neg_c = eng.find(AlarmKind::CageNegY, AlarmLevel::Critical)->settings();
+  EXPECT_DOUBLE_EQ(neg_c.threshold, cfg.critical_fraction * cfg.gap_neg_y);
+  EXPECT_DOUBLE_EQ(neg_c.deadband, cfg.deadband * cfg.gap_neg_y);
+  EXPECT_FALSE(neg_c.latch);  // latch_critical = false
+  const AlarmSettings& guide_w = eng.find(AlarmKind::GuideRope, AlarmLevel::Warning)->settings();
+  EXPECT_DOUBLE_EQ(guide_w.threshold, cfg.warning_fraction * cfg.guide_rope_gap);
+  EXPECT_DOUBLE_EQ(guide_w.off_delay, 0.7);
+  EXPECT_TRUE(eng.find(AlarmKind::ModelFault, AlarmLevel::Critical)->settings().latch);  // always latched
+  EXPECT_FALSE(eng.find(AlarmKind::ModelDomain, AlarmLevel::Critical)->settings().latch);
+  EXPECT_TRUE(eng.find(AlarmKind::RopeSlack, AlarmLevel::Critical)->settings().low);
+  EXPECT_FALSE(eng.find(AlarmKind::RopeOverload, AlarmLevel::Critical)->settings().low);
+  const AlarmSettings& pred = eng.find(AlarmKind::PredictedSlack, AlarmLevel::Warning)->settings();
+  EXPECT_DOUBLE_EQ(pred.off_delay, 0.7);
+  EXPECT_DOUBLE_EQ(pred.on_delay, 0.0);
+  EXPECT_FALSE(pred.latch);
+  EXPECT_DOUBLE_EQ(eng.find(AlarmKind::InputStale, AlarmLevel::Warning)->settings().off_delay, 0.0);
+}

@@ -12,11 +12,12 @@
 #include <thread>
 
 #include "hoist/service/forecast_rules.hpp"
-#include "hoist/service/latest_mailbox.hpp"
+#include "hoist/rt/latest_mailbox.hpp"
 #include "hoist/service/messages.hpp"
 
 using namespace hoist;
 using namespace hoist::svc;
+using hoist::rt::LatestMailbox;
 
 TEST(LatestMailbox, NewestWinsAndReplacedItemsAreCounted) {
   LatestMailbox<int> box(0);

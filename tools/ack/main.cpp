@@ -21,7 +21,7 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
-#include "hoist/service/alarms.hpp"
+#include "hoist/contract/alarm_vocabulary.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"hoist-alarm-ack: acknowledge, shelve or unshelve hoist-twind alarms (one HOIST_ALARM_ACK message)",
@@ -31,12 +31,12 @@ int main(int argc, char** argv) {
   std::string kind = "*", level = "both", user, url, prefix;
   double shelve = 0.0;
   bool unshelve = false;
-  // Every kind the daemon knows (hoist::svc::AlarmKind), so the list cannot
+  // Every kind the daemon knows (hoist::contract::AlarmKind), so the list cannot
   // fall behind the engine.
   std::vector<std::string> kinds{"*"};
   std::string kind_list;
-  for (int i = 0; i < hoist::svc::kAlarmKinds; ++i) {
-    kinds.emplace_back(hoist::svc::toString(static_cast<hoist::svc::AlarmKind>(i)));
+  for (int i = 0; i < hoist::contract::kAlarmKinds; ++i) {
+    kinds.emplace_back(hoist::contract::toString(static_cast<hoist::contract::AlarmKind>(i)));
     kind_list += kinds.back() + ", ";
   }
   app.add_option("--kind", kind, "alarm kind: " + kind_list + "or * for all")
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"warning", "critical", "both"}));
   // The longest shelve the daemon grants ([alarms] max_shelve, default
   // 3600 s): refuse more here rather than have it clamped silently.
-  const double max_shelve = hoist::svc::AlarmConfig{}.max_shelve;
+  const double max_shelve = hoist::contract::kDefaultMaxShelve;
   auto* sh = app.add_option("--shelve", shelve,
                             "shelve for this many seconds instead of acknowledging (at most " +
                                 std::to_string(static_cast<long>(max_shelve)) + " s)")

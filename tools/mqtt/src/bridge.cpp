@@ -31,6 +31,7 @@
 #include "hoist/mqtt/command.hpp"
 #include "hoist/mqtt/outbox.hpp"
 #include "hoist/msg/codec.hpp"
+#include "hoist/rt/log_rate_limiter.hpp"
 
 namespace hoist::mqtt {
 
@@ -68,32 +69,6 @@ const char* eventName(int e) {
   }
   return "?";
 }
-
-/// Allows a few log lines per window, then counts the suppressed ones.
-class LogLimiter {
- public:
-  bool allow(Clock::time_point now, std::uint64_t& suppressed) {
-    if (now - start_ > std::chrono::seconds(10)) {
-      start_ = now;
-      suppressed = suppressed_;
-      suppressed_ = 0;
-      n_ = 0;
-    } else {
-      suppressed = 0;
-    }
-    if (n_ < 5) {
-      ++n_;
-      return true;
-    }
-    ++suppressed_;
-    return false;
-  }
-
- private:
-  Clock::time_point start_{};
-  int n_ = 0;
-  std::uint64_t suppressed_ = 0;
-};
 
 }  // namespace
 
@@ -156,7 +131,11 @@ struct Bridge::Impl {
   std::uint64_t published = 0, publish_errors = 0;
   std::uint64_t cmd_received = 0, cmd_forwarded = 0, cmd_rejected = 0, cmd_lcm_failures = 0;
   std::array<std::uint64_t, kCommandRejects> cmd_by_reason{};
-  LogLimiter cmd_log, lcm_log;
+  /// A few log lines per 10 s for commands and for LCM input, then counted
+  /// (hoist/rt/log_rate_limiter.hpp).
+  static constexpr int kCmdLog = 0, kLcmLog = 1;
+  hoist::rt::LogRateLimiter<2> log_limit{5, 10.0};
+  double sinceStart(Clock::time_point t) const { return std::chrono::duration<double>(t - started).count(); }
   bool logged_too_many_shafts = false;
 
   Impl(const BridgeConfig& c, const std::string& password)
@@ -293,8 +272,8 @@ struct Bridge::Impl {
 
   void decodeError(const char* type, hoist::msg::DecodeStatus st, const std::string& channel) {
     ++decode_errors[std::string(type) + "/" + hoist::msg::toString(st)];
-    std::uint64_t suppressed = 0;
-    if (lcm_log.allow(Clock::now(), suppressed))
+    std::int64_t suppressed = 0;
+    if (log_limit.allow(kLcmLog, sinceStart(Clock::now()), suppressed))
       spdlog::warn("undecodable {} on {} ({}){}", type, printable(channel), hoist::msg::toString(st),
                    suppressed ? fmt::format(" ({} similar lines suppressed)", suppressed) : "");
   }
@@ -355,8 +334,8 @@ struct Bridge::Impl {
   void onAlarm(Shaft& s, const hoist::alarm_t& m) {
     if (!validKind(m.kind) || m.level < 1 || m.level > 2) {
       ++alarm_rejected;
-      std::uint64_t suppressed = 0;
-      if (lcm_log.allow(Clock::now(), suppressed))
+      std::int64_t suppressed = 0;
+      if (log_limit.allow(kLcmLog, sinceStart(Clock::now()), suppressed))
         spdlog::warn("ignored alarm on shaft '{}' with kind '{}' level {} (kind must be [A-Z0-9_]{{1,32}}, level 1 or 2)",
                      s.name, printable(m.kind, 32), int(m.level));
       return;
@@ -625,8 +604,8 @@ struct Bridge::Impl {
       Shaft& s = shafts.at(it->second);
       ++cmd_received;
       const auto now = Clock::now();
-      std::uint64_t suppressed = 0;
-      const bool may_log = cmd_log.allow(now, suppressed);
+      std::int64_t suppressed = 0;
+      const bool may_log = log_limit.allow(kCmdLog, sinceStart(now), suppressed);
       if (may_log && suppressed) spdlog::warn("{} command log lines suppressed", suppressed);
       CommandResult r = parseAckCommand(m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
                                         static_cast<std::size_t>(cfg.max_command_bytes), hoist::bus::wallUtime());

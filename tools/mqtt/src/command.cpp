@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "hoist/msg/codec.hpp"
-#include "hoist/service/alarm_command.hpp"
+#include "hoist/contract/alarm_command.hpp"
 
 namespace hoist::mqtt {
 
@@ -53,22 +53,22 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
       r.detail = printable(error, 120);
       return r;
     }
-    hoist::svc::AlarmCommand cmd;
-    switch (hoist::svc::validateAlarmCommand(r.ack.kind, r.ack.level, r.ack.action, r.ack.shelve_duration, cmd)) {
-      case hoist::svc::CommandError::None: break;
-      case hoist::svc::CommandError::UnknownKind:
+    hoist::contract::AlarmCommand cmd;
+    switch (hoist::contract::validateAlarmCommand(r.ack.kind, r.ack.level, r.ack.action, r.ack.shelve_duration, cmd)) {
+      case hoist::contract::CommandError::None: break;
+      case hoist::contract::CommandError::UnknownKind:
         r.reject = CommandReject::UnknownKind;
         r.detail = "unknown alarm kind '" + printable(r.ack.kind, 32) + "'";
         return r;
-      case hoist::svc::CommandError::BadLevel:
+      case hoist::contract::CommandError::BadLevel:
         r.reject = CommandReject::BadLevel;
         r.detail = "level " + std::to_string(int(r.ack.level)) + " (0 both, 1 WARNING, 2 CRITICAL)";
         return r;
-      case hoist::svc::CommandError::BadAction:
+      case hoist::contract::CommandError::BadAction:
         r.reject = CommandReject::BadAction;
         r.detail = "action " + std::to_string(int(r.ack.action)) + " (1 ack, 2 shelve, 3 unshelve)";
         return r;
-      case hoist::svc::CommandError::BadShelveDuration:
+      case hoist::contract::CommandError::BadShelveDuration:
         r.reject = CommandReject::BadShelveDuration;
         r.detail = "shelve needs a shelve_duration > 0 s";
         return r;

@@ -52,29 +52,21 @@
 #include <optional>
 #include <string_view>
 
+#include "hoist/contract/alarm_vocabulary.hpp"
+
 namespace hoist::svc {
 
-enum class AlarmKind : std::uint8_t {
-  CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher,
-  RopeSlack, RopeOverload,  // issue 17: live rope-force alarms
-  PredictedClearance, PredictedSlack  // issue 17: look-ahead forecasts
-};
-inline constexpr int kAlarmKinds = 11;
+// The alarm vocabulary (kinds, levels, event types, their names) is the
+// contract with the daemon's clients: hoist/contract/alarm_vocabulary.hpp.
+using contract::AlarmEventType;
+using contract::AlarmKind;
+using contract::AlarmLevel;
+using contract::kAlarmKinds;
+using contract::parseAlarmKind;
+using contract::toString;
+
 /// A re-shelve that moves the expiry by less than this [s] is not effective.
 inline constexpr double kReshelveResolution = 1.0;
-
-/// Values match alarm_t.LEVEL_*.
-enum class AlarmLevel : std::int8_t { None = 0, Warning = 1, Critical = 2 };
-
-/// Values match alarm_t.EVENT_*.
-enum class AlarmEventType : std::int8_t {
-  Raise = 1, Clear = 2, Ack = 3, Shelve = 4, Unshelve = 5, Reannounce = 6
-};
-
-const char* toString(AlarmKind k);        ///< "CAGE_POS_Y", ...
-const char* toString(AlarmLevel l);       ///< "NONE", "WARNING", "CRITICAL"
-const char* toString(AlarmEventType e);   ///< "RAISE", ...
-std::optional<AlarmKind> parseAlarmKind(std::string_view s);  ///< case-sensitive names above
 
 /// The [alarms] section (see docs/service.md).  Lengths in metres, times in seconds.
 struct AlarmConfig {
@@ -88,7 +80,7 @@ struct AlarmConfig {
   double off_delay = 1.0;          ///< value must stay under threshold - deadband this long to clear [s]
   double reannounce = 10.0;        ///< re-announce active alarms every ... [s]; 0 = never
   bool latch_critical = true;      ///< CRITICAL stays active until acknowledged
-  double max_shelve = 3600.0;      ///< longest shelve an operator may set [s]
+  double max_shelve = contract::kDefaultMaxShelve;  ///< longest shelve an operator may set [s]
   /// Rope-force alarms (issue 17), as fractions of the static rope force at
   /// the current length (ShaftModel::staticRopeForce, m g + Fa); see
   /// docs/service.md for the defaults' reasons.
@@ -226,6 +218,8 @@ Clearance computeClearance(double y_c, double theta, double h, double guide_defl
 /// All alarms of the twin.
 class AlarmEngine {
  public:
+  /// The number of binary alarms; which ones, in which order, is the slot
+  /// table in alarms.cpp (kSlotTable).
   static constexpr int kSlots = 14;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
@@ -252,7 +246,7 @@ class AlarmEngine {
   double ropeOverloadThreshold() const;
   /// MODEL_FAULT events report `value` against `limit` (e.g. an implausible
   /// output and its bound; 1/0 for a non-finite state).
-  void setModelFaultDetail(double value, double limit) { alarms_[7].setDetail(value, limit); }
+  void setModelFaultDetail(double value, double limit);
   /// Look-ahead result (issue 17): `predicted` true while the latest
   /// forecast has a scenario that crosses the threshold within the horizon;
   /// `seconds` when (after the forecast's start), `horizon` the horizon

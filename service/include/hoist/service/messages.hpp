@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "hoist/service/alarm_command.hpp"
+#include "hoist/contract/alarm_command.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
@@ -40,7 +40,7 @@ struct AlarmTextContext {
 /// (truncated, always terminated; no allocation).
 void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n);
 
-// printable(): hoist/service/alarm_command.hpp.
+// printable(): hoist/contract/alarm_command.hpp.
 
 /// A validated operator command (the rule is validateAlarmCommand, shared with hoist-mqtt).
 using AckCommand = AlarmCommand;

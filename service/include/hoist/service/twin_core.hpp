@@ -45,7 +45,7 @@
 #include <cstdint>
 #include <memory>
 
-#include "hoist/service/alarm_command.hpp"
+#include "hoist/contract/alarm_command.hpp"
 #include "hoist/service/alarms.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/input_validator.hpp"
@@ -106,7 +106,14 @@ class ClockPolicy {
 };
 std::unique_ptr<ClockPolicy> makeClock(ClockMode mode);
 
-// AlarmAction (operator command, alarm_ack_t): hoist/service/alarm_command.hpp.
+// Operator commands (alarm_ack_t) and their validation are the contract with
+// the daemon's clients: hoist/contract/alarm_command.hpp.
+using contract::AlarmAction;
+using contract::AlarmCommand;
+using contract::CommandError;
+using contract::kCommandErrors;
+using contract::printable;
+using contract::validateAlarmCommand;
 
 class TwinCore {
  public:

@@ -7,7 +7,7 @@
 // `user` (default "mqtt") and `utime` (default: the bridge's clock) may be
 // left out.  The JSON is converted by the codec's strict fromJson (unknown
 // keys, wrong types, out-of-range integers rejected) and then validated by
-// the daemon's own rule (hoist::svc::validateAlarmCommand), so the bridge
+// the daemon's own rule (hoist::contract::validateAlarmCommand), so the bridge
 // forwards exactly what hoist-twind would accept.
 #pragma once
 
@@ -16,7 +16,7 @@
 #include <string>
 
 #include "hoist/alarm_ack_t.hpp"
-#include "hoist/service/alarm_command.hpp"
+#include "hoist/contract/alarm_command.hpp"
 
 namespace hoist::mqtt {
 
@@ -44,7 +44,7 @@ struct CommandResult {
 /// Parses and validates one payload.  Never throws.
 CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime);
 
-/// printable(): the daemon's own, hoist/service/alarm_command.hpp.
-using hoist::svc::printable;
+/// printable(): the daemon's own, hoist/contract/alarm_command.hpp.
+using hoist::contract::printable;
 
 }  // namespace hoist::mqtt

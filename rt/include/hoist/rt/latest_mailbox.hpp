@@ -1,4 +1,4 @@
-// hoist/service/latest_mailbox.hpp -- a single-slot, lock-free, wait-free
+// hoist/rt/latest_mailbox.hpp -- a single-slot, lock-free, wait-free
 // mailbox between exactly one writer thread and one reader thread: the
 // reader always gets the NEWEST item; an item the reader has not taken yet
 // is replaced by the next one (counted by the writer as dropped), so a slow
@@ -17,7 +17,7 @@
 #include <array>
 #include <atomic>
 
-namespace hoist::svc {
+namespace hoist::rt {
 
 template <class T>
 class LatestMailbox {
@@ -55,4 +55,4 @@ class LatestMailbox {
   std::atomic<unsigned> middle_{2u};   // the slot in between (| kFresh when unread)
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::rt

@@ -1,4 +1,4 @@
-// hoist/service/alarm_command.hpp -- validation of an operator's alarm command
+// hoist/contract/alarm_command.hpp -- validation of an operator's alarm command
 // (the fields of alarm_ack_t), shared by hoist-twind (commands from LCM) and
 // hoist-mqtt (commands from an MQTT broker), so both accept exactly the same
 // commands.  Pure: no I/O, no LCM types, no allocation.
@@ -8,9 +8,9 @@
 #include <optional>
 #include <string_view>
 
-#include "hoist/service/alarms.hpp"
+#include "hoist/contract/alarm_vocabulary.hpp"
 
-namespace hoist::svc {
+namespace hoist::contract {
 
 /// Operator command; values match alarm_ack_t.ACTION_*.
 enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3 };
@@ -42,4 +42,4 @@ CommandError validateAlarmCommand(std::string_view kind, int level, int action, 
 /// replaced by '?', "..." appended when cut (for network strings in logs).
 std::string printable(const std::string& s, std::size_t max = 64);
 
-}  // namespace hoist::svc
+}  // namespace hoist::contract

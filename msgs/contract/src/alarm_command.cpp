@@ -1,10 +1,10 @@
-// Operator alarm commands: see hoist/service/alarm_command.hpp.
+// Operator alarm commands: see hoist/contract/alarm_command.hpp.
 #include <algorithm>
-#include "hoist/service/alarm_command.hpp"
+#include "hoist/contract/alarm_command.hpp"
 
 #include <cmath>
 
-namespace hoist::svc {
+namespace hoist::contract {
 
 const char* toString(AlarmAction a) {
   switch (a) {
@@ -59,4 +59,4 @@ std::string printable(const std::string& s, std::size_t max) {
   return o;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::contract

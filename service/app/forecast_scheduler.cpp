@@ -1,0 +1,108 @@
+// The forecast scheduler of one shaft: see forecast_scheduler.hpp.
+#include "forecast_scheduler.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "hoist/service/forecast_rules.hpp"
+
+namespace hoist::svc {
+
+ForecastScheduler::ForecastScheduler(ShaftContext& ctx, ShaftOutputs& out) : ctx_(ctx), out_(out) {
+  fast_ = dynamic_cast<const FastSolver*>(&ctx_.core.solver());
+  if (!fast_) throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
+  job_ = std::make_unique<ForecastJob>(ctx_.core.solver().modelPtr(), ctx_.cfg);
+  log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
+}
+
+void ForecastScheduler::setPool(ForecastPool* pool, double phase) {
+  pool_ = pool;
+  phase_ = phase;
+  next_t_ = phase / ctx_.cfg.forecast.rate;
+}
+
+bool ForecastScheduler::acceptPlan(const TripPlan& plan, std::int64_t seq) {
+  const bool first = !have_plan_;
+  have_plan_ = true;
+  plan_ = plan;
+  plan_seq_ = seq;
+  return first;
+}
+
+void ForecastScheduler::afterStep(std::int64_t utime) {
+  TwinCore& core = ctx_.core;
+  const ForecastConfig& fc = ctx_.cfg.forecast;
+  const double tp = core.output().t;
+  const double period = 1.0 / fc.rate;
+  // The published time restarts at the first input (wall clock) or a new
+  // stream: re-align the schedule when it went back.
+  if (tp + period < next_t_) next_t_ = (std::floor(tp / period) + phase_) * period;
+  if (tp + 1e-9 < next_t_) return;
+  while (next_t_ <= tp + 1e-9) next_t_ += period;
+  if (core.degraded() || !core.solver().finite()) {
+    // A state just re-initialized after a fault, stale input, the domain
+    // edge, a limited catch-up: not a state to forecast from.  The
+    // predictions are withdrawn (MODEL_FAULT / INPUT_STALE / MODEL_DOMAIN
+    // say what is wrong).
+    ++ctx_.stats.forecasts_skipped;
+    core.setPredictions(false, 0.0, false, 0.0, fc.horizon);
+    return;
+  }
+  ForecastSnapshot& snap = job_->snapshotSlot();
+  fast_->saveState(snap.state);
+  snap.utime = utime;
+  snap.t_published = tp;
+  snap.has_plan = have_plan_;
+  snap.plan = plan_;
+  snap.plan_seq = plan_seq_;
+  if (core.clock() == ClockMode::Input || !pool_) {
+    // Deterministic: the forecast runs here, at this instant, and its result
+    // is published before the next input is read.
+    const auto c0 = ShaftContext::Clock::now();
+    const ForecastResult& r = job_->runNow();
+    ctx_.sync_pause += ShaftContext::Clock::now() - c0;
+    onResult(r);
+    return;
+  }
+  if (job_->postSnapshot()) ++ctx_.stats.forecasts_dropped;
+  pool_->notify();
+}
+
+void ForecastScheduler::pollResult() {
+  if (const ForecastResult* r = job_->takeResult()) onResult(*r);
+}
+
+void ForecastScheduler::onResult(const ForecastResult& r) {
+  ShaftStats& st = ctx_.stats;
+  if (r.failed) {
+    ++st.forecast_failures;
+    return;
+  }
+  ++st.forecasts;
+  const double us = r.compute_s * 1e6;
+  st.forecast_hist.add(us);
+  st.forecast_total.add(us);
+  if (r.plan_error != PlanError::None) {
+    // The plan was valid when it came, but no longer fits the motion (e.g.
+    // braking already, the target closer than the plan's stopping distance):
+    // "continue" used the no-plan rule.
+    ++st.plan_unusable;
+    std::int64_t suppressed = 0;
+    if (log_limit_.allow(kLogPlan, ctx_.wallNow(), suppressed))
+      ctx_.log.info("{}trip plan seq {} no longer fits the motion at t = {:.2f} s ({}): the continue scenario uses "
+                    "the no-plan rule [{} similar suppressed]",
+                    ctx_.tag, plan_seq_, r.t_published, hoist::toString(r.plan_error), suppressed);
+  }
+  const ForecastSummary* sc[ForecastResult::kScenarios];
+  for (int i = 0; i < ForecastResult::kScenarios; ++i) sc[i] = &r.scenario[i];
+  AlarmCause& cause = ctx_.cause;
+  cause.slack_threshold = slackThreshold(ctx_.cfg, ctx_.core.solver().model(), r.kin.l);
+  const ForecastVerdict v = judgeForecast(sc, ForecastResult::kScenarios, cause.slack_threshold);
+  cause.predicted_clearance_scenario = v.clearance ? ForecastResult::kNames[v.clearance_scenario] : "";
+  cause.predicted_slack_scenario = v.slack ? ForecastResult::kNames[v.slack_scenario] : "";
+  ctx_.core.setPredictions(v.clearance, v.clearance_s, v.slack, v.slack_s, ctx_.cfg.forecast.horizon);
+  out_.publishForecast(r);
+  out_.publishAlarmEvents();
+}
+
+}  // namespace hoist::svc

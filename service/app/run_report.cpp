@@ -1,0 +1,140 @@
+// The daemon's run report: see run_report.hpp.
+#include "run_report.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "hoist/io/checked_file.hpp"
+#include "hoist/version.hpp"
+
+namespace hoist::svc {
+
+namespace {
+
+nlohmann::ordered_json histogramJson(const LatencyHistogram& h) {
+  nlohmann::ordered_json bins = nlohmann::ordered_json::array();
+  for (int b = 0; b < LatencyHistogram::kBins; ++b)
+    if (h.binCount(b) != 0) bins.push_back({LatencyHistogram::binLowerUs(b), h.binCount(b)});
+  return {{"count", h.count()}, {"p50", h.quantile(0.5)},     {"p99", h.quantile(0.99)},
+          {"p999", h.quantile(0.999)}, {"max", h.max()}, {"bins", std::move(bins)}};
+}
+
+/// Per twin and tick, in microseconds: where the process's CPU time went.
+/// model_step excludes the envelope; tick_other is the rest of each shaft's
+/// tick (alarms, health bookkeeping, histograms) and the loop around it;
+/// receive is every drain of the input socket; timer_and_rest is the
+/// process's CPU time (user + system, all threads) minus all of the above:
+/// timer wake-ups, Asio, the kernel's share of the work not inside those
+/// calls, the log thread.
+nlohmann::ordered_json costSplit(const RunFacts& f) {
+  std::int64_t model = 0, env = 0, publish = 0, shaft_ticks = 0, exact = 0, bounded = 0;
+  for (const ShaftTwin* sp : f.shafts) {
+    const ShaftRunStats st = sp->runStats();
+    model += st.ns_model;
+    env += st.ns_envelope;
+    publish += st.ns_publish;
+    shaft_ticks += st.ticks;
+    exact += st.envelope_exact;
+    bounded += st.envelope_bounded;
+  }
+  const double cpu = static_cast<double>(f.cpu_ns);
+  const double per = shaft_ticks > 0 ? 1e-3 / static_cast<double>(shaft_ticks) : 0.0;
+  const double other = static_cast<double>(f.ns_ticks - model - publish);
+  publish += f.ns_flush;  // the batched sends (outside the shafts' ticks)
+  return {{"twin_ticks", shaft_ticks},
+          {"model_step", per * static_cast<double>(model - env)},
+          {"envelope", per * static_cast<double>(env)},
+          {"publish", per * static_cast<double>(publish)},
+          {"receive", per * static_cast<double>(f.ns_receive)},
+          {"tick_other", per * other},
+          {"timer_and_rest", per * (cpu - static_cast<double>(f.ns_ticks + f.ns_receive + f.ns_flush))},
+          {"process_cpu", per * cpu},
+          {"envelope_exact", exact},
+          {"envelope_bounded", bounded}};
+}
+
+nlohmann::ordered_json shaftJson(const ShaftTwin& sp) {
+  const ShaftRunStats s = sp.runStats();
+  const TwinConfig& c = sp.config();
+  nlohmann::ordered_json o;
+  o["label"] = s.label;
+  o["channel_prefix"] = c.service.channel_prefix;
+  o["clock"] = toString(c.service.clock);
+  o["rate_hz"] = c.service.rate;
+  o["modes"] = c.shaft.n;
+  o["ticks"] = s.ticks;
+  o["steps"] = s.steps;
+  o["deadline_misses"] = s.deadline_misses;
+  o["inputs_accepted"] = s.accepted;
+  o["inputs_rejected"] = s.rejected;
+  o["sequence_gaps"] = s.seq_gaps;
+  o["alarm_events"] = s.alarm_events;
+  o["model_faults"] = s.model_faults;
+  o["publish_failures"] = s.publish_failures;
+  o["nonfinite_withheld"] = s.nonfinite_blocked;
+  o["step_us"] = histogramJson(*s.step);
+  o["late_us"] = histogramJson(*s.late);
+  return o;
+}
+
+}  // namespace
+
+bool writeRunReport(const std::string& path, const RunFacts& f, spdlog::logger& log) {
+  char host[256] = "";
+  gethostname(host, sizeof host - 1);
+  const std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  nlohmann::ordered_json j;
+  j["tool"] = "hoist-twind";
+  j["version"] = hoist::kVersionString;
+  j["command"] = f.command_line;
+  j["host"] = host;
+  j["date"] = date;
+  j["cpus_online"] = sysconf(_SC_NPROCESSORS_ONLN);
+  j["duration_s"] = f.duration_s;
+  j["stop_reason"] = f.stop_reason;
+  j["realtime"] = {{"memory_lock", f.realtime.mlockall},
+                   {"scheduling", f.realtime.scheduling},
+                   {"affinity", f.realtime.affinity}};
+  j["log_lines_dropped"] = f.log_lines_dropped;
+  if (f.receiver)
+    j["input_socket"] = {{"rcvbuf_bytes", f.receiver->rcvbuf()},
+                         {"datagrams", f.receiver->received()},
+                         {"kernel_drops", f.receiver->refreshKernelDrops()},
+                         {"ignored", f.receiver->ignored()},
+                         {"malformed", f.receiver->malformed()}};
+  if (f.sender) j["output_socket"] = {{"datagrams", f.sender->sent()}, {"system_calls", f.sender->systemCalls()}};
+  j["cost_split_us_per_twin_tick"] = costSplit(f);
+  j["histogram_note"] =
+      "times in microseconds; " + std::to_string(LatencyHistogram::kPerDecade) +
+      " logarithmic bins per decade from 0.1 us, so quantiles are bin centres (about 1.2 % resolution); "
+      "bins are [lower edge, count]";
+  nlohmann::ordered_json shafts = nlohmann::ordered_json::array();
+  for (const ShaftTwin* sp : f.shafts) shafts.push_back(shaftJson(*sp));
+  j["shafts"] = std::move(shafts);
+  const std::string tmp = path + ".tmp";
+  try {
+    // Every byte checked, with the errno text (hoist/io/checked_file.hpp).
+    hoist::io::CheckedFile file(tmp, "--report");
+    // Invalid UTF-8 (a path or host name) is replaced, never a throw at stop.
+    file.write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    file.close();
+  } catch (const hoist::io::WriteError& e) {
+    log.error("cannot write the run report: {}", e.what());
+    std::remove(tmp.c_str());
+    return false;
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    log.error("cannot write the run report {}: rename from {}: {}", path, tmp, std::strerror(errno));
+    return false;
+  }
+  log.info("run report written to {}", path);
+  return true;
+}
+
+}  // namespace hoist::svc

@@ -1,0 +1,83 @@
+// ShaftContext: what every room of one hosted shaft shares (shaft_twin.hpp
+// draws the rooms): the configuration, the names, the log, the model
+// (TwinCore), the statistics and the shaft's wall clock.  Plain data plus
+// two clock helpers; the rooms hold a reference to it.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "hoist/bus/channels.hpp"
+#include "hoist/rt/rt_log.hpp"
+#include "hoist/service/config.hpp"
+#include "hoist/service/twin_core.hpp"
+#include "shaft_stats.hpp"
+
+namespace hoist::svc {
+
+using rt::RtLog;
+
+/// Operator names (alarm commands) are cut to this many printable characters.
+inline constexpr std::size_t kUserMax = 64;
+
+/// Test-only fault injection (hidden command-line options, tests/hardening).
+struct TestHooks {
+  double inject_fault_at = -1.0;  ///< wall time [s] at which the model state is treated as non-finite once
+  int fail_publish_every = 0;     ///< every N-th LCM publish is treated as failed (0 = never)
+};
+
+/// Who or what caused the alarm events about to be published, for their
+/// text (set by the room that causes them, read by ShaftOutputs).
+struct AlarmCause {
+  std::string user;                              ///< operator of the command being applied ("" for the twin itself)
+  double requested_shelve = 0.0;                 ///< that command's requested shelve duration [s]
+  const char* predicted_clearance_scenario = ""; ///< PREDICTED_CLEARANCE: the scenario that predicts it (static string)
+  const char* predicted_slack_scenario = "";     ///< PREDICTED_SLACK: the scenario that predicts it (static string)
+  double slack_threshold = 0.0;                  ///< PREDICTED_SLACK threshold of the latest forecast [N]
+};
+
+struct ShaftContext {
+  using Clock = std::chrono::steady_clock;
+
+  ShaftContext(const TwinConfig& config, std::string shaft_label, RtLog& rt_log, TestHooks test_hooks,
+               std::int64_t instance)
+      : cfg(config),
+        label(std::move(shaft_label)),
+        tag(label.empty() ? std::string() : "[" + label + "] "),
+        log(rt_log),
+        hooks(test_hooks),
+        instance_id(instance),
+        ch(cfg.service.channel_prefix),
+        core(cfg, cfg.service.clock) {
+    if (cfg.forecast.enabled) cfg.forecast.validate(cfg.service.rate);
+  }
+  ShaftContext(const ShaftContext&) = delete;
+  ShaftContext& operator=(const ShaftContext&) = delete;
+
+  TwinConfig cfg;                 ///< this shaft's effective configuration
+  std::string label;              ///< as given ("" for a daemon with one shaft)
+  std::string tag;                ///< log-line prefix: "[label] " or ""
+  RtLog& log;                     ///< the daemon's real-time log ring (never blocks)
+  TestHooks hooks;                ///< test-only fault injection
+  std::int64_t instance_id = 0;   ///< this process's random id (HOIST_CAGE/HOIST_HEALTH/HOIST_FORECAST)
+  bus::Channels ch;               ///< channel names: prefix + HOIST_*
+  TwinCore core;                  ///< the model, input validation, alarms (no I/O)
+  ShaftStats stats;               ///< every counter and histogram of this shaft
+  AlarmCause cause;               ///< what the next alarm events' text names besides the event
+  Clock::time_point start{};      ///< the loop's start: wall times are measured from it
+  /// --clock input: wall time spent in synchronous forecasts, not counted as
+  /// time passing for this shaft's staleness and health windows (the inputs
+  /// wait in the socket meanwhile; they are not late).
+  Clock::duration sync_pause{};
+
+  /// Wall time of `t` [s] on this shaft's clock.
+  double wallAt(Clock::time_point t) const {
+    return std::chrono::duration<double>(t - start - sync_pause).count();
+  }
+  /// Wall time now [s] on this shaft's clock.
+  double wallNow() const { return wallAt(Clock::now()); }
+};
+
+}  // namespace hoist::svc

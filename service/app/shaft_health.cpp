@@ -1,0 +1,182 @@
+// Statistics and health of one shaft: see shaft_health.hpp.
+#include "shaft_health.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "hoist/bus/lcm_util.hpp"
+
+namespace hoist::svc {
+
+ShaftHealth::ShaftHealth(ShaftContext& ctx) : ctx_(ctx) {
+  statm_fd_ = ::open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
+}
+
+ShaftHealth::~ShaftHealth() {
+  if (statm_fd_ >= 0) ::close(statm_fd_);
+}
+
+bool ShaftHealth::due(double wall) const {
+  const ServiceConfig& s = ctx_.cfg.service;
+  return wall - last_wall_ >= 1.0 / s.health_rate - 0.5 / s.rate;
+}
+
+void ShaftHealth::fill(hoist::health_t& m, double wall) const {
+  const TwinCore& core = ctx_.core;
+  const ShaftStats& st = ctx_.stats;
+  const InputCounters& c = core.counters();
+  const AlarmEngine& al = core.alarms();
+  m.utime = bus::wallUtime();
+  m.uptime = std::max(0.0, wall);
+  m.t = core.publishedTime(core.modelTime());
+  m.window = std::max(0.0, wall - std::max(0.0, last_wall_));
+  m.ticks = st.ticks;
+  m.steps = core.steps();
+  m.deadline_misses = st.deadline_misses;
+  m.step_p50_us = st.step_hist.quantile(0.5);
+  m.step_p99_us = st.step_hist.quantile(0.99);
+  m.step_max_us = st.step_hist.max();
+  m.late_p50_us = st.late_hist.quantile(0.5);
+  m.late_p99_us = st.late_hist.quantile(0.99);
+  m.late_max_us = st.late_hist.max();
+  m.input_age = core.inputAge(wall);
+  m.accepted = c.accepted;
+  m.seq_gaps = c.seq_gaps;
+  m.rejected_total = c.rejectedTotal();
+  for (int i = 0; i < kRejectReasons; ++i) m.rejected[i] = c.rejected[i];
+  m.rejected[kRejectReasons] = st.command_decode_rejects;
+  m.rejected[kRejectReasons + 1] = st.handler_exceptions;
+  for (int i = 0; i < kPlanRejectReasons; ++i)
+    m.rejected[kRejectReasons + 2 + i] = st.plan_rejects[static_cast<std::size_t>(i)];
+  m.forecast_p50_us = st.forecast_hist.count() > 0 ? st.forecast_hist.quantile(0.5) : 0.0;
+  m.forecast_p99_us = st.forecast_hist.count() > 0 ? st.forecast_hist.quantile(0.99) : 0.0;
+  m.forecasts = st.forecasts;
+  m.forecasts_dropped = st.forecasts_dropped;
+  m.forecasts_skipped = st.forecasts_skipped;
+  m.plans_accepted = st.plans_accepted;
+  m.plans_rejected = st.plansRejected();
+  m.alarms_active = al.activeCount();
+  m.alarms_unacked = al.unackedCount();
+  m.alarms_shelved = al.shelvedCount();
+  m.alarm_events = st.alarm_events;
+  m.model_faults = core.modelFaults();
+  m.model_resets = core.modelResets();
+  m.publish_failures = st.publish_failures;
+  m.nonfinite_blocked = st.nonfinite_blocked;
+  m.degraded = core.degraded();
+  m.rss_kb = rssKb();
+  m.commands_dropped = st.commands_dropped;
+  m.commands_invalid = st.commands_invalid;
+  m.catchup_limited = core.catchupLimited();
+  m.datagrams_ignored = ignored_counter_ ? *ignored_counter_ : 0;
+}
+
+void ShaftHealth::endWindow(const hoist::health_t& m, double wall, bool final_report) {
+  ShaftStats& st = ctx_.stats;
+  const InputCounters& c = ctx_.core.counters();
+  if (!final_report)
+    ctx_.log.debug("{}health: t={:.2f} s steps={} step p50/p99/max={:.0f}/{:.0f}/{:.0f} us late "
+                   "p50/p99/max={:.0f}/{:.0f}/{:.0f} us misses={} inputs ok={} rejected={} gaps={} "
+                   "alarms active={} faults={} publish failures={}{}",
+                   ctx_.tag, m.t, m.steps, m.step_p50_us, m.step_p99_us, m.step_max_us, m.late_p50_us,
+                   m.late_p99_us, m.late_max_us, st.deadline_misses, c.accepted, c.rejectedTotal(), c.seq_gaps,
+                   m.alarms_active, m.model_faults, st.publish_failures, m.degraded ? " DEGRADED" : "");
+  // The whole-run histograms take each window at its end (one add per
+  // value per tick instead of two: with hundreds of shafts every histogram
+  // bin touched is a cache miss).
+  st.step_total.merge(st.step_hist);
+  st.late_total.merge(st.late_hist);
+  st.step_hist.reset();
+  st.late_hist.reset();
+  st.forecast_hist.reset();
+  last_wall_ = wall;
+}
+
+void ShaftHealth::logFinal() const {
+  const TwinCore& core = ctx_.core;
+  const ShaftStats& st = ctx_.stats;
+  const InputCounters& c = core.counters();
+  const std::string& tag = ctx_.tag;
+  RtLog& log = ctx_.log;
+  log.info("{}final health: t={:.2f} s ticks={} steps={} over the whole run: step p50/p99/p99.9/max="
+           "{:.1f}/{:.1f}/{:.1f}/{:.0f} us, tick lateness p50/p99/p99.9/max={:.0f}/{:.0f}/{:.0f}/{:.0f} us, "
+           "deadline misses={}; inputs accepted={} rejected={} sequence gaps={}; alarms "
+           "active={} events={}; model faults={} resets={}; publish failures={} withheld "
+           "(non-finite)={}{}",
+           tag, core.modelTime(), st.ticks, core.steps(), st.step_total.quantile(0.5), st.step_total.quantile(0.99),
+           st.step_total.quantile(0.999), st.step_total.max(), st.late_total.quantile(0.5),
+           st.late_total.quantile(0.99), st.late_total.quantile(0.999), st.late_total.max(), st.deadline_misses,
+           c.accepted, c.rejectedTotal(), c.seq_gaps, core.alarms().activeCount(), st.alarm_events,
+           core.modelFaults(), core.modelResets(), st.publish_failures, st.nonfinite_blocked,
+           core.degraded() ? " DEGRADED" : "");
+  for (int i = 0; i < kRejectReasons; ++i)
+    if (c.rejected[i] > 0) log.info("{}  rejected {}: {}", tag, toString(static_cast<RejectReason>(i)), c.rejected[i]);
+  if (st.command_decode_rejects > 0)
+    log.info("{}  rejected alarm commands (command_decode): {}", tag, st.command_decode_rejects);
+  if (st.handler_exceptions > 0) log.info("{}  exceptions caught in LCM handlers: {}", tag, st.handler_exceptions);
+  if (ctx_.cfg.forecast.enabled) {
+    log.info("{}forecasts: {} done (compute p50/p99/max {:.1f}/{:.1f}/{:.1f} ms), {} dropped (worker late), {} "
+             "skipped (degraded), {} failed; trip plans accepted {}, no longer fitting the motion {}",
+             tag, st.forecasts, st.forecast_total.quantile(0.5) / 1e3, st.forecast_total.quantile(0.99) / 1e3,
+             st.forecast_total.max() / 1e3, st.forecasts_dropped, st.forecasts_skipped, st.forecast_failures,
+             st.plans_accepted, st.plan_unusable);
+    for (int i = 0; i < kPlanRejectReasons; ++i)
+      if (st.plan_rejects[static_cast<std::size_t>(i)] > 0)
+        log.info("{}  rejected trip plans {}: {}", tag, toString(static_cast<PlanReject>(i)),
+                 st.plan_rejects[static_cast<std::size_t>(i)]);
+  }
+}
+
+std::int64_t ShaftHealth::rssKb() const {
+  // /proc/self/statm: size resident ... in pages.  pread into a stack
+  // buffer: no allocation.
+  if (statm_fd_ < 0) return -1;
+  char b[128];
+  const ssize_t n = ::pread(statm_fd_, b, sizeof b - 1, 0);
+  if (n <= 0) return -1;
+  b[n] = '\0';
+  long size = 0, resident = 0;
+  if (std::sscanf(b, "%ld %ld", &size, &resident) != 2) return -1;
+  return static_cast<std::int64_t>(resident) * (::sysconf(_SC_PAGESIZE) / 1024);
+}
+
+ShaftRunStats ShaftHealth::runStats() const {
+  ShaftRunStats s;
+  const TwinCore& core = ctx_.core;
+  const ShaftStats& st = ctx_.stats;
+  const InputCounters& c = core.counters();
+  const std::string& prefix = ctx_.cfg.service.channel_prefix;
+  s.label = !ctx_.label.empty() ? ctx_.label : prefix.empty() ? "default" : prefix;
+  s.ticks = st.ticks;
+  s.steps = core.steps();
+  s.deadline_misses = st.deadline_misses;
+  s.accepted = c.accepted;
+  s.rejected = c.rejectedTotal();
+  s.seq_gaps = c.seq_gaps;
+  s.alarm_events = st.alarm_events;
+  s.model_faults = core.modelFaults();
+  s.publish_failures = st.publish_failures;
+  s.nonfinite_blocked = st.nonfinite_blocked;
+  s.step = &st.step_total;
+  s.late = &st.late_total;
+  s.ns_model = st.ns_model;
+  s.ns_envelope = core.envelopeNanos();
+  s.ns_publish = st.ns_publish;
+  s.ns_tick = st.ns_tick;
+  s.envelope_exact = core.envelope().exactEvaluations();
+  s.envelope_bounded = core.envelope().boundedEvaluations();
+  s.forecasts = st.forecasts;
+  s.forecasts_dropped = st.forecasts_dropped;
+  s.forecasts_skipped = st.forecasts_skipped;
+  s.plans_accepted = st.plans_accepted;
+  s.plans_rejected = st.plansRejected();
+  s.commands_applied = st.commands_applied;
+  s.commands_dropped = st.commands_dropped;
+  s.commands_invalid = st.commands_invalid;
+  s.forecast = &st.forecast_total;
+  return s;
+}
+
+}  // namespace hoist::svc

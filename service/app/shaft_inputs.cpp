@@ -1,0 +1,262 @@
+// The inputs of one shaft: see shaft_inputs.hpp.
+#include "shaft_inputs.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <optional>
+
+#include "forecast_scheduler.hpp"
+#include "hoist/alarm_ack_t.hpp"
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/contract/alarm_command.hpp"
+#include "hoist/service/messages.hpp"
+#include "hoist/service/winder_decode.hpp"
+
+namespace hoist::svc {
+
+using std::chrono::duration;
+
+ShaftInputs::ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast)
+    : ctx_(ctx), in_(in), out_(out), forecast_(forecast) {
+  log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
+  routes_[kWinder] = {this, &ctx_.ch.winder, &ShaftInputs::handleWinder, "HOIST_WINDER"};
+  routes_[kAck] = {this, &ctx_.ch.ack, &ShaftInputs::handleAck, "HOIST_ALARM_ACK"};
+  routes_[kTripPlan] = {this, &ctx_.ch.trip_plan, &ShaftInputs::handleTripPlan, "HOIST_TRIP_PLAN"};
+  routes_[kOwnHealth] = {this, &ctx_.ch.health, &ShaftInputs::handleOwnHealth, "HOIST_HEALTH"};
+  text_[0] = '\0';
+}
+
+void ShaftInputs::Route::onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+  try {
+    (self->*handle)(rbuf);
+  } catch (const std::exception& e) {
+    self->handlerFailed(e.what(), name);
+  } catch (...) {
+    self->handlerFailed("unknown exception", name);
+  }
+}
+
+void ShaftInputs::add(bus::InputRouter* router, Route& r) {
+  if (router) {
+    router->add(*r.channel, [&r](const lcm::ReceiveBuffer* rb, const std::string& c) { r.onMessage(rb, c); });
+    return;
+  }
+  // lcm::subscribe takes a regular expression: subscribe to the literal
+  // names (a prefix "mine.1/" must not match "mineX1/").
+  in_.subscribe(regexEscape(*r.channel), &Route::onMessage, &r);
+}
+
+void ShaftInputs::subscribe(bus::InputRouter* router, bool own_health) {
+  // Our own health channel too: another publisher there (by instance_id) is
+  // a second twin on our outputs.  Here when outputs share the input URL;
+  // else the daemon watches the output URL (watchOwnOutputs).
+  add(router, routes_[kWinder]);
+  add(router, routes_[kAck]);
+  if (forecast_) add(router, routes_[kTripPlan]);
+  if (own_health) add(router, routes_[kOwnHealth]);
+}
+
+void ShaftInputs::watchOwnOutputs(bus::InputRouter* router) { add(router, routes_[kOwnHealth]); }
+
+void ShaftInputs::forgetSilentPublisher(double wall) {
+  if (other_seen_wall_ >= 0.0 && wall - other_seen_wall_ > 3.0 / ctx_.cfg.service.health_rate) {
+    other_seen_wall_ = -1.0;
+    ctx_.core.setDuplicatePublisher(false, 0.0);
+  }
+}
+
+// ---- logging -------------------------------------------------------------------
+
+void ShaftInputs::logReject(RejectReason r, const char* detail) {
+  std::int64_t suppressed = 0;
+  if (!log_limit_.allow(static_cast<int>(r), ctx_.wallNow(), suppressed)) return;
+  if (suppressed > 0)
+    ctx_.log.warn("{}rejected winder input ({}): {} [{} similar suppressed]", ctx_.tag, toString(r), detail,
+                  suppressed);
+  else
+    ctx_.log.warn("{}rejected winder input ({}): {}", ctx_.tag, toString(r), detail);
+}
+
+void ShaftInputs::handlerFailed(const char* what, const char* channel) {
+  ++ctx_.stats.handler_exceptions;
+  std::int64_t suppressed = 0;
+  if (log_limit_.allow(kLogHandlerException, ctx_.wallNow(), suppressed))
+    ctx_.log.error("{}exception in the {} handler caught (message dropped): {} [{} similar suppressed]", ctx_.tag,
+                   channel, what, suppressed);
+}
+
+void ShaftInputs::logJunk(const std::string& what) {
+  std::int64_t suppressed = 0;
+  if (!log_limit_.allow(kLogJunkCommand, ctx_.wallNow(), suppressed)) return;
+  if (suppressed > 0) ctx_.log.warn("{}{} junk alarm-command log lines suppressed", ctx_.tag, suppressed);
+  ctx_.log.warn("{}{}", ctx_.tag, what);
+}
+
+void ShaftInputs::rejectPlan(PlanReject r, const char* detail) {
+  ++ctx_.stats.plan_rejects[static_cast<std::size_t>(r)];
+  std::int64_t suppressed = 0;
+  if (!log_limit_.allow(kLogPlan, ctx_.wallNow(), suppressed)) return;
+  ctx_.log.warn("{}rejected trip plan ({}): {} [{} similar suppressed]", ctx_.tag, toString(r), detail, suppressed);
+}
+
+// ---- HOIST_WINDER ----------------------------------------------------------------
+
+void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
+  TwinCore& core = ctx_.core;
+  const double wall = ctx_.wallNow();
+  WinderSample s;
+  const WinderDecode dec = decodeWinder(rbuf->data, rbuf->data_size, winder_in_, s);
+  if (dec != WinderDecode::Ok) {
+    core.rejectUndecodable();
+    std::snprintf(text_, sizeof text_, "%u bytes: %s", static_cast<unsigned>(rbuf->data_size), describe(dec));
+    logReject(RejectReason::Decode, text_);
+    return;
+  }
+
+  const auto t0 = ShaftContext::Clock::now();
+  const InputResult res = core.onInput(s, wall);
+  const auto t1 = ShaftContext::Clock::now();
+  if (!res.accepted) {
+    std::snprintf(text_, sizeof text_, "seq %lld utime %lld v %g a %g%s%g",
+                  static_cast<long long>(s.seq), static_cast<long long>(s.utime), s.v, s.a,
+                  s.has_length ? " length " : " (no length) ", s.has_length ? s.length : 0.0);
+    logReject(res.reason, text_);
+  }
+  if (res.reinitialized)
+    ctx_.log.info("{}new winder stream (seq {}): model re-initialized at l = {} m", ctx_.tag, s.seq,
+                  core.output().kin.l);
+  if (res.republish) out_.publishCage(s.utime);  // the held state, flagged degraded
+  if (res.stepped) {
+    ctx_.stats.step_hist.add(duration<double, std::micro>(t1 - t0).count());
+    out_.publishStep(s.utime);
+    if (forecast_) forecast_->afterStep(s.utime);
+  }
+  out_.publishAlarmEvents();
+}
+
+// ---- HOIST_ALARM_ACK -------------------------------------------------------------
+
+void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
+  // Operator commands are rare and outside the tick: decoding them into the
+  // message's std::strings may allocate.  Anyone on the group can send
+  // commands (docs/security.md): at most max_commands_per_tick are handled
+  // per tick (the rest are dropped and counted); junk is logged under a rate
+  // limit; every EFFECTIVE command is audited (log line and the HOIST_ALARM
+  // events it causes carry the user) and never rate-limited.
+  ShaftStats& st = ctx_.stats;
+  const int budget = ctx_.cfg.service.max_commands_per_tick;
+  if (++commands_this_tick_ > budget) {
+    ++st.commands_dropped;
+    logJunk(fmt::format("alarm command dropped: more than service.max_commands_per_tick = {} this tick", budget));
+    return;
+  }
+  hoist::alarm_ack_t ack;
+  const auto size = static_cast<std::size_t>(rbuf->data_size);
+  // Every length is validated before anything is decoded (a 37-byte command
+  // with a string length of 0 or 0x80000000 used to kill the daemon).
+  if (const auto dst = hoist::msg::checkedDecode(rbuf->data, size, ack); dst != hoist::msg::DecodeStatus::ok) {
+    ++st.command_decode_rejects;
+    ++st.commands_invalid;
+    logJunk(fmt::format("ignored undecodable alarm command ({} bytes, {})", size, hoist::msg::toString(dst)));
+    return;
+  }
+  const std::string user = printable(ack.user, kUserMax);
+  const char* why = "";
+  const std::optional<AckCommand> cmd = validateAck(ack, why);
+  if (!cmd) {
+    ++st.commands_invalid;
+    logJunk(fmt::format("ignored alarm command from '{}' (kind '{}'): {}", user, printable(ack.kind), why));
+    return;
+  }
+  const int n = ctx_.core.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
+  const char* what = cmd->action == AlarmAction::Ack      ? "acknowledge"
+                     : cmd->action == AlarmAction::Shelve ? "shelve"
+                                                          : "unshelve";
+  if (n == 0) {
+    // Not effective (nothing to acknowledge, already shelved, ...): no
+    // state changed, so no event and no audit line (a flood of identical
+    // commands stays silent).
+    logJunk(fmt::format("alarm command from '{}' had no effect: {} {}", user, what,
+                        cmd->kind ? toString(*cmd->kind) : "*"));
+    return;
+  }
+  ++st.commands_applied;
+  char for_s[96] = "";
+  if (cmd->action == AlarmAction::Shelve) {
+    const double eff = std::min(cmd->shelve_duration, ctx_.cfg.alarms.max_shelve);
+    if (eff < cmd->shelve_duration)
+      std::snprintf(for_s, sizeof for_s, " for %g s (requested %g s, clamped to max_shelve)", eff,
+                    cmd->shelve_duration);
+    else
+      std::snprintf(for_s, sizeof for_s, " for %g s", eff);
+  }
+  ctx_.log.info("{}AUDIT operator '{}': {} {}/{}{} -> {} alarm(s)", ctx_.tag, user, what,
+                cmd->kind ? toString(*cmd->kind) : "*", cmd->level == AlarmLevel::None ? "*" : toString(cmd->level),
+                for_s, n);
+  AlarmCause& cause = ctx_.cause;
+  cause.user = user;
+  cause.requested_shelve = cmd->action == AlarmAction::Shelve ? cmd->shelve_duration : 0.0;
+  out_.publishAlarmEvents();
+  cause.user.clear();
+  cause.requested_shelve = 0.0;
+}
+
+// ---- HOIST_TRIP_PLAN -------------------------------------------------------------
+
+void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
+  // Every byte is validated before anything is decoded (checked decoder);
+  // trip_plan_t is flat (no string, no array): decoding allocates nothing.
+  const auto size = static_cast<std::size_t>(rbuf->data_size);
+  if (const auto dst = hoist::msg::checkedDecode(rbuf->data, size, plan_in_); dst != hoist::msg::DecodeStatus::ok) {
+    std::snprintf(text_, sizeof text_, "%zu bytes: %s", size, hoist::msg::toString(dst));
+    rejectPlan(PlanReject::Decode, text_);
+    return;
+  }
+  const trip_plan_t& m = plan_in_;
+  if (forecast_->hasPlan() && m.seq <= forecast_->planSeq()) {
+    std::snprintf(text_, sizeof text_, "seq %lld is not newer than the plan in force (seq %lld)",
+                  static_cast<long long>(m.seq), static_cast<long long>(forecast_->planSeq()));
+    rejectPlan(PlanReject::OldSeq, text_);
+    return;
+  }
+  const TripPlan p{m.target_length, m.vmax, m.amax, m.jerk};
+  const CageOutput& o = ctx_.core.output();
+  const PlanCheck pc = checkPlan(p, ctx_.core.modelTime(), o.kin, ctx_.cfg.shaft, plan_scratch_);
+  if (!pc.ok()) {
+    // describe() allocates: plans are rare, off the tick (as alarm commands).
+    const std::string why = describe(pc);
+    std::snprintf(text_, sizeof text_, "seq %lld target %g m vmax %g amax %g jerk %g at l = %.3f m, v = %.3f m/s, "
+                  "a = %.3f m/s^2: %s",
+                  static_cast<long long>(m.seq), m.target_length, m.vmax, m.amax, m.jerk, o.kin.l, o.kin.v, o.kin.a,
+                  why.c_str());
+    rejectPlan(planReject(pc.error), text_);
+    return;
+  }
+  ++ctx_.stats.plans_accepted;
+  if (forecast_->acceptPlan(p, m.seq))
+    ctx_.log.info("{}trip plan accepted (seq {}): target {} m, vmax {} m/s, amax {} m/s^2, jerk {} m/s^3", ctx_.tag,
+                  m.seq, m.target_length, m.vmax, m.amax, m.jerk);
+}
+
+// ---- our own HOIST_HEALTH from another instance ------------------------------------
+
+void ShaftInputs::handleOwnHealth(const lcm::ReceiveBuffer* rbuf) {
+  // instance_id is the first field after utime: read it without decoding
+  // the whole message (8-byte fingerprint, int64 utime, int64 instance_id).
+  if (rbuf->data_size < 24) return;
+  const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
+  std::int64_t fp = 0, id = 0;
+  for (int i = 0; i < 8; ++i) fp = (fp << 8) | b[i];
+  for (int i = 16; i < 24; ++i) id = static_cast<std::int64_t>((static_cast<std::uint64_t>(id) << 8) | b[i]);
+  if (fp != static_cast<std::int64_t>(hoist::health_t::getHash()) || id == ctx_.instance_id) return;
+  const double wall = ctx_.wallNow();
+  if (!(other_seen_wall_ >= 0.0) || id != other_id_)
+    ctx_.log.error("{}another publisher (instance {}) on {}: a second twin with the same channels? "
+                   "(this one is instance {})", ctx_.tag, id, ctx_.ch.health, ctx_.instance_id);
+  other_id_ = id;
+  other_seen_wall_ = wall;
+  ctx_.core.setDuplicatePublisher(true, static_cast<double>(id));
+  out_.publishAlarmEvents();
+}
+
+}  // namespace hoist::svc

@@ -1,0 +1,97 @@
+// ShaftInputs: the room of one shaft that receives -- it subscribes to the
+// shaft's input channels, decodes and validates every datagram, and acts on
+// it: winder samples go to the model (TwinCore), operator alarm commands
+// (HOIST_ALARM_ACK) are validated, budgeted and applied, trip plans are
+// checked and handed to the ForecastScheduler, and our own HOIST_HEALTH
+// seen from another instance raises DUPLICATE_PUBLISHER.
+//
+// Each input channel is one row of routes_ (channel, handler, name):
+// subscribe() registers every row, on the daemon's receive path or on LCM,
+// and every handler runs inside one try/catch (a throw is counted as
+// "handler_exception" in HOIST_HEALTH and logged, rate-limited).
+//
+// Real time: winder samples and trip plans decode into preallocated
+// messages (no allocation); operator commands are rare and may allocate
+// (their strings), bounded per tick (see handleAck).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+
+#include "hoist/bus/udpm_receiver.hpp"
+#include "hoist/trip_plan_t.hpp"
+#include "hoist/winder_t.hpp"
+#include "shaft_context.hpp"
+#include "shaft_outputs.hpp"
+
+namespace hoist::svc {
+
+class ForecastScheduler;
+
+class ShaftInputs {
+ public:
+  /// `in` receives when the daemon has no own receive path; `forecast` is
+  /// nullptr without [forecast] enabled (trip plans are then not subscribed).
+  ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast);
+  ShaftInputs(const ShaftInputs&) = delete;
+  ShaftInputs& operator=(const ShaftInputs&) = delete;
+
+  /// Subscribe to the input channels (before the loop starts): through
+  /// `router` (the daemon's own udpm receive path, exact names) when given,
+  /// else through LCM (escaped, literal names).  `own_health`: also watch
+  /// our own HOIST_HEALTH here (outputs go to the input URL).
+  void subscribe(bus::InputRouter* router, bool own_health);
+  /// Watch our own HOIST_HEALTH through `router` (the output URL's socket).
+  void watchOwnOutputs(bus::InputRouter* router);
+  /// Once per tick, at its start: a new command budget.
+  void beginTick() { commands_this_tick_ = 0; }
+  /// Once per tick: the other publisher of our outputs is forgotten after
+  /// three health periods without a word.
+  void forgetSilentPublisher(double wall);
+
+ private:
+  using Handle = void (ShaftInputs::*)(const lcm::ReceiveBuffer*);
+  /// One input channel: where it comes from and who handles it.
+  struct Route {
+    ShaftInputs* self = nullptr;       ///< the room
+    const std::string* channel = nullptr;  ///< exact channel name (in ctx.ch)
+    Handle handle = nullptr;           ///< the handler
+    const char* name = "";             ///< for log lines: "HOIST_WINDER", ...
+    /// The guarded entry point (LCM's callback signature).
+    void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  };
+  enum RouteId { kWinder, kAck, kTripPlan, kOwnHealth, kRoutes };
+
+  void handleWinder(const lcm::ReceiveBuffer* rbuf);
+  void handleAck(const lcm::ReceiveBuffer* rbuf);
+  void handleTripPlan(const lcm::ReceiveBuffer* rbuf);
+  void handleOwnHealth(const lcm::ReceiveBuffer* rbuf);
+  void handlerFailed(const char* what, const char* channel);
+  void logReject(RejectReason r, const char* detail);
+  void rejectPlan(PlanReject r, const char* detail);
+  void logJunk(const std::string& what);
+  void add(bus::InputRouter* router, Route& r);
+
+  ShaftContext& ctx_;               ///< the shaft's shared state
+  lcm::LCM& in_;                    ///< LCM's receive path (when the daemon has none of its own)
+  ShaftOutputs& out_;               ///< publishes what an input causes (cage, shape, alarm events)
+  ForecastScheduler* forecast_;     ///< the forecast room (nullptr without forecasts)
+  std::array<Route, kRoutes> routes_{};  ///< the input channels and their handlers
+  // Log rate limiter keys: one per RejectReason, then these.
+  static constexpr int kLogJunkCommand = kRejectReasons;          ///< invalid/ineffective/dropped commands
+  static constexpr int kLogHandlerException = kRejectReasons + 1; ///< exceptions caught in handlers
+  static constexpr int kLogPlan = kRejectReasons + 2;             ///< rejected trip plans
+  static constexpr int kLogKeys = kRejectReasons + 3;             ///< number of keys
+  LogRateLimiter<kLogKeys> log_limit_{5};  ///< rate limit of this room's warning lines
+  int commands_this_tick_ = 0;      ///< valid commands applied or dropped this tick
+  std::int64_t other_id_ = 0;       ///< another publisher's instance id
+  double other_seen_wall_ = -1.0;   ///< when it was last seen (< 0: not seen)
+  hoist::winder_t winder_in_;       ///< decode scratch of HOIST_WINDER
+  hoist::trip_plan_t plan_in_;      ///< decode scratch of HOIST_TRIP_PLAN (flat: no allocation)
+  MotionProfile plan_scratch_;      ///< checkPlan's workspace
+  char text_[256];                  ///< the text of a rejection being logged
+};
+
+}  // namespace hoist::svc

@@ -1,0 +1,299 @@
+// The outputs of one shaft: see shaft_outputs.hpp.
+#include "shaft_outputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "hoist/bus/lcm_util.hpp"
+#include "hoist/service/messages.hpp"
+
+namespace hoist::svc {
+
+namespace {
+
+bool finiteAll(const hoist::cage_state_t& m) {
+  bool ok = std::isfinite(m.t) && std::isfinite(m.l) && std::isfinite(m.v) && std::isfinite(m.a) &&
+            std::isfinite(m.x_c) && std::isfinite(m.y_c) && std::isfinite(m.theta) &&
+            std::isfinite(m.y_top) && std::isfinite(m.y_bottom) &&
+            std::isfinite(m.guide_deflection) && std::isfinite(m.clearance_pos_y) &&
+            std::isfinite(m.clearance_neg_y) && std::isfinite(m.clearance_guide) &&
+            std::isfinite(m.min_clearance) && std::isfinite(m.rope_slack_threshold) &&
+            std::isfinite(m.rope_overload_threshold);
+  for (double v : m.lambdas) ok = ok && std::isfinite(v);
+  return ok;
+}
+
+bool finiteAll(const hoist::guide_shape_t& m) {
+  bool ok = std::isfinite(m.t) && std::isfinite(m.l) && std::isfinite(m.h);
+  for (int i = 0; i < m.n; ++i)
+    ok = ok && std::isfinite(m.x[i]) && std::isfinite(m.y1[i]) && std::isfinite(m.y2[i]);
+  return ok;
+}
+
+bool finiteAll(const hoist::alarm_t& m) {
+  return std::isfinite(m.t) && std::isfinite(m.value) && std::isfinite(m.threshold) &&
+         std::isfinite(m.shelved_for);
+}
+
+bool finiteAll(const hoist::health_t& m) {
+  return std::isfinite(m.uptime) && std::isfinite(m.t) && std::isfinite(m.rate) &&
+         std::isfinite(m.window) && std::isfinite(m.step_p50_us) && std::isfinite(m.step_p99_us) &&
+         std::isfinite(m.step_max_us) && std::isfinite(m.late_p50_us) &&
+         std::isfinite(m.late_p99_us) && std::isfinite(m.late_max_us) && std::isfinite(m.input_age);
+}
+
+bool finiteAll(const hoist::forecast_t& m) {
+  bool ok = std::isfinite(m.t_start) && std::isfinite(m.l) && std::isfinite(m.v) && std::isfinite(m.a) &&
+            std::isfinite(m.compute_time);
+  for (int i = 0; i < m.num_scenarios; ++i) {
+    const hoist::forecast_scenario_t& s = m.scenarios[static_cast<std::size_t>(i)];
+    ok = ok && std::isfinite(s.horizon) && std::isfinite(s.t_reached) && std::isfinite(s.min_clearance) &&
+         std::isfinite(s.t_min_clearance) && std::isfinite(s.t_warning) && std::isfinite(s.t_critical) &&
+         std::isfinite(s.peak_y_c) && std::isfinite(s.peak_theta) && std::isfinite(s.lambda0_min) &&
+         std::isfinite(s.lambda0_max);
+    for (double v : s.peak_lambdas) ok = ok && std::isfinite(v);
+    for (int k = 0; k < s.num_points; ++k) {
+      const auto j = static_cast<std::size_t>(k);
+      ok = ok && std::isfinite(s.series_t[j]) && std::isfinite(s.series_min_clearance[j]) &&
+           std::isfinite(s.series_lambda0_min[j]) && std::isfinite(s.series_lambda0_max[j]);
+    }
+  }
+  return ok;
+}
+
+int divider(double rate, double sub_rate) {
+  if (!(sub_rate > 0.0)) return 1;
+  return std::max(1, static_cast<int>(std::lround(rate / sub_rate)));
+}
+
+}  // namespace
+
+ShaftOutputs::ShaftOutputs(ShaftContext& ctx, lcm::LCM& out) : ctx_(ctx), out_(out) {
+  const ServiceConfig& s = ctx_.cfg.service;
+  cage_div_ = divider(s.rate, s.cage_rate);
+  shape_div_ = divider(s.rate, s.shape_rate);
+  log_limit_.setLimit(s.log_rate_limit);
+
+  // Preallocate every outgoing message and its buffer.
+  const GuideRopeEnvelope& sh = ctx_.core.shape();
+  shape_msg_.n = static_cast<int32_t>(sh.depths().size());
+  shape_msg_.x.assign(sh.depths().data(), sh.depths().data() + sh.depths().size());
+  shape_msg_.y1.assign(shape_msg_.n, 0.0);
+  shape_msg_.y2.assign(shape_msg_.n, 0.0);
+  shape_msg_.h = ctx_.cfg.shaft.h;
+  health_msg_.clock = toString(s.clock);
+  health_msg_.rate = s.rate;
+  health_msg_.n_reasons = kRejectReasons + kExtraReasons;
+  health_msg_.reject_reason.resize(kRejectReasons + kExtraReasons);
+  health_msg_.rejected.assign(kRejectReasons + kExtraReasons, 0);
+  for (int i = 0; i < kRejectReasons; ++i)
+    health_msg_.reject_reason[i] = toString(static_cast<RejectReason>(i));
+  health_msg_.reject_reason[kRejectReasons] = "command_decode";
+  health_msg_.reject_reason[kRejectReasons + 1] = "handler_exception";
+  for (int i = 0; i < kPlanRejectReasons; ++i)
+    health_msg_.reject_reason[kRejectReasons + 2 + i] = toString(static_cast<PlanReject>(i));
+
+  // Look-ahead forecasts: the message, sized once.  A non-finite scenario
+  // keeps its status in the message; the numbers of a scenario that stopped
+  // early cover [0, t_reached].
+  if (ctx_.cfg.forecast.enabled) {
+    forecast_msg_.instance_id = ctx_.instance_id;
+    forecast_msg_.num_scenarios = ForecastResult::kScenarios;
+    forecast_msg_.scenarios.resize(ForecastResult::kScenarios);
+    for (int i = 0; i < ForecastResult::kScenarios; ++i) {
+      hoist::forecast_scenario_t& m = forecast_msg_.scenarios[static_cast<std::size_t>(i)];
+      m.name = ForecastResult::kNames[i];
+      m.num_points = static_cast<int16_t>(ctx_.cfg.forecast.series_points);
+      m.series_t.assign(m.num_points, 0.0);
+      m.series_min_clearance.assign(m.num_points, 0.0);
+      m.series_lambda0_min.assign(m.num_points, 0.0);
+      m.series_lambda0_max.assign(m.num_points, 0.0);
+    }
+    forecast_buf_.resize(static_cast<std::size_t>(forecast_msg_.getEncodedSize()) + 64);
+  }
+  alarm_msg_.kind.reserve(64);
+  alarm_msg_.user.reserve(kUserMax + 4);
+  cage_msg_.instance_id = ctx_.instance_id;
+  health_msg_.instance_id = ctx_.instance_id;
+  alarm_msg_.message.reserve(sizeof text_);
+  cage_buf_.resize(static_cast<std::size_t>(cage_msg_.getEncodedSize()) + 64);
+  shape_buf_.resize(static_cast<std::size_t>(shape_msg_.getEncodedSize()) + 64);
+  alarm_buf_.resize(static_cast<std::size_t>(alarm_msg_.getEncodedSize()) + 64 + sizeof text_);
+  health_buf_.resize(static_cast<std::size_t>(health_msg_.getEncodedSize()) + 256);
+  text_[0] = '\0';
+}
+
+bool ShaftOutputs::publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len,
+                                bool batch) {
+  ShaftStats& st = ctx_.stats;
+  const int every = ctx_.hooks.fail_publish_every;
+  const bool injected = every > 0 && ++st.publish_attempts % every == 0;
+  const auto n = static_cast<std::size_t>(len);
+  bool ok = false;
+  if (injected) ok = false;
+  else if (sender_ && batch && sender_->queue(channel, buf.data(), n, &st.publish_failures)) ok = true;
+  else if (sender_ && n <= UdpmSender::kMaxPayload) ok = sender_->send(channel, buf.data(), n);
+  else ok = out_.publish(channel, buf.data(), static_cast<unsigned int>(len)) == 0;
+  if (!ok) {
+    ++st.publish_failures;
+    std::int64_t suppressed = 0;
+    if (log_limit_.allow(kLogPublish, ctx_.wallNow(), suppressed))
+      ctx_.log.error("{}LCM publish failed on {} [{} similar suppressed]", ctx_.tag, channel, suppressed);
+    return false;
+  }
+  return true;
+}
+
+template <class Msg>
+bool ShaftOutputs::encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
+                                    bool batch) {
+  ShaftStats& st = ctx_.stats;
+  if (!finiteAll(msg)) {
+    ++st.nonfinite_blocked;
+    std::int64_t suppressed = 0;
+    if (log_limit_.allow(kLogPublish, ctx_.wallNow(), suppressed))
+      ctx_.log.error("{}withheld a message on {}: non-finite value", ctx_.tag, channel);
+    return false;
+  }
+  const int need = msg.getEncodedSize();
+  if (need > static_cast<int>(buf.size())) {
+    ++st.publish_failures;
+    ctx_.log.error("{}message on {} too large for its buffer ({} > {} bytes)", ctx_.tag, channel, need, buf.size());
+    return false;
+  }
+  const int len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  if (len < 0) {
+    ++st.publish_failures;
+    return false;
+  }
+  return publishBytes(channel, buf, len, batch);
+}
+
+void ShaftOutputs::publishTick(std::int64_t k, std::int64_t utime) {
+  if (k % cage_div_ == 0) publishCage(utime, true);
+  if (ctx_.cfg.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime, true);
+}
+
+void ShaftOutputs::publishStep(std::int64_t utime) {
+  publishCage(utime);
+  const double rate = ctx_.cfg.service.shape_rate;
+  const double t = ctx_.core.modelTime();
+  if (rate > 0.0 && t - last_shape_t_ >= 1.0 / rate - 1e-9) {
+    last_shape_t_ = t;
+    publishShape(utime, false);
+  }
+}
+
+void ShaftOutputs::publishCage(std::int64_t utime, bool batch) {
+  cage_msg_.utime = utime;
+  cage_msg_.seq = cage_seq_++;
+  toCageMessage(ctx_.core.output(), cage_msg_);
+  encodeAndPublish(ctx_.ch.cage, cage_msg_, cage_buf_, batch);
+}
+
+void ShaftOutputs::publishShape(std::int64_t utime, bool batch) {
+  TwinCore& core = ctx_.core;
+  core.evaluateShape();
+  const GuideRopeEnvelope& sh = core.shape();
+  shape_msg_.utime = utime;
+  shape_msg_.t = core.output().t;
+  shape_msg_.l = core.output().kin.l;
+  for (int i = 0; i < shape_msg_.n; ++i) {
+    shape_msg_.y1[i] = sh.y1()(i);
+    shape_msg_.y2[i] = sh.y2()(i);
+  }
+  encodeAndPublish(ctx_.ch.shape, shape_msg_, shape_buf_, batch);
+}
+
+void ShaftOutputs::publishAlarmEvents() {
+  TwinCore& core = ctx_.core;
+  const AlarmEvents& ev = core.events();
+  if (ev.empty()) return;
+  const std::int64_t utime = bus::wallUtime();
+  const AlarmCause& cause = ctx_.cause;
+  AlarmTextContext tc;
+  tc.alarms = &ctx_.cfg.alarms;
+  tc.stale_timeout = core.staleTimeout();
+  tc.range = core.validRange();
+  tc.fault_what = core.lastFaultWhat();
+  tc.requested_shelve = cause.requested_shelve;
+  tc.predicted_clearance_scenario = cause.predicted_clearance_scenario;
+  tc.predicted_slack_scenario = cause.predicted_slack_scenario;
+  tc.slack_threshold = cause.slack_threshold;
+  alarm_msg_.user.assign(cause.user);  // who caused these events ("" for the twin itself)
+  RtLog& log = ctx_.log;
+  const std::string& tag = ctx_.tag;
+  for (const AlarmEvent& e : ev) {
+    describeAlarm(e, tc, text_, sizeof text_);
+    alarm_msg_.utime = utime;
+    alarm_msg_.id = alarm_id_++;
+    alarm_msg_.t = core.publishedTime(e.t);  // one time origin with HOIST_CAGE.t
+    alarm_msg_.kind.assign(toString(e.kind));
+    alarm_msg_.level = static_cast<int8_t>(e.level);
+    alarm_msg_.event_type = static_cast<int8_t>(e.type);
+    alarm_msg_.active = e.active;
+    alarm_msg_.acked = e.acked;
+    alarm_msg_.shelved = e.shelved;
+    alarm_msg_.latched = e.latched;
+    alarm_msg_.value = e.value;
+    alarm_msg_.threshold = e.threshold;
+    alarm_msg_.shelved_for = e.shelved_for;
+    alarm_msg_.message.assign(text_);
+    if (encodeAndPublish(ctx_.ch.alarm, alarm_msg_, alarm_buf_)) ++ctx_.stats.alarm_events;
+    switch (e.type) {
+      case AlarmEventType::Reannounce: log.debug("{}alarm: {} (t = {:.2f} s)", tag, text_, alarm_msg_.t); break;
+      case AlarmEventType::Raise:
+        if (e.level == AlarmLevel::Critical) log.error("{}ALARM {} (t = {:.2f} s)", tag, text_, alarm_msg_.t);
+        else log.warn("{}ALARM {} (t = {:.2f} s)", tag, text_, alarm_msg_.t);
+        break;
+      default:
+        if (!cause.user.empty()) log.info("{}alarm: {} (t = {:.2f} s, by '{}')", tag, text_, alarm_msg_.t, cause.user);
+        else log.info("{}alarm: {} (t = {:.2f} s)", tag, text_, alarm_msg_.t);
+        break;
+    }
+  }
+  if (ev.dropped() > 0) log.error("{}{} alarm events dropped (event buffer full)", tag, ev.dropped());
+  core.clearEvents();
+}
+
+void ShaftOutputs::publishForecast(const ForecastResult& r) {
+  forecast_t& m = forecast_msg_;
+  m.utime = r.utime;
+  m.seq = forecast_seq_++;
+  m.t_start = r.t_published;
+  m.l = r.kin.l;
+  m.v = r.kin.v;
+  m.a = r.kin.a;
+  m.plan_seq = r.plan_seq;
+  m.compute_time = r.compute_s;
+  for (int i = 0; i < ForecastResult::kScenarios; ++i) {
+    const ForecastSummary& f = r.scenario[i];
+    forecast_scenario_t& s = m.scenarios[static_cast<std::size_t>(i)];
+    s.status = static_cast<int8_t>(f.status);
+    s.horizon = f.horizon;
+    s.t_reached = f.t_reached;
+    s.min_clearance = f.min_clearance;
+    s.t_min_clearance = f.t_min_clearance;
+    s.t_warning = f.t_warning;
+    s.t_critical = f.t_critical;
+    s.peak_y_c = f.peak_y_c;
+    s.peak_theta = f.peak_theta;
+    for (int k = 0; k < 4; ++k) s.peak_lambdas[k] = f.peak_lambda[static_cast<std::size_t>(k)];
+    s.lambda0_min = f.lambda0_min;
+    s.lambda0_max = f.lambda0_max;
+    const int np = std::clamp(f.series_count, 0, static_cast<int>(s.series_t.size()));
+    s.num_points = static_cast<int16_t>(np);
+    for (int k = 0; k < np; ++k) {
+      const auto j = static_cast<std::size_t>(k);
+      s.series_t[j] = f.series_t[j];
+      s.series_min_clearance[j] = f.series_min_clearance[j];
+      s.series_lambda0_min[j] = f.series_lambda0_min[j];
+      s.series_lambda0_max[j] = f.series_lambda0_max[j];
+    }
+  }
+  encodeAndPublish(ctx_.ch.forecast, m, forecast_buf_);
+}
+
+void ShaftOutputs::publishHealth() { encodeAndPublish(ctx_.ch.health, health_msg_, health_buf_); }
+
+}  // namespace hoist::svc

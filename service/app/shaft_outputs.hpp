@@ -1,0 +1,90 @@
+// ShaftOutputs: the room of one shaft that owns every outgoing message --
+// preallocated messages and encode buffers, the all-finite check, encoding,
+// and publishing through the daemon's UdpmSender or LCM -- for HOIST_CAGE,
+// HOIST_GUIDE_SHAPE, HOIST_ALARM, HOIST_HEALTH and HOIST_FORECAST.  What
+// goes into HOIST_HEALTH is ShaftHealth's job; it fills health() before
+// publishHealth().
+//
+// Real time: nothing here allocates after construction (the alarm text goes
+// into a fixed buffer; the std::string fields of the messages are reserved).
+#pragma once
+
+#include <cstdint>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <vector>
+
+#include "forecast_pool.hpp"
+#include "hoist/alarm_t.hpp"
+#include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_t.hpp"
+#include "hoist/guide_shape_t.hpp"
+#include "hoist/health_t.hpp"
+#include "shaft_context.hpp"
+#include "udpm_sender.hpp"
+
+namespace hoist::svc {
+
+class ShaftOutputs {
+ public:
+  /// Publishes through `out` unless setSender() gives the daemon's own publisher.
+  ShaftOutputs(ShaftContext& ctx, lcm::LCM& out);
+  ShaftOutputs(const ShaftOutputs&) = delete;
+  ShaftOutputs& operator=(const ShaftOutputs&) = delete;
+
+  /// The daemon's own udpm publisher (udpm_sender.hpp), used instead of
+  /// LCM's publish when set (udpm output URLs).
+  void setSender(UdpmSender* s) { sender_ = s; }
+  /// The LCM instance that publishes (the input one unless lcm_url_out is set).
+  const lcm::LCM& lcm() const { return out_; }
+
+  /// --clock wall, after the model stepped in tick k: HOIST_CAGE every
+  /// cage_rate period and HOIST_GUIDE_SHAPE every shape_rate period, queued
+  /// on the sender (sent at the daemon's next flush, in the same tick).
+  void publishTick(std::int64_t k, std::int64_t utime);
+  /// --clock input, after an input was stepped: HOIST_CAGE, and
+  /// HOIST_GUIDE_SHAPE when a shape_rate period of model time has passed.
+  void publishStep(std::int64_t utime);
+  /// HOIST_CAGE now (e.g. the held state of a rejected input, flagged degraded).
+  void publishCage(std::int64_t utime, bool batch = false);
+  /// Publishes and logs the model's pending alarm events (ctx.cause names
+  /// who caused them), then clears them.
+  void publishAlarmEvents();
+  /// HOIST_FORECAST from a forecast result.
+  void publishForecast(const ForecastResult& r);
+  /// The health message, for ShaftHealth to fill before publishHealth().
+  hoist::health_t& health() { return health_msg_; }
+  void publishHealth();
+
+ private:
+  void publishShape(std::int64_t utime, bool batch);
+  bool publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len, bool batch);
+  template <class Msg>
+  bool encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
+                        bool batch = false);
+
+  ShaftContext& ctx_;            ///< the shaft's shared state
+  lcm::LCM& out_;                ///< publishes (lcm_url_out, or the input instance) unless sender_ is set
+  UdpmSender* sender_ = nullptr; ///< the daemon's own publisher, or nullptr
+  int cage_div_ = 1;             ///< --clock wall: HOIST_CAGE every cage_div_ ticks
+  int shape_div_ = 1;            ///< --clock wall: HOIST_GUIDE_SHAPE every shape_div_ ticks
+  double last_shape_t_ = -1e300; ///< --clock input: model time of the last shape message
+  static constexpr int kLogPublish = 0;  ///< log limiter key: publish failures, withheld messages
+  LogRateLimiter<1> log_limit_{5};       ///< rate limit of this room's error lines
+  std::int64_t cage_seq_ = 0;     ///< HOIST_CAGE.seq of the next message
+  std::int64_t alarm_id_ = 0;     ///< HOIST_ALARM.id of the next event
+  std::int64_t forecast_seq_ = 0; ///< HOIST_FORECAST.seq of the next message
+  hoist::cage_state_t cage_msg_;      ///< preallocated HOIST_CAGE
+  hoist::guide_shape_t shape_msg_;    ///< preallocated HOIST_GUIDE_SHAPE (sized to the shape's depths)
+  hoist::alarm_t alarm_msg_;          ///< preallocated HOIST_ALARM (strings reserved)
+  hoist::health_t health_msg_;        ///< preallocated HOIST_HEALTH (reason names set once)
+  hoist::forecast_t forecast_msg_;    ///< preallocated HOIST_FORECAST (scenarios and series sized once)
+  std::vector<std::uint8_t> cage_buf_;      ///< encode buffer of cage_msg_
+  std::vector<std::uint8_t> shape_buf_;     ///< encode buffer of shape_msg_
+  std::vector<std::uint8_t> alarm_buf_;     ///< encode buffer of alarm_msg_
+  std::vector<std::uint8_t> health_buf_;    ///< encode buffer of health_msg_
+  std::vector<std::uint8_t> forecast_buf_;  ///< encode buffer of forecast_msg_ (empty without forecasts)
+  char text_[256];                          ///< the alarm text being published
+};
+
+}  // namespace hoist::svc

@@ -1,0 +1,66 @@
+// ShaftStats: every counter and histogram of one hosted shaft, in one plain
+// struct.  Each room of the shaft (shaft_twin.hpp) increments the fields
+// marked with its name; ShaftHealth (shaft_health.hpp) reads them all for
+// HOIST_HEALTH, the final log lines and the run report.  No logic here.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "hoist/service/forecast_rules.hpp"
+#include "hoist/service/health.hpp"
+#include "hoist/service/input_validator.hpp"
+
+namespace hoist::svc {
+
+/// HOIST_HEALTH's extra rejection reasons after the winder reasons (not in
+/// rejected_total, which counts winder inputs): undecodable alarm commands,
+/// exceptions caught in an input handler, then one per PlanReject.
+inline constexpr int kExtraReasons = 2 + kPlanRejectReasons;
+
+struct ShaftStats {
+  // ---- the tick (ShaftTwin) ----
+  std::int64_t ticks = 0;            ///< ticks run
+  std::int64_t deadline_misses = 0;  ///< deadlines the schedule skipped
+  std::int64_t ns_model = 0;         ///< steady-clock ns in the model (core tick + housekeeping)
+  std::int64_t ns_publish = 0;       ///< steady-clock ns publishing from the tick (encode + send)
+  std::int64_t ns_tick = 0;          ///< steady-clock ns in whole tick() calls
+  LatencyHistogram step_hist;        ///< model step time [us], this health window
+  LatencyHistogram late_hist;        ///< tick lateness [us], this health window
+  LatencyHistogram step_total;       ///< model step time [us], whole run (windows merged at each health report)
+  LatencyHistogram late_total;       ///< tick lateness [us], whole run
+
+  // ---- inputs (ShaftInputs) ----
+  std::int64_t command_decode_rejects = 0;  ///< undecodable alarm commands
+  std::int64_t handler_exceptions = 0;      ///< exceptions caught in an input handler
+  std::int64_t command_decodes_dropped = 0; ///< command datagrams beyond the tick's decode bound (not decoded)
+  std::int64_t commands_dropped = 0;        ///< valid commands beyond max_commands_per_tick, plus decode-bound drops
+  std::int64_t commands_invalid = 0;        ///< undecodable or invalid commands
+  std::int64_t commands_applied = 0;        ///< effective commands (audited)
+  std::int64_t plans_accepted = 0;          ///< trip plans accepted
+  std::array<std::int64_t, kPlanRejectReasons> plan_rejects{};  ///< trip plans rejected, per reason
+
+  // ---- outputs (ShaftOutputs) ----
+  std::int64_t publish_failures = 0;   ///< publishes that failed (socket, encode, buffer size)
+  std::int64_t nonfinite_blocked = 0;  ///< messages withheld because a field was not finite
+  std::int64_t alarm_events = 0;       ///< HOIST_ALARM events published
+  std::int64_t publish_attempts = 0;   ///< publishes tried (TestHooks::fail_publish_every counts them)
+
+  // ---- forecasts (ForecastScheduler) ----
+  std::int64_t forecasts = 0;          ///< forecasts done
+  std::int64_t forecasts_dropped = 0;  ///< snapshots replaced before the worker took them
+  std::int64_t forecasts_skipped = 0;  ///< forecast instants skipped (degraded state)
+  std::int64_t forecast_failures = 0;  ///< forecasts whose engine threw (nothing published)
+  std::int64_t plan_unusable = 0;      ///< forecasts whose accepted plan no longer fit the motion
+  LatencyHistogram forecast_hist;      ///< forecast compute time [us], this health window
+  LatencyHistogram forecast_total;     ///< forecast compute time [us], whole run
+
+  /// Trip plans rejected, all reasons.
+  std::int64_t plansRejected() const {
+    std::int64_t n = 0;
+    for (auto v : plan_rejects) n += v;
+    return n;
+  }
+};
+
+}  // namespace hoist::svc

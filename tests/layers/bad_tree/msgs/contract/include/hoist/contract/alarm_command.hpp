@@ -1,0 +1,1 @@
+// fixture: the daemon-client contract

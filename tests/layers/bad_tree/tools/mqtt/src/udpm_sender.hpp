@@ -1,0 +1,1 @@
+// fixture: a tool's own header, named like a daemon header
