@@ -9,10 +9,14 @@ arrays of either, strings, consts) and writes
   OUT/include/hoist/msg/codec.hpp   the API (DecodeStatus, checkedDecode, toJson,
                                     fromJson, jsonSchema, TypeInfo, allTypes,
                                     allFinite, csvColumns/csvHeader/csvRow,
-                                    enums::<type>::k<Stem>Names, allEnums)
+                                    allEnums)
   OUT/src/codec.cpp                 one byte walker, one JSON converter pair,
                                     one JSON Schema, one all-finite check and
                                     one CSV column table per type
+  OUT/names/include/hoist/msg/names.hpp
+                                    the name tables and channels alone
+                                    (header-only, no LCM or JSON)
+  OUT/js/hoist_msgs.js              the same for the dashboard page (ES module)
 
 The steps live in lcmgen/ (parse.py, fingerprint.py, sizes.py, schema.py,
 emit.py); the C++ is in the Jinja2 templates of templates/ (Debian package
@@ -38,6 +42,8 @@ or the fingerprint):
                        the CSV column of MEMBER is COLUMN (an array's:
                        COLUMN_FIRST, COLUMN_FIRST+1, ...; FIRST default 0)
   // @csvfirst A,B,... these members' CSV columns come first, in this order
+  // @channel NAME     the type's LCM channel without the prefix (kChannels,
+                       CHANNELS of hoist_msgs.js)
 
 Usage: lcm_codec_gen.py --out DIR FILE.lcm...
        lcm_codec_gen.py --fingerprints FILE.lcm...   (prints name and hash)

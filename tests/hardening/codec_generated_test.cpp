@@ -3,7 +3,8 @@
 // scalar, fixed or variable array element, nested value -- is caught), the
 // CSV writers (header and row agree; hoist-sim's columns first for
 // cage_state_t) and the name tables of the `@enum` members (they match the
-// .lcm constants as lcm-gen and the JSON Schema give them).
+// .lcm constants as lcm-gen and the JSON Schema give them); the `@channel`
+// names equal hoist/bus/channels.hpp's.
 //
 // The messages are built from each type's JSON Schema, not by hand: every
 // number 1.5, every string a comma and a quote, every variable array two
@@ -19,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "hoist/bus/channels.hpp"
 #include "hoist/msg/codec.hpp"
 
 using namespace hoist;
@@ -282,4 +284,19 @@ TEST(CodecGenerated, NameTablesMatchTheLcmConstants) {
     EXPECT_EQ(n, e.names.size());
   }
   EXPECT_EQ(seen, (std::set<std::string>{"hoist.alarm_t.level", "hoist.alarm_t.event_type", "hoist.alarm_t.kind"}));
+}
+
+TEST(CodecGenerated, ChannelsMatchBusChannels) {
+  // `// @channel` in the .lcm files against the names the programs use.
+  const std::map<std::string_view, std::string_view> bus = {
+      {"hoist.winder_t", bus::kChannelWinder},         {"hoist.cage_state_t", bus::kChannelCage},
+      {"hoist.guide_shape_t", bus::kChannelGuideShape}, {"hoist.alarm_t", bus::kChannelAlarm},
+      {"hoist.alarm_ack_t", bus::kChannelAlarmAck},    {"hoist.health_t", bus::kChannelHealth},
+      {"hoist.forecast_t", bus::kChannelForecast},     {"hoist.trip_plan_t", bus::kChannelTripPlan}};
+  std::map<std::string_view, std::string_view> gen;
+  for (const ChannelInfo& c : kChannels) {
+    EXPECT_NE(findByName(c.type), nullptr) << c.type;
+    gen[c.type] = c.channel;
+  }
+  EXPECT_EQ(gen, bus);
 }

@@ -1,4 +1,5 @@
-"""Step 3: Structs -> OUT/include/hoist/msg/codec.hpp and OUT/src/codec.cpp,
+"""Step 3: Structs -> OUT/include/hoist/msg/codec.hpp, OUT/src/codec.cpp and
+OUT/names/include/hoist/msg/names.hpp and OUT/js/hoist_msgs.js,
 rendered from the Jinja2 templates in msgs/codec/templates/.  This module
 only prepares what the templates read (TypeView, MemberView); the C++ is in
 the templates."""
@@ -49,6 +50,7 @@ class TypeView:
         self.fingerprint = fingerprint(st)
         self.max_size = max_size(st)
         self.schema = schema(st)
+        self.channel = st.channel
         counts = {m.dims[0][1] for m in st.members if m.var_array}
         self.members = [MemberView(st, m, counts) for m in st.members]
         self.enums = [EnumView(e) for e in st.enums]
@@ -146,12 +148,17 @@ def render(structs):
     structs = sorted(structs, key=lambda s: s.full)
     check(structs)
     types = [TypeView(s) for s in structs]
-    ctx = {"banner": BANNER, "types": types,
+    channels = [t for t in types if t.channel]
+    if len({t.channel for t in channels}) != len(channels):
+        raise GenError("two types name the same @channel")
+    ctx = {"banner": BANNER, "types": types, "channels": channels,
            "enums": [(t, e) for t in types for e in t.enums]}
     env = environment()
     return {
         os.path.join("include", "hoist", "msg", "codec.hpp"): env.get_template("codec.hpp.j2").render(ctx),
         os.path.join("src", "codec.cpp"): env.get_template("codec.cpp.j2").render(ctx),
+        os.path.join("names", "include", "hoist", "msg", "names.hpp"): env.get_template("names.hpp.j2").render(ctx),
+        os.path.join("js", "hoist_msgs.js"): env.get_template("hoist_msgs.js.j2").render(ctx),
     }
 
 

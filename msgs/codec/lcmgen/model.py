@@ -73,6 +73,7 @@ class Struct:
         self.csv_annot = {}       # member -> (column name, first index)
         self.csv_first = []       # members whose CSV columns come first, in order
         self.enums = []           # Enum, in the order of the annotations
+        self.channel = None       # its LCM channel without the prefix (@channel)
 
     @property
     def full(self):

@@ -15,6 +15,7 @@ ANNOTATIONS = {
     "enum": rf"@enum\s+({_ID})\s+({_ID}_)(?![\w])",
     "csv": rf"@csv\s+({_ID})\s+({_ID})(?:\s+(\d+))?(?![\w])",
     "csvfirst": rf"@csvfirst\s+({_ID}(?:,{_ID})*)(?![\w,])",
+    "channel": r"@channel\s+([A-Z][A-Z0-9_]*)(?![\w])",
 }
 _WANT = {
     "max": "'@max COUNT N|CONST'",
@@ -22,6 +23,7 @@ _WANT = {
     "enum": "'@enum MEMBER PREFIX_'",
     "csv": "'@csv MEMBER COLUMN [FIRST]'",
     "csvfirst": "'@csvfirst MEMBER,MEMBER,...'",
+    "channel": "'@channel NAME' (upper case)",
 }
 _ANY_ANNOTATION = "|".join(f"(?:{p})" for p in ANNOTATIONS.values())
 
@@ -120,6 +122,10 @@ def read_annotations(st, comments, first_line, last_line):
             if st.csv_first:
                 raise GenError(f"{st.path}:{ln}: {st.full}: second @csvfirst")
             st.csv_first = a.group(1).split(",")
+        for a in re.finditer(ANNOTATIONS["channel"], c):
+            if st.channel:
+                raise GenError(f"{st.path}:{ln}: {st.full}: second @channel")
+            st.channel = a.group(1)
 
 
 def parse_file(path):
