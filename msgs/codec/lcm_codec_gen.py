@@ -52,6 +52,7 @@ import argparse
 import os
 import sys
 
+sys.dont_write_bytecode = True  # run at build time: no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from lcmgen.emit import generate  # noqa: E402
