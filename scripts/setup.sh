@@ -30,7 +30,7 @@ say() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
 # ---- 1. Debian packages -----------------------------------------------------
 required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev liblcm-bin
           libglib2.0-dev libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libtomlplusplus-dev
-          libcli11-dev gnuplot-nox python3 iproute2 libsystemd-dev nlohmann-json3-dev)
+          libcli11-dev gnuplot-nox python3 python3-jinja2 iproute2 libsystemd-dev nlohmann-json3-dev)
 # hoist-dash's page (uPlot from npm) and its browser tests (headless Chromium
 # driven by puppeteer-core, the @foxglove/ws-protocol client): Node, npm, Chromium.
 dashboard=(nodejs npm chromium fonts-dejavu-core)

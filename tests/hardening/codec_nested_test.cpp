@@ -6,7 +6,9 @@
 // codec_test; this covers the shapes msgs/ does not use yet.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
+#include <limits>
 #include <set>
 
 #include "hoist/msg/codec.hpp"
@@ -230,4 +232,37 @@ TEST(CodecGenNested, FromJsonPathsAndSchema) {
     }
   };
   same(s, j);
+}
+
+// allFinite and the CSV columns reach every nesting shape: a nested value,
+// a fixed array of them, two levels down, inside a variable array.
+TEST(CodecGenNested, AllFiniteAndCsvReachNestedValues) {
+  codectest_outer_t o = outer();
+  EXPECT_TRUE(allFinite(o));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  using Place = std::function<double&(codectest_outer_t&)>;
+  const std::vector<Place> places = {
+      [](codectest_outer_t& m) -> double& { return m.inner.x; },
+      [](codectest_outer_t& m) -> double& { return m.inner.one.v[0]; },
+      [](codectest_outer_t& m) -> double& { return m.two[1].pair[0].v[1]; },
+      [](codectest_outer_t& m) -> double& { return m.two[1].leaves[2].v[2]; },
+      [](codectest_outer_t& m) -> double& { return m.more[0].leaves[0].v[0]; }};
+  for (const Place& at : places) {
+    codectest_outer_t bad = outer();
+    at(bad) = nan;
+    EXPECT_FALSE(allFinite(bad));
+    at(bad) = std::numeric_limits<double>::infinity();
+    EXPECT_FALSE(allFinite(bad));
+  }
+
+  std::string header, row;
+  csvHeader<codectest_outer_t>(header);
+  csvRow(row, o);
+  EXPECT_EQ(header.rfind("utime,inner.x,inner.one.k,inner.one.tag,inner.one.n,inner.pair_0.k,", 0), 0u) << header;
+  EXPECT_NE(header.find(",two_1.pair_1.n,two_1.num_leaves,count,flag"), std::string::npos) << header;
+  EXPECT_EQ(header.find("leaves_"), std::string::npos) << header;  // variable arrays: no columns
+  EXPECT_EQ(header.find("more"), std::string::npos) << header;
+  EXPECT_EQ(row.rfind("123456789,1.5,1,\"one\",1,2,\"p0\",2,", 0), 0u) << row;
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','), std::count(row.begin(), row.end(), ','));
+  EXPECT_TRUE(allEnums().empty());  // no @enum in these types
 }

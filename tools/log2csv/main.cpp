@@ -14,31 +14,29 @@
 // note on stderr lists them.  A channel whose messages change type midway is
 // written to DIR/<CHANNEL>.<type>.csv for the later type.
 //
-// Columns (doubles printed with 17 significant digits, round-trip exact):
-//   hoist.cage_state_t  t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4 (exactly as
-//                       hoist-sim's output), then utime,seq,input_seq,y_top,
-//                       y_bottom,guide_deflection,clearance_pos_y,
-//                       clearance_neg_y,clearance_guide,min_clearance,
-//                       alarm_level,degraded,rope_slack_threshold,
-//                       rope_overload_threshold (the last two: issue 17, appended)
-//   hoist.winder_t      utime,seq,v,a,has_length,length,log_utime
+// Columns: those that hoist_msgs_codec generates from msgs/*.lcm
+// (hoist::msg::csvHeader / csvRow; docs/codec.md): one per member in the
+// .lcm file's order, a fixed array NAME_0.., no columns for variable-length
+// arrays; doubles with 17 significant digits (round-trip exact), strings
+// quoted, alarm levels and events by name.  Per type:
+//   hoist.cage_state_t  t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4 first (exactly
+//                       as hoist-sim's output; `@csvfirst` in cage_state_t.lcm),
+//                       then the other members in order
+//   hoist.winder_t      the members, then log_utime (the log event's timestamp)
 //   hoist.guide_shape_t t,x,y1,y2,l,utime (one row per depth sample, like
 //                       hoist-sim --shape-out)
-//   hoist.alarm_t       utime,id,t,kind,level,event,active,acked,shelved,latched,
-//                       value,threshold,shelved_for,message
-//   hoist.alarm_ack_t   utime,kind,level,action,shelve_duration,user
-//   hoist.health_t      utime,uptime,t,clock,rate,window,ticks,steps,deadline_misses,
-//                       step_p50_us,...,degraded, then rejected_<reason> per reason
-//   hoist.forecast_t    one row per scenario: utime,seq,instance_id,t_start,l,v,a,
-//                       plan_seq,compute_time,scenario,name,status,horizon,t_reached,
-//                       min_clearance,t_min_clearance,t_warning,t_critical,peak_y_c,
-//                       peak_theta,peak_lambda_1..peak_lambda_4,lambda0_min,
-//                       lambda0_max,num_points (times of a scenario in s after
-//                       t_start, -1 = none within the horizon).  The decimated
-//                       series go to DIR/<CHANNEL>.series.csv, one row per
-//                       point: utime,seq,scenario,name,i,t,min_clearance,
+//   hoist.alarm_t       the members (event_type in a column "event")
+//   hoist.alarm_ack_t, hoist.trip_plan_t  the members
+//   hoist.health_t      the members, then rejected_<reason> per reason
+//   hoist.forecast_t    one row per scenario: the forecast's columns with
+//                       num_scenarios replaced by the scenario's index
+//                       "scenario", then the scenario's (name,status,...,
+//                       peak_lambda_1..peak_lambda_4,lambda0_min,lambda0_max,
+//                       num_points; times in s after t_start, -1 = none
+//                       within the horizon).  The decimated series go to
+//                       DIR/<CHANNEL>.series.csv, one row per point:
+//                       utime,seq,scenario,name,i,t,min_clearance,
 //                       lambda0_min,lambda0_max.
-//   hoist.trip_plan_t   utime,seq,target_length,vmax,amax,jerk
 // Exit status: 0 on success; 1 if the log cannot be read, a file cannot be
 // written to its last byte (the path and the errno text are printed), or --
 // unless --lenient -- the log had corrupt regions (bytes skipped, events
@@ -55,12 +53,13 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
+#include <string_view>
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/forecast_scenario_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
@@ -71,23 +70,6 @@
 #include "hoist/winder_t.hpp"
 
 namespace {
-
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-/// CSV field quoting (RFC 4180) for free text.
-std::string csvQuote(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += "\"\"";
-    else if (c == '\n' || c == '\r') out += ' ';
-    else out += c;
-  }
-  return out + "\"";
-}
 
 using Event = hoist::io::LcmLogEvent;
 
@@ -139,14 +121,14 @@ class Converter {
   bool handle(const Event& ev) {
     const hoist::msg::TypeInfo* t = hoist::msg::findByFingerprint(ev.data.data(), ev.data.size());
     const std::string name = t ? t->name : "";
-    if (name == "hoist.cage_state_t") return cage(ev);
-    if (name == "hoist.winder_t") return winder(ev);
+    if (name == "hoist.cage_state_t") return table<hoist::cage_state_t>(ev, "cage_state_t");
+    if (name == "hoist.winder_t") return table<hoist::winder_t>(ev, "winder_t", logUtime);
     if (name == "hoist.guide_shape_t") return shape(ev);
-    if (name == "hoist.alarm_t") return alarm(ev);
-    if (name == "hoist.alarm_ack_t") return ack(ev);
-    if (name == "hoist.health_t") return health(ev);
+    if (name == "hoist.alarm_t") return table<hoist::alarm_t>(ev, "alarm_t");
+    if (name == "hoist.alarm_ack_t") return table<hoist::alarm_ack_t>(ev, "alarm_ack_t");
+    if (name == "hoist.health_t") return table<hoist::health_t>(ev, "health_t", rejectedByReason);
     if (name == "hoist.forecast_t") return forecast(ev);
-    if (name == "hoist.trip_plan_t") return plan(ev);
+    if (name == "hoist.trip_plan_t") return table<hoist::trip_plan_t>(ev, "trip_plan_t");
     ++unknown_[ev.channel];
     return false;
   }
@@ -223,49 +205,68 @@ class Converter {
     return true;
   }
 
-  bool cage(const Event& ev) {
-    hoist::cage_state_t m{};
+  /// One row per message: the generated CSV columns of Msg (hoist/msg/codec.hpp,
+  /// from msgs/*.lcm), then the columns `extra(ev, m, header, row)` appends.
+  template <class Msg, class Extra>
+  bool table(const Event& ev, const char* type, Extra extra) {
+    Msg m{};
     if (!decode(ev, m)) return false;
-    Writer* w = writer(ev.channel, "cage_state_t",
-                       "t,l,v,a,x_c,y_c,theta,lambda_0,lambda_1,lambda_2,lambda_3,lambda_4,utime,seq,"
-                       "input_seq,y_top,y_bottom,guide_deflection,clearance_pos_y,clearance_neg_y,"
-                       "clearance_guide,min_clearance,alarm_level,degraded,rope_slack_threshold,"
-                       "rope_overload_threshold");
-    std::ostringstream os;
-    os << num(m.t) << ',' << num(m.l) << ',' << num(m.v) << ',' << num(m.a) << ',' << num(m.x_c)
-       << ',' << num(m.y_c) << ',' << num(m.theta);
-    for (double v : m.lambdas) os << ',' << num(v);
-    os << ',' << m.utime << ',' << m.seq << ',' << m.input_seq << ',' << num(m.y_top) << ','
-       << num(m.y_bottom) << ',' << num(m.guide_deflection) << ',' << num(m.clearance_pos_y) << ','
-       << num(m.clearance_neg_y) << ',' << num(m.clearance_guide) << ',' << num(m.min_clearance)
-       << ',' << int(m.alarm_level) << ',' << int(m.degraded) << ',' << num(m.rope_slack_threshold) << ','
-       << num(m.rope_overload_threshold);
-    w->write(os.str());
+    std::string head, row;
+    hoist::msg::csvHeader<Msg>(head);
+    hoist::msg::csvRow(row, m);
+    extra(ev, m, head, row);
+    writer(ev.channel, type, head)->write(row);
     return true;
   }
+  template <class Msg>
+  bool table(const Event& ev, const char* type) {
+    return table<Msg>(ev, type, [](const Event&, const Msg&, std::string&, std::string&) {});
+  }
 
+  /// winder_t: then the log event's own timestamp.
+  static void logUtime(const Event& ev, const hoist::winder_t&, std::string& head, std::string& row) {
+    head += ",log_utime";
+    row += ',';
+    hoist::msg::csvInt(row, ev.timestamp);
+  }
+  /// health_t: then rejected_<reason> per reason (the pair of variable arrays
+  /// reject_reason / rejected, as columns of their own).
+  static void rejectedByReason(const Event&, const hoist::health_t& m, std::string& head, std::string& row) {
+    for (const auto& r : m.reject_reason) head += ",rejected_" + r;
+    for (auto v : m.rejected) {
+      row += ',';
+      hoist::msg::csvInt(row, v);
+    }
+  }
+
+  /// One row per scenario: the forecast's columns with its count column
+  /// (num_scenarios) replaced by the scenario's index, then the scenario's
+  /// columns; the decimated series (variable arrays: no columns) one row per
+  /// point in DIR/<CHANNEL>.series.csv.
+  static constexpr std::string_view kScenarioCount = "num_scenarios";
   bool forecast(const Event& ev) {
     hoist::forecast_t m{};
     if (!decode(ev, m)) return false;
     if (m.scenarios.empty()) return true;  // nothing to tabulate (counted as a message, no row)
-    Writer* w = writer(ev.channel, "forecast_t",
-                       "utime,seq,instance_id,t_start,l,v,a,plan_seq,compute_time,scenario,name,status,horizon,"
-                       "t_reached,min_clearance,t_min_clearance,t_warning,t_critical,peak_y_c,peak_theta,"
-                       "peak_lambda_1,peak_lambda_2,peak_lambda_3,peak_lambda_4,lambda0_min,lambda0_max,"
-                       "num_points");
+    std::string head;
+    for (const auto& c : hoist::msg::csvColumns<hoist::forecast_t>()) {
+      head += c.name == kScenarioCount ? std::string_view("scenario") : std::string_view(c.name);
+      head += ',';
+    }
+    hoist::msg::csvHeader<hoist::forecast_scenario_t>(head);
+    Writer* w = writer(ev.channel, "forecast_t", head);
     --w->rows;  // rows counted per scenario below
     bool any_points = false;
     for (std::size_t i = 0; i < m.scenarios.size(); ++i) {
       const auto& sc = m.scenarios[i];
-      std::ostringstream os;
-      os << m.utime << ',' << m.seq << ',' << m.instance_id << ',' << num(m.t_start) << ',' << num(m.l) << ','
-         << num(m.v) << ',' << num(m.a) << ',' << m.plan_seq << ',' << num(m.compute_time) << ',' << i << ','
-         << csvQuote(sc.name) << ',' << int(sc.status) << ',' << num(sc.horizon) << ',' << num(sc.t_reached)
-         << ',' << num(sc.min_clearance) << ',' << num(sc.t_min_clearance) << ',' << num(sc.t_warning) << ','
-         << num(sc.t_critical) << ',' << num(sc.peak_y_c) << ',' << num(sc.peak_theta);
-      for (double v : sc.peak_lambdas) os << ',' << num(v);
-      os << ',' << num(sc.lambda0_min) << ',' << num(sc.lambda0_max) << ',' << sc.num_points;
-      w->write(os.str());
+      std::string row;
+      for (const auto& c : hoist::msg::csvColumns<hoist::forecast_t>()) {
+        if (c.name == kScenarioCount) hoist::msg::csvInt(row, static_cast<std::int64_t>(i));
+        else c.write(row, m);
+        row += ',';
+      }
+      hoist::msg::csvRow(row, sc);
+      w->write(row);
       ++w->rows;
       any_points = any_points || sc.num_points > 0;
     }
@@ -276,110 +277,40 @@ class Converter {
     for (std::size_t i = 0; i < m.scenarios.size(); ++i) {
       const auto& sc = m.scenarios[i];
       for (std::size_t k = 0; k < sc.series_t.size(); ++k) {
-        std::ostringstream os;
-        os << m.utime << ',' << m.seq << ',' << i << ',' << csvQuote(sc.name) << ',' << k << ','
-           << num(sc.series_t[k]) << ',' << num(sc.series_min_clearance[k]) << ','
-           << num(sc.series_lambda0_min[k]) << ',' << num(sc.series_lambda0_max[k]);
-        s->write(os.str());
+        std::string row;
+        for (const std::int64_t v : {m.utime, m.seq, static_cast<std::int64_t>(i)}) {
+          hoist::msg::csvInt(row, v);
+          row += ',';
+        }
+        hoist::msg::csvText(row, sc.name);
+        row += ',';
+        hoist::msg::csvInt(row, static_cast<std::int64_t>(k));
+        for (const double v : {sc.series_t[k], sc.series_min_clearance[k], sc.series_lambda0_min[k],
+                               sc.series_lambda0_max[k]}) {
+          row += ',';
+          hoist::msg::csvReal(row, v);
+        }
+        s->write(row);
         ++s->rows;
       }
     }
     return true;
   }
 
-  bool plan(const Event& ev) {
-    hoist::trip_plan_t m{};
-    if (!decode(ev, m)) return false;
-    Writer* w = writer(ev.channel, "trip_plan_t", "utime,seq,target_length,vmax,amax,jerk");
-    std::ostringstream os;
-    os << m.utime << ',' << m.seq << ',' << num(m.target_length) << ',' << num(m.vmax) << ',' << num(m.amax)
-       << ',' << num(m.jerk);
-    w->write(os.str());
-    return true;
-  }
-
-  bool winder(const Event& ev) {
-    hoist::winder_t m{};
-    if (!decode(ev, m)) return false;
-    Writer* w = writer(ev.channel, "winder_t", "utime,seq,v,a,has_length,length,log_utime");
-    {
-      std::ostringstream os;
-      os << m.utime << ',' << m.seq << ',' << num(m.v) << ',' << num(m.a) << ',' << int(m.has_length)
-           << ',' << num(m.length) << ',' << ev.timestamp;
-      w->write(os.str());
-    }
-    return true;
-  }
-
+  /// One row per depth sample, t,x,y1,y2,l,utime (as hoist-sim --shape-out).
   bool shape(const Event& ev) {
     hoist::guide_shape_t m{};
     if (!decode(ev, m)) return false;
     Writer* w = writer(ev.channel, "guide_shape_t", "t,x,y1,y2,l,utime");
-    for (int i = 0; i < m.n; ++i)
-      {
-      std::ostringstream os;
-      os << num(m.t) << ',' << num(m.x[i]) << ',' << num(m.y1[i]) << ',' << num(m.y2[i]) << ','
-             << num(m.l) << ',' << m.utime;
-      w->write(os.str());
+    for (std::size_t i = 0; i < m.x.size(); ++i) {
+      std::string row;
+      for (const double v : {m.t, m.x[i], m.y1[i], m.y2[i], m.l}) {
+        hoist::msg::csvReal(row, v);
+        row += ',';
+      }
+      hoist::msg::csvInt(row, m.utime);
+      w->write(row);
     }
-    return true;
-  }
-
-  bool alarm(const Event& ev) {
-    hoist::alarm_t m{};
-    if (!decode(ev, m)) return false;
-    Writer* w = writer(ev.channel, "alarm_t",
-                       "utime,id,t,kind,level,event,active,acked,shelved,latched,value,threshold,"
-                       "shelved_for,message");
-    static const char* levels[] = {"NONE", "WARNING", "CRITICAL"};
-    static const char* events[] = {"?", "RAISE", "CLEAR", "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE"};
-    const char* lvl = (m.level >= 0 && m.level <= 2) ? levels[m.level] : "?";
-    const char* evn = (m.event_type >= 1 && m.event_type <= 6) ? events[m.event_type] : "?";
-    {
-      std::ostringstream os;
-      os << m.utime << ',' << m.id << ',' << num(m.t) << ',' << csvQuote(m.kind) << ',' << lvl << ','
-           << evn << ',' << int(m.active) << ',' << int(m.acked) << ',' << int(m.shelved) << ','
-           << int(m.latched) << ',' << num(m.value) << ',' << num(m.threshold) << ','
-           << num(m.shelved_for) << ',' << csvQuote(m.message);
-      w->write(os.str());
-    }
-    return true;
-  }
-
-  bool ack(const Event& ev) {
-    hoist::alarm_ack_t m{};
-    if (!decode(ev, m)) return false;
-    Writer* w = writer(ev.channel, "alarm_ack_t", "utime,kind,level,action,shelve_duration,user");
-    {
-      std::ostringstream os;
-      os << m.utime << ',' << csvQuote(m.kind) << ',' << int(m.level) << ',' << int(m.action) << ','
-           << num(m.shelve_duration) << ',' << csvQuote(m.user);
-      w->write(os.str());
-    }
-    return true;
-  }
-
-  bool health(const Event& ev) {
-    hoist::health_t m{};
-    if (!decode(ev, m)) return false;
-    std::string header =
-        "utime,uptime,t,clock,rate,window,ticks,steps,deadline_misses,step_p50_us,step_p99_us,"
-        "step_max_us,late_p50_us,late_p99_us,late_max_us,input_age,accepted,seq_gaps,rejected_total,"
-        "alarms_active,alarms_unacked,alarms_shelved,alarm_events,model_faults,model_resets,"
-        "publish_failures,nonfinite_blocked,degraded";
-    for (const auto& r : m.reject_reason) header += ",rejected_" + r;
-    Writer* w = writer(ev.channel, "health_t", header);
-    std::ostringstream os;
-    os << m.utime << ',' << num(m.uptime) << ',' << num(m.t) << ',' << m.clock << ',' << num(m.rate)
-       << ',' << num(m.window) << ',' << m.ticks << ',' << m.steps << ',' << m.deadline_misses << ','
-       << num(m.step_p50_us) << ',' << num(m.step_p99_us) << ',' << num(m.step_max_us) << ','
-       << num(m.late_p50_us) << ',' << num(m.late_p99_us) << ',' << num(m.late_max_us) << ','
-       << num(m.input_age) << ',' << m.accepted << ',' << m.seq_gaps << ',' << m.rejected_total << ','
-       << m.alarms_active << ',' << m.alarms_unacked << ',' << m.alarms_shelved << ','
-       << m.alarm_events << ',' << m.model_faults << ',' << m.model_resets << ','
-       << m.publish_failures << ',' << m.nonfinite_blocked << ',' << int(m.degraded);
-    for (auto v : m.rejected) os << ',' << v;
-    w->write(os.str());
     return true;
   }
 

@@ -77,9 +77,8 @@ class Monitor {
     guarded([&] {
       hoist::alarm_t m;
       if (!decode(rb, m)) return;
-      static const char* lv[] = {"", "WARNING", "CRITICAL"};
       const std::string key = hoist::msg::terminalSafe(m.kind, 40) + "/" +
-                              ((m.level >= 0 && m.level <= 2) ? lv[m.level] : "?");
+                              std::string(hoist::msg::enums::alarm_t::levelName(m.level));
       if (m.active && !m.shelved) {
         if (active_.size() < kMaxActive || active_.count(key)) active_[key] = true;
         else ++active_overflow_;

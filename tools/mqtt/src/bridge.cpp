@@ -57,18 +57,8 @@ bool validKind(const std::string& k) {
   return true;
 }
 
-const char* levelName(int level) { return level == 1 ? "WARNING" : level == 2 ? "CRITICAL" : "NONE"; }
-const char* eventName(int e) {
-  switch (e) {
-    case hoist::alarm_t::EVENT_RAISE: return "RAISE";
-    case hoist::alarm_t::EVENT_CLEAR: return "CLEAR";
-    case hoist::alarm_t::EVENT_ACK: return "ACK";
-    case hoist::alarm_t::EVENT_SHELVE: return "SHELVE";
-    case hoist::alarm_t::EVENT_UNSHELVE: return "UNSHELVE";
-    case hoist::alarm_t::EVENT_REANNOUNCE: return "REANNOUNCE";
-  }
-  return "?";
-}
+/// The names of alarm_t's levels and events (generated from alarm_t.lcm).
+namespace alarm_names = hoist::msg::enums::alarm_t;
 
 }  // namespace
 
@@ -383,11 +373,11 @@ struct Bridge::Impl {
     j["shaft"] = s.name;
     j["kind"] = kind;
     j["active"] = level > 0;
-    j["level"] = levelName(level);
+    j["level"] = std::string(alarm_names::levelName(level));
     j["unacked"] = unacked;
     j["shelved"] = shelved;
     j["utime"] = a.last.utime;
-    j["last_event"] = eventName(a.last.event_type);
+    j["last_event"] = std::string(alarm_names::eventName(a.last.event_type));
     j["warning"] = a.by_level[1] ? hoist::msg::toJson(*a.by_level[1]) : json(nullptr);
     j["critical"] = a.by_level[2] ? hoist::msg::toJson(*a.by_level[2]) : json(nullptr);
     return j;
