@@ -166,6 +166,36 @@ TEST_F(EstimateCli, UnobservedValuesAreNan) {
   EXPECT_EQ(last[t.col("sensors")], 3.0);
   EXPECT_EQ(last[t.col("fa_observed")], 0.0);
   EXPECT_EQ(last[t.col("moment_observed")], 1.0);
+  for (double x : t.column("mismatch")) ASSERT_EQ(x, 0.0);  // a cage at rest that reads steadily: no mismatch
+}
+
+// A cage "at rest" whose IMU reads a 1 Hz oscillation of 5 sigma: no load
+// explains it, so the window's NIS exceeds its bound; the summary names the
+// first time, the window's NIS and the bound.
+TEST_F(EstimateCli, MismatchIsReportedWithTheWindowsNisAndBound) {
+  std::string text = "t,l,v,a,f_y,omega\n";
+  char row[128];
+  for (int i = 0; i <= 1000; ++i) {
+    std::snprintf(row, sizeof row, "%.2f,50,0,0,%.17g,0\n", 0.01 * i, 0.01 * std::sin(2.0 * M_PI * 0.01 * i));
+    text += row;
+  }
+  const CapturedRun e = estimate({"--config", write("c.toml", "[model]\nmodes = 5\n"), "--measurements",
+                                  write("m.csv", text), "--out", path("o.csv")});
+  ASSERT_EQ(e.status, 0) << e.output;
+  const Table t = readCsv(path("o.csv"));
+  double first = -1.0;
+  for (const auto& r : t.rows)
+    if (r[t.col("mismatch")] == 1.0) {
+      first = r[t.col("t")];
+      EXPECT_EQ(r[t.col("nis_exceeded")], 1.0);
+      EXPECT_GT(r[t.col("nis_window")], r[t.col("nis_bound")]);
+      break;
+    }
+  ASSERT_GT(first, 0.0) << "MODEL_MISMATCH never rose";
+  char want[64];
+  std::snprintf(want, sizeof want, "first at t = %.2f s (window NIS ", first);
+  EXPECT_NE(e.output.find(want), std::string::npos) << e.output;
+  EXPECT_NE(e.output.find("> bound "), std::string::npos) << e.output;
 }
 
 TEST_F(EstimateCli, BadInputExitsTwoNamingTheThing) {

@@ -197,6 +197,7 @@ int run(const Options& o) {
   hoist::EstimatorCounters counts;
   long rows = 0, mismatch_rows = 0;
   double first_mismatch = std::nan("");
+  std::string first_why;  // what raised it first: the NIS window against its bound, or a drifting load
   int last_decile = 0;
   const bool tty = ::isatty(2);
   try {
@@ -209,7 +210,15 @@ int run(const Options& o) {
           ++rows;
           if (e.mismatch) {
             ++mismatch_rows;
-            if (std::isnan(first_mismatch)) first_mismatch = e.t;
+            if (std::isnan(first_mismatch)) {
+              first_mismatch = e.t;
+              if (e.nis_exceeded)
+                first_why = "window NIS " + fmt("%.1f", e.nis_window) + " over " + std::to_string(e.nis_dof) +
+                            " dof > bound " + fmt("%.1f", e.nis_bound);
+              if (e.drift_exceeded)
+                first_why += (first_why.empty() ? "" : "; ") + std::string("load drift ") + fmt("%.1f", e.drift) +
+                             " sigma during the trip";
+            }
           }
           last = e;
           counts = c;
@@ -244,7 +253,8 @@ int run(const Options& o) {
       << " N, b = " << p.b << " m). Updates accepted " << counts.accepted << ", gated " << counts.gated
       << ", load changes " << counts.load_changes << ", implausible " << counts.implausible
       << "; MODEL_MISMATCH in " << mismatch_rows << " rows, first "
-      << (std::isnan(first_mismatch) ? std::string("none") : "at t = " + fmt("%.2f", first_mismatch) + " s")
+      << (std::isnan(first_mismatch) ? std::string("none")
+                                     : "at t = " + fmt("%.2f", first_mismatch) + " s (" + first_why + ")")
       << ".\n";
     std::cout << s.str();
   }
