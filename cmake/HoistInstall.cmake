@@ -25,7 +25,7 @@ set(HOIST_DOC_SUBDIR "${CMAKE_INSTALL_DATAROOTDIR}/doc/hoist-twin")
 set(HOIST_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/hoist")
 
 # ---- programs -------------------------------------------------------------------
-set(_hoist_programs hoist-sim hoist-study hoist-twind hoist-replay hoist-log2csv hoist-monitor
+set(_hoist_programs hoist-sim hoist-estimate hoist-study hoist-twind hoist-replay hoist-log2csv hoist-monitor
                     hoist-alarm-ack hoist-wakeup-latency hoist-timing-test hoist-mqtt)
 foreach(p ${_hoist_programs})
   if(TARGET ${p})

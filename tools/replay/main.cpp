@@ -1,7 +1,8 @@
 // hoist-replay -- publishes the winder input HOIST_WINDER (winder_t) for
 // hoist-twind, in real time or faster.
 //
-//   hoist-replay [--profile FILE|SPEC | --lcm-log FILE] [--speed X] [--rate HZ]
+//   hoist-replay [--profile FILE|SPEC | --lcm-log FILE | --measurements FILE.csv]
+//                [--speed X] [--rate HZ]
 //                [--lcm-url URL] [--with-length] [--channel-prefix P]
 //
 // Sources:
@@ -19,6 +20,14 @@
 //     hoist::msg::checkedDecode as a winder_t; skipped bytes, lost events and
 //     undecodable payloads are reported and make the exit status 1 unless
 //     --lenient.
+//   * a measurement CSV (t,l,v,a[,f_y,omega,rope_load]; hoist-sim
+//     --write-measurements, hoist-estimate's input): every row is published
+//     at its own time -- first HOIST_CAGE_IMU (cage_imu_t, when the row has
+//     both f_y and omega) and HOIST_ROPE_LOAD (rope_load_t, when it has
+//     rope_load), then HOIST_WINDER with the row's l (has_length), v and a,
+//     all with the row's utime -- so that the daemon has a step's sensor
+//     samples when the step's winder input arrives.  Each channel has its
+//     own seq = 0, 1, 2, ...; --rate does not apply.
 // Message k carries seq = k and utime = (wall time at start, us) + round((t_k -
 // t0) * 1e6): utime follows PROFILE time whatever the speed, so that
 // `hoist-twind --clock input` steps the model exactly by the profile's dt.
@@ -50,6 +59,9 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
+#include "hoist/cage_imu_t.hpp"
+#include "hoist/rope_load_t.hpp"
+#include "hoist/io/estimator_config.hpp"
 #include "hoist/io/config.hpp"
 #include "cli_util.hpp"
 #include "timing_cli.hpp"
@@ -138,6 +150,15 @@ int main(int argc, char** argv) {
                      ->check(CLI::ExistingFile);
   prof->excludes(logopt);
   logopt->excludes(prof);
+  std::string meas_path;
+  auto* measopt = app.add_option("--measurements", meas_path,
+                                 "publish the winder and sensor channels (HOIST_WINDER with l, HOIST_CAGE_IMU, "
+                                 "HOIST_ROPE_LOAD) from a measurement CSV t,l,v,a[,f_y,omega,rope_load] at its own "
+                                 "times (hoist-sim --write-measurements writes one)")
+                      ->check(CLI::ExistingFile);
+  measopt->excludes(prof)->excludes(logopt);
+  prof->excludes(measopt);
+  logopt->excludes(measopt);
   app.add_option("--speed", speed, "playback speed factor; 0 = as fast as possible (default 1)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--rate", rate, "messages per second of profile time (default 100)")
@@ -172,6 +193,16 @@ int main(int argc, char** argv) {
     return 1;
   }
   const std::string channel = hoist::bus::channel(prefix, hoist::bus::kChannelWinder);
+  // --measurements: read (and validate) the whole file before anything is published.
+  std::vector<hoist::MeasurementSample> meas;
+  if (!meas_path.empty()) {
+    try {
+      meas = hoist::io::readMeasurementsCsvFile(meas_path);
+    } catch (const std::exception& e) {
+      std::cerr << "hoist-replay: " << e.what() << "\n";
+      return 2;
+    }
+  }
   struct sigaction sa {};
   sa.sa_handler = onSignal;  // no SA_RESTART: interrupt the sleep
   sigaction(SIGINT, &sa, nullptr);
@@ -235,6 +266,53 @@ int main(int argc, char** argv) {
                 << (log_bad ? "; " + std::to_string(log_bad) + " undecodable HOIST_WINDER payload(s) skipped"
                             : std::string())
                 << "\n";
+  } else if (!meas_path.empty()) {
+    const std::string ch_imu = hoist::bus::channel(prefix, hoist::bus::kChannelCageImu);
+    const std::string ch_rope = hoist::bus::channel(prefix, hoist::bus::kChannelRopeLoad);
+    const double t0 = meas.front().t, t1 = meas.back().t;
+    long sent_imu = 0, sent_rope = 0, half_imu = 0;
+    hoist::cage_imu_t imu{};
+    hoist::rope_load_t rope{};
+    auto publish = [&](const std::string& ch, const auto& m, long& count) {
+      const int len = m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      if (len < 0 || lcm.publish(ch, buf.data(), static_cast<unsigned>(len)) != 0) ++failed;
+      else ++count;
+    };
+    const unsigned kImu = hoist::kSensorImuAccel | hoist::kSensorImuRate;
+    for (std::size_t k = 0; k < meas.size() && !g_signal; ++k) {
+      const hoist::MeasurementSample& m = meas[k];
+      if (speed > 0.0 && !sleepUntil(start_ns + static_cast<std::int64_t>((m.t - t0) / speed * 1e9))) break;
+      const std::int64_t utime = start_utime + std::llround((m.t - t0) * 1e6);
+      if ((m.present & kImu) == kImu) {
+        imu.utime = utime;
+        imu.seq = sent_imu;
+        imu.f_y = m.z.f_y;
+        imu.omega = m.z.omega;
+        publish(ch_imu, imu, sent_imu);
+      } else if (m.present & kImu) {
+        ++half_imu;  // cage_imu_t carries both or neither
+      }
+      if (m.present & hoist::kSensorRopeLoad) {
+        rope.utime = utime;
+        rope.seq = sent_rope;
+        rope.force = m.z.rope_load;
+        publish(ch_rope, rope, sent_rope);
+      }
+      msg.utime = utime;
+      msg.seq = static_cast<std::int64_t>(k);
+      msg.v = m.k.v;
+      msg.a = m.k.a;
+      msg.has_length = true;
+      msg.length = m.k.l;
+      publish(channel, msg, sent);
+      progress.update(m.t, t0, t1, sent + sent_imu + sent_rope);
+    }
+    if (half_imu > 0)
+      std::cerr << "hoist-replay: warning: " << half_imu << " row(s) of " << meas_path
+                << " have only one of f_y and omega: no cage_imu_t sent for them (it carries both)\n";
+    if (!quiet && !g_signal)
+      std::cerr << "hoist-replay: published " << sent_imu << " messages on " << ch_imu << ", " << sent_rope
+                << " on " << ch_rope << "\n";
   } else {
     double l0 = 50.0;
     try {

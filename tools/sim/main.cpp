@@ -5,6 +5,7 @@
 //             [--modes N] [--initial static|rest|config] [--method fast|paper]
 //             [--static-correction on|off]
 //             [--shape-out FILE.csv --shape-times 18,36,60]
+//             [--write-measurements FILE.csv [--sensor-noise A,W,F] [--seed N]]
 //   hoist-sim study ...        (runs hoist-study: the paper's parameter studies)
 //
 // Phases, each timed in the summary: load (config, profile), setup (mode
@@ -15,6 +16,12 @@
 // run whose output cannot fit the free space of --out's file system is
 // refused.  Every file is written to its last byte or the run fails naming
 // it (hoist/io/checked_file.hpp).
+// --write-measurements: what a cage IMU and a rope load cell would read on
+// this run (hoist::sensorModel on the solver's response, plus seeded
+// Gaussian noise), in the measurement CSV of hoist-estimate
+// (t,l,v,a,f_y,omega,rope_load; hoist/io/estimator_config.hpp).  The run's
+// load is the config's: a "truth" config with another [load] makes data for
+// hoist-estimate run with the real config.
 // Exit status: 0 done, 2 bad input (config, profile, options), 1 the run
 // failed (non-finite or implausible state -- the message names the time, the
 // quantity and its value --, write error, out of memory).
@@ -39,12 +46,15 @@
 
 #include "hoist/io/checked_file.hpp"
 #include "hoist/io/config.hpp"
+#include "hoist/io/estimator_config.hpp"
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
 #include "hoist/scenario.hpp"
 #include "hoist/shaft_model.hpp"
 #include "hoist/plausibility.hpp"
 #include "hoist/simulator.hpp"
+#include "hoist/load_estimator.hpp"
+#include <random>
 
 namespace {
 
@@ -58,6 +68,9 @@ struct Options {
   int modes = 0, shape_points = 401;
   std::string initial, method = "fast", static_correction;
   bool quiet = false, print_config = false, progress = false;
+  // --write-measurements (synthetic sensor data for hoist-estimate)
+  std::string write_measurements, sensor_noise;
+  std::uint64_t seed = 1;
 };
 
 /// The command line, for the messages of unexpected failures (out of memory).
@@ -87,6 +100,35 @@ std::vector<double> parseTimes(const std::string& s) {
   if (out.empty()) throw UsageError("--shape-times: no times given");
   std::sort(out.begin(), out.end());
   return out;
+}
+
+/// --sensor-noise A,W,F: three finite standard deviations >= 0.
+hoist::SensorNoise parseSensorNoise(const std::string& s) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t pos = 0;
+    double x = 0;
+    try {
+      x = std::stod(item, &pos);
+    } catch (...) {
+      pos = 0;
+    }
+    while (pos < item.size() && item[pos] == ' ') ++pos;
+    if (item.empty() || pos != item.size() || !std::isfinite(x) || x < 0.0)
+      throw UsageError("--sensor-noise: expected three standard deviations >= 0 (f_y [m/s^2], omega [rad/s], "
+                       "rope_load [N]), got '" + item + "'");
+    v.push_back(x);
+  }
+  if (v.size() != 3)
+    throw UsageError("--sensor-noise: expected three comma-separated values A,W,F (f_y [m/s^2], omega [rad/s], "
+                     "rope_load [N]), got " + std::to_string(v.size()));
+  hoist::SensorNoise n;
+  n.imu_accel = v[0];
+  n.imu_rate = v[1];
+  n.rope_load = v[2];
+  return n;
 }
 
 /// Progress on stderr: on a terminal one line rewritten in place; with
@@ -228,7 +270,16 @@ int run(const Options& o) {
   hoist::ShaftParams p;
   // A daemon configuration (shaft + [service]/[alarms]) is accepted as well;
   // hoist-twind validates those sections.
-  if (!o.config.empty()) p = hoist::io::loadShaftConfig(o.config, {"service", "alarms", "forecast"});
+  // [sensors] gives --write-measurements' default noise.
+  hoist::SensorNoise noise;
+  if (!o.config.empty()) {
+    const toml::table tbl = hoist::io::loadTomlFile(o.config);
+    p = hoist::io::shaftParamsFromToml(tbl, o.config, hoist::io::daemonSections());
+    noise = hoist::io::estimatorConfigFromToml(tbl, o.config).settings.noise;
+  }
+  if (!o.sensor_noise.empty()) noise = parseSensorNoise(o.sensor_noise);
+  if (!o.write_measurements.empty() && o.method == "paper")
+    throw UsageError("--write-measurements needs the cage's rates, which only --method fast computes");
   if (o.modes != 0) p.n = o.modes;
   if (!o.initial.empty() && o.initial != "config") p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
   if (o.rho_inf >= 0.0) p.rho_inf = o.rho_inf;
@@ -281,7 +332,8 @@ int run(const Options& o) {
     if (!o.quiet) std::cerr << "hoist-sim: profile written to " << o.write_profile << "\n";
     if (o.out.empty()) return 0;
   }
-  if (o.out.empty()) throw UsageError("--out FILE.csv is required (or --write-profile / --print-config alone)");
+  if (o.out.empty() && o.write_measurements.empty())
+    throw UsageError("--out FILE.csv is required (or --write-measurements, or --write-profile / --print-config alone)");
   const double t0 = profile.startTime();
   if (!std::isfinite(o.t_end)) throw UsageError("--t-end " + num(o.t_end) + ": must be a finite time in seconds");
   const double t_end = o.t_end < 0 ? profile.endTime() : o.t_end;
@@ -331,13 +383,20 @@ int run(const Options& o) {
       static_cast<double>(shape_times.size()) * std::max(2, o.shape_points) * 4 * 15.0;
   const double bytes_est = rows_est * kBytesPerRow;
   // A run that cannot fit the disk is refused now, not after hours.
-  if (const double free = freeBytesFor(o.out); free >= 0.0 && bytes_est > free)
+  if (const double free = o.out.empty() ? -1.0 : freeBytesFor(o.out); free >= 0.0 && bytes_est > free)
     throw UsageError(t_end_opt + ": the output would be about " + bytesText(bytes_est) + " (" + num(rows_est) +
                      " rows of about " + num(kBytesPerRow) + " B at --dt " + num(o.dt) + " s), but only " +
                      bytesText(free) + " are free for --out " + o.out + "; shorten --t-end or raise --dt");
   // Open outputs before the long part so a bad path fails at once; rows are
   // streamed into them as they are computed.
-  hoist::io::CheckedFile out(o.out, "--out");
+  hoist::io::CheckedFile out;
+  if (!o.out.empty()) out = hoist::io::CheckedFile(o.out, "--out");
+  hoist::io::CheckedFile meas_file;
+  if (!o.write_measurements.empty()) meas_file = hoist::io::CheckedFile(o.write_measurements, "--write-measurements");
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  hoist::MeasurementSample meas;
+  meas.present = hoist::kSensorImuAccel | hoist::kSensorImuRate | hoist::kSensorRopeLoad;
   hoist::io::CheckedFile shape_file;
   if (!o.shape_out.empty()) shape_file = hoist::io::CheckedFile(o.shape_out, "--shape-out");
   const double load_s = secondsSince(t_load);
@@ -375,7 +434,8 @@ int run(const Options& o) {
                                : (!o.quiet && ::isatty(2)) ? Progress::Mode::Terminal
                                                            : Progress::Mode::Off;
   Progress progress(pmode);
-  out.write(std::string(hoist::io::kResultHeader) + "\n");
+  if (out.isOpen()) out.write(std::string(hoist::io::kResultHeader) + "\n");
+  if (meas_file.isOpen()) meas_file.write(std::string(hoist::io::kMeasurementHeader) + "\n");
   if (shape_file.isOpen()) shape_file.write(std::string(hoist::io::kShapeHeader) + "\n");
   std::string line;
   line.reserve(512);
@@ -408,7 +468,19 @@ int run(const Options& o) {
           const auto tw = Clock::now();
           line.clear();
           hoist::io::appendResultRow(line, r);
-          out.write(line);
+          if (out.isOpen()) out.write(line);
+          if (meas_file.isOpen()) {
+            // The sensor model on this response plus noise, drawn in a fixed order (reproducible by --seed).
+            const hoist::SensorValues z = hoist::sensorModel(r, p.g);
+            meas.t = r.t;
+            meas.k = r.kin;
+            meas.z.f_y = z.f_y + noise.imu_accel * n01(rng);
+            meas.z.omega = z.omega + noise.imu_rate * n01(rng);
+            meas.z.rope_load = z.rope_load + noise.rope_load * n01(rng);
+            line.clear();
+            hoist::io::appendMeasurementRow(line, meas);
+            meas_file.write(line);
+          }
           ++rows;
           pk_x.see(r.x_c, r.t);
           pk_y.see(r.y_c, r.t);
@@ -449,6 +521,7 @@ int run(const Options& o) {
   const auto t_out = Clock::now();
   out.close();
   shape_file.close();
+  meas_file.close();
   out_s += secondsSince(t_out);
 
   if (!o.quiet) {
@@ -459,7 +532,7 @@ int run(const Options& o) {
                  "  peak |y_c|      = %.4e m    at t = %.2f s\n"
                  "  peak |theta|    = %.4e rad  at t = %.2f s\n"
                  "  peak |lambda_0| = %.4e N    at t = %.2f s\n",
-                 rows, o.out.c_str(), o.shape_out.empty() ? "" : ", shapes to ", o.shape_out.c_str(), pk_x.value,
+                 rows, o.out.empty() ? o.write_measurements.c_str() : o.out.c_str(), o.shape_out.empty() ? "" : ", shapes to ", o.shape_out.c_str(), pk_x.value,
                  pk_x.t, pk_y.value, pk_y.t, pk_th.value, pk_th.t, pk_l[0].value, pk_l[0].t);
     for (int k = 1; k < 5; ++k)
       std::fprintf(stderr, "  peak |lambda_%d| = %.4e N    at t = %.2f s\n", k, pk_l[k].value, pk_l[k].t);
@@ -530,6 +603,14 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(1e-6, 1e6));
   app.add_option("--write-profile", o.write_profile, "also write the profile used as CSV t,l,v,a");
+  app.add_option("--write-measurements", o.write_measurements,
+                 "also write what a cage IMU and a rope load cell read on this run (t,l,v,a,f_y,omega,rope_load; "
+                 "input of hoist-estimate): the sensor model on the response plus seeded Gaussian noise; "
+                 "--out may then be left out");
+  app.add_option("--sensor-noise", o.sensor_noise,
+                 "A,W,F: noise standard deviations of f_y [m/s^2], omega [rad/s] and rope_load [N] for "
+                 "--write-measurements (default: the config's [sensors], else 0.002,0.0001,20)");
+  app.add_option("--seed", o.seed, "seed of --write-measurements' noise (default 1)");
   app.add_flag("--print-config", o.print_config, "print the effective shaft configuration as TOML and exit");
   app.add_flag("-q,--quiet", o.quiet, "no progress, estimate or summary");
   app.add_flag("--progress", o.progress,

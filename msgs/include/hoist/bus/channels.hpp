@@ -18,6 +18,9 @@ inline constexpr std::string_view kChannelAlarmAck = "HOIST_ALARM_ACK";    ///< 
 inline constexpr std::string_view kChannelHealth = "HOIST_HEALTH";         ///< health_t, out
 inline constexpr std::string_view kChannelForecast = "HOIST_FORECAST";     ///< forecast_t, out (issue 17)
 inline constexpr std::string_view kChannelTripPlan = "HOIST_TRIP_PLAN";    ///< trip_plan_t, into the twin (issue 17)
+inline constexpr std::string_view kChannelCageImu = "HOIST_CAGE_IMU";      ///< cage_imu_t, into the twin's estimator
+inline constexpr std::string_view kChannelRopeLoad = "HOIST_ROPE_LOAD";    ///< rope_load_t, into the twin's estimator
+inline constexpr std::string_view kChannelEstimate = "HOIST_ESTIMATE";     ///< estimate_t, out ([estimator] enabled)
 
 /// prefix + name, e.g. channel("north/", kChannelCage) == "north/HOIST_CAGE".
 inline std::string channel(std::string_view prefix, std::string_view name) {
@@ -30,7 +33,7 @@ inline std::string channel(std::string_view prefix, std::string_view name) {
 
 /// All channel names of one shaft with its prefix.
 struct Channels {
-  std::string winder, cage, shape, alarm, ack, health, forecast, trip_plan;
+  std::string winder, cage, shape, alarm, ack, health, forecast, trip_plan, cage_imu, rope_load, estimate;
   explicit Channels(std::string_view prefix = "")
       : winder(channel(prefix, kChannelWinder)),
         cage(channel(prefix, kChannelCage)),
@@ -39,7 +42,10 @@ struct Channels {
         ack(channel(prefix, kChannelAlarmAck)),
         health(channel(prefix, kChannelHealth)),
         forecast(channel(prefix, kChannelForecast)),
-        trip_plan(channel(prefix, kChannelTripPlan)) {}
+        trip_plan(channel(prefix, kChannelTripPlan)),
+        cage_imu(channel(prefix, kChannelCageImu)),
+        rope_load(channel(prefix, kChannelRopeLoad)),
+        estimate(channel(prefix, kChannelEstimate)) {}
 };
 
 }  // namespace hoist::bus

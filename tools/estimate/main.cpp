@@ -1,0 +1,319 @@
+// hoist-estimate -- the load estimator on recorded data: the eccentric
+// load's force Fa, offset b and moment M = Fa b, the cage state they imply
+// and the model check (NIS, MODEL_MISMATCH), from a measurement CSV of the
+// winder (t,l,v,a) and the sensors (f_y, omega, rope_load; any may be
+// absent).  The same code as hoist-twind's live estimator
+// (hoist::estimateRecorded, hoist/load_estimator.hpp): with the same
+// configuration and `hoist-twind --clock input` both give the same numbers.
+//
+//   hoist-estimate --config FILE --measurements FILE.csv --out FILE.csv
+//                  [--modes N] [--max-step S] [--progress] [-q]
+//
+// --config: a shaft TOML or hoist-twind's configuration ([service],
+// [alarms], [forecast], [sensors], [estimator] are accepted; [estimator]
+// enabled is not needed here).  The substep length is --max-step, else the
+// file's [service] max_step, else 0.0025 s (the daemon's default), so that
+// the live and offline estimators agree.
+// Output: one row per measurement row (kOutputHeader); a value that is not
+// observed (sigma < 0 in the estimate, or its sensor not seen yet:
+// fa_observed / moment_observed) is written as nan with its sigma.
+// A one-paragraph summary goes to stdout (not with -q).
+// Exit status: 0 done, 2 bad input (naming file, line, column or option),
+// 1 the run failed (model domain, write error).
+#include "hoist/version.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <new>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+#include "hoist/io/checked_file.hpp"
+#include "hoist/io/config.hpp"
+#include "hoist/io/estimator_config.hpp"
+#include "hoist/io/profile.hpp"
+#include "hoist/io/results.hpp"
+#include "hoist/load_estimator.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string config, measurements, out;
+  int modes = 0;
+  double max_step = -1.0;
+  bool progress = false, quiet = false;
+};
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+constexpr const char* kOutputHeader =
+    "t,l,Fa,b,moment,sigma_Fa,sigma_moment,y_c,theta,sigma_y_c,sigma_theta,"
+    "lambda_0,lambda_1,lambda_2,lambda_3,lambda_4,nis,nis_window,mismatch,"
+    "sigma_b,x_c,sigma_x_c,sigma_lambda_0,sigma_lambda_1,sigma_lambda_2,sigma_lambda_3,sigma_lambda_4,"
+    "theta_open,nis_dof,nis_lower,nis_upper,nis_bound,drift,nis_exceeded,drift_exceeded,sensors,"
+    "fa_observed,moment_observed,accepted,gated,load_changes,implausible";
+
+void num(std::string& s, double v) {
+  if (std::isnan(v)) s += "nan";
+  else hoist::io::appendNumber(s, v);
+  s += ',';
+}
+void integer(std::string& s, long long v) {
+  s += std::to_string(v);
+  s += ',';
+}
+
+/// A value with its sigma; both nan when not observed (sigma < 0, or no
+/// sample of its sensor yet: LoadEstimate then carries the prior).
+void observed(double v, double sigma, bool seen, double& v_out, double& s_out) {
+  const bool ok = seen && sigma >= 0.0;
+  v_out = ok ? v : std::nan("");
+  s_out = ok ? sigma : std::nan("");
+}
+
+void appendRow(std::string& s, const hoist::LoadEstimate& e, const hoist::EstimatorCounters& c) {
+  double Fa, sFa, b, sb, M, sM;
+  observed(e.Fa, e.sigma_Fa, e.fa_observed, Fa, sFa);
+  observed(e.b, e.sigma_b, e.fa_observed && e.moment_observed, b, sb);
+  observed(e.moment, e.sigma_moment, e.moment_observed, M, sM);
+  num(s, e.t);
+  num(s, e.kin.l);
+  num(s, Fa);
+  num(s, b);
+  num(s, M);
+  num(s, sFa);
+  num(s, sM);
+  num(s, e.y_c);
+  num(s, e.theta);
+  num(s, e.sigma_y_c);
+  num(s, e.sigma_theta);
+  for (double l : e.lambda) num(s, l);
+  num(s, e.nis);
+  num(s, e.nis_window);
+  integer(s, e.mismatch ? 1 : 0);
+  num(s, sb);
+  num(s, e.x_c);
+  num(s, e.sigma_x_c);
+  for (double l : e.sigma_lambda) num(s, l);
+  num(s, e.theta_open);
+  integer(s, e.nis_dof);
+  num(s, e.nis_lower);
+  num(s, e.nis_upper);
+  num(s, e.nis_bound);
+  num(s, e.drift);
+  integer(s, e.nis_exceeded ? 1 : 0);
+  integer(s, e.drift_exceeded ? 1 : 0);
+  integer(s, e.sensors);
+  integer(s, e.fa_observed ? 1 : 0);
+  integer(s, e.moment_observed ? 1 : 0);
+  integer(s, c.accepted);
+  integer(s, c.gated);
+  integer(s, c.load_changes);
+  integer(s, c.implausible);
+  s.back() = '\n';
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+std::string withSigma(const char* name, double v, double sigma, bool seen, const char* unit, const char* f) {
+  if (!seen || sigma < 0.0) return std::string(name) + " not observed";
+  return std::string(name) + " = " + fmt(f, v) + " +- " + fmt(f, sigma) + " " + unit;
+}
+
+std::string sensorNames(unsigned bits) {
+  std::string s;
+  if (bits & hoist::kSensorImuAccel) s += "f_y";
+  if (bits & hoist::kSensorImuRate) s += s.empty() ? "omega" : ", omega";
+  if (bits & hoist::kSensorRopeLoad) s += s.empty() ? "rope_load" : ", rope_load";
+  return s.empty() ? "none" : s;
+}
+
+int run(const Options& o) {
+  const auto t_start = Clock::now();
+  // ---- input ------------------------------------------------------------
+  const toml::table tbl = hoist::io::loadTomlFile(o.config);
+  hoist::ShaftParams p = hoist::io::shaftParamsFromToml(tbl, o.config, hoist::io::daemonSections());
+  const hoist::io::EstimatorConfig ec = hoist::io::estimatorConfigFromToml(tbl, o.config);
+  const double max_step = o.max_step >= 0.0 ? o.max_step : hoist::io::serviceMaxStep(tbl, o.config, 0.0025);
+  if (o.modes != 0) p.n = o.modes;
+  try {
+    p.validate();
+  } catch (const hoist::ParamError& e) {
+    throw UsageError(std::string("--modes: ") + e.what());
+  }
+  hoist::io::MeasurementColumns cols;
+  const std::vector<hoist::MeasurementSample> samples =
+      hoist::io::readMeasurementsCsvFile(o.measurements, {}, &cols);
+  {
+    std::vector<hoist::ProfileSample> ps(samples.size());
+    for (std::size_t i = 0; i < samples.size(); ++i) ps[i] = {samples[i].t, samples[i].k};
+    hoist::io::checkProfileInShaft(hoist::HoistProfile(std::move(ps)), p, o.measurements);
+  }
+  // The NIS window holds one entry per sample: size it for the file's rate.
+  hoist::EstimatorSettings set = ec.settings;
+  double min_dt = samples[1].t - samples[0].t;
+  for (std::size_t i = 2; i < samples.size(); ++i) min_dt = std::min(min_dt, samples[i].t - samples[i - 1].t);
+  const double rate = std::ceil(1.0 / min_dt - 1e-9);
+  if (rate > set.max_rate) {
+    if (rate > 100000.0 || set.nis_window * rate > 5.0e6)
+      throw UsageError("--measurements " + o.measurements + ": rows as close as " + fmt("%g", min_dt) +
+                       " s apart (" + fmt("%g", rate) + " Hz) are too fast for estimator.nis_window = " +
+                       fmt("%g", set.nis_window) + " s (at most 5e6 window entries, 100 kHz)");
+    set.max_rate = static_cast<int>(rate);
+  }
+  try {
+    for (std::size_t i = 1; i < samples.size(); ++i) hoist::substepCount(samples[i].t - samples[i - 1].t, max_step);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--max-step ") + fmt("%g", max_step) + ": " + e.what());
+  }
+  if (cols.sensors == 0 && !o.quiet)
+    std::cerr << "hoist-estimate: warning: " << o.measurements
+              << " has no sensor column (f_y, omega, rope_load): the estimate is the open-loop twin\n";
+  if (!cols.ignored.empty() && !o.quiet) {
+    std::string list;
+    for (const auto& c : cols.ignored) list += (list.empty() ? "" : ", ") + c;
+    std::cerr << "hoist-estimate: " << o.measurements << ": ignored columns: " << list << "\n";
+  }
+  hoist::io::CheckedFile out(o.out, "--out");
+
+  // ---- estimate -----------------------------------------------------------
+  out.write(std::string(kOutputHeader) + "\n");
+  std::string line;
+  line.reserve(1024);
+  hoist::LoadEstimate last;
+  hoist::EstimatorCounters counts;
+  long rows = 0, mismatch_rows = 0;
+  double first_mismatch = std::nan("");
+  std::string first_why;  // what raised it first: the NIS window against its bound, or a drifting load
+  int last_decile = 0;
+  const bool tty = ::isatty(2);
+  try {
+    hoist::estimateRecorded(
+        p, set, max_step, samples,
+        [&](const hoist::LoadEstimate& e, const hoist::EstimatorCounters& c) {
+          line.clear();
+          appendRow(line, e, c);
+          out.write(line);
+          ++rows;
+          if (e.mismatch) {
+            ++mismatch_rows;
+            if (std::isnan(first_mismatch)) {
+              first_mismatch = e.t;
+              if (e.nis_exceeded)
+                first_why = "window NIS " + fmt("%.1f", e.nis_window) + " over " + std::to_string(e.nis_dof) +
+                            " dof > bound " + fmt("%.1f", e.nis_bound);
+              if (e.drift_exceeded)
+                first_why += (first_why.empty() ? "" : "; ") + std::string("load drift ") + fmt("%.1f", e.drift) +
+                             " sigma during the trip";
+            }
+          }
+          last = e;
+          counts = c;
+        },
+        [&](double f) {
+          if (!o.progress) return;
+          if (tty) {
+            std::fprintf(stderr, "\rhoist-estimate: %3.0f %%", 100.0 * f);
+          } else {
+            const int decile = static_cast<int>(f * 10.0 + 1e-9);
+            if (decile <= last_decile) return;
+            last_decile = decile;
+            std::fprintf(stderr, "hoist-estimate: progress %3d %%\n", decile * 10);
+          }
+          std::fflush(stderr);
+        });
+  } catch (const std::domain_error& e) {
+    throw std::runtime_error(std::string("the model left its domain: ") + e.what());
+  }
+  if (o.progress && tty) std::fputc('\n', stderr);
+  out.close();
+  const double secs = std::chrono::duration<double>(Clock::now() - t_start).count();
+  if (!o.quiet) {
+    std::ostringstream s;
+    s << "hoist-estimate: " << rows << " rows from " << o.measurements << " (t = " << samples.front().t << " .. "
+      << samples.back().t << " s, sensors: " << sensorNames(cols.sensors) << ") at n = " << p.n
+      << ", max step " << max_step << " s, written to " << o.out << " in " << fmt("%.2f", secs)
+      << " s. Final (t = " << last.t << " s): "
+      << withSigma("Fa", last.Fa, last.sigma_Fa, last.fa_observed, "N", "%.1f") << ", "
+      << withSigma("b", last.b, last.sigma_b, last.fa_observed && last.moment_observed, "m", "%.4f") << ", "
+      << withSigma("M", last.moment, last.sigma_moment, last.moment_observed, "N m", "%.1f") << " (configured Fa = " << p.Fa
+      << " N, b = " << p.b << " m). Updates accepted " << counts.accepted << ", gated " << counts.gated
+      << ", load changes " << counts.load_changes << ", implausible " << counts.implausible
+      << "; MODEL_MISMATCH in " << mismatch_rows << " rows, first "
+      << (std::isnan(first_mismatch) ? std::string("none")
+                                     : "at t = " + fmt("%.2f", first_mismatch) + " s (" + first_why + ")")
+      << ".\n";
+    std::cout << s.str();
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{
+      "hoist-estimate: estimate the eccentric load (Fa, b, M = Fa b), the cage state it implies and the\n"
+      "model check (NIS, MODEL_MISMATCH) from recorded winder and sensor data -- the same estimator as\n"
+      "hoist-twind's [estimator] (docs/estimation.md).\n"
+      "Input CSV columns: t,l,v,a and optionally f_y [m/s^2], omega [rad/s], rope_load [N] (an absent\n"
+      "column: no such sensor; an empty field: no sample in that row); hoist-sim --write-measurements\n"
+      "writes such files.",
+      "hoist-estimate"};
+  app.name("hoist-estimate");
+  app.set_version_flag("--version", std::string("hoist-estimate ") + hoist::kVersionString);
+  app.add_option("--config", o.config,
+                 "shaft TOML or hoist-twind's configuration: the twin's shaft, [sensors] noise and [estimator] "
+                 "tuning (enabled is not needed here)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--measurements", o.measurements, "measurement CSV (t,l,v,a[,f_y,omega,rope_load])")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--out", o.out, "estimate CSV to write (one row per measurement row)")->required();
+  app.add_option("--modes", o.modes, "assumed modes per rope n (overrides model.modes)")
+      ->check(CLI::Range(1, hoist::kMaxModes));
+  app.add_option("--max-step", o.max_step,
+                 "largest integration step [s] (default: the config's [service] max_step, else 0.0025 as in "
+                 "hoist-twind; 0: one step per row)")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_flag("--progress", o.progress, "show progress on stderr");
+  app.add_flag("-q,--quiet", o.quiet, "no summary and no warnings");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  try {
+    return run(o);
+  } catch (const hoist::io::InputError& e) {
+    std::cerr << "hoist-estimate: error: " << e.what() << "\n";
+    return 2;
+  } catch (const UsageError& e) {
+    std::cerr << "hoist-estimate: error: " << e.what() << "\n";
+    return 2;
+  } catch (const hoist::io::WriteError& e) {
+    std::cerr << "hoist-estimate: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "hoist-estimate: error: out of memory (std::bad_alloc)\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "hoist-estimate: error: " << e.what() << "\n";
+    return 1;
+  }
+}
