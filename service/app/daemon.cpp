@@ -559,20 +559,15 @@ bool Daemon::writeReport() const {
     shafts.push_back(std::move(o));
   }
   j["shafts"] = std::move(shafts);
-  const std::string tmp = opt_.report_path + ".tmp";
   try {
-    // Every byte checked, with the errno text (hoist/io/checked_file.hpp).
-    hoist::io::CheckedFile f(tmp, "--report");
+    // Every byte checked, with the errno text; a fresh temporary file renamed
+    // onto a regular file only (hoist/io/checked_file.hpp).
+    hoist::io::CheckedFile f(opt_.report_path, "--report");
     // Invalid UTF-8 (a path or host name) is replaced, never a throw at stop.
     f.write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
     f.close();
   } catch (const hoist::io::WriteError& e) {
     out_->error("cannot write the run report: {}", e.what());
-    std::remove(tmp.c_str());
-    return false;
-  }
-  if (std::rename(tmp.c_str(), opt_.report_path.c_str()) != 0) {
-    out_->error("cannot write the run report {}: rename from {}: {}", opt_.report_path, tmp, std::strerror(errno));
     return false;
   }
   out_->info("run report written to {}", opt_.report_path);

@@ -28,6 +28,7 @@
 
 #include "daemon.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/io/checked_file.hpp"
 #include "hoist/service/budget.hpp"
 #include "hoist/service/config_file.hpp"
 
@@ -241,6 +242,7 @@ int main(int argc, char** argv) {
   opt.realtime.mlockall = mlock;
   opt.realtime.fifo_priority = rt_priority;
   opt.report_path = report;
+  if (const std::string bad = report.empty() ? "" : hoist::io::outputPathError(report, "--report"); !bad.empty()) { std::cerr << "hoist-twind: configuration error: " << bad << "\n"; return 2; }
   for (int i = 0; i < argc; ++i) opt.command_line += (i ? " " : "") + std::string(argv[i]);
 
   // The loop thread never writes to the terminal itself: its lines go
