@@ -57,6 +57,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
@@ -98,6 +99,7 @@ struct Writer {
   std::optional<hoist::io::CheckedFile> f;
   std::string path;
   std::string type;
+  std::string channel;
   long rows = 0;
   std::string error;  ///< the first failure, with the path and errno text ("": none)
   void open() {
@@ -159,9 +161,11 @@ class Converter {
         os << "hoist-log2csv: error: " << w->error << "\n";
         failed_ = true;
       } else {
-        os << "hoist-log2csv: " << w->rows << " rows of hoist." << w->type << " -> " << w->path << "\n";
+        os << "hoist-log2csv: " << w->rows << " rows of hoist." << w->type << " on "
+           << hoist::msg::terminalSafe(w->channel) << " -> " << w->path << "\n";
       }
     }
+    for (const auto& n : notes_) os << "hoist-log2csv: note: " << n << "\n";
     for (const auto& [ch, n] : unknown_)
       os << "hoist-log2csv: note: skipped " << n << " event(s) of an unknown type on channel "
          << hoist::msg::terminalSafe(ch) << "\n";
@@ -190,24 +194,49 @@ class Converter {
     return s.empty() ? std::string("_") : s;
   }
   static std::string fileName(const std::string& key) { return key + ".csv"; }
+  static std::string hash8(const std::string& s) {  // FNV-1a, 32 bits
+    std::uint32_t h = 2166136261u;
+    for (unsigned char c : s) h = (h ^ c) * 16777619u;
+    char buf[12];
+    std::snprintf(buf, sizeof buf, "%08x", h);
+    return buf;
+  }
 
   /// The writer for (channel, type), created with `header` on first use
   /// (`suffix`: a second file of the channel, DIR/<CHANNEL><suffix>.csv).
+  /// Two channels never share a file: names that sanitize alike
+  /// ("a/HOIST_WINDER", "a_HOIST_WINDER") get distinct files (the later one
+  /// DIR/<CHANNEL>.<hash of its name>.csv), and a note names both.
   Writer* writer(const std::string& channel, const char* type, const std::string& header,
                  const char* suffix = "") {
-    std::string key = sanitize(channel) + suffix;
-    auto it = writers_.find(key);
-    if (it != writers_.end() && it->second->type != type) {
-      key += std::string(".") + type;
-      it = writers_.find(key);
-    }
+    const std::string id = channel + '\0' + suffix + '\0' + type;
+    auto it = writers_.find(id);
     if (it == writers_.end()) {
+      std::string key = sanitize(channel) + suffix;
+      const auto owner = [&](const std::string& k) -> const Owner* {
+        auto o = files_.find(k);
+        return o == files_.end() ? nullptr : &o->second;
+      };
+      // The channel's messages changed type midway: a second file of its own.
+      if (const Owner* o = owner(key); o && o->channel == channel) key += std::string(".") + type;
+      if (const Owner* o = owner(key); o && o->channel != channel) {
+        std::string alt = sanitize(channel) + "." + hash8(channel) + suffix;
+        for (int n = 2; owner(alt) && !(owner(alt)->channel == channel); ++n)
+          alt = sanitize(channel) + "." + hash8(channel) + "-" + std::to_string(n) + suffix;
+        if (owner(alt)) alt += std::string(".") + type;
+        notes_.push_back("channels " + hoist::msg::terminalSafe(o->channel) + " and " +
+                         hoist::msg::terminalSafe(channel) + " have the same file name " + fileName(key) +
+                         ": the second is written to " + fileName(alt));
+        key = alt;
+      }
+      files_[key] = Owner{channel};
       auto w = std::make_unique<Writer>();
       w->type = type;
+      w->channel = channel;
       w->path = (dir_ / fileName(key)).string();
       w->open();
       w->write(header);
-      it = writers_.emplace(key, std::move(w)).first;
+      it = writers_.emplace(id, std::move(w)).first;
     }
     ++it->second->rows;
     return it->second.get();
@@ -384,7 +413,12 @@ class Converter {
   }
 
   std::filesystem::path dir_;
-  std::map<std::string, std::unique_ptr<Writer>> writers_;
+  struct Owner {
+    std::string channel;
+  };
+  std::map<std::string, std::unique_ptr<Writer>> writers_;  // by channel, suffix and type
+  std::map<std::string, Owner> files_;                      // file stem -> the channel written there
+  std::vector<std::string> notes_;
   std::map<std::string, long> unknown_;
   std::map<std::pair<std::string, std::string>, long> bad_;  // (channel, status)
   bool failed_ = false;
