@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
     const ShaftParams base = loadParams(c);
     const HoistProfile profile = loadProfile(c, base);
     if (advise->parsed()) {
+      checkTraceSize(c, profile, 1);
       const int rc = runAdvisor(aa, c, base, profile, ps);
       reportPlots(ps);
       return rc;
@@ -114,6 +115,9 @@ int main(int argc, char** argv) {
         }
       }
     }
+    std::size_t runs = 0;
+    for (const auto& s : todo) runs = std::max(runs, s.runs.size());  // one study's traces at a time
+    checkTraceSize(c, profile, runs);
     int rc = 0;
     for (const auto& s : todo) rc = std::max(rc, runStudy(s, c, base, profile, ps));
     reportPlots(ps);
