@@ -435,11 +435,14 @@ int main(int argc, char** argv) {
       "the next event) and reported; the exit status is then 1 unless --lenient.\n"
       "Exit status: 0 ok, 1 unreadable log / unwritable file / data lost, 2 bad usage."};
   app.name("hoist-log2csv");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-log2csv ") + hoist::kVersionString);
   std::string log_path, out_dir;
   bool lenient = false;
-  app.add_option("LOGFILE", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
-  app.add_option("--out-dir", out_dir, "output directory (created if missing)")->required();
+  // Required, but checked after parsing: CLI11 reports a missing LOGFILE
+  // before an unknown option, and "--bogus-opt" must be named.
+  app.add_option("LOGFILE", log_path, "LCM log file (required)")->check(CLI::ExistingFile);
+  app.add_option("--out-dir", out_dir, "output directory (created if missing; required)");
   app.add_flag("--lenient", lenient,
                "exit 0 even when corrupt events were skipped or events failed to decode");
   try {
@@ -448,6 +451,11 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
+  for (const auto& [given, what] : {std::pair{!log_path.empty(), "LOGFILE"}, std::pair{!out_dir.empty(), "--out-dir"}})
+    if (!given) {
+      std::cerr << "hoist-log2csv: " << what << " is required\nRun with --help for more information.\n";
+      return 2;
+    }
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {

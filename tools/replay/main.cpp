@@ -132,6 +132,7 @@ int main(int argc, char** argv) {
       "With no source it plays the paper's trapezoid (Fig. 2: 50 m -> 300 m, 60 s).\n"
       "--timing-test ... runs hoist-timing-test (the real-time check of a running hoist-twind)."};
   app.name("hoist-replay");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-replay ") + hoist::kVersionString);
   std::string profile_arg, log_path, url, config_path;
   std::vector<std::string> prefixes;
