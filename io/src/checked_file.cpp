@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -40,7 +41,17 @@ std::string prefix(const std::string& path, const std::string& label) {
   return label.empty() ? path : label + " " + path;
 }
 
-/// "" if the target is absent or a regular file; else why not (errno in `err`).
+/// The null device itself (character device 1:3; not a symlink to it):
+/// written to as a discard sink, never replaced.
+bool isNullDevice(const struct stat& st) { return S_ISCHR(st.st_mode) && st.st_rdev == makedev(1, 3); }
+
+bool isNullDevicePath(const std::string& path) {
+  struct stat st{};
+  return ::lstat(path.c_str(), &st) == 0 && isNullDevice(st);
+}
+
+/// "" if the target is absent, a regular file or the null device; else why
+/// not (errno in `err`).
 std::string targetProblem(const std::string& path, int& err) {
   struct stat st{};
   if (::lstat(path.c_str(), &st) != 0) {
@@ -48,7 +59,7 @@ std::string targetProblem(const std::string& path, int& err) {
     err = errno;
     return std::string("cannot check the target: ") + std::strerror(errno);
   }
-  if (S_ISREG(st.st_mode)) return {};
+  if (S_ISREG(st.st_mode) || isNullDevice(st)) return {};
   err = S_ISDIR(st.st_mode) ? EISDIR : EEXIST;
   return std::string("exists and is ") + kindOf(st.st_mode) + "; refusing to replace it (give a regular file's path)";
 }
@@ -63,6 +74,7 @@ std::string outputPathError(const std::string& path, const std::string& label) {
   if (path.back() == '/') return prefix(path, label) + ": names a directory, not a file";
   int err = 0;
   if (std::string p = targetProblem(path, err); !p.empty()) return prefix(path, label) + ": " + p;
+  if (isNullDevicePath(path)) return {};
   const std::string dir = dirOf(path);
   struct stat st{};
   if (::stat(dir.c_str(), &st) != 0)
@@ -81,6 +93,22 @@ CheckedFile::CheckedFile(std::string path, std::string label) : path_(std::move(
   if (path_.empty()) fail("empty path", ENOENT);
   int err = 0;
   if (std::string p = targetProblem(path_, err); !p.empty()) fail(p.c_str(), err);
+  if (isNullDevicePath(path_)) {  // "--out /dev/null": discard the data, the node is left alone
+    const int nfd = ::open(path_.c_str(), O_WRONLY | O_NOFOLLOW | O_NOCTTY | O_CLOEXEC);
+    struct stat st{};
+    if (nfd < 0) fail("cannot open for writing", errno);
+    if (::fstat(nfd, &st) != 0 || !isNullDevice(st)) {  // swapped meanwhile
+      ::close(nfd);
+      fail("is no longer the null device; refusing to write to it", EEXIST);
+    }
+    f_ = ::fdopen(nfd, "w");
+    if (f_ == nullptr) {
+      const int e = errno;
+      ::close(nfd);
+      fail("cannot open for writing", e);
+    }
+    return;
+  }
   // A fresh name each attempt: O_EXCL fails on anything already there (a
   // planted symlink included, which O_CREAT|O_EXCL never follows).
   static std::atomic<unsigned> counter{0};
@@ -177,6 +205,7 @@ void CheckedFile::close() {
   std::FILE* f = std::exchange(f_, nullptr);
   errno = 0;
   if (std::fclose(f) != 0) fail("close failed", errno ? errno : EIO);
+  if (tmp_.empty()) return;  // the null device: nothing to rename
   // The target may have been replaced by something not ours meanwhile.
   int err = 0;
   if (std::string p = targetProblem(path_, err); !p.empty()) fail(p.c_str(), err);

@@ -32,7 +32,7 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-/// The WriteError message of opening `path`, or "" (a test failure) if it opened.
+/// The WriteError message of writing "x" to `path`, or "" if it was written.
 std::string openError(const fs::path& path) {
   try {
     CheckedFile f(path.string(), "--report");
@@ -112,9 +112,17 @@ TEST(CheckedFile, RefusesASymlinkAndLeavesItsTargetAlone) {
 TEST(CheckedFile, RefusesADirectoryAndACharacterDevice) {
   const fs::path d = freshDir("dir");
   EXPECT_NE(openError(d).find("a directory"), std::string::npos);
-  // A character device is only stat()ed, never opened for writing: refused.
+  // A character device other than the null device is only stat()ed, never
+  // opened for writing: refused (/dev/full: never written, so no ENOSPC).
+  if (fs::exists("/dev/full") && fs::is_character_file("/dev/full")) {
+    EXPECT_NE(hoist::io::outputPathError("/dev/full", "--report").find("a character device"), std::string::npos);
+    EXPECT_NE(openError("/dev/full").find("a character device"), std::string::npos);
+  }
+  // The null device is a discard sink: written to, left a character device.
   if (fs::exists("/dev/null") && fs::is_character_file("/dev/null")) {
-    EXPECT_NE(hoist::io::outputPathError("/dev/null", "--report").find("a character device"), std::string::npos);
+    EXPECT_EQ(hoist::io::outputPathError("/dev/null", "--out"), "");
+    EXPECT_EQ(openError("/dev/null"), "");
+    EXPECT_TRUE(fs::is_character_file(fs::symlink_status("/dev/null")));
   }
 }
 

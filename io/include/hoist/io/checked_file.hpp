@@ -16,8 +16,11 @@
 //     reused), and is renamed onto the target only by close(), when every
 //     byte is written; a failed or abandoned write removes it;
 //   - a target that exists and is not a regular file (a device node such
-//     as /dev/null, a FIFO, a socket, a directory, a symbolic link) is
-//     refused when opening and again just before the rename;
+//     as /dev/full or /dev/sda, a FIFO, a socket, a directory, a symbolic
+//     link) is refused when opening and again just before the rename; the
+//     one exception is the null device itself (character device 1:3, e.g.
+//     "--out /dev/null" to discard a run's rows), which is written to as a
+//     sink and never replaced;
 //   - outputPathError() checks at start-up, before any work, that the
 //     target would be accepted and that its directory exists and is
 //     writable, so a bad path is reported at once, not when a long run
