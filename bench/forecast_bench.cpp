@@ -11,6 +11,10 @@
 
 #include <memory>
 
+#include <cstdio>
+#include <string>
+
+#include "hoist/version.hpp"
 #include "hoist/forecast.hpp"
 #include "hoist/scenario.hpp"
 #include "hoist/simulator.hpp"
@@ -72,4 +76,24 @@ BENCHMARK(BM_ForecastPlan)->Args({25, 25})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// BENCHMARK_MAIN() plus --version (from the one version header) and a
+// usage line naming the program.
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--version") {
+      std::printf("hoist-forecast-bench %s\n", hoist::kVersionString);
+      return 0;
+    }
+    if (a == "--help" || a == "-h") {
+      std::printf("usage: hoist-forecast-bench [Google Benchmark options]\n"
+                  "The look-ahead forecast's cost (docs/lookahead.md).  Options:\n");
+      std::fflush(stdout);
+    }
+  }
+  benchmark::Initialize(&argc, argv);  // --help: prints Google Benchmark's options, exits 0
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -7,9 +7,15 @@
 // over a 20-s horizon.
 //
 //   build/bin/hoist-forecast-table [n] [every_s]
+#include <cctype>
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
+
+#include "hoist/version.hpp"
 
 #include "hoist/forecast.hpp"
 #include "hoist/scenario.hpp"
@@ -17,13 +23,63 @@
 
 using namespace hoist;
 
+namespace {
+
+const char* kUsage =
+    "usage: hoist-forecast-table [N] [EVERY_S]\n"
+    "The look-ahead forecasts along the paper's trip on the demo shaft, as the Markdown table of\n"
+    "docs/lookahead.md.\n"
+    "  N        assumed modes per rope, 1..1000 (default 50)\n"
+    "  EVERY_S  seconds between forecasts along the trip, > 0 (default 5)\n"
+    "  --help   this text;  --version  the version\n"
+    "Exit status: 0 ok, 2 bad usage.\n";
+
+int usageError(const std::string& what) {
+  std::fprintf(stderr, "hoist-forecast-table: %s\n%s", what.c_str(), kUsage);
+  return 2;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   ShaftParams p;
-  p.n = argc > 1 ? std::atoi(argv[1]) : 50;
-  const double every = argc > 2 ? std::atof(argv[2]) : 5.0;
-  if (p.n < 1 || p.n > kMaxModes || !(every > 0.0)) {
-    std::fprintf(stderr, "usage: hoist-forecast-table [n 1..1000] [every_s > 0]\n");
-    return 2;
+  p.n = 50;
+  double every = 5.0;
+  int positional = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    if (a == "--version") {
+      std::printf("hoist-forecast-table %s\n", hoist::kVersionString);
+      return 0;
+    }
+    char* end = nullptr;
+    errno = 0;
+    if (positional == 0) {
+      const long n = std::strtol(a.c_str(), &end, 10);
+      if (a.empty() || *end != '\0' || errno != 0) {
+        if (a.size() > 1 && a[0] == '-' && !std::isdigit(static_cast<unsigned char>(a[1])))
+          return usageError("unknown option '" + a + "'");
+        return usageError("N: '" + a + "' is not an integer");
+      }
+      if (n < 1 || n > kMaxModes) return usageError("N: must be in 1..1000 (got " + a + ")");
+      p.n = static_cast<int>(n);
+    } else if (positional == 1) {
+      every = std::strtod(a.c_str(), &end);
+      if (a.empty() || *end != '\0' || errno != 0) {
+        if (a.size() > 1 && a[0] == '-' && !std::isdigit(static_cast<unsigned char>(a[1])) && a[1] != '.')
+          return usageError("unknown option '" + a + "'");
+        return usageError("EVERY_S: '" + a + "' is not a number");
+      }
+      if (!(every > 0.0) || !std::isfinite(every)) return usageError("EVERY_S: must be > 0 (got " + a + ")");
+    } else {
+      if (a.size() > 1 && a[0] == '-') return usageError("unknown option '" + a + "'");
+      return usageError("unexpected argument '" + a + "'");
+    }
+    ++positional;
   }
   auto model = std::make_shared<const ShaftModel>(p);
   ForecastOptions o;

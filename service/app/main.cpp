@@ -28,6 +28,7 @@
 
 #include "daemon.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/io/checked_file.hpp"
 #include "hoist/service/budget.hpp"
 #include "hoist/service/config_file.hpp"
 
@@ -65,6 +66,7 @@ int main(int argc, char** argv) {
       "alarms (HOIST_ALARM; commands on HOIST_ALARM_ACK) and its own health (HOIST_HEALTH).\n"
       "Runs with the paper's shaft when given no --config."};
   app.name("hoist-twind");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-twind ") + hoist::kVersionString);
   std::vector<std::string> config_paths;
   std::string lcm_url, clock, prefix, log_level = "info", cpus, report;
@@ -179,6 +181,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
+  if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-twind", app.count("--lcm-url") > 0, lcm_url, lcm_url); !bad.empty()) { std::cerr << bad << "\n"; return 2; }
   opt.lcm_url = hoist::bus::resolveLcmUrl(lcm_url, shaft_url);
   if (const std::string bad = hoist::bus::lcmUrlError(opt.lcm_url); !bad.empty()) {
     const char* env = std::getenv("LCM_DEFAULT_URL");
@@ -241,6 +244,7 @@ int main(int argc, char** argv) {
   opt.realtime.mlockall = mlock;
   opt.realtime.fifo_priority = rt_priority;
   opt.report_path = report;
+  if (const std::string bad = report.empty() ? "" : hoist::io::outputPathError(report, "--report"); !bad.empty()) { std::cerr << "hoist-twind: configuration error: " << bad << "\n"; return 2; }
   for (int i = 0; i < argc; ++i) opt.command_line += (i ? " " : "") + std::string(argv[i]);
 
   // The loop thread never writes to the terminal itself: its lines go

@@ -117,20 +117,15 @@ bool writeRunReport(const std::string& path, const RunFacts& f, spdlog::logger& 
   nlohmann::ordered_json shafts = nlohmann::ordered_json::array();
   for (const ShaftTwin* sp : f.shafts) shafts.push_back(shaftJson(*sp));
   j["shafts"] = std::move(shafts);
-  const std::string tmp = path + ".tmp";
   try {
-    // Every byte checked, with the errno text (hoist/io/checked_file.hpp).
-    hoist::io::CheckedFile file(tmp, "--report");
+    // Every byte checked, with the errno text; a fresh temporary file renamed
+    // onto a regular file only (hoist/io/checked_file.hpp).
+    hoist::io::CheckedFile file(path, "--report");
     // Invalid UTF-8 (a path or host name) is replaced, never a throw at stop.
     file.write(j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
     file.close();
   } catch (const hoist::io::WriteError& e) {
     log.error("cannot write the run report: {}", e.what());
-    std::remove(tmp.c_str());
-    return false;
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    log.error("cannot write the run report {}: rename from {}: {}", path, tmp, std::strerror(errno));
     return false;
   }
   log.info("run report written to {}", path);

@@ -15,8 +15,15 @@ fail() { echo "FAIL: $*"; exit 1; }
 "$spy" --bogus >/dev/null 2>&1; [ $? -eq 2 ] || fail "an unknown option must exit 2"
 "$spy" --lcm-url >/dev/null 2>&1; [ $? -eq 2 ] || fail "--lcm-url without a URL must exit 2"
 "$spy" --lcm-url 'bogus://x' >/dev/null 2>&1; [ $? -eq 2 ] || fail "a bad LCM URL must exit 2"
+"$spy" --lcm-url 'udpm://239.255.76.67:7667?ttl=abc' >/dev/null 2>&1; [ $? -eq 2 ] || fail "ttl=abc must exit 2"
+"$spy" --lcm-url '' >/dev/null 2>&1; [ $? -eq 2 ] || fail "an empty --lcm-url must exit 2"
 cp=$("$spy" --print-classpath) || fail "--print-classpath (a jar is missing)"
 echo "class path: $cp"
+# Without a display: one clear line, no Java HeadlessException trace.
+out=$(env -u DISPLAY -u WAYLAND_DISPLAY "$spy" 2>&1); rc=$?
+[ $rc -eq 1 ] || fail "without a display: exit $rc (expected 1): $out"
+case "$out" in *"hoist-lcm-spy: no display"*) ;; *) fail "without a display: $out" ;; esac
+case "$out" in *Exception*) fail "without a display: a Java trace: $out" ;; esac
 case "$cp" in *jchart2d*) ;; *) fail "jchart2d.jar is not on the class path" ;; esac
 rm -rf "$work" && mkdir -p "$work/classes" || exit 1
 javac -nowarn -cp "$cp" -d "$work/classes" "$src/SpyFieldViewTest.java" || fail "javac SpyFieldViewTest"

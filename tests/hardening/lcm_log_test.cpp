@@ -282,18 +282,25 @@ TEST(Log2Csv, HostileLogsExitNonZeroWithBoundedMemory) {
 
 // A full disk: every file is checked to its last byte.
 TEST(Log2Csv, FullDiskIsAnErrorNamingTheFile) {
-  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  // The full disk: a 16 KiB file size limit (600 rows are about 40 kB);
+  // hoist-log2csv refuses to write to /dev/full itself (a device node).
   const auto d = workDir("full");
   writeBytes(d / "a.lcmlog", winderLog(600));
   fs::create_directories(d / "out");
-  fs::create_symlink("/dev/full", d / "out" / "HOIST_WINDER.csv");
-  const auto res = runMeasured({HOIST_LOG2CSV, (d / "a.lcmlog").string(), "--out-dir", (d / "out").string()},
-                               (d / "run.log").string());
-  const std::string out = slurp(d / "run.log");
+  const auto res = hoist::test::runCapturedWithFileSizeLimit(
+      HOIST_LOG2CSV, {(d / "a.lcmlog").string(), "--out-dir", (d / "out").string()}, 16);
+  const std::string& out = res.output;
   EXPECT_EQ(res.status, 1) << out;
   EXPECT_NE(out.find("HOIST_WINDER.csv"), std::string::npos) << out;
-  EXPECT_NE(out.find("No space left on device"), std::string::npos) << out;
+  EXPECT_NE(out.find("File too large"), std::string::npos) << out;
   EXPECT_EQ(out.find("600 rows"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(d / "out" / "HOIST_WINDER.csv")) << "a short file left behind";
+  if (fs::exists("/dev/full")) {
+    fs::create_symlink("/dev/full", d / "out" / "HOIST_WINDER.csv");
+    const auto dev = hoist::test::runCaptured(HOIST_LOG2CSV, {(d / "a.lcmlog").string(), "--out-dir", (d / "out").string()});
+    EXPECT_EQ(dev.status, 1) << dev.output;
+    EXPECT_NE(dev.output.find("a symbolic link"), std::string::npos) << dev.output;
+  }
 }
 
 // Issue 17: HOIST_FORECAST (nested forecast_scenario_t) to CSV -- one row

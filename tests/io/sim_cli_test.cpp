@@ -342,21 +342,27 @@ TEST_F(SimCli, ProgressLinesWithoutATerminal) {
 // Issue 12.6: every file written to its last byte, or exit 1 naming the
 // option, the path and the errno text (the streaming writer included).
 TEST_F(SimCli, FullDiskAndUnwritablePathsExitOneNamingTheFile) {
+  // The full disk: a 64 KiB file size limit (runCapturedWithFileSizeLimit;
+  // /dev/full is refused now, as every device node: last case).
   struct Case {
     std::vector<std::string> args;
     std::string expect;
+    bool full;
   };
   const std::vector<Case> cases = {
-      {{"--profile", "paper", "--out", "/dev/full"}, "--out /dev/full: write failed: No space left on device"},
-      {{"--profile", "paper", "--out", path("o.csv"), "--shape-out", "/dev/full"},
-       "--shape-out /dev/full: write failed: No space left on device"},
-      {{"--profile", "paper", "--write-profile", "/dev/full"},
-       "--write-profile /dev/full: write failed: No space left on device"},
+      {{"--profile", "paper", "--out", path("full.csv")}, "--out " + path("full.csv") + ": write failed: File too large",
+       true},
+      {{"--profile", "paper", "--out", "/dev/null", "--shape-out", path("s.csv"), "--shape-times", "18,36,60",
+        "--shape-points", "2001"},
+       "--shape-out " + path("s.csv") + ": write failed: File too large", true},
+      {{"--profile", "paper", "--write-profile", path("p.csv")},
+       "--write-profile " + path("p.csv") + ": write failed: File too large", true},
       {{"--profile", "paper", "--out", path("no/such/dir/o.csv")},
-       "--out " + path("no/such/dir/o.csv") + ": cannot open for writing: No such file or directory"},
+       "--out " + path("no/such/dir/o.csv") + ": cannot open for writing: No such file or directory", false},
+      {{"--profile", "paper", "--out", "/dev/full"}, "--out /dev/full: exists and is a character device", false},
   };
   for (const auto& c : cases) {
-    const SimRun r = sim(c.args);
+    const SimRun r = c.full ? hoist::test::runCapturedWithFileSizeLimit(HOIST_SIM, c.args, 64) : sim(c.args);
     EXPECT_EQ(r.status, 1) << r.output;
     EXPECT_NE(r.output.find("hoist-sim: error: " + c.expect), std::string::npos) << "want '" << c.expect << "' in:\n"
                                                                                  << r.output;

@@ -180,6 +180,18 @@ inline CapturedRun runCaptured(const std::string& exe, const std::vector<std::st
   return r;
 }
 
+/// A full disk for the files a program writes: runCaptured with the file size
+/// limited to `kib` KiB (RLIMIT_FSIZE; SIGXFSZ ignored), so a write past it
+/// fails with EFBIG ("File too large").  The programs refuse to write to
+/// /dev/full (a device node, not a file of theirs: hoist/io/checked_file.hpp),
+/// which the full-disk tests used before.  The null device is not limited.
+inline CapturedRun runCapturedWithFileSizeLimit(const std::string& exe, const std::vector<std::string>& args,
+                                                long kib) {
+  std::vector<std::string> a = {"-c", "trap '' XFSZ; ulimit -f " + std::to_string(kib * 2) + " && exec \"$0\" \"$@\"",
+                                exe};
+  a.insert(a.end(), args.begin(), args.end());
+  return runCaptured("/bin/sh", a);
+}
 
 #ifdef HOIST_TEST_WORK_DIR
 /// A fresh directory for one test's files.

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   CLI::App app{"hoist-alarm-ack: acknowledge, shelve or unshelve hoist-twind alarms (one HOIST_ALARM_ACK message)",
                "hoist-alarm-ack"};
   app.name("hoist-alarm-ack");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-alarm-ack ") + hoist::kVersionString);
   std::string kind = "*", level = "both", user, url, prefix;
   double shelve = 0.0;
@@ -85,11 +86,13 @@ int main(int argc, char** argv) {
                       : (shelve > 0 ? hoist::alarm_ack_t::ACTION_SHELVE : hoist::alarm_ack_t::ACTION_ACK);
   m.shelve_duration = shelve;
   m.user = user;
-  url = hoist::bus::resolveLcmUrl(url);
-  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
-    std::cerr << "hoist-alarm-ack: " << bad << "\n";
+  if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-alarm-ack", app.count("--lcm-url") > 0, url,
+                                                            hoist::bus::resolveLcmUrl(url));
+      !bad.empty()) {
+    std::cerr << bad << "\n";
     return 2;
   }
+  url = hoist::bus::resolveLcmUrl(url);
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::cerr << "hoist-alarm-ack: cannot open LCM (" << (url.empty() ? "default URL" : url)

@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
       "advertised under its LCM channel name in JSON encoding.  Binds loopback by default: anyone who\n"
       "can reach the port can acknowledge and shelve alarms unless --read-only (docs/security.md)."};
   app.name("hoist-dash");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-dash ") + hoist::kVersionString);
   std::string bind = "127.0.0.1", url, web_root, log_level = "info";
   int port = 8080;
@@ -149,6 +150,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-dash", app.count("--lcm-url") > 0, url, hoist::bus::resolveLcmUrl(url)); !bad.empty()) { std::fprintf(stderr, "%s\n", bad.c_str()); return 2; }
   url = hoist::bus::resolveLcmUrl(url);
   lcm::LCM lcm(url);
   if (!lcm.good()) {

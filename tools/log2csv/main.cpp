@@ -55,6 +55,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
@@ -80,6 +81,7 @@ struct Writer {
   std::optional<hoist::io::CheckedFile> f;
   std::string path;
   std::string type;
+  std::string channel;
   long rows = 0;
   std::string error;  ///< the first failure, with the path and errno text ("": none)
   void open() {
@@ -141,9 +143,11 @@ class Converter {
         os << "hoist-log2csv: error: " << w->error << "\n";
         failed_ = true;
       } else {
-        os << "hoist-log2csv: " << w->rows << " rows of hoist." << w->type << " -> " << w->path << "\n";
+        os << "hoist-log2csv: " << w->rows << " rows of hoist." << w->type << " on "
+           << hoist::msg::terminalSafe(w->channel) << " -> " << w->path << "\n";
       }
     }
+    for (const auto& n : notes_) os << "hoist-log2csv: note: " << n << "\n";
     for (const auto& [ch, n] : unknown_)
       os << "hoist-log2csv: note: skipped " << n << " event(s) of an unknown type on channel "
          << hoist::msg::terminalSafe(ch) << "\n";
@@ -172,24 +176,49 @@ class Converter {
     return s.empty() ? std::string("_") : s;
   }
   static std::string fileName(const std::string& key) { return key + ".csv"; }
+  static std::string hash8(const std::string& s) {  // FNV-1a, 32 bits
+    std::uint32_t h = 2166136261u;
+    for (unsigned char c : s) h = (h ^ c) * 16777619u;
+    char buf[12];
+    std::snprintf(buf, sizeof buf, "%08x", h);
+    return buf;
+  }
 
   /// The writer for (channel, type), created with `header` on first use
   /// (`suffix`: a second file of the channel, DIR/<CHANNEL><suffix>.csv).
+  /// Two channels never share a file: names that sanitize alike
+  /// ("a/HOIST_WINDER", "a_HOIST_WINDER") get distinct files (the later one
+  /// DIR/<CHANNEL>.<hash of its name>.csv), and a note names both.
   Writer* writer(const std::string& channel, const char* type, const std::string& header,
                  const char* suffix = "") {
-    std::string key = sanitize(channel) + suffix;
-    auto it = writers_.find(key);
-    if (it != writers_.end() && it->second->type != type) {
-      key += std::string(".") + type;
-      it = writers_.find(key);
-    }
+    const std::string id = channel + '\0' + suffix + '\0' + type;
+    auto it = writers_.find(id);
     if (it == writers_.end()) {
+      std::string key = sanitize(channel) + suffix;
+      const auto owner = [&](const std::string& k) -> const Owner* {
+        auto o = files_.find(k);
+        return o == files_.end() ? nullptr : &o->second;
+      };
+      // The channel's messages changed type midway: a second file of its own.
+      if (const Owner* o = owner(key); o && o->channel == channel) key += std::string(".") + type;
+      if (const Owner* o = owner(key); o && o->channel != channel) {
+        std::string alt = sanitize(channel) + "." + hash8(channel) + suffix;
+        for (int n = 2; owner(alt) && !(owner(alt)->channel == channel); ++n)
+          alt = sanitize(channel) + "." + hash8(channel) + "-" + std::to_string(n) + suffix;
+        if (owner(alt)) alt += std::string(".") + type;
+        notes_.push_back("channels " + hoist::msg::terminalSafe(o->channel) + " and " +
+                         hoist::msg::terminalSafe(channel) + " have the same file name " + fileName(key) +
+                         ": the second is written to " + fileName(alt));
+        key = alt;
+      }
+      files_[key] = Owner{channel};
       auto w = std::make_unique<Writer>();
       w->type = type;
+      w->channel = channel;
       w->path = (dir_ / fileName(key)).string();
       w->open();
       w->write(header);
-      it = writers_.emplace(key, std::move(w)).first;
+      it = writers_.emplace(id, std::move(w)).first;
     }
     ++it->second->rows;
     return it->second.get();
@@ -315,7 +344,12 @@ class Converter {
   }
 
   std::filesystem::path dir_;
-  std::map<std::string, std::unique_ptr<Writer>> writers_;
+  struct Owner {
+    std::string channel;
+  };
+  std::map<std::string, std::unique_ptr<Writer>> writers_;  // by channel, suffix and type
+  std::map<std::string, Owner> files_;                      // file stem -> the channel written there
+  std::vector<std::string> notes_;
   std::map<std::string, long> unknown_;
   std::map<std::pair<std::string, std::string>, long> bad_;  // (channel, status)
   bool failed_ = false;
@@ -332,11 +366,14 @@ int main(int argc, char** argv) {
       "the next event) and reported; the exit status is then 1 unless --lenient.\n"
       "Exit status: 0 ok, 1 unreadable log / unwritable file / data lost, 2 bad usage."};
   app.name("hoist-log2csv");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-log2csv ") + hoist::kVersionString);
   std::string log_path, out_dir;
   bool lenient = false;
-  app.add_option("LOGFILE", log_path, "LCM log file")->required()->check(CLI::ExistingFile);
-  app.add_option("--out-dir", out_dir, "output directory (created if missing)")->required();
+  // Required, but checked after parsing: CLI11 reports a missing LOGFILE
+  // before an unknown option, and "--bogus-opt" must be named.
+  app.add_option("LOGFILE", log_path, "LCM log file (required)")->check(CLI::ExistingFile);
+  app.add_option("--out-dir", out_dir, "output directory (created if missing; required)");
   app.add_flag("--lenient", lenient,
                "exit 0 even when corrupt events were skipped or events failed to decode");
   try {
@@ -345,6 +382,11 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
+  for (const auto& [given, what] : {std::pair{!log_path.empty(), "LOGFILE"}, std::pair{!out_dir.empty(), "--out-dir"}})
+    if (!given) {
+      std::cerr << "hoist-log2csv: " << what << " is required\nRun with --help for more information.\n";
+      return 2;
+    }
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {

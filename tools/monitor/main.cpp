@@ -233,6 +233,7 @@ int main(int argc, char** argv) {
       "with HOIST_FORECAST, per scenario the worst forecast clearance and the time to violation\n"
       "(seconds to the first CRITICAL / WARNING crossing)."};
   app.name("hoist-monitor");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-monitor ") + hoist::kVersionString);
   std::string url, prefix;
   double period = 1.0, duration = 0.0;
@@ -250,11 +251,13 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  url = hoist::bus::resolveLcmUrl(url);
-  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
-    std::fprintf(stderr, "hoist-monitor: %s\n", bad.c_str());
+  if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-monitor", app.count("--lcm-url") > 0, url,
+                                                            hoist::bus::resolveLcmUrl(url));
+      !bad.empty()) {
+    std::fprintf(stderr, "%s\n", bad.c_str());
     return 2;
   }
+  url = hoist::bus::resolveLcmUrl(url);
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     std::fprintf(stderr, "hoist-monitor: cannot open LCM at %s\n", hoist::bus::describeLcmUrl(url).c_str());

@@ -18,6 +18,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "hoist/bus/lcm_url.hpp"
 #include "hoist/io/error.hpp"
 #include "hoist/mqtt/bridge.hpp"
 #include "hoist/mqtt/config.hpp"
@@ -32,6 +33,7 @@ int main(int argc, char** argv) {
                "operator alarm commands back (docs/mqtt.md)",
                "hoist-mqtt"};
   app.set_version_flag("--version", std::string("hoist-mqtt ") + hoist::kVersionString);
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   std::string config_path, broker, client_id, lcm_url;
   std::vector<std::string> prefixes;
   bool no_commands = false, quiet = false;
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
   }
   // LCM URL precedence: --lcm-url, $LCM_DEFAULT_URL, [bridge] lcm_url, LCM's default.
   if (const char* env = std::getenv("LCM_DEFAULT_URL"); lcm_url.empty() && env && *env) cfg.lcm_url = env;
+  if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-mqtt", app.count("--lcm-url") > 0, lcm_url, cfg.lcm_url); !bad.empty()) { std::cerr << bad << "\n"; return 2; }
 
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);

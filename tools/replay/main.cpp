@@ -28,6 +28,12 @@
 //     all with the row's utime -- so that the daemon has a step's sensor
 //     samples when the step's winder input arrives.  Each channel has its
 //     own seq = 0, 1, 2, ...; --rate does not apply.
+//     --lenient.  A gap between consecutive HOIST_WINDER timestamps longer
+//     than --max-gap S (default 10 s; a corrupted log had gaps of 33 s, 67 s
+//     and 10^15 us), or a timestamp that goes backwards, is reported on
+//     stderr and played as S seconds (backwards: as no pause), so a replay
+//     never sleeps for hours without a word; --restamp utimes follow the
+//     shortened timeline.
 // Message k carries seq = k and utime = (wall time at start, us) + round((t_k -
 // t0) * 1e6): utime follows PROFILE time whatever the speed, so that
 // `hoist-twind --clock input` steps the model exactly by the profile's dt.
@@ -106,6 +112,7 @@ class Progress {
   void done() {
     if (on_) std::fputc('\n', stderr);
   }
+  bool active() const { return on_ && last_ != 0; }
 
  private:
   bool on_;
@@ -138,6 +145,7 @@ int main(int argc, char** argv) {
       "With no source it plays the paper's trapezoid (Fig. 2: 50 m -> 300 m, 60 s).\n"
       "--timing-test ... runs hoist-timing-test (the real-time check of a running hoist-twind)."};
   app.name("hoist-replay");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-replay ") + hoist::kVersionString);
   std::string profile_arg, log_path, url, config_path;
   std::vector<std::string> prefixes;
@@ -174,14 +182,21 @@ int main(int argc, char** argv) {
   bool lenient = false;
   app.add_flag("--lenient", lenient,
                "--lcm-log: exit 0 even when corrupt events were skipped or payloads failed to decode");
+  double max_gap = 10.0;
+  app.add_option("--max-gap", max_gap,
+                 "--lcm-log: a timestamp gap longer than S seconds between HOIST_WINDER events is reported and "
+                 "played as S seconds (default 10)")
+      ->check(numberIn(0.0, 1e6, false, "in [0, 1e6] s"));
   app.add_flag("-q,--quiet", quiet, "no progress display");
   if (const auto rc = hoist::replay::parseCommandLine(app, argc, argv)) return *rc;
 
-  url = hoist::bus::resolveLcmUrl(url);
-  if (const std::string bad = hoist::bus::lcmUrlError(url); !bad.empty()) {
-    std::cerr << "hoist-replay: " << bad << "\n";
+  if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-replay", app.count("--lcm-url") > 0, url,
+                                                            hoist::bus::resolveLcmUrl(url));
+      !bad.empty()) {
+    std::cerr << bad << "\n";
     return 2;
   }
+  url = hoist::bus::resolveLcmUrl(url);
   if (prefixes.size() > 1) {
     std::cerr << "hoist-replay: --channel-prefix: only one prefix (several shafts: hoist-timing-test)\n";
     return 2;
@@ -222,7 +237,9 @@ int main(int argc, char** argv) {
       std::cerr << "hoist-replay: " << log.error() << "\n";
       return 1;
     }
-    std::int64_t first_ts = 0, first_utime = 0;
+    std::int64_t first_ts = 0, first_utime = 0, prev_ts = 0, cut_us = 0;  // cut_us: time removed from gaps
+    long gaps = 0;
+    const std::int64_t max_gap_us = static_cast<std::int64_t>(std::llround(max_gap * 1e6));
     bool first = true;
     hoist::io::LcmLogEvent ev;
     while (log.next(ev)) {
@@ -238,16 +255,35 @@ int main(int argc, char** argv) {
         continue;
       }
       if (first) {
-        first_ts = ev.timestamp;
+        first_ts = prev_ts = ev.timestamp;
         first = false;
       }
-      const double t_rel = static_cast<double>(ev.timestamp - first_ts) * 1e-6;
+      // The gap in unsigned arithmetic: timestamps are whatever the file says.
+      const auto gap = static_cast<std::int64_t>(static_cast<std::uint64_t>(ev.timestamp) -
+                                                 static_cast<std::uint64_t>(prev_ts));
+      if (gap > max_gap_us || gap < 0) {
+        const std::int64_t played = gap < 0 ? 0 : max_gap_us;
+        if (gaps++ < 10)
+          std::fprintf(stderr, "%shoist-replay: %s: event %lld at byte %lld: timestamp %s %.6g s%s; played as %.6g s "
+                               "(--max-gap %g)\n",
+                       progress.active() ? "\n" : "", log_path.c_str(), static_cast<long long>(ev.eventnum),
+                       static_cast<long long>(ev.offset), gap < 0 ? "goes back by" : "gap of",
+                       std::fabs(static_cast<double>(gap)) * 1e-6, gap < 0 ? "" : " after the previous event",
+                       static_cast<double>(played) * 1e-6, max_gap);
+        cut_us = static_cast<std::int64_t>(static_cast<std::uint64_t>(cut_us) +
+                                           static_cast<std::uint64_t>(gap - played));
+      }
+      prev_ts = ev.timestamp;
+      const std::int64_t rel_us = static_cast<std::int64_t>(static_cast<std::uint64_t>(ev.timestamp) -
+                                                            static_cast<std::uint64_t>(first_ts) -
+                                                            static_cast<std::uint64_t>(cut_us));
+      const double t_rel = static_cast<double>(rel_us) * 1e-6;
       if (speed > 0.0 && !sleepUntil(start_ns + static_cast<std::int64_t>(t_rel / speed * 1e9))) break;
       const void* data = ev.data.data();
       int len = static_cast<int>(ev.data.size());
       if (restamp) {
         if (sent == 0) first_utime = msg.utime;
-        msg.utime = start_utime + (msg.utime - first_utime);
+        msg.utime = start_utime + (msg.utime - first_utime) - cut_us;
         len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
         data = buf.data();
       }
@@ -261,10 +297,11 @@ int main(int argc, char** argv) {
       return 1;
     }
     log_lost = log.stats().lost() || log_bad > 0;
-    if (!g_signal && (log_lost || !quiet))
+    if (!g_signal && (log_lost || gaps || !quiet))
       std::cerr << "hoist-replay: " << log_path << ": " << log.summary()
                 << (log_bad ? "; " + std::to_string(log_bad) + " undecodable HOIST_WINDER payload(s) skipped"
                             : std::string())
+                << (gaps ? "; " + std::to_string(gaps) + " timestamp gap(s) over --max-gap shortened" : std::string())
                 << "\n";
   } else if (!meas_path.empty()) {
     const std::string ch_imu = hoist::bus::channel(prefix, hoist::bus::kChannelCageImu);

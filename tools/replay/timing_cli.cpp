@@ -9,6 +9,8 @@
 #include <cmath>
 #include <iostream>
 
+#include <tuple>
+
 #include "cli_util.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/bus/channels.hpp"
@@ -56,6 +58,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
                "lateness, step time, end-to-end latency and rejected inputs against budgets (see the end)."};
   app.footer(kTimingHelp);
   app.name(program);
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", program + " " + hoist::kVersionString);
   std::string url, config_path, report_path;
   std::vector<std::string> prefixes;
@@ -98,6 +101,13 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   budget("--max-rejected", budgets.max_rejected, "budget: inputs rejected by the daemon (default 0)");
   app.add_option("--report", report_path, "also write the Markdown report to FILE");
   if (const auto rc = parseCommandLine(app, argc, argv)) return *rc;
+  for (const auto& [opt, given, value, resolved] :
+       {std::tuple{"--lcm-url", app.count("--lcm-url") > 0, url, hoist::bus::resolveLcmUrl(url)},
+        std::tuple{"--lcm-url-out", app.count("--lcm-url-out") > 0, url_out, url_out}})
+    if (const std::string bad = hoist::bus::lcmUrlUsageError(program, given, value, resolved, opt); !bad.empty()) {
+      std::cerr << bad << "\n";
+      return 2;
+    }
   url = hoist::bus::resolveLcmUrl(url);
 
   TimingTestOptions o;

@@ -556,6 +556,7 @@ int main(int argc, char** argv) {
       "Also: 'hoist-sim study NAME ...' runs the paper's parameter studies (hoist-study --help).",
       "hoist-sim"};
   app.name("hoist-sim");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-sim ") + hoist::kVersionString);
   app.add_option("--config", o.config, "shaft TOML; missing keys take the paper's values (--print-config lists every key)")
       ->check(CLI::ExistingFile);

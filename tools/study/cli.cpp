@@ -28,6 +28,22 @@ CLI::Validator numberAbove(double lo, bool inclusive) {
       },
       inclusive ? "NUMBER >= 0" : "NUMBER > 0");
 }
+CLI::Validator numberAtMost(double hi) {
+  return CLI::Validator(
+      [hi](std::string& in) -> std::string {
+        double v = 0;
+        std::size_t pos = 0;
+        try {
+          v = std::stod(in, &pos);
+        } catch (...) {
+          return "'" + in + "' is not a number";
+        }
+        if (pos != in.size() || !std::isfinite(v)) return "'" + in + "' is not a finite number";
+        if (v > hi) return "must be <= " + fmtg(hi) + ", got " + in;
+        return {};
+      },
+      "NUMBER");
+}
 void addCommon(CLI::App* sub, Common& c, [[maybe_unused]] bool advisor, bool paper) {
   sub->add_option("--out-dir", c.out_dir, "Directory for CSVs, scripts and PNGs (created)")
       ->capture_default_str();
@@ -37,7 +53,10 @@ void addCommon(CLI::App* sub, Common& c, [[maybe_unused]] bool advisor, bool pap
                   "Hoist profile CSV (t,v,a[,l]) or SPEC; default: the paper's Fig. 2 trapezoid");
   sub->add_option("--modes", c.modes, "Assumed modes per rope (overrides model.modes)")
       ->check(CLI::Range(1, kMaxModes));
-  sub->add_option("--dt", c.dt, "Output step [s]")->capture_default_str()->check(numberAbove(0, false));
+  sub->add_option("--dt", c.dt, "Output step [s], as hoist-sim: 1e-6 .. 1")
+      ->capture_default_str()
+      ->check(numberAbove(1e-6, true))
+      ->check(numberAtMost(1.0));
   sub->add_option("--max-step", c.max_step, "Largest integration step [s] (0: --dt)")
       ->capture_default_str()
       ->check(numberAbove(0, true));
@@ -145,6 +164,20 @@ HoistProfile loadProfile(const Common& c, const ShaftParams& p) {
   } catch (const std::exception& e) {
     throw UsageError(std::string("--profile: ") + e.what());
   }
+}
+
+void checkTraceSize(const Common& c, const HoistProfile& profile, std::size_t runs) {
+  const double span = profile.endTime() - profile.startTime();
+  const double rows = std::floor(span / c.dt) + 2.0;
+  if (!(rows <= kMaxRunRows))
+    throw UsageError("--dt: " + fmtg(c.dt) + " s gives " + fmtg(rows, "%.3g") + " output rows per run over the " +
+                     fmtg(span) + " s profile, more than " + fmtg(kMaxRunRows, "%.0e") +
+                     " (each run's trace is held in memory, 96 B a row); raise --dt or shorten the profile");
+  if (!(rows * static_cast<double>(runs) <= kMaxStudyRows))
+    throw UsageError("--dt: " + fmtg(c.dt) + " s gives " + fmtg(rows, "%.3g") + " output rows per run, " +
+                     std::to_string(runs) + " runs hold " + fmtg(rows * static_cast<double>(runs), "%.3g") +
+                     " rows in memory, more than " + fmtg(kMaxStudyRows, "%.0e") +
+                     "; raise --dt or give fewer --values");
 }
 
 RunOptions runOptions(const Common& c, const ShaftParams& p) {

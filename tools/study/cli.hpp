@@ -49,6 +49,13 @@ std::pair<double, double> parseRange(const std::string& opt, const std::string& 
 ShaftParams loadParams(const Common& c);
 /// The profile of --profile (the paper's trapezoid by default).
 HoistProfile loadProfile(const Common& c, const ShaftParams& p);
+/// Rows a run's trace holds in memory (all runs' traces are kept until the
+/// study is written): at most kMaxRunRows per run, kMaxStudyRows in all.
+inline constexpr double kMaxRunRows = 1e7;     // 12 doubles a row: about 1 GB
+inline constexpr double kMaxStudyRows = 2e7;   // about 2 GB for a whole study
+/// Throws UsageError naming --dt (and --values when `runs` > 1) when the
+/// traces of `runs` runs of `profile` at --dt would exceed those limits.
+void checkTraceSize(const Common& c, const HoistProfile& profile, std::size_t runs);
 /// Simulation options of --dt/--max-step for `p`.
 RunOptions runOptions(const Common& c, const ShaftParams& p);
 

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
       "PNG figures rendered by gnuplot (with the .gp script next to each PNG).\n"
       "Exit status: 0 ok, 1 run or file failure, 2 usage/config error, 3 advise: infeasible."};
   app.name("hoist-study");  // usage lines name the program, not the path it was run by
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-study ") + hoist::kVersionString);
   app.require_subcommand(1, 1);
   app.fallthrough(false);
@@ -77,6 +78,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 200));
   addCommon(advise, c, true, false);
 
+  // CLI11 says "A subcommand is required" before naming an unknown option.
+  if (argc > 1 && argv[1][0] == '-') {
+    const std::string a = argv[1];
+    if (a != "-h" && a != "--help" && a != "--version") {
+      std::fprintf(stderr, "hoist-study: unknown option '%s' (the first argument is the study: response, preload, "
+                           "tension-difference, eccentric-load, mass, all, sweep or advise; see --help)\n", a.c_str());
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -93,6 +103,7 @@ int main(int argc, char** argv) {
     const ShaftParams base = loadParams(c);
     const HoistProfile profile = loadProfile(c, base);
     if (advise->parsed()) {
+      checkTraceSize(c, profile, 1);
       const int rc = runAdvisor(aa, c, base, profile, ps);
       reportPlots(ps);
       return rc;
@@ -114,6 +125,9 @@ int main(int argc, char** argv) {
         }
       }
     }
+    std::size_t runs = 0;
+    for (const auto& s : todo) runs = std::max(runs, s.runs.size());  // one study's traces at a time
+    checkTraceSize(c, profile, runs);
     int rc = 0;
     for (const auto& s : todo) rc = std::max(rc, runStudy(s, c, base, profile, ps));
     reportPlots(ps);

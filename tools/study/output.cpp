@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -104,8 +105,13 @@ void writeGnuplotScript(const std::string& dir, const Figure& fig) {
                "  set terminal pngcairo size %d,%d font ',9' linewidth 1.2\n"
                "} else {\n  set terminal png size %d,%d\n}\nset termoption noenhanced\n",
                fig.width, fig.height, fig.width, fig.height);
-  f.printf("set output %s\nset datafile separator ','\nset grid\nset key %s samplen 2\n",
-               gpQuote(fig.name + ".png").c_str(), fig.key.c_str());
+  // hoist-study runs the script with hoist_output='-': the PNG comes on
+  // gnuplot's stdout and is written by hoist-study's checked writer
+  // (runGnuplot); run by hand, gnuplot writes NAME.png itself.
+  f.printf("if (!exists('hoist_output')) hoist_output = %s\n"
+           "if (hoist_output eq '-') { set output } else { set output hoist_output }\n"
+           "set datafile separator ','\nset grid\nset key %s samplen 2\n",
+           gpQuote(fig.name + ".png").c_str(), fig.key.c_str());
   f.printf("set multiplot layout %d,%d title %s\n", rows, fig.cols, gpQuote(fig.title).c_str());
   for (const auto& p : fig.panels) {
     f.printf("set xlabel %s\nset ylabel %s\n", gpQuote(p.xlabel).c_str(), gpQuote(p.ylabel).c_str());
@@ -137,29 +143,78 @@ std::string findGnuplot() {
 
 bool runGnuplot(const std::string& gnuplot, const std::string& dir, const std::string& script,
                 std::string& err) {
+  // The PNG is written by us (io::CheckedFile: a fresh temporary file, never
+  // a device node, FIFO or planted symlink at NAME.png), from gnuplot's stdout.
+  std::string png = script;
+  if (png.size() > 3 && png.compare(png.size() - 3, 3, ".gp") == 0) png.resize(png.size() - 3);
+  png = (std::filesystem::path(dir) / (png + ".png")).string();
+  std::optional<io::CheckedFile> out;
+  try {
+    out.emplace(png);
+  } catch (const io::WriteError& e) {
+    err = e.what();
+    return false;
+  }
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) {
+    err = std::string("pipe failed: ") + std::strerror(errno);
+    return false;
+  }
   const pid_t pid = ::fork();
   if (pid < 0) {
     err = std::string("fork failed: ") + std::strerror(errno);
+    ::close(fds[0]);
+    ::close(fds[1]);
     return false;
   }
   if (pid == 0) {
     if (::chdir(dir.c_str()) != 0) ::_exit(126);
-    // gnuplot's own warnings go to our stderr; stdout is not used.
-    const int devnull = ::open("/dev/null", O_WRONLY);
-    if (devnull >= 0) ::dup2(devnull, STDOUT_FILENO);
-    ::execl(gnuplot.c_str(), "gnuplot", script.c_str(), static_cast<char*>(nullptr));
+    // gnuplot's own warnings go to our stderr; its stdout is the PNG.
+    if (::dup2(fds[1], STDOUT_FILENO) < 0) ::_exit(126);
+    ::execl(gnuplot.c_str(), "gnuplot", "-e", "hoist_output='-'", script.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
+  ::close(fds[1]);
+  std::string write_err;
+  char buf[65536];
+  for (;;) {
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    if (!write_err.empty()) continue;  // drain, so gnuplot is not blocked
+    try {
+      out->write(std::string_view(buf, static_cast<std::size_t>(n)));
+    } catch (const io::WriteError& e) {
+      write_err = e.what();
+    }
+  }
+  ::close(fds[0]);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) {
       err = std::string("waitpid failed: ") + std::strerror(errno);
       return false;
     }
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return true;
-  err = "gnuplot " + script + " in " + dir + " failed (status " +
-        std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
-  return false;
+  if (!write_err.empty()) {
+    err = write_err;
+    return false;
+  }
+  if (!(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
+    err = "gnuplot " + script + " in " + dir + " failed (status " +
+          std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
+    return false;
+  }
+  if (out->bytes() == 0) {
+    err = "gnuplot " + script + " in " + dir + " wrote no image";
+    return false;
+  }
+  try {
+    out->close();
+  } catch (const io::WriteError& e) {
+    err = e.what();
+    return false;
+  }
+  return true;
 }
 
 }  // namespace hoist::study::out
