@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
       h.input_age = -1.0;
       h.rss_kb = -1;
       lcm.publish(name + "HOIST_HEALTH", &h);
+      if (count > 1) std::this_thread::sleep_for(std::chrono::microseconds(300));  // no receive-buffer overflow
     }
     if (r + 1 < rounds) std::this_thread::sleep_for(std::chrono::milliseconds(period_ms));
   }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <spdlog/spdlog.h>
+
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/msg/codec.hpp"
@@ -158,8 +160,14 @@ std::uint64_t Hub::counter(const std::string& what) const {
 Json Hub::stats() const {
   Json c = Json::object();
   for (const auto& [k, v] : counters_) c[k] = v;
+  Json disc{{"enabled", opt_.discover}, {"slots", prefix_list_.size()}, {"max", opt_.max_prefixes},
+            {"table_full", prefix_list_.size() >= opt_.max_prefixes}, {"refused_total", refused_total_},
+            {"last_refused", last_refused_}, {"candidates", Json::array()}, {"confirmed", Json::array()},
+            {"status", Json::array()}};
+  for (const auto& [p, e] : disc_) disc[e.confirmed ? "confirmed" : "candidates"].push_back(p);
+  for (const auto& [id, st] : statuses_) disc["status"].push_back(st);
   return Json{{"clients", clients_.size()}, {"prefixes", prefix_list_}, {"read_only", opt_.read_only},
-              {"channels", channels_.size()}, {"counters", c}};
+              {"channels", channels_.size()}, {"counters", c}, {"discovery", disc}};
 }
 
 void Hub::addPrefix(const std::string& prefix) {
@@ -251,6 +259,7 @@ void Hub::addClient(Client& c) {
   for (const auto& [topic, ch] : channels_) all.push_back(&ch);
   std::sort(all.begin(), all.end(), [](const Channel* a, const Channel* b) { return a->id < b->id; });
   c.sendText(std::make_shared<const std::string>(advertiseOf(all).dump()));
+  for (const auto& [id, st] : statuses_) c.sendText(std::make_shared<const std::string>(st.dump()));
 }
 
 void Hub::removeClient(Client& c) { clients_.erase(&c); }
@@ -301,12 +310,9 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
     return;
   }
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
+  if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
-    if (opt_.discover && suffix == "HOIST_HEALTH") {
-      addPrefix(prefix);
-      ch = channelFor(channel);
-    }
     if (ch == nullptr) {
       // An alarm of a shaft not announced yet (its first HOIST_HEALTH is up
       // to a second away): keep it for the alarm list, bounded.
@@ -332,7 +338,183 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   broadcast(*ch, payload);
 }
 
+std::string Hub::shaftName(const std::string& prefix) {
+  std::string s = prefix;
+  if (!s.empty() && (s.back() == '/' || s.back() == '_' || s.back() == '-' || s.back() == '.')) s.pop_back();
+  return s.empty() ? std::string("default") : s;
+}
+
+void Hub::noteHealth(Evidence& e, std::int64_t instance, std::uint64_t now) const {
+  const double gap = e.last_ns == 0 ? 0.0 : static_cast<double>(now - std::min(now, e.last_ns)) * 1e-9;
+  if (e.count == 0 || instance != e.instance || gap > opt_.health_gap_s) {
+    e.count = 1;  // a new run of evidence
+    e.instance = instance;
+    if (e.first_ns == 0) e.first_ns = now;
+  } else {
+    ++e.count;
+  }
+  e.last_ns = now;
+  if (e.instance != 0 && e.count >= opt_.confirm_count) e.confirmed = true;
+}
+
+void Hub::onDiscoveryHealth(const std::string& prefix, const Json& health) {
+  const std::uint64_t now = clock_();
+  const std::int64_t instance = health.value("instance_id", std::int64_t{0});
+  if (const auto it = disc_.find(prefix); it != disc_.end()) {
+    noteHealth(it->second, instance, now);
+    return;
+  }
+  if (std::find(prefix_list_.begin(), prefix_list_.end(), prefix) != prefix_list_.end()) return;  // fixed
+  Evidence& e = refused_[prefix];
+  noteHealth(e, instance, now);
+  maintainDiscovery();  // free the slots of silent candidates first
+  if (prefix_list_.size() >= opt_.max_prefixes) {
+    // Real daemons first: the weakest slot (an unconfirmed candidate with less
+    // evidence, or a confirmed prefix silent for confirmed_idle_s) gives way
+    // to a prefix with more evidence of a daemon behind it.
+    std::string weakest;
+    const Evidence* w = nullptr;
+    for (const auto& [p, d] : disc_) {
+      const bool idle = static_cast<double>(now - std::min(now, d.last_ns)) * 1e-9 > opt_.confirmed_idle_s;
+      if (d.confirmed && !idle) continue;
+      if (w == nullptr || (d.confirmed ? 1 : 0) < (w->confirmed ? 1 : 0) || d.count < w->count ||
+          (d.count == w->count && d.last_ns < w->last_ns)) {
+        w = &d;
+        weakest = p;
+      }
+    }
+    const bool idle_w = w != nullptr && static_cast<double>(now - std::min(now, w->last_ns)) * 1e-9 > opt_.confirmed_idle_s;
+    const bool stronger = w != nullptr && e.instance != 0 && (idle_w || (!w->confirmed && e.count > w->count));
+    if (!stronger) {
+      count("prefix_refused_table_full");
+      count("prefix_limit_reached");  // the older counter name
+      ++refused_total_;
+      last_refusal_ns_ = now;
+      last_refused_ = msg::terminalSafe(prefix, 64);
+      if (refused_.size() > 256) {  // bounded: forget the stalest
+        auto stalest = refused_.begin();
+        for (auto it = refused_.begin(); it != refused_.end(); ++it)
+          if (it->second.last_ns < stalest->second.last_ns) stalest = it;
+        if (stalest->first != prefix) refused_.erase(stalest);
+      }
+      setStatus("discovery-full", 2,
+                "shaft table full (" + std::to_string(opt_.max_prefixes) + " prefixes): HOIST_HEALTH from prefix '" +
+                    last_refused_ + "' refused (" + std::to_string(refused_total_) +
+                    " refused so far); list the plant's shafts with --channel-prefix");
+      return;
+    }
+    spdlog::warn("shaft discovery: prefix '{}' ({}) gives way to '{}' (daemon instance {}, {} health messages)",
+                 msg::terminalSafe(weakest, 64), w->confirmed ? "silent" : "unconfirmed", msg::terminalSafe(prefix, 64),
+                 e.instance, e.count);
+    count("prefix_replaced");
+    removePrefix(weakest);
+  }
+  const Evidence got = e;
+  refused_.erase(prefix);
+  addPrefix(prefix);
+  if (std::find(prefix_list_.begin(), prefix_list_.end(), prefix) != prefix_list_.end()) disc_[prefix] = got;
+  checkNameClashes();
+}
+
+void Hub::maintainDiscovery() {
+  if (!opt_.discover) return;
+  const std::uint64_t now = clock_();
+  std::vector<std::string> gone;
+  for (const auto& [p, d] : disc_)
+    if (!d.confirmed && static_cast<double>(now - std::min(now, d.last_ns)) * 1e-9 > opt_.candidate_ttl_s)
+      gone.push_back(p);
+  for (const auto& p : gone) {
+    count("prefix_aged_out");
+    removePrefix(p);
+  }
+  if (!gone.empty()) checkNameClashes();
+  for (auto it = refused_.begin(); it != refused_.end();)
+    it = static_cast<double>(now - std::min(now, it->second.last_ns)) * 1e-9 > 10.0 ? refused_.erase(it) : std::next(it);
+  // The table-full status lasts while refusals keep coming (10 s).
+  if (statuses_.count("discovery-full") && static_cast<double>(now - std::min(now, last_refusal_ns_)) * 1e-9 > 10.0)
+    clearStatus("discovery-full");
+}
+
+void Hub::checkNameClashes() {
+  std::map<std::string, std::vector<std::string>> by_name;
+  for (const auto& p : prefix_list_) by_name[shaftName(p)].push_back(p);
+  std::set<std::string> live;
+  for (const auto& [name, ps] : by_name) {
+    if (ps.size() < 2) continue;
+    const std::string id = "discovery-clash:" + name;
+    live.insert(id);
+    std::string list;
+    for (const auto& p : ps) list += (list.empty() ? "'" : ", '") + msg::terminalSafe(p, 64) + "'";
+    const std::string text = "prefixes " + list + " all give the shaft name '" + msg::terminalSafe(name, 64) +
+                             "': one of them may be forged; check which daemon is real and list the plant's shafts "
+                             "with --channel-prefix";
+    if (!statuses_.count(id) || statuses_[id]["message"] != text) {
+      count("prefix_name_clash");
+      spdlog::warn("shaft discovery: {}", text);
+      setStatus(id, 2, text);
+    }
+  }
+  std::vector<std::string> old;
+  for (const auto& [id, st] : statuses_)
+    if (id.rfind("discovery-clash:", 0) == 0 && !live.count(id)) old.push_back(id);
+  for (const auto& id : old) clearStatus(id);
+}
+
+void Hub::setStatus(const std::string& id, int level, const std::string& text) {
+  Json st{{"op", "status"}, {"level", level}, {"message", text}, {"id", id}};
+  const bool same = statuses_.count(id) && statuses_[id] == st;
+  if (!statuses_.count(id) && spdlog::should_log(spdlog::level::warn) && id == "discovery-full")
+    spdlog::warn("shaft discovery: {}", text);
+  statuses_[id] = st;
+  if (same) return;
+  const auto frame = std::make_shared<const std::string>(st.dump());
+  for (Client* c : clients_) c->sendText(frame);
+}
+
+void Hub::clearStatus(const std::string& id) {
+  if (statuses_.erase(id) == 0) return;
+  if (id == "discovery-full") spdlog::info("shaft discovery: the table has room again");
+  const auto frame = std::make_shared<const std::string>(Json{{"op", "removeStatus"}, {"statusIds", {id}}}.dump());
+  for (Client* c : clients_) c->sendText(frame);
+}
+
+void Hub::removePrefix(const std::string& prefix) {
+  const auto pit = std::find(prefix_list_.begin(), prefix_list_.end(), prefix);
+  if (pit == prefix_list_.end()) return;
+  prefix_list_.erase(pit);
+  disc_.erase(prefix);
+  decimators_.erase(prefix);
+  Json ids = Json::array();
+  for (auto it = channels_.begin(); it != channels_.end();) {
+    if (it->second.prefix != prefix) {
+      ++it;
+      continue;
+    }
+    const std::uint32_t id = it->second.id;
+    ids.push_back(id);
+    for (Client* c : clients_) {
+      if (const auto s = c->by_chan_.find(id); s != c->by_chan_.end()) {
+        c->subs_.erase(s->second);
+        c->by_chan_.erase(s);
+      }
+      for (auto p = c->published_.begin(); p != c->published_.end();)
+        p = p->second == it->first ? c->published_.erase(p) : std::next(p);
+    }
+    by_id_.erase(id);
+    it = channels_.erase(it);
+  }
+  const auto frame = std::make_shared<const std::string>(Json{{"op", "unadvertise"}, {"channelIds", ids}}.dump());
+  for (Client* c : clients_) c->sendText(frame);
+}
+
 void Hub::flushDecimated() {
+  if (opt_.discover) {
+    const std::uint64_t now = clock_();
+    if (now - std::min(now, last_maintain_ns_) >= 500'000'000ULL) {
+      last_maintain_ns_ = now;
+      maintainDiscovery();
+    }
+  }
   for (auto& [prefix, dec] : decimators_) {
     if (dec.empty()) continue;
     const auto payload = std::make_shared<const std::string>(dec.take().dump());

@@ -74,6 +74,15 @@ class Hub {
     std::vector<std::string> prefixes;  ///< fixed prefixes (--channel-prefix); empty: discover
     bool discover = true;               ///< add prefixes seen on *HOIST_HEALTH
     std::size_t max_prefixes = 16;
+    // Discovery (docs/dashboard.md "Shaft discovery"): a discovered prefix is
+    // a candidate until `confirm_count` HOIST_HEALTH messages of one non-zero
+    // daemon instance id arrived at most `health_gap_s` apart; a candidate
+    // silent for `candidate_ttl_s` loses its slot, and a confirmed prefix
+    // silent for `confirmed_idle_s` may be replaced when the table is full.
+    int confirm_count = 3;
+    double health_gap_s = 3.0;
+    double candidate_ttl_s = 3.0;
+    double confirmed_idle_s = 60.0;
     std::size_t max_lcm_bytes = 1 << 20;  ///< larger LCM messages are dropped (counted)
     Json shaft_meta = Json::object();     ///< prefix -> {warning_fraction, ...} (serverInfo metadata)
   };
@@ -90,8 +99,14 @@ class Hub {
   /// A raw LCM message: validated and decoded by the codec (failures
   /// counted, never thrown), then sent to the subscribers.
   void onLcm(const std::string& channel, const void* data, std::size_t size);
-  /// Flush the decimated channels (call at the display rate, ~25 Hz).
+  /// Flush the decimated channels (call at the display rate, ~25 Hz); also
+  /// ages out discovered prefixes and updates the discovery status.
   void flushDecimated();
+  /// Ages out silent candidate prefixes; updates the discovery status.
+  void maintainDiscovery();
+  /// The shaft name of a channel prefix: the prefix without one trailing
+  /// separator ('/', '_', '-', '.'), "default" for "" (hoist-mqtt's rule).
+  static std::string shaftName(const std::string& prefix);
 
   void onClientText(Client& c, std::string_view text);
   void onClientBinary(Client& c, std::string_view bytes);
@@ -112,7 +127,19 @@ class Hub {
     std::shared_ptr<const std::string> latest;                   // replayed on subscribe (health, shape)
     std::map<std::string, std::shared_ptr<const std::string>> table;  // alarms: kind/level -> latest
   };
+  struct Evidence {  // what a discovered prefix has shown of itself
+    std::uint64_t first_ns = 0, last_ns = 0;
+    int count = 0;             // health messages of `instance` at most health_gap_s apart
+    std::int64_t instance = 0;
+    bool confirmed = false;
+  };
   void addPrefix(const std::string& prefix);
+  void removePrefix(const std::string& prefix);
+  void onDiscoveryHealth(const std::string& prefix, const Json& health);
+  void noteHealth(Evidence& e, std::int64_t instance, std::uint64_t now) const;
+  void setStatus(const std::string& id, int level, const std::string& msg);  ///< persistent, to every client
+  void clearStatus(const std::string& id);
+  void checkNameClashes();
   Channel* channelFor(const std::string& topic);
   Json advertiseOf(const std::vector<const Channel*>& chans) const;
   void broadcast(Channel& ch, const std::shared_ptr<const std::string>& payload);
@@ -134,6 +161,11 @@ class Hub {
   std::map<std::string, MinMaxDecimator> decimators_;   // by prefix
   std::map<std::string, std::map<std::string, std::shared_ptr<const std::string>>> pending_alarms_;
   std::uint32_t next_id_ = 1;
+  std::map<std::string, Evidence> disc_;     // discovered prefixes in the table
+  std::map<std::string, Evidence> refused_;  // recently refused prefixes (bounded)
+  std::uint64_t last_refusal_ns_ = 0, refused_total_ = 0, last_maintain_ns_ = 0;
+  std::string last_refused_;
+  std::map<std::string, Json> statuses_;     // persistent statuses by id (sent to new clients)
   std::map<std::string, std::uint64_t> counters_;
   std::string session_id_;
 };
