@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -218,6 +219,30 @@ void Hub::addPrefix(const std::string& prefix) {
       auto& sd = channels_[d.topic] = std::move(d);
       by_id_[sd.id] = &sd;
       added.push_back(&sd);
+      // The trend history: sent whole on subscribe, then nothing (the
+      // decimated channel carries the rest).
+      Channel hc;
+      hc.id = next_id_++;
+      hc.topic = prefix + kHistorySuffix;
+      hc.prefix = prefix;
+      hc.suffix = kHistorySuffix;
+      hc.schema_name = "hoist_dash.cage_history";
+      hc.schema = Json{{"type", "object"},
+                       {"title", "hoist_dash.cage_history"},
+                       {"description",
+                        "The recent HOIST_CAGE history kept by hoist-dash (up to its history window), sent once on "
+                        "subscribe: per bucket the first and last utime and the smallest and largest value of each "
+                        "field in `fields` (rows of `min` and `max` in that order; null = not a number)"},
+                       {"properties",
+                        {{"fields", {{"type", "array"}, {"items", {{"type", "string"}}}}},
+                         {"first_utime", {{"type", "array"}, {"items", {{"type", "integer"}}}}},
+                         {"last_utime", {{"type", "array"}, {"items", {{"type", "integer"}}}}},
+                         {"min", {{"type", "array"}}},
+                         {"max", {{"type", "array"}}}}}}
+                      .dump();
+      auto& sh = channels_[hc.topic] = std::move(hc);
+      by_id_[sh.id] = &sh;
+      added.push_back(&sh);
     }
   }
   const auto adv = std::make_shared<const std::string>(advertiseOf(added).dump());
@@ -311,6 +336,7 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
   if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
+  if (suffix == "HOIST_ALARM" && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
     if (ch == nullptr) {
@@ -328,7 +354,9 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   count("lcm_decoded");
   const auto payload = std::make_shared<const std::string>(j.dump());
-  if (suffix == "HOIST_HEALTH" || suffix == "HOIST_GUIDE_SHAPE" || suffix == "HOIST_FORECAST") ch->latest = payload;
+  if (suffix == "HOIST_HEALTH" || suffix == "HOIST_GUIDE_SHAPE" || suffix == "HOIST_FORECAST" ||
+      suffix == "HOIST_TRIP_PLAN")
+    ch->latest = payload;  // sent on subscribe (the trip plan: the speed axis's vmax)
   if (suffix == "HOIST_ALARM") {
     const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
     if (ch->table.size() < 64 || ch->table.count(key)) ch->table[key] = payload;
@@ -336,6 +364,107 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   if (suffix == "HOIST_CAGE") decimators_[prefix].add(j);
   broadcast(*ch, payload);
+}
+
+const std::vector<std::string>& Hub::historyFields() {
+  static const std::vector<std::string> f{"y_c",       "theta",     "lambdas.0",     "lambdas.1",
+                                          "lambdas.2", "lambdas.3", "lambdas.4",     "min_clearance",
+                                          "v",         "l",         "rope_slack_threshold", "rope_overload_threshold"};
+  return f;
+}
+
+namespace {
+double fieldOf(const Json& m, const std::string& f) {
+  const Json* v = nullptr;
+  if (f.rfind("lambdas.", 0) == 0) {
+    const auto k = static_cast<std::size_t>(f[8] - '0');
+    const auto it = m.find("lambdas");
+    if (it != m.end() && it->is_array() && k < it->size()) v = &(*it)[k];
+  } else if (const auto it = m.find(f); it != m.end()) {
+    v = &*it;
+  }
+  return v != nullptr && v->is_number() ? v->get<double>() : std::nan("");
+}
+}  // namespace
+
+void Hub::addHistory(const std::string& prefix, const Json& d) {
+  if (!d.is_object() || !d.contains("last") || !d["last"].is_object()) return;
+  const std::int64_t t0 = d.value("first", Json::object()).value("utime", std::int64_t{0});
+  const std::int64_t t1 = d["last"].value("utime", std::int64_t{0});
+  if (t1 <= 0) return;
+  auto& h = history_[prefix];
+  if (!h.empty() && t1 < h.back().last_utime) h.clear();  // a restarted daemon: time went back
+  const Json& mn = d.value("count", 0) > 1 ? d["min"] : d["last"];
+  const Json& mx = d.value("count", 0) > 1 ? d["max"] : d["last"];
+  const auto& fields = historyFields();
+  const auto bucket_us = static_cast<std::int64_t>(opt_.history_bucket_s * 1e6);
+  if (h.empty() || t1 - h.back().first_utime >= bucket_us) {
+    HistBucket b;
+    b.first_utime = t0 > 0 ? t0 : t1;
+    b.last_utime = t1;
+    b.min.resize(fields.size());
+    b.max.resize(fields.size());
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      b.min[i] = fieldOf(mn, fields[i]);
+      b.max[i] = fieldOf(mx, fields[i]);
+    }
+    h.push_back(std::move(b));
+  } else {
+    HistBucket& b = h.back();
+    b.last_utime = t1;
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      const double lo = fieldOf(mn, fields[i]), hi = fieldOf(mx, fields[i]);
+      if (std::isnan(b.min[i]) || lo < b.min[i]) b.min[i] = lo;
+      if (std::isnan(b.max[i]) || hi > b.max[i]) b.max[i] = hi;
+    }
+  }
+  const auto keep_us = static_cast<std::int64_t>(opt_.history_s * 1e6);
+  const std::size_t cap = static_cast<std::size_t>(opt_.history_s / std::max(1e-3, opt_.history_bucket_s)) + 16;
+  while (!h.empty() && (h.front().last_utime < t1 - keep_us || h.size() > cap)) h.pop_front();
+}
+
+std::string Hub::historyOf(const std::string& prefix) const {
+  Json out{{"fields", historyFields()}, {"first_utime", Json::array()}, {"last_utime", Json::array()},
+           {"min", Json::array()}, {"max", Json::array()}};
+  const auto it = history_.find(prefix);
+  if (it != history_.end()) {
+    auto row = [](const std::vector<double>& v) {
+      Json r = Json::array();
+      for (double x : v) r.push_back(std::isfinite(x) ? Json(x) : Json(nullptr));
+      return r;
+    };
+    for (const auto& b : it->second) {
+      out["first_utime"].push_back(b.first_utime);
+      out["last_utime"].push_back(b.last_utime);
+      out["min"].push_back(row(b.min));
+      out["max"].push_back(row(b.max));
+    }
+  }
+  return out.dump();
+}
+
+void Hub::annotateAlarm(const std::string& prefix, Json& j) {
+  const std::string key = prefix + "\n" + j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
+  const int event = j.value("event_type", 0);
+  const std::int64_t utime = j.value("utime", std::int64_t{0});
+  auto it = alarm_ids_.find(key);
+  if (it == alarm_ids_.end()) {
+    if (alarm_ids_.size() >= 64 * std::max<std::size_t>(opt_.max_prefixes, 1)) {
+      count("alarm_identities_full");
+      return;
+    }
+    it = alarm_ids_.emplace(key, AlarmIdentity{utime, 0, j.value("t", 0.0), event == 1}).first;
+  } else if (event == 1) {  // EVENT_RAISE: a new activation
+    it->second = AlarmIdentity{utime, 0, j.value("t", 0.0), true};
+  }
+  if (event == 6) it->second.reannounce_utime = utime;  // EVENT_REANNOUNCE
+  AlarmIdentity& a = it->second;
+  j["dash_activation_utime"] = a.activation_utime;
+  j["dash_activation_t"] = a.activation_t;
+  j["dash_activation_known"] = a.known;
+  j["dash_reannounce_utime"] = a.reannounce_utime;
+  // Back to normal (inactive, acknowledged, not shelved): the next raise is a new activation.
+  if (!j.value("active", false) && j.value("acked", false) && !j.value("shelved", false)) alarm_ids_.erase(it);
 }
 
 std::string Hub::shaftName(const std::string& prefix) {
@@ -484,6 +613,9 @@ void Hub::removePrefix(const std::string& prefix) {
   prefix_list_.erase(pit);
   disc_.erase(prefix);
   decimators_.erase(prefix);
+  history_.erase(prefix);
+  for (auto it = alarm_ids_.begin(); it != alarm_ids_.end();)
+    it = it->first.compare(0, prefix.size() + 1, prefix + "\n") == 0 ? alarm_ids_.erase(it) : std::next(it);
   Json ids = Json::array();
   for (auto it = channels_.begin(); it != channels_.end();) {
     if (it->second.prefix != prefix) {
@@ -517,7 +649,9 @@ void Hub::flushDecimated() {
   }
   for (auto& [prefix, dec] : decimators_) {
     if (dec.empty()) continue;
-    const auto payload = std::make_shared<const std::string>(dec.take().dump());
+    const Json d = dec.take();
+    addHistory(prefix, d);
+    const auto payload = std::make_shared<const std::string>(d.dump());
     if (Channel* ch = channelFor(prefix + kDecimatedSuffix)) broadcast(*ch, payload);
   }
 }
@@ -587,6 +721,7 @@ void Hub::handleSubscribe(Client& c, const Json& j) {
     count("ws_subscriptions");
     // Low-rate state is sent at once: the latest health/shape, the alarm table.
     if (ch->second->latest) sendTo(c, id, *ch->second->latest);
+    if (ch->second->suffix == kHistorySuffix) sendTo(c, id, historyOf(ch->second->prefix));
     for (const auto& [key, p] : ch->second->table) sendTo(c, id, *p);
   }
 }
@@ -685,13 +820,29 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
     status(c, 2, "rejected: client channel " + std::to_string(chan) + " was not advertised");
     return;
   }
-  const Json j = Json::parse(payload.begin(), payload.end(), nullptr, false);
+  Json j = Json::parse(payload.begin(), payload.end(), nullptr, false);
   alarm_ack_t ack{};
   std::string err;
   if (j.is_discarded() || !j.is_object()) {
     count("commands_rejected_invalid");
     status(c, 2, "rejected command: payload is not a JSON object");
     return;
+  }
+  // Optional fields (as in hoist-mqtt): utime is the server's anyway, and
+  // shelve_duration matters only for SHELVE (where validation requires it).
+  if (!j.contains("utime")) j["utime"] = 0;
+  if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
+  // The alarm the page drew (its activation): a command for an alarm that
+  // was cleared and raised again since, or is gone, is refused.
+  std::optional<std::int64_t> expect_activation;
+  if (const auto ea = j.find("activation_utime"); ea != j.end()) {
+    if (!ea->is_number_integer()) {
+      count("commands_rejected_invalid");
+      status(c, 2, "rejected command: activation_utime must be an integer (us since the epoch)");
+      return;
+    }
+    expect_activation = ea->get<std::int64_t>();
+    j.erase("activation_utime");
   }
   bool parsed = false;
   try {
@@ -710,6 +861,24 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
     status(c, 2, "rejected command: " + why);
     return;
   }
+  static const char* level_names[] = {"(both levels)", "WARNING", "CRITICAL"};
+  const std::string alarm_name = ack.kind + " " + level_names[ack.level];
+  std::string since;
+  if (expect_activation) {
+    const std::string prefix = it->second.substr(0, it->second.size() - std::string(bus::kChannelAlarmAck).size());
+    const auto id = alarm_ids_.find(prefix + "\n" + ack.kind + "/" + std::to_string(ack.level));
+    if (ack.level == 0 || ack.kind == "*" || ack.kind.empty() || id == alarm_ids_.end() ||
+        id->second.activation_utime != *expect_activation) {
+      count("commands_refused_stale");
+      const std::string now = id == alarm_ids_.end() || ack.level == 0
+                                  ? "it is no longer in the list"
+                                  : "it was raised again at utime " + std::to_string(id->second.activation_utime);
+      status(c, 2, "refused: " + alarm_name + " changed since your page drew it (" + now +
+                       "); nothing was sent -- check the alarm list and try again");
+      return;
+    }
+    since = " (active since utime " + std::to_string(*expect_activation) + ")";
+  }
   ack.utime = static_cast<std::int64_t>(clock_() / 1000);  // the command's time is the server's
   std::vector<std::uint8_t> buf(static_cast<std::size_t>(ack.getEncodedSize()));
   if (ack.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0 || !publish_(it->second, buf)) {
@@ -719,8 +888,8 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
   }
   count("commands_published");
   static const char* actions[] = {"", "acknowledge", "shelve", "unshelve"};
-  status(c, 0, std::string("sent ") + actions[ack.action] + " " + ack.kind + " (level " +
-                   std::to_string(ack.level) + ") by " + ack.user + " on " + it->second);
+  status(c, 0, std::string("sent ") + actions[ack.action] + " " + alarm_name + since + " by " + ack.user + " on " +
+                   it->second);
 }
 
 }  // namespace hoist::dash

@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -83,6 +84,8 @@ class Hub {
     double health_gap_s = 3.0;
     double candidate_ttl_s = 3.0;
     double confirmed_idle_s = 60.0;
+    double history_s = 300.0;         ///< trend history kept per shaft (the page's longest window)
+    double history_bucket_s = 0.2;    ///< its resolution (min and max per bucket)
     std::size_t max_lcm_bytes = 1 << 20;  ///< larger LCM messages are dropped (counted)
     Json shaft_meta = Json::object();     ///< prefix -> {warning_fraction, ...} (serverInfo metadata)
   };
@@ -119,6 +122,10 @@ class Hub {
   bool readOnly() const { return opt_.read_only; }
 
   static constexpr const char* kDecimatedSuffix = "HOIST_CAGE/decimated";
+  /// The recent trend history of a shaft, sent whole on subscribe (docs/dashboard.md).
+  static constexpr const char* kHistorySuffix = "HOIST_CAGE/history";
+  /// The cage fields the history keeps (min and max per bucket); "lambdas.K" is lambdas[K].
+  static const std::vector<std::string>& historyFields();
 
  private:
   struct Channel {
@@ -133,6 +140,18 @@ class Hub {
     std::int64_t instance = 0;
     bool confirmed = false;
   };
+  struct HistBucket {
+    std::int64_t first_utime = 0, last_utime = 0;
+    std::vector<double> min, max;  // historyFields() order
+  };
+  struct AlarmIdentity {  // one alarm's activation, kept across re-announces
+    std::int64_t activation_utime = 0, reannounce_utime = 0;
+    double activation_t = 0.0;
+    bool known = false;  // false: first heard after its RAISE (hoist-dash started later)
+  };
+  void annotateAlarm(const std::string& prefix, Json& j);
+  void addHistory(const std::string& prefix, const Json& decimated);
+  std::string historyOf(const std::string& prefix) const;
   void addPrefix(const std::string& prefix);
   void removePrefix(const std::string& prefix);
   void onDiscoveryHealth(const std::string& prefix, const Json& health);
@@ -165,7 +184,9 @@ class Hub {
   std::map<std::string, Evidence> refused_;  // recently refused prefixes (bounded)
   std::uint64_t last_refusal_ns_ = 0, refused_total_ = 0, last_maintain_ns_ = 0;
   std::string last_refused_;
-  std::map<std::string, Json> statuses_;     // persistent statuses by id (sent to new clients)
+  std::map<std::string, Json> statuses_;
+  std::map<std::string, std::deque<HistBucket>> history_;      // by prefix
+  std::map<std::string, AlarmIdentity> alarm_ids_;             // by prefix + kind/level     // persistent statuses by id (sent to new clients)
   std::map<std::string, std::uint64_t> counters_;
   std::string session_id_;
 };
