@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <optional>
 
 #include <spdlog/spdlog.h>
@@ -467,6 +469,18 @@ void Hub::annotateAlarm(const std::string& prefix, Json& j) {
   if (!j.value("active", false) && j.value("acked", false) && !j.value("shelved", false)) alarm_ids_.erase(it);
 }
 
+namespace {
+// "HH:MM:SS UTC" of a utime (us since the epoch), for messages to operators.
+std::string utcClock(std::int64_t utime) {
+  const std::time_t t = static_cast<std::time_t>(utime / 1'000'000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%02d:%02d:%02d UTC", tm.tm_hour, tm.tm_min, tm.tm_sec);
+  return buf;
+}
+}  // namespace
+
 std::string Hub::shaftName(const std::string& prefix) {
   std::string s = prefix;
   if (!s.empty() && (s.back() == '/' || s.back() == '_' || s.back() == '-' || s.back() == '.')) s.pop_back();
@@ -872,12 +886,12 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
       count("commands_refused_stale");
       const std::string now = id == alarm_ids_.end() || ack.level == 0
                                   ? "it is no longer in the list"
-                                  : "it was raised again at utime " + std::to_string(id->second.activation_utime);
+                                  : "it was raised again at " + utcClock(id->second.activation_utime);
       status(c, 2, "refused: " + alarm_name + " changed since your page drew it (" + now +
                        "); nothing was sent -- check the alarm list and try again");
       return;
     }
-    since = " (active since utime " + std::to_string(*expect_activation) + ")";
+    since = " (active since " + utcClock(*expect_activation) + ")";
   }
   ack.utime = static_cast<std::int64_t>(clock_() / 1000);  // the command's time is the server's
   std::vector<std::uint8_t> buf(static_cast<std::size_t>(ack.getEncodedSize()));

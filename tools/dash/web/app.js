@@ -241,10 +241,25 @@
     const c = (min + max) / 2;
     return [c - span / 2, c + span / 2];
   };
-  // Tick labels with as many decimals as the tick spacing needs: distinct labels.
-  const ticks = (u, splits, ax, space, incr) => {
-    const d = incr >= 1 || !(incr > 0) ? 0 : Math.min(6, Math.ceil(-Math.log10(incr) - 1e-9));
-    return splits.map((v) => fix(v, d));
+  // Ticks: the smallest "nice" step (1, 2, 2.5, 5 x 10^k) of at least a
+  // fifth of the range -- 3 to 6 ticks on every axis -- labelled with as
+  // many decimals as they need to be exact, hence distinct.
+  const niceStep = (span) => {
+    const raw = span / 5, p = Math.pow(10, Math.floor(Math.log10(raw)));
+    for (const m of [1, 2, 2.5, 5, 10]) if (m * p >= raw * (1 - 1e-9)) return m * p;
+    return 10 * p;
+  };
+  const splits = (u, axisIdx, min, max) => {
+    if (!(max > min) || !isFinite(min) || !isFinite(max)) return [min];
+    const step = niceStep(max - min);
+    const out = [];
+    for (let k = Math.ceil(min / step - 1e-9); k * step <= max + 1e-9 * step; k++) out.push(k === 0 ? 0 : k * step);
+    return out;
+  };
+  const ticks = (u, vals) => {
+    let d = 0;
+    while (d < 8 && vals.some((v) => Math.abs(v * 10 ** d - Math.round(v * 10 ** d)) > 1e-6 * Math.max(1, Math.abs(v * 10 ** d)))) d++;
+    return vals.map((v) => fix(v, d));
   };
   function speedRange(s, min, max) {
     const seen = Math.max(Math.abs(isFinite(min) ? min : 0), Math.abs(isFinite(max) ? max : 0));
@@ -273,10 +288,10 @@
       const scales = { x: { time: true }, y: { range: yrange } };
       const hms = (u, vals) => vals.map((v) => new Date(v * 1000).toLocaleTimeString([], { hour12: false }));
       const axes = [{ stroke: "#8a96a3", grid: { stroke: "#252c34" }, values: hms, size: 24, space: 90 },
-                    { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60, space: 24, values: ticks }];
+                    { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60, splits, values: ticks }];
       if (series.some((sr) => sr[4] === "l")) {
         scales.l = { range: (u, lo, hi) => spanAtLeast(lo, hi, 2) };
-        axes.push({ scale: "l", side: 1, stroke: "#fca5a5", grid: { show: false }, size: 50, space: 24, values: ticks });
+        axes.push({ scale: "l", side: 1, stroke: "#fca5a5", grid: { show: false }, size: 50, splits, values: ticks });
       }
       const opts = {
         ...chartSize(plotEl), scales, axes, legend: { show: true, live: false },
@@ -332,9 +347,12 @@
     const [w, c] = thresholds(s);
     // The rope-force alarms' thresholds as the daemon publishes them (issue 17; absent from older daemons).
     const kN = (x) => (typeof x === "number" && x > 0 ? x / 1e3 : NaN);
-    return { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
-             slk: kN(m.rope_slack_threshold), ovl: kN(m.rope_overload_threshold),
-             clr: m.min_clearance * 1e3, warn: w, crit: c, v: m.v, l: m.l };
+    const v = { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
+                slk: kN(m.rope_slack_threshold), ovl: kN(m.rope_overload_threshold),
+                clr: m.min_clearance * 1e3, warn: w, crit: c, v: m.v, l: m.l };
+    // uPlot's gaps are null: a NaN would spoil the axis range of its chart.
+    for (const k of Object.keys(v)) if (!(typeof v[k] === "number" && isFinite(v[k]))) v[k] = null;
+    return v;
   }
 
   function onCage(s, d) {
