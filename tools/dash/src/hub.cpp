@@ -546,7 +546,8 @@ void Hub::onDiscoveryHealth(const std::string& prefix, const Json& health) {
                     " refused so far); list the plant's shafts with --channel-prefix");
       return;
     }
-    spdlog::warn("shaft discovery: prefix '{}' ({}) gives way to '{}' (daemon instance {}, {} health messages)",
+    if (logAllowed())
+      spdlog::warn("shaft discovery: prefix '{}' ({}) gives way to '{}' (daemon instance {}, {} health messages)",
                  msg::terminalSafe(weakest, 64), w->confirmed ? "silent" : "unconfirmed", msg::terminalSafe(prefix, 64),
                  e.instance, e.count);
     count("prefix_replaced");
@@ -593,7 +594,7 @@ void Hub::checkNameClashes() {
                              "with --channel-prefix";
     if (!statuses_.count(id) || statuses_[id]["message"] != text) {
       count("prefix_name_clash");
-      spdlog::warn("shaft discovery: {}", text);
+      if (logAllowed()) spdlog::warn("shaft discovery: {}", text);
       setStatus(id, 2, text);
     }
   }
@@ -601,6 +602,15 @@ void Hub::checkNameClashes() {
   for (const auto& [id, st] : statuses_)
     if (id.rfind("discovery-clash:", 0) == 0 && !live.count(id)) old.push_back(id);
   for (const auto& id : old) clearStatus(id);
+}
+
+bool Hub::logAllowed() {
+  const std::uint64_t now = clock_();
+  if (now - std::min(now, log_window_ns_) > 10'000'000'000ULL) {
+    log_window_ns_ = now;
+    log_lines_ = 0;
+  }
+  return ++log_lines_ <= 10;
 }
 
 void Hub::setStatus(const std::string& id, int level, const std::string& text) {

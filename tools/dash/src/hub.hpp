@@ -159,6 +159,7 @@ class Hub {
   void setStatus(const std::string& id, int level, const std::string& msg);  ///< persistent, to every client
   void clearStatus(const std::string& id);
   void checkNameClashes();
+  bool logAllowed();  ///< discovery log lines: at most 10 per 10 s
   Channel* channelFor(const std::string& topic);
   Json advertiseOf(const std::vector<const Channel*>& chans) const;
   void broadcast(Channel& ch, const std::shared_ptr<const std::string>& payload);
@@ -184,6 +185,7 @@ class Hub {
   std::map<std::string, Evidence> refused_;  // recently refused prefixes (bounded)
   std::uint64_t last_refusal_ns_ = 0, refused_total_ = 0, last_maintain_ns_ = 0;
   std::string last_refused_;
+  std::uint64_t log_window_ns_ = 0, log_lines_ = 0;
   std::map<std::string, Json> statuses_;
   std::map<std::string, std::deque<HistBucket>> history_;      // by prefix
   std::map<std::string, AlarmIdentity> alarm_ids_;             // by prefix + kind/level     // persistent statuses by id (sent to new clients)
