@@ -399,6 +399,31 @@ TEST_F(HubClockTest, NoInstanceIdNeverConfirmsAndTwoPrefixesOfOneShaftNameAreRep
   EXPECT_EQ(Hub::shaftName("north/"), "north");
 }
 
+TEST_F(HubClockTest, AlarmsOfPrefixesThatNeverSendHealthAreForgotten) {
+  Hub hub = makeTimed();
+  auto alarmOn = [&](const std::string& prefix) {
+    alarm_t a{};
+    a.utime = 1;
+    a.kind = "INPUT_STALE";
+    a.level = 1;
+    a.event_type = 1;
+    a.active = true;
+    const auto b = encode(a);
+    hub.onLcm(prefix + "HOIST_ALARM", b.data(), b.size());
+  };
+  for (int i = 0; i < 10; ++i) alarmOn("forged" + std::to_string(i) + "/");  // never followed by health
+  advance(31.0);
+  hub.maintainDiscovery();
+  alarmOn("north/");  // a real daemon's first alarm, its health a moment later
+  advance(0.5);
+  health(hub, "north/", 9);
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", channelId(c, "north/HOIST_ALARM")}}}}}.dump());
+  ASSERT_EQ(c.data.size(), 1u) << "the early alarm of the real shaft was kept";
+  EXPECT_EQ(Json::parse(c.data[0].substr(13))["kind"], "INPUT_STALE");
+}
+
 TEST_F(HubClockTest, ActivationKeptAcrossReannouncesAndStaleCommandsRefused) {
   Hub hub = makeTimed({""});
   RecClient c;

@@ -182,6 +182,7 @@ void Hub::addPrefix(const std::string& prefix) {
   prefix_list_.push_back(prefix);
   std::vector<const Channel*> added;
   auto pending = pending_alarms_.extract(prefix);
+  pending_since_.erase(prefix);
   for (const auto& t : msg::allTypes()) {
     const std::string suffix = channelSuffixOfType(t.name);
     if (suffix.empty()) continue;
@@ -346,6 +347,7 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
       // to a second away): keep it for the alarm list, bounded.
       if (opt_.discover && suffix == "HOIST_ALARM" &&
           (pending_alarms_.count(prefix) || pending_alarms_.size() < opt_.max_prefixes)) {
+        pending_since_.emplace(prefix, clock_());
         auto& t = pending_alarms_[prefix];
         const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
         if (t.size() < 64 || t.count(key)) t[key] = std::make_shared<const std::string>(j.dump());
@@ -572,6 +574,16 @@ void Hub::maintainDiscovery() {
     removePrefix(p);
   }
   if (!gone.empty()) checkNameClashes();
+  // Alarms of a prefix whose health never came (a real daemon's follows within
+  // a second): forgotten after 30 s, so forged ones cannot hold the room.
+  for (auto it = pending_since_.begin(); it != pending_since_.end();) {
+    if (static_cast<double>(now - std::min(now, it->second)) * 1e-9 > 30.0) {
+      pending_alarms_.erase(it->first);
+      it = pending_since_.erase(it);
+    } else {
+      ++it;
+    }
+  }
   for (auto it = refused_.begin(); it != refused_.end();)
     it = static_cast<double>(now - std::min(now, it->second.last_ns)) * 1e-9 > 10.0 ? refused_.erase(it) : std::next(it);
   // The table-full status lasts while refusals keep coming (10 s).

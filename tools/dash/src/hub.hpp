@@ -180,6 +180,7 @@ class Hub {
   std::map<std::uint32_t, Channel*> by_id_;
   std::map<std::string, MinMaxDecimator> decimators_;   // by prefix
   std::map<std::string, std::map<std::string, std::shared_ptr<const std::string>>> pending_alarms_;
+  std::map<std::string, std::uint64_t> pending_since_;  // when each pending prefix was first heard (aged out)
   std::uint32_t next_id_ = 1;
   std::map<std::string, Evidence> disc_;     // discovered prefixes in the table
   std::map<std::string, Evidence> refused_;  // recently refused prefixes (bounded)
