@@ -630,14 +630,22 @@ void Hub::setStatus(const std::string& id, int level, const std::string& text) {
   const bool same = statuses_.count(id) && statuses_[id] == st;
   if (!statuses_.count(id) && spdlog::should_log(spdlog::level::warn) && id == "discovery-full")
     spdlog::warn("shaft discovery: {}", text);
+  const bool fresh = !statuses_.count(id);
   statuses_[id] = st;
   if (same) return;
+  // A flood of refusals updates the text, but clients get it at most once a
+  // second (control frames are not droppable: a flood must not fill queues).
+  const std::uint64_t now = clock_();
+  auto& sent = status_sent_ns_[id];
+  if (!fresh && now - std::min(now, sent) < 1'000'000'000ULL) return;
+  sent = now;
   const auto frame = std::make_shared<const std::string>(st.dump());
   for (Client* c : clients_) c->sendText(frame);
 }
 
 void Hub::clearStatus(const std::string& id) {
   if (statuses_.erase(id) == 0) return;
+  status_sent_ns_.erase(id);
   if (id == "discovery-full") spdlog::info("shaft discovery: the table has room again");
   const auto frame = std::make_shared<const std::string>(Json{{"op", "removeStatus"}, {"statusIds", {id}}}.dump());
   for (Client* c : clients_) c->sendText(frame);

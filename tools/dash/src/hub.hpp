@@ -187,9 +187,10 @@ class Hub {
   std::uint64_t last_refusal_ns_ = 0, refused_total_ = 0, last_maintain_ns_ = 0;
   std::string last_refused_;
   std::uint64_t log_window_ns_ = 0, log_lines_ = 0;
-  std::map<std::string, Json> statuses_;
+  std::map<std::string, Json> statuses_;     // persistent statuses by id (sent to new clients)
+  std::map<std::string, std::uint64_t> status_sent_ns_;  // last broadcast of each persistent status (at most 1/s per id)
   std::map<std::string, std::deque<HistBucket>> history_;      // by prefix
-  std::map<std::string, AlarmIdentity> alarm_ids_;             // by prefix + kind/level     // persistent statuses by id (sent to new clients)
+  std::map<std::string, AlarmIdentity> alarm_ids_;             // by prefix + kind/level
   std::map<std::string, std::uint64_t> counters_;
   std::string session_id_;
 };
