@@ -361,6 +361,10 @@ TEST_F(HubClockTest, OneShotPrefixesAgeOutAndARealDaemonTakesTheirSlot) {
   health(hub, "north/", 7);
   EXPECT_EQ(std::count(hub.prefixes().begin(), hub.prefixes().end(), "north/"), 1);
   EXPECT_EQ(hub.counter("prefix_replaced"), 1u);
+  std::string latest;
+  for (const auto& m : c.text)
+    if (m["op"] == "status" && m.value("id", "") == "discovery-full") latest = m["message"];
+  EXPECT_NE(latest.find("(297 refused so far)"), std::string::npos) << "the throttled text, updated a second later: " << latest;
   advance(1.0);
   health(hub, "north/", 7);  // third message of one instance at the health rate: confirmed
   EXPECT_EQ(hub.stats()["discovery"]["confirmed"], Json::array({"north/"}));

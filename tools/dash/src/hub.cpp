@@ -586,6 +586,20 @@ void Hub::maintainDiscovery() {
   }
   for (auto it = refused_.begin(); it != refused_.end();)
     it = static_cast<double>(now - std::min(now, it->second.last_ns)) * 1e-9 > 10.0 ? refused_.erase(it) : std::next(it);
+  // Statuses whose text changed while throttled: the latest, now.
+  for (auto it = status_dirty_.begin(); it != status_dirty_.end();) {
+    const auto st = statuses_.find(*it);
+    if (st != statuses_.end() && now - std::min(now, status_sent_ns_[*it]) >= 1'000'000'000ULL) {
+      status_sent_ns_[*it] = now;
+      const auto frame = std::make_shared<const std::string>(st->second.dump());
+      for (Client* c : clients_) c->sendText(frame);
+      it = status_dirty_.erase(it);
+    } else if (st == statuses_.end()) {
+      it = status_dirty_.erase(it);
+    } else {
+      ++it;
+    }
+  }
   // The table-full status lasts while refusals keep coming (10 s).
   if (statuses_.count("discovery-full") && static_cast<double>(now - std::min(now, last_refusal_ns_)) * 1e-9 > 10.0)
     clearStatus("discovery-full");
@@ -637,8 +651,12 @@ void Hub::setStatus(const std::string& id, int level, const std::string& text) {
   // second (control frames are not droppable: a flood must not fill queues).
   const std::uint64_t now = clock_();
   auto& sent = status_sent_ns_[id];
-  if (!fresh && now - std::min(now, sent) < 1'000'000'000ULL) return;
+  if (!fresh && now - std::min(now, sent) < 1'000'000'000ULL) {
+    status_dirty_.insert(id);
+    return;
+  }
   sent = now;
+  status_dirty_.erase(id);
   const auto frame = std::make_shared<const std::string>(st.dump());
   for (Client* c : clients_) c->sendText(frame);
 }
@@ -646,6 +664,7 @@ void Hub::setStatus(const std::string& id, int level, const std::string& text) {
 void Hub::clearStatus(const std::string& id) {
   if (statuses_.erase(id) == 0) return;
   status_sent_ns_.erase(id);
+  status_dirty_.erase(id);
   if (id == "discovery-full") spdlog::info("shaft discovery: the table has room again");
   const auto frame = std::make_shared<const std::string>(Json{{"op", "removeStatus"}, {"statusIds", {id}}}.dump());
   for (Client* c : clients_) c->sendText(frame);

@@ -189,6 +189,7 @@ class Hub {
   std::uint64_t log_window_ns_ = 0, log_lines_ = 0;
   std::map<std::string, Json> statuses_;     // persistent statuses by id (sent to new clients)
   std::map<std::string, std::uint64_t> status_sent_ns_;  // last broadcast of each persistent status (at most 1/s per id)
+  std::set<std::string> status_dirty_;                   // changed since its last broadcast (sent by maintainDiscovery)
   std::map<std::string, std::deque<HistBucket>> history_;      // by prefix
   std::map<std::string, AlarmIdentity> alarm_ids_;             // by prefix + kind/level
   std::map<std::string, std::uint64_t> counters_;

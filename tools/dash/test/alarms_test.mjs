@@ -19,6 +19,8 @@
 //    message (nothing published); a command without utime and
 //    shelve_duration (a Foxglove client) is accepted.
 // 6. Each side's gap is shown; no negative zero anywhere on the page.
+// 7. 40 forged shafts: the full table is a notice on the page while it
+//    lasts; the forged tabs leave once they age out.
 import fs from "node:fs";
 import path from "node:path";
 import puppeteer from "puppeteer-core";
@@ -184,6 +186,18 @@ check(gaps.note.includes(`+y ${gaps.pos.toFixed(1)} mm`) && gaps.note.includes(`
 const negZero = gaps.text.match(/(^|[^\d.])-0(\.0+)?(?![\d.])/gm);
 check(!negZero, `no negative zero on the page (${negZero ? negZero.join(",") : "none"})`);
 await page.screenshot({ path: path.join(dir, "alarms.png") });
+
+// ---- 7. a full shaft table is visible on the page while it lasts; forged shafts leave ---------------------
+if (!process.env.HOIST_HEALTH_FORGE) fail("HOIST_HEALTH_FORGE (tests/dash: hoist-test-health-forge) is not set");
+const { spawnSync } = await import("node:child_process");
+spawnSync(process.env.HOIST_HEALTH_FORGE, [lcm, "forged%d/", "40", "1", "0", "99"]);
+await page.waitForSelector('#notices .notice[data-status-id="discovery-full"]', { visible: true, timeout: 3000 });
+const notice = await page.$eval('#notices .notice[data-status-id="discovery-full"]', (e) => e.textContent);
+const tabs = await page.evaluate(() => document.querySelectorAll("#tabs button").length);
+check(/shaft table full/.test(notice) && tabs === 16, `the page shows "${notice}" (${tabs} tabs)`);
+await page.waitForFunction(() => document.querySelectorAll("#tabs button").length === 1, { timeout: 8000 });
+check(await page.evaluate(() => document.querySelector('[data-shaft=""]') !== null && !document.querySelector('[data-shaft=""]').hidden),
+      "the forged shafts aged out and left the page; the real shaft stays selected");
 check(errors.length === 0, `no errors in the page's console (${errors.join(" | ")})`);
 await browser.close();
 await stop(twind);
