@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <optional>
@@ -434,7 +435,16 @@ std::string Hub::historyOf(const std::string& prefix) const {
   if (it != history_.end()) {
     auto row = [](const std::vector<double>& v) {
       Json r = Json::array();
-      for (double x : v) r.push_back(std::isfinite(x) ? Json(x) : Json(nullptr));
+      // 6 significant digits (a trend's resolution): half the JSON.
+      char buf[32];
+      for (double x : v) {
+        if (!std::isfinite(x)) {
+          r.push_back(nullptr);
+          continue;
+        }
+        std::snprintf(buf, sizeof buf, "%.6g", x);
+        r.push_back(std::strtod(buf, nullptr));
+      }
       return r;
     };
     for (const auto& b : it->second) {
