@@ -3,12 +3,14 @@
 // validation, the static-file lookup's traversal checks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
@@ -301,6 +303,190 @@ TEST_F(HubTest, BadClientMessagesGetAnErrorStatusAndAreCounted) {
   EXPECT_EQ(hub.counter("ws_rejected_unsupported_op"), 1u);
   EXPECT_EQ(hub.counter("ws_rejected_bad_request"), 5u);
   EXPECT_EQ(hub.counter("ws_rejected_unknown_binary_op"), 1u);
+}
+
+// ---- issue 23/24: discovery aging, alarm identity, history, optional command fields ----
+
+class HubClockTest : public HubTest {
+ protected:
+  Hub makeTimed(std::vector<std::string> prefixes = {}) {
+    Hub::Options o;
+    o.prefixes = std::move(prefixes);
+    o.discover = o.prefixes.empty();
+    o.max_prefixes = 4;
+    return Hub(
+        o, [this](const std::string& ch, const std::vector<std::uint8_t>& b) {
+          pub.push_back({ch, b});
+          return true;
+        },
+        [this] { return now_ns; });
+  }
+  void health(Hub& hub, const std::string& prefix, std::int64_t instance) {
+    health_t h{};
+    h.instance_id = instance;
+    const auto b = encode(h);
+    hub.onLcm(prefix + "HOIST_HEALTH", b.data(), b.size());
+  }
+  void alarm(Hub& hub, const std::string& kind, int event, std::int64_t utime, bool active = true, bool acked = false) {
+    alarm_t a{};
+    a.utime = utime;
+    a.kind = kind;
+    a.level = 1;
+    a.event_type = static_cast<std::int8_t>(event);
+    a.active = active;
+    a.acked = acked;
+    const auto b = encode(a);
+    hub.onLcm("HOIST_ALARM", b.data(), b.size());
+  }
+  void advance(double s) { now_ns += static_cast<std::uint64_t>(s * 1e9); }
+  std::uint64_t now_ns = 1'700'000'000'000'000'000ULL;
+};
+
+TEST_F(HubClockTest, OneShotPrefixesAgeOutAndARealDaemonTakesTheirSlot) {
+  Hub hub = makeTimed();
+  RecClient c;
+  hub.addClient(c);
+  for (int i = 0; i < 300; ++i) health(hub, "forged" + std::to_string(i) + "/", 42);  // one datagram each
+  EXPECT_EQ(hub.prefixes().size(), 4u);
+  EXPECT_EQ(hub.counter("prefix_refused_table_full"), 296u);
+  EXPECT_TRUE(hub.stats()["discovery"]["table_full"].get<bool>());
+  int statuses = 0;
+  for (const auto& m : c.text) statuses += m["op"] == "status" && m.value("id", "") == "discovery-full";
+  EXPECT_EQ(statuses, 1) << "a full table is a status the clients see, at most once a second (not one per refusal)";
+  // The real daemon keeps sending at the health rate: with its second message
+  // it has more evidence than a one-shot candidate and takes its slot.
+  health(hub, "north/", 7);
+  EXPECT_EQ(std::count(hub.prefixes().begin(), hub.prefixes().end(), "north/"), 0);
+  advance(1.0);
+  health(hub, "north/", 7);
+  EXPECT_EQ(std::count(hub.prefixes().begin(), hub.prefixes().end(), "north/"), 1);
+  EXPECT_EQ(hub.counter("prefix_replaced"), 1u);
+  std::string latest;
+  for (const auto& m : c.text)
+    if (m["op"] == "status" && m.value("id", "") == "discovery-full") latest = m["message"];
+  EXPECT_NE(latest.find("(297 refused so far)"), std::string::npos) << "the throttled text, updated a second later: " << latest;
+  advance(1.0);
+  health(hub, "north/", 7);  // third message of one instance at the health rate: confirmed
+  EXPECT_EQ(hub.stats()["discovery"]["confirmed"], Json::array({"north/"}));
+  // The forged candidates fall silent and age out; the confirmed one stays.
+  advance(3.5);
+  hub.maintainDiscovery();
+  EXPECT_EQ(hub.prefixes(), std::vector<std::string>{"north/"});
+  EXPECT_EQ(hub.counter("prefix_aged_out"), 3u);
+  bool unadvertised = false;
+  for (const auto& m : c.text) unadvertised |= m["op"] == "unadvertise";
+  EXPECT_TRUE(unadvertised);
+  advance(11.0);
+  hub.maintainDiscovery();
+  bool removed = false;
+  for (const auto& m : c.text) removed |= m["op"] == "removeStatus";
+  EXPECT_TRUE(removed) << "the table-full status ends once refusals stop";
+}
+
+TEST_F(HubClockTest, NoInstanceIdNeverConfirmsAndTwoPrefixesOfOneShaftNameAreReported) {
+  Hub hub = makeTimed();
+  for (int k = 0; k < 5; ++k) {
+    health(hub, "a/", 0);  // no daemon instance id
+    advance(1.0);
+  }
+  EXPECT_TRUE(hub.stats()["discovery"]["confirmed"].empty());
+  health(hub, "north/", 5);
+  health(hub, "north_", 6);
+  EXPECT_EQ(std::count(hub.prefixes().begin(), hub.prefixes().end(), "north/"), 1);
+  EXPECT_EQ(std::count(hub.prefixes().begin(), hub.prefixes().end(), "north_"), 1);
+  EXPECT_EQ(hub.counter("prefix_name_clash"), 1u);
+  bool clash = false;
+  const Json stats = hub.stats();
+  for (const auto& st : stats["discovery"]["status"]) clash |= st["id"] == "discovery-clash:north";
+  EXPECT_TRUE(clash);
+  EXPECT_EQ(Hub::shaftName(""), "default");
+  EXPECT_EQ(Hub::shaftName("north/"), "north");
+}
+
+TEST_F(HubClockTest, AlarmsOfPrefixesThatNeverSendHealthAreForgotten) {
+  Hub hub = makeTimed();
+  auto alarmOn = [&](const std::string& prefix) {
+    alarm_t a{};
+    a.utime = 1;
+    a.kind = "INPUT_STALE";
+    a.level = 1;
+    a.event_type = 1;
+    a.active = true;
+    const auto b = encode(a);
+    hub.onLcm(prefix + "HOIST_ALARM", b.data(), b.size());
+  };
+  for (int i = 0; i < 10; ++i) alarmOn("forged" + std::to_string(i) + "/");  // never followed by health
+  advance(31.0);
+  hub.maintainDiscovery();
+  alarmOn("north/");  // a real daemon's first alarm, its health a moment later
+  advance(0.5);
+  health(hub, "north/", 9);
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 1}, {"channelId", channelId(c, "north/HOIST_ALARM")}}}}}.dump());
+  ASSERT_EQ(c.data.size(), 1u) << "the early alarm of the real shaft was kept";
+  EXPECT_EQ(Json::parse(c.data[0].substr(13))["kind"], "INPUT_STALE");
+}
+
+TEST_F(HubClockTest, ActivationKeptAcrossReannouncesAndStaleCommandsRefused) {
+  Hub hub = makeTimed({""});
+  RecClient c;
+  hub.addClient(c);
+  alarm(hub, "CAGE_POS_Y", 1, 1000);   // RAISE
+  alarm(hub, "CAGE_POS_Y", 6, 31000);  // REANNOUNCE
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "HOIST_ALARM")}}}}}.dump());
+  ASSERT_EQ(c.data.size(), 1u);
+  const Json a = Json::parse(c.data[0].substr(13));
+  EXPECT_EQ(a["utime"], 31000);
+  EXPECT_EQ(a["dash_activation_utime"], 1000);
+  EXPECT_EQ(a["dash_reannounce_utime"], 31000);
+  EXPECT_TRUE(a["dash_activation_known"].get<bool>());
+
+  hub.onClientText(c, Json{{"op", "advertise"},
+                           {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}}}}}.dump());
+  // Drawn at activation 1000: sent.  Then cleared and raised again: refused.
+  hub.onClientBinary(c, clientMessage(5, {{"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"user", "ann"},
+                                          {"activation_utime", 1000}}));
+  ASSERT_EQ(pub.size(), 1u) << "no utime, no shelve_duration: accepted (Foxglove clients)";
+  alarm(hub, "CAGE_POS_Y", 2, 40000, false, true);  // cleared, acknowledged: normal
+  alarm(hub, "CAGE_POS_Y", 1, 50000);               // raised again
+  hub.onClientBinary(c, clientMessage(5, {{"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 1}, {"user", "ann"},
+                                          {"activation_utime", 1000}}));
+  EXPECT_EQ(pub.size(), 1u);
+  EXPECT_EQ(hub.counter("commands_refused_stale"), 1u);
+  ASSERT_NE(c.lastStatus(), nullptr);
+  EXPECT_NE((*c.lastStatus())["message"].get<std::string>().find("CAGE_POS_Y WARNING changed since your page drew it"),
+            std::string::npos);
+  // A shelve still needs its duration.
+  hub.onClientBinary(c, clientMessage(5, {{"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 2}, {"user", "ann"}}));
+  EXPECT_EQ(pub.size(), 1u);
+}
+
+TEST_F(HubClockTest, HistoryIsSentOnSubscribeAndBounded) {
+  Hub hub = makeTimed({""});
+  for (int i = 0; i < 400 * 25; ++i) {  // 400 s at 25 Hz, one cage state per flush
+    cage_state_t m{};
+    m.utime = 1'000'000'000 + static_cast<std::int64_t>(i) * 40'000;
+    m.y_c = 0.001 * (i % 7);
+    m.l = 10.0 + i * 0.001;
+    const auto b = encode(m);
+    hub.onLcm("HOIST_CAGE", b.data(), b.size());
+    hub.flushDecimated();
+  }
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 9}, {"channelId", channelId(c, "HOIST_CAGE/history")}}}}}.dump());
+  ASSERT_EQ(c.data.size(), 1u);
+  const Json h = Json::parse(c.data[0].substr(13));
+  const auto n = h["first_utime"].size();
+  EXPECT_GE(n, 1400u);  // 300 s in 0.2 s buckets
+  EXPECT_LE(n, 1520u);
+  const double span = (h["last_utime"].back().get<double>() - h["first_utime"][0].get<double>()) * 1e-6;
+  EXPECT_NEAR(span, 300.0, 1.0);
+  const auto yi = static_cast<std::size_t>(std::find(Hub::historyFields().begin(), Hub::historyFields().end(), "y_c") -
+                                           Hub::historyFields().begin());
+  EXPECT_DOUBLE_EQ(h["min"][10][yi].get<double>(), 0.0);  // min and max of each bucket
+  EXPECT_DOUBLE_EQ(h["max"][10][yi].get<double>(), 0.006);
 }
 
 TEST(StaticFilesTest, OnlyKnownFilesTraversalRefusedInEveryEncoding) {

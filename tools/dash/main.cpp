@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <boost/asio.hpp>
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -76,10 +77,11 @@ int main(int argc, char** argv) {
   std::string bind = "127.0.0.1", url, web_root, log_level = "info";
   int port = 8080;
   bool read_only = false;
-  std::vector<std::string> prefixes, origins;
+  std::vector<std::string> prefixes, origins, allow_hosts;
   double warning_fraction = 0.5, critical_fraction = 0.8;
   double rate = 25.0, duration = 0.0;
-  std::size_t max_clients = 64, max_msg = 64 * 1024, max_queue_kb = 2048;
+  std::size_t max_clients = 64, max_msg = 64 * 1024, max_queue_kb = 2048, max_per_peer = 32;
+  double max_peer_rate = 30.0;
   app.add_option("--bind", bind, "address to listen on (default 127.0.0.1: this machine only)");
   app.add_option("--port", port, "TCP port (default 8080; 0 = any free port, printed at start-up)")
       ->check(CLI::Range(0, 65535));
@@ -100,6 +102,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1.0, 100.0));
   app.add_option("--max-clients", max_clients, "WebSocket clients at a time (default 64)")
       ->check(CLI::Range(1, 10000));
+  app.add_option("--max-per-peer", max_per_peer,
+                 "connections (HTTP and WebSocket) at a time from one remote address (default 32); a newcomer "
+                 "is never refused while one address holds more than its share of the connections")
+      ->check(CLI::Range(1, 10000));
+  app.add_option("--max-peer-rate", max_peer_rate,
+                 "new connections a second from one remote address (default 30, bursts of twice that)")
+      ->check(CLI::Range(1.0, 100000.0));
   app.add_option("--max-message", max_msg, "largest accepted WebSocket message [bytes] (default 65536)")
       ->check(CLI::Range(64, 16 * 1024 * 1024));
   app.add_option("--max-queue-kb", max_queue_kb, "send queue per client before data is dropped [KiB] (default 2048)")
@@ -107,6 +116,10 @@ int main(int argc, char** argv) {
   app.add_option("--allow-origin", origins,
                  "also accept WebSocket connections from pages of this origin (repeatable; '*' = any). "
                  "Default: only the dashboard's own page and non-browser clients");
+  app.add_option("--allow-host", allow_hosts,
+                 "also answer requests whose Host header names this host name or address (repeatable; no port: "
+                 "the port is not compared). Default: the --bind address, localhost, and 127.0.0.1 and ::1 when "
+                 "bound to loopback or to all addresses. Any other Host gets 403 (DNS rebinding)");
   app.add_option("--duration", duration, "stop after this many seconds (default: until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error (default info)")
@@ -141,6 +154,35 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hoist-dash: --bind %s: not an IP address (%s)\n", bind.c_str(), ec.message().c_str());
     return 2;
   }
+  // The names this dashboard answers to (server.hpp: Limits::allowed_hosts).
+  std::vector<std::string> hosts{"localhost"};
+  auto addHost = [&hosts](const std::string& h) {
+    if (std::find(hosts.begin(), hosts.end(), h) == hosts.end()) hosts.push_back(h);
+  };
+  if (!addr.is_unspecified()) addHost(addr.to_string());
+  if (addr.is_loopback() || addr.is_unspecified()) {
+    addHost("127.0.0.1");
+    addHost("::1");
+  }
+  for (const auto& h : allow_hosts) {
+    // An address (IPv6 with or without brackets), or a host name without a port.
+    boost::system::error_code aec;
+    std::string inner = h.size() > 2 && h.front() == '[' && h.back() == ']' ? h.substr(1, h.size() - 2) : h;
+    const auto a = net::ip::make_address(inner, aec);
+    const std::string norm = aec ? hoist::dash::Server::hostOfHeader(h) : a.to_string();
+    if (norm.empty() || (aec && h.find_first_of(":[]") != std::string::npos)) {
+      std::fprintf(stderr,
+                   "hoist-dash: --allow-host '%s': not a host name or IP address (give the name without a port, "
+                   "IPv6 as ::1 or [::1])\n",
+                   h.c_str());
+      return 2;
+    }
+    addHost(norm);
+  }
+  if (addr.is_unspecified() && allow_hosts.empty())
+    spdlog::warn("--bind {}: only requests addressed to localhost, 127.0.0.1 or ::1 are answered; add "
+                 "--allow-host NAME for each name or address operators use to reach this machine",
+                 bind);
   if (web_root.empty()) web_root = defaultWebRoot();
   std::unique_ptr<hoist::dash::StaticFiles> files;
   try {
@@ -192,6 +234,9 @@ int main(int argc, char** argv) {
   lim.max_ws_message = max_msg;
   lim.max_queue_bytes = max_queue_kb * 1024;
   lim.allowed_origins = origins;
+  lim.allowed_hosts = hosts;
+  lim.max_per_peer = max_per_peer;
+  lim.max_attempts_per_s = max_peer_rate;
   hoist::dash::Server server(io, hub, *files, lim);
   try {
     server.listen({addr, static_cast<unsigned short>(port)});

@@ -3,7 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <optional>
+
+#include <spdlog/spdlog.h>
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/channels.hpp"
@@ -158,8 +164,14 @@ std::uint64_t Hub::counter(const std::string& what) const {
 Json Hub::stats() const {
   Json c = Json::object();
   for (const auto& [k, v] : counters_) c[k] = v;
+  Json disc{{"enabled", opt_.discover}, {"slots", prefix_list_.size()}, {"max", opt_.max_prefixes},
+            {"table_full", prefix_list_.size() >= opt_.max_prefixes}, {"refused_total", refused_total_},
+            {"last_refused", last_refused_}, {"candidates", Json::array()}, {"confirmed", Json::array()},
+            {"status", Json::array()}};
+  for (const auto& [p, e] : disc_) disc[e.confirmed ? "confirmed" : "candidates"].push_back(p);
+  for (const auto& [id, st] : statuses_) disc["status"].push_back(st);
   return Json{{"clients", clients_.size()}, {"prefixes", prefix_list_}, {"read_only", opt_.read_only},
-              {"channels", channels_.size()}, {"counters", c}};
+              {"channels", channels_.size()}, {"counters", c}, {"discovery", disc}};
 }
 
 void Hub::addPrefix(const std::string& prefix) {
@@ -171,6 +183,7 @@ void Hub::addPrefix(const std::string& prefix) {
   prefix_list_.push_back(prefix);
   std::vector<const Channel*> added;
   auto pending = pending_alarms_.extract(prefix);
+  pending_since_.erase(prefix);
   for (const auto& t : msg::allTypes()) {
     const std::string suffix = channelSuffixOfType(t.name);
     if (suffix.empty()) continue;
@@ -210,6 +223,30 @@ void Hub::addPrefix(const std::string& prefix) {
       auto& sd = channels_[d.topic] = std::move(d);
       by_id_[sd.id] = &sd;
       added.push_back(&sd);
+      // The trend history: sent whole on subscribe, then nothing (the
+      // decimated channel carries the rest).
+      Channel hc;
+      hc.id = next_id_++;
+      hc.topic = prefix + kHistorySuffix;
+      hc.prefix = prefix;
+      hc.suffix = kHistorySuffix;
+      hc.schema_name = "hoist_dash.cage_history";
+      hc.schema = Json{{"type", "object"},
+                       {"title", "hoist_dash.cage_history"},
+                       {"description",
+                        "The recent HOIST_CAGE history kept by hoist-dash (up to its history window), sent once on "
+                        "subscribe: per bucket the first and last utime and the smallest and largest value of each "
+                        "field in `fields` (rows of `min` and `max` in that order; null = not a number)"},
+                       {"properties",
+                        {{"fields", {{"type", "array"}, {"items", {{"type", "string"}}}}},
+                         {"first_utime", {{"type", "array"}, {"items", {{"type", "integer"}}}}},
+                         {"last_utime", {{"type", "array"}, {"items", {{"type", "integer"}}}}},
+                         {"min", {{"type", "array"}}},
+                         {"max", {{"type", "array"}}}}}}
+                      .dump();
+      auto& sh = channels_[hc.topic] = std::move(hc);
+      by_id_[sh.id] = &sh;
+      added.push_back(&sh);
     }
   }
   const auto adv = std::make_shared<const std::string>(advertiseOf(added).dump());
@@ -251,6 +288,7 @@ void Hub::addClient(Client& c) {
   for (const auto& [topic, ch] : channels_) all.push_back(&ch);
   std::sort(all.begin(), all.end(), [](const Channel* a, const Channel* b) { return a->id < b->id; });
   c.sendText(std::make_shared<const std::string>(advertiseOf(all).dump()));
+  for (const auto& [id, st] : statuses_) c.sendText(std::make_shared<const std::string>(st.dump()));
 }
 
 void Hub::removeClient(Client& c) { clients_.erase(&c); }
@@ -301,17 +339,16 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
     return;
   }
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
+  if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
+  if (suffix == "HOIST_ALARM" && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
-    if (opt_.discover && suffix == "HOIST_HEALTH") {
-      addPrefix(prefix);
-      ch = channelFor(channel);
-    }
     if (ch == nullptr) {
       // An alarm of a shaft not announced yet (its first HOIST_HEALTH is up
       // to a second away): keep it for the alarm list, bounded.
       if (opt_.discover && suffix == "HOIST_ALARM" &&
           (pending_alarms_.count(prefix) || pending_alarms_.size() < opt_.max_prefixes)) {
+        pending_since_.emplace(prefix, clock_());
         auto& t = pending_alarms_[prefix];
         const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
         if (t.size() < 64 || t.count(key)) t[key] = std::make_shared<const std::string>(j.dump());
@@ -322,7 +359,9 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   count("lcm_decoded");
   const auto payload = std::make_shared<const std::string>(j.dump());
-  if (suffix == "HOIST_HEALTH" || suffix == "HOIST_GUIDE_SHAPE" || suffix == "HOIST_FORECAST") ch->latest = payload;
+  if (suffix == "HOIST_HEALTH" || suffix == "HOIST_GUIDE_SHAPE" || suffix == "HOIST_FORECAST" ||
+      suffix == "HOIST_TRIP_PLAN")
+    ch->latest = payload;  // sent on subscribe (the trip plan: the speed axis's vmax)
   if (suffix == "HOIST_ALARM") {
     const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
     if (ch->table.size() < 64 || ch->table.count(key)) ch->table[key] = payload;
@@ -332,10 +371,360 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   broadcast(*ch, payload);
 }
 
+const std::vector<std::string>& Hub::historyFields() {
+  static const std::vector<std::string> f{"y_c",       "theta",     "lambdas.0",     "lambdas.1",
+                                          "lambdas.2", "lambdas.3", "lambdas.4",     "min_clearance",
+                                          "v",         "l",         "rope_slack_threshold", "rope_overload_threshold"};
+  return f;
+}
+
+namespace {
+double fieldOf(const Json& m, const std::string& f) {
+  const Json* v = nullptr;
+  if (f.rfind("lambdas.", 0) == 0) {
+    const auto k = static_cast<std::size_t>(f[8] - '0');
+    const auto it = m.find("lambdas");
+    if (it != m.end() && it->is_array() && k < it->size()) v = &(*it)[k];
+  } else if (const auto it = m.find(f); it != m.end()) {
+    v = &*it;
+  }
+  return v != nullptr && v->is_number() ? v->get<double>() : std::nan("");
+}
+}  // namespace
+
+void Hub::addHistory(const std::string& prefix, const Json& d) {
+  if (!d.is_object() || !d.contains("last") || !d["last"].is_object()) return;
+  const std::int64_t t0 = d.value("first", Json::object()).value("utime", std::int64_t{0});
+  const std::int64_t t1 = d["last"].value("utime", std::int64_t{0});
+  if (t1 <= 0) return;
+  auto& h = history_[prefix];
+  if (!h.empty() && t1 < h.back().last_utime) h.clear();  // a restarted daemon: time went back
+  const Json& mn = d.value("count", 0) > 1 ? d["min"] : d["last"];
+  const Json& mx = d.value("count", 0) > 1 ? d["max"] : d["last"];
+  const auto& fields = historyFields();
+  const auto bucket_us = static_cast<std::int64_t>(opt_.history_bucket_s * 1e6);
+  if (h.empty() || t1 - h.back().first_utime >= bucket_us) {
+    HistBucket b;
+    b.first_utime = t0 > 0 ? t0 : t1;
+    b.last_utime = t1;
+    b.min.resize(fields.size());
+    b.max.resize(fields.size());
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      b.min[i] = fieldOf(mn, fields[i]);
+      b.max[i] = fieldOf(mx, fields[i]);
+    }
+    h.push_back(std::move(b));
+  } else {
+    HistBucket& b = h.back();
+    b.last_utime = t1;
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      const double lo = fieldOf(mn, fields[i]), hi = fieldOf(mx, fields[i]);
+      if (std::isnan(b.min[i]) || lo < b.min[i]) b.min[i] = lo;
+      if (std::isnan(b.max[i]) || hi > b.max[i]) b.max[i] = hi;
+    }
+  }
+  const auto keep_us = static_cast<std::int64_t>(opt_.history_s * 1e6);
+  const std::size_t cap = static_cast<std::size_t>(opt_.history_s / std::max(1e-3, opt_.history_bucket_s)) + 16;
+  while (!h.empty() && (h.front().last_utime < t1 - keep_us || h.size() > cap)) h.pop_front();
+}
+
+std::string Hub::historyOf(const std::string& prefix) const {
+  Json out{{"fields", historyFields()}, {"first_utime", Json::array()}, {"last_utime", Json::array()},
+           {"min", Json::array()}, {"max", Json::array()}};
+  const auto it = history_.find(prefix);
+  if (it != history_.end()) {
+    auto row = [](const std::vector<double>& v) {
+      Json r = Json::array();
+      // 6 significant digits (a trend's resolution): half the JSON.
+      char buf[32];
+      for (double x : v) {
+        if (!std::isfinite(x)) {
+          r.push_back(nullptr);
+          continue;
+        }
+        std::snprintf(buf, sizeof buf, "%.6g", x);
+        r.push_back(std::strtod(buf, nullptr));
+      }
+      return r;
+    };
+    for (const auto& b : it->second) {
+      out["first_utime"].push_back(b.first_utime);
+      out["last_utime"].push_back(b.last_utime);
+      out["min"].push_back(row(b.min));
+      out["max"].push_back(row(b.max));
+    }
+  }
+  return out.dump();
+}
+
+void Hub::annotateAlarm(const std::string& prefix, Json& j) {
+  const std::string key = prefix + "\n" + j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
+  const int event = j.value("event_type", 0);
+  const std::int64_t utime = j.value("utime", std::int64_t{0});
+  auto it = alarm_ids_.find(key);
+  if (it == alarm_ids_.end()) {
+    if (alarm_ids_.size() >= 64 * std::max<std::size_t>(opt_.max_prefixes, 1)) {
+      count("alarm_identities_full");
+      return;
+    }
+    it = alarm_ids_.emplace(key, AlarmIdentity{utime, 0, j.value("t", 0.0), event == 1}).first;
+  } else if (event == 1) {  // EVENT_RAISE: a new activation
+    it->second = AlarmIdentity{utime, 0, j.value("t", 0.0), true};
+  }
+  if (event == 6) it->second.reannounce_utime = utime;  // EVENT_REANNOUNCE
+  AlarmIdentity& a = it->second;
+  j["dash_activation_utime"] = a.activation_utime;
+  j["dash_activation_t"] = a.activation_t;
+  j["dash_activation_known"] = a.known;
+  j["dash_reannounce_utime"] = a.reannounce_utime;
+  // Back to normal (inactive, acknowledged, not shelved): the next raise is a new activation.
+  if (!j.value("active", false) && j.value("acked", false) && !j.value("shelved", false)) alarm_ids_.erase(it);
+}
+
+namespace {
+// "HH:MM:SS UTC" of a utime (us since the epoch), for messages to operators.
+std::string utcClock(std::int64_t utime) {
+  const std::time_t t = static_cast<std::time_t>(utime / 1'000'000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%02d:%02d:%02d UTC", tm.tm_hour, tm.tm_min, tm.tm_sec);
+  return buf;
+}
+}  // namespace
+
+std::string Hub::shaftName(const std::string& prefix) {
+  std::string s = prefix;
+  if (!s.empty() && (s.back() == '/' || s.back() == '_' || s.back() == '-' || s.back() == '.')) s.pop_back();
+  return s.empty() ? std::string("default") : s;
+}
+
+void Hub::noteHealth(Evidence& e, std::int64_t instance, std::uint64_t now) const {
+  const double gap = e.last_ns == 0 ? 0.0 : static_cast<double>(now - std::min(now, e.last_ns)) * 1e-9;
+  if (e.count == 0 || instance != e.instance || gap > opt_.health_gap_s) {
+    e.count = 1;  // a new run of evidence
+    e.instance = instance;
+    if (e.first_ns == 0) e.first_ns = now;
+  } else {
+    ++e.count;
+  }
+  e.last_ns = now;
+  if (e.instance != 0 && e.count >= opt_.confirm_count) e.confirmed = true;
+}
+
+void Hub::onDiscoveryHealth(const std::string& prefix, const Json& health) {
+  const std::uint64_t now = clock_();
+  const std::int64_t instance = health.value("instance_id", std::int64_t{0});
+  if (const auto it = disc_.find(prefix); it != disc_.end()) {
+    noteHealth(it->second, instance, now);
+    return;
+  }
+  if (std::find(prefix_list_.begin(), prefix_list_.end(), prefix) != prefix_list_.end()) return;  // fixed
+  Evidence& e = refused_[prefix];
+  noteHealth(e, instance, now);
+  maintainDiscovery();  // free the slots of silent candidates first
+  if (prefix_list_.size() >= opt_.max_prefixes) {
+    // Real daemons first: the weakest slot (an unconfirmed candidate with less
+    // evidence, or a confirmed prefix silent for confirmed_idle_s) gives way
+    // to a prefix with more evidence of a daemon behind it.
+    std::string weakest;
+    const Evidence* w = nullptr;
+    for (const auto& [p, d] : disc_) {
+      const bool idle = static_cast<double>(now - std::min(now, d.last_ns)) * 1e-9 > opt_.confirmed_idle_s;
+      if (d.confirmed && !idle) continue;
+      if (w == nullptr || (d.confirmed ? 1 : 0) < (w->confirmed ? 1 : 0) || d.count < w->count ||
+          (d.count == w->count && d.last_ns < w->last_ns)) {
+        w = &d;
+        weakest = p;
+      }
+    }
+    const bool idle_w = w != nullptr && static_cast<double>(now - std::min(now, w->last_ns)) * 1e-9 > opt_.confirmed_idle_s;
+    const bool stronger = w != nullptr && e.instance != 0 && (idle_w || (!w->confirmed && e.count > w->count));
+    if (!stronger) {
+      count("prefix_refused_table_full");
+      count("prefix_limit_reached");  // the older counter name
+      ++refused_total_;
+      last_refusal_ns_ = now;
+      last_refused_ = msg::terminalSafe(prefix, 64);
+      if (refused_.size() > 256) {  // bounded: forget the stalest
+        auto stalest = refused_.begin();
+        for (auto it = refused_.begin(); it != refused_.end(); ++it)
+          if (it->second.last_ns < stalest->second.last_ns) stalest = it;
+        if (stalest->first != prefix) refused_.erase(stalest);
+      }
+      setStatus("discovery-full", 2,
+                "shaft table full (" + std::to_string(opt_.max_prefixes) + " prefixes): HOIST_HEALTH from prefix '" +
+                    last_refused_ + "' refused (" + std::to_string(refused_total_) +
+                    " refused so far); list the plant's shafts with --channel-prefix");
+      return;
+    }
+    if (logAllowed())
+      spdlog::warn("shaft discovery: prefix '{}' ({}) gives way to '{}' (daemon instance {}, {} health messages)",
+                 msg::terminalSafe(weakest, 64), w->confirmed ? "silent" : "unconfirmed", msg::terminalSafe(prefix, 64),
+                 e.instance, e.count);
+    count("prefix_replaced");
+    removePrefix(weakest);
+  }
+  const Evidence got = e;
+  refused_.erase(prefix);
+  addPrefix(prefix);
+  if (std::find(prefix_list_.begin(), prefix_list_.end(), prefix) != prefix_list_.end()) disc_[prefix] = got;
+  checkNameClashes();
+}
+
+void Hub::maintainDiscovery() {
+  if (!opt_.discover) return;
+  const std::uint64_t now = clock_();
+  std::vector<std::string> gone;
+  for (const auto& [p, d] : disc_)
+    if (!d.confirmed && static_cast<double>(now - std::min(now, d.last_ns)) * 1e-9 > opt_.candidate_ttl_s)
+      gone.push_back(p);
+  for (const auto& p : gone) {
+    count("prefix_aged_out");
+    removePrefix(p);
+  }
+  if (!gone.empty()) checkNameClashes();
+  // Alarms of a prefix whose health never came (a real daemon's follows within
+  // a second): forgotten after 30 s, so forged ones cannot hold the room.
+  for (auto it = pending_since_.begin(); it != pending_since_.end();) {
+    if (static_cast<double>(now - std::min(now, it->second)) * 1e-9 > 30.0) {
+      pending_alarms_.erase(it->first);
+      it = pending_since_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (auto it = refused_.begin(); it != refused_.end();)
+    it = static_cast<double>(now - std::min(now, it->second.last_ns)) * 1e-9 > 10.0 ? refused_.erase(it) : std::next(it);
+  // Statuses whose text changed while throttled: the latest, now.
+  for (auto it = status_dirty_.begin(); it != status_dirty_.end();) {
+    const auto st = statuses_.find(*it);
+    if (st != statuses_.end() && now - std::min(now, status_sent_ns_[*it]) >= 1'000'000'000ULL) {
+      status_sent_ns_[*it] = now;
+      const auto frame = std::make_shared<const std::string>(st->second.dump());
+      for (Client* c : clients_) c->sendText(frame);
+      it = status_dirty_.erase(it);
+    } else if (st == statuses_.end()) {
+      it = status_dirty_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  // The table-full status lasts while refusals keep coming (10 s).
+  if (statuses_.count("discovery-full") && static_cast<double>(now - std::min(now, last_refusal_ns_)) * 1e-9 > 10.0)
+    clearStatus("discovery-full");
+}
+
+void Hub::checkNameClashes() {
+  std::map<std::string, std::vector<std::string>> by_name;
+  for (const auto& p : prefix_list_) by_name[shaftName(p)].push_back(p);
+  std::set<std::string> live;
+  for (const auto& [name, ps] : by_name) {
+    if (ps.size() < 2) continue;
+    const std::string id = "discovery-clash:" + name;
+    live.insert(id);
+    std::string list;
+    for (const auto& p : ps) list += (list.empty() ? "'" : ", '") + msg::terminalSafe(p, 64) + "'";
+    const std::string text = "prefixes " + list + " all give the shaft name '" + msg::terminalSafe(name, 64) +
+                             "': one of them may be forged; check which daemon is real and list the plant's shafts "
+                             "with --channel-prefix";
+    if (!statuses_.count(id) || statuses_[id]["message"] != text) {
+      count("prefix_name_clash");
+      if (logAllowed()) spdlog::warn("shaft discovery: {}", text);
+      setStatus(id, 2, text);
+    }
+  }
+  std::vector<std::string> old;
+  for (const auto& [id, st] : statuses_)
+    if (id.rfind("discovery-clash:", 0) == 0 && !live.count(id)) old.push_back(id);
+  for (const auto& id : old) clearStatus(id);
+}
+
+bool Hub::logAllowed() {
+  const std::uint64_t now = clock_();
+  if (now - std::min(now, log_window_ns_) > 10'000'000'000ULL) {
+    log_window_ns_ = now;
+    log_lines_ = 0;
+  }
+  return ++log_lines_ <= 10;
+}
+
+void Hub::setStatus(const std::string& id, int level, const std::string& text) {
+  Json st{{"op", "status"}, {"level", level}, {"message", text}, {"id", id}};
+  const bool same = statuses_.count(id) && statuses_[id] == st;
+  if (!statuses_.count(id) && spdlog::should_log(spdlog::level::warn) && id == "discovery-full")
+    spdlog::warn("shaft discovery: {}", text);
+  const bool fresh = !statuses_.count(id);
+  statuses_[id] = st;
+  if (same) return;
+  // A flood of refusals updates the text, but clients get it at most once a
+  // second (control frames are not droppable: a flood must not fill queues).
+  const std::uint64_t now = clock_();
+  auto& sent = status_sent_ns_[id];
+  if (!fresh && now - std::min(now, sent) < 1'000'000'000ULL) {
+    status_dirty_.insert(id);
+    return;
+  }
+  sent = now;
+  status_dirty_.erase(id);
+  const auto frame = std::make_shared<const std::string>(st.dump());
+  for (Client* c : clients_) c->sendText(frame);
+}
+
+void Hub::clearStatus(const std::string& id) {
+  if (statuses_.erase(id) == 0) return;
+  status_sent_ns_.erase(id);
+  status_dirty_.erase(id);
+  if (id == "discovery-full") spdlog::info("shaft discovery: the table has room again");
+  const auto frame = std::make_shared<const std::string>(Json{{"op", "removeStatus"}, {"statusIds", {id}}}.dump());
+  for (Client* c : clients_) c->sendText(frame);
+}
+
+void Hub::removePrefix(const std::string& prefix) {
+  const auto pit = std::find(prefix_list_.begin(), prefix_list_.end(), prefix);
+  if (pit == prefix_list_.end()) return;
+  prefix_list_.erase(pit);
+  disc_.erase(prefix);
+  decimators_.erase(prefix);
+  history_.erase(prefix);
+  for (auto it = alarm_ids_.begin(); it != alarm_ids_.end();)
+    it = it->first.compare(0, prefix.size() + 1, prefix + "\n") == 0 ? alarm_ids_.erase(it) : std::next(it);
+  Json ids = Json::array();
+  for (auto it = channels_.begin(); it != channels_.end();) {
+    if (it->second.prefix != prefix) {
+      ++it;
+      continue;
+    }
+    const std::uint32_t id = it->second.id;
+    ids.push_back(id);
+    for (Client* c : clients_) {
+      if (const auto s = c->by_chan_.find(id); s != c->by_chan_.end()) {
+        c->subs_.erase(s->second);
+        c->by_chan_.erase(s);
+      }
+      for (auto p = c->published_.begin(); p != c->published_.end();)
+        p = p->second == it->first ? c->published_.erase(p) : std::next(p);
+    }
+    by_id_.erase(id);
+    it = channels_.erase(it);
+  }
+  const auto frame = std::make_shared<const std::string>(Json{{"op", "unadvertise"}, {"channelIds", ids}}.dump());
+  for (Client* c : clients_) c->sendText(frame);
+}
+
 void Hub::flushDecimated() {
+  if (opt_.discover) {
+    const std::uint64_t now = clock_();
+    if (now - std::min(now, last_maintain_ns_) >= 500'000'000ULL) {
+      last_maintain_ns_ = now;
+      maintainDiscovery();
+    }
+  }
   for (auto& [prefix, dec] : decimators_) {
     if (dec.empty()) continue;
-    const auto payload = std::make_shared<const std::string>(dec.take().dump());
+    const Json d = dec.take();
+    addHistory(prefix, d);
+    const auto payload = std::make_shared<const std::string>(d.dump());
     if (Channel* ch = channelFor(prefix + kDecimatedSuffix)) broadcast(*ch, payload);
   }
 }
@@ -405,6 +794,7 @@ void Hub::handleSubscribe(Client& c, const Json& j) {
     count("ws_subscriptions");
     // Low-rate state is sent at once: the latest health/shape, the alarm table.
     if (ch->second->latest) sendTo(c, id, *ch->second->latest);
+    if (ch->second->suffix == kHistorySuffix) sendTo(c, id, historyOf(ch->second->prefix));
     for (const auto& [key, p] : ch->second->table) sendTo(c, id, *p);
   }
 }
@@ -503,13 +893,29 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
     status(c, 2, "rejected: client channel " + std::to_string(chan) + " was not advertised");
     return;
   }
-  const Json j = Json::parse(payload.begin(), payload.end(), nullptr, false);
+  Json j = Json::parse(payload.begin(), payload.end(), nullptr, false);
   alarm_ack_t ack{};
   std::string err;
   if (j.is_discarded() || !j.is_object()) {
     count("commands_rejected_invalid");
     status(c, 2, "rejected command: payload is not a JSON object");
     return;
+  }
+  // Optional fields (as in hoist-mqtt): utime is the server's anyway, and
+  // shelve_duration matters only for SHELVE (where validation requires it).
+  if (!j.contains("utime")) j["utime"] = 0;
+  if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
+  // The alarm the page drew (its activation): a command for an alarm that
+  // was cleared and raised again since, or is gone, is refused.
+  std::optional<std::int64_t> expect_activation;
+  if (const auto ea = j.find("activation_utime"); ea != j.end()) {
+    if (!ea->is_number_integer()) {
+      count("commands_rejected_invalid");
+      status(c, 2, "rejected command: activation_utime must be an integer (us since the epoch)");
+      return;
+    }
+    expect_activation = ea->get<std::int64_t>();
+    j.erase("activation_utime");
   }
   bool parsed = false;
   try {
@@ -528,6 +934,24 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
     status(c, 2, "rejected command: " + why);
     return;
   }
+  static const char* level_names[] = {"(both levels)", "WARNING", "CRITICAL"};
+  const std::string alarm_name = ack.kind + " " + level_names[ack.level];
+  std::string since;
+  if (expect_activation) {
+    const std::string prefix = it->second.substr(0, it->second.size() - std::string(bus::kChannelAlarmAck).size());
+    const auto id = alarm_ids_.find(prefix + "\n" + ack.kind + "/" + std::to_string(ack.level));
+    if (ack.level == 0 || ack.kind == "*" || ack.kind.empty() || id == alarm_ids_.end() ||
+        id->second.activation_utime != *expect_activation) {
+      count("commands_refused_stale");
+      const std::string now = id == alarm_ids_.end() || ack.level == 0
+                                  ? "it is no longer in the list"
+                                  : "it was raised again at " + utcClock(id->second.activation_utime);
+      status(c, 2, "refused: " + alarm_name + " changed since your page drew it (" + now +
+                       "); nothing was sent -- check the alarm list and try again");
+      return;
+    }
+    since = " (active since " + utcClock(*expect_activation) + ")";
+  }
   ack.utime = static_cast<std::int64_t>(clock_() / 1000);  // the command's time is the server's
   std::vector<std::uint8_t> buf(static_cast<std::size_t>(ack.getEncodedSize()));
   if (ack.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0 || !publish_(it->second, buf)) {
@@ -537,8 +961,8 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
   }
   count("commands_published");
   static const char* actions[] = {"", "acknowledge", "shelve", "unshelve"};
-  status(c, 0, std::string("sent ") + actions[ack.action] + " " + ack.kind + " (level " +
-                   std::to_string(ack.level) + ") by " + ack.user + " on " + it->second);
+  status(c, 0, std::string("sent ") + actions[ack.action] + " " + alarm_name + since + " by " + ack.user + " on " +
+                   it->second);
 }
 
 }  // namespace hoist::dash

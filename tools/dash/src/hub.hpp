@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -74,6 +75,17 @@ class Hub {
     std::vector<std::string> prefixes;  ///< fixed prefixes (--channel-prefix); empty: discover
     bool discover = true;               ///< add prefixes seen on *HOIST_HEALTH
     std::size_t max_prefixes = 16;
+    // Discovery (docs/dashboard.md "Shaft discovery"): a discovered prefix is
+    // a candidate until `confirm_count` HOIST_HEALTH messages of one non-zero
+    // daemon instance id arrived at most `health_gap_s` apart; a candidate
+    // silent for `candidate_ttl_s` loses its slot, and a confirmed prefix
+    // silent for `confirmed_idle_s` may be replaced when the table is full.
+    int confirm_count = 3;
+    double health_gap_s = 3.0;
+    double candidate_ttl_s = 3.0;
+    double confirmed_idle_s = 60.0;
+    double history_s = 300.0;         ///< trend history kept per shaft (the page's longest window)
+    double history_bucket_s = 0.2;    ///< its resolution (min and max per bucket)
     std::size_t max_lcm_bytes = 1 << 20;  ///< larger LCM messages are dropped (counted)
     Json shaft_meta = Json::object();     ///< prefix -> {warning_fraction, ...} (serverInfo metadata)
   };
@@ -90,8 +102,14 @@ class Hub {
   /// A raw LCM message: validated and decoded by the codec (failures
   /// counted, never thrown), then sent to the subscribers.
   void onLcm(const std::string& channel, const void* data, std::size_t size);
-  /// Flush the decimated channels (call at the display rate, ~25 Hz).
+  /// Flush the decimated channels (call at the display rate, ~25 Hz); also
+  /// ages out discovered prefixes and updates the discovery status.
   void flushDecimated();
+  /// Ages out silent candidate prefixes; updates the discovery status.
+  void maintainDiscovery();
+  /// The shaft name of a channel prefix: the prefix without one trailing
+  /// separator ('/', '_', '-', '.'), "default" for "" (hoist-mqtt's rule).
+  static std::string shaftName(const std::string& prefix);
 
   void onClientText(Client& c, std::string_view text);
   void onClientBinary(Client& c, std::string_view bytes);
@@ -104,6 +122,10 @@ class Hub {
   bool readOnly() const { return opt_.read_only; }
 
   static constexpr const char* kDecimatedSuffix = "HOIST_CAGE/decimated";
+  /// The recent trend history of a shaft, sent whole on subscribe (docs/dashboard.md).
+  static constexpr const char* kHistorySuffix = "HOIST_CAGE/history";
+  /// The cage fields the history keeps (min and max per bucket); "lambdas.K" is lambdas[K].
+  static const std::vector<std::string>& historyFields();
 
  private:
   struct Channel {
@@ -112,7 +134,32 @@ class Hub {
     std::shared_ptr<const std::string> latest;                   // replayed on subscribe (health, shape)
     std::map<std::string, std::shared_ptr<const std::string>> table;  // alarms: kind/level -> latest
   };
+  struct Evidence {  // what a discovered prefix has shown of itself
+    std::uint64_t first_ns = 0, last_ns = 0;
+    int count = 0;             // health messages of `instance` at most health_gap_s apart
+    std::int64_t instance = 0;
+    bool confirmed = false;
+  };
+  struct HistBucket {
+    std::int64_t first_utime = 0, last_utime = 0;
+    std::vector<double> min, max;  // historyFields() order
+  };
+  struct AlarmIdentity {  // one alarm's activation, kept across re-announces
+    std::int64_t activation_utime = 0, reannounce_utime = 0;
+    double activation_t = 0.0;
+    bool known = false;  // false: first heard after its RAISE (hoist-dash started later)
+  };
+  void annotateAlarm(const std::string& prefix, Json& j);
+  void addHistory(const std::string& prefix, const Json& decimated);
+  std::string historyOf(const std::string& prefix) const;
   void addPrefix(const std::string& prefix);
+  void removePrefix(const std::string& prefix);
+  void onDiscoveryHealth(const std::string& prefix, const Json& health);
+  void noteHealth(Evidence& e, std::int64_t instance, std::uint64_t now) const;
+  void setStatus(const std::string& id, int level, const std::string& msg);  ///< persistent, to every client
+  void clearStatus(const std::string& id);
+  void checkNameClashes();
+  bool logAllowed();  ///< discovery log lines: at most 10 per 10 s
   Channel* channelFor(const std::string& topic);
   Json advertiseOf(const std::vector<const Channel*>& chans) const;
   void broadcast(Channel& ch, const std::shared_ptr<const std::string>& payload);
@@ -133,7 +180,18 @@ class Hub {
   std::map<std::uint32_t, Channel*> by_id_;
   std::map<std::string, MinMaxDecimator> decimators_;   // by prefix
   std::map<std::string, std::map<std::string, std::shared_ptr<const std::string>>> pending_alarms_;
+  std::map<std::string, std::uint64_t> pending_since_;  // when each pending prefix was first heard (aged out)
   std::uint32_t next_id_ = 1;
+  std::map<std::string, Evidence> disc_;     // discovered prefixes in the table
+  std::map<std::string, Evidence> refused_;  // recently refused prefixes (bounded)
+  std::uint64_t last_refusal_ns_ = 0, refused_total_ = 0, last_maintain_ns_ = 0;
+  std::string last_refused_;
+  std::uint64_t log_window_ns_ = 0, log_lines_ = 0;
+  std::map<std::string, Json> statuses_;     // persistent statuses by id (sent to new clients)
+  std::map<std::string, std::uint64_t> status_sent_ns_;  // last broadcast of each persistent status (at most 1/s per id)
+  std::set<std::string> status_dirty_;                   // changed since its last broadcast (sent by maintainDiscovery)
+  std::map<std::string, std::deque<HistBucket>> history_;      // by prefix
+  std::map<std::string, AlarmIdentity> alarm_ids_;             // by prefix + kind/level
   std::map<std::string, std::uint64_t> counters_;
   std::string session_id_;
 };

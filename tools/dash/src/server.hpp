@@ -4,7 +4,11 @@
 // counters as JSON); a WebSocket upgrade that offers the subprotocol
 // foxglove.websocket.v1 becomes a protocol client of the Hub.  Everything runs
 // on the one io_context thread.  Limits: request header 8 KiB and no request
-// body, 30 s to send a request, at most `max_connections` at a time, incoming
+// body, 30 s to send a request, at most `max_connections` WebSockets and twice
+// that in connections, per peer (remote address) at most `max_per_peer`
+// connections and `max_attempts_per_s` new ones a second, with a reserve: a
+// newcomer is never refused while another peer holds more than its fair
+// share (that peer's oldest connection is closed instead), incoming
 // WebSocket messages at most `max_ws_message` bytes, and a bounded send queue
 // per client: data frames beyond `max_queue_bytes` are dropped (counted),
 // a client whose control frames overflow twice that is disconnected.
@@ -12,10 +16,14 @@
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <chrono>
 #include <cstddef>
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hub.hpp"
@@ -31,7 +39,27 @@ class Server {
     std::size_t max_queue_bytes = 2 * 1024 * 1024;
     std::size_t max_queue_frames = 1024;
     std::vector<std::string> allowed_origins;  ///< besides the page's own; "*" = any
+    /// Host names and addresses this server answers to (lower case, IPv6
+    /// without brackets, no port).  A request whose Host header names
+    /// anything else gets 403, HTTP and WebSocket alike (DNS rebinding).
+    /// Empty: every Host is accepted (unit tests only; main.cpp always sets it).
+    std::vector<std::string> allowed_hosts;
+    /// Per peer (remote address): connections (HTTP and WebSocket) at a
+    /// time, and new connections per second (a token bucket of twice that).
+    std::size_t max_per_peer = 32;
+    double max_attempts_per_s = 30.0;
   };
+  /// The host part of a Host header value, lower case, without brackets,
+  /// port or trailing dot; "" when the value is malformed (a bad port, an
+  /// unclosed bracket, characters no host name has).
+  static std::string hostOfHeader(std::string_view host);
+  /// Is this Host header value one of limits().allowed_hosts?  (The port is
+  /// not compared: a tunnel or proxy may change it, a rebinding attack
+  /// changes the name.)
+  bool hostAllowed(std::string_view host_header) const;
+  /// Is this Origin header value allowed for a request with this (allowed)
+  /// Host header: the page's own ("http(s)://" + Host) or --allow-origin?
+  bool originAllowed(std::string_view origin, std::string_view host_header) const;
   Server(boost::asio::io_context& io, Hub& hub, const StaticFiles& files, Limits limits);
   ~Server();
   /// Binds and listens; throws boost::system::system_error (e.g. port in use).
@@ -43,16 +71,45 @@ class Server {
   struct Conn {
     virtual ~Conn() = default;
     virtual void shutdown() = 0;
+    /// An HTTP connection waiting for (the rest of) a request: may be
+    /// closed to make room.  WebSockets and HTTP answers in flight are not idle.
+    virtual bool idle() const = 0;
+    std::string peer_key;    ///< remote address ("" unknown)
+    bool ws = false;         ///< a WebSocket session
+    std::uint64_t seq = 0;   ///< accept order (oldest first when evicting)
   };
   Hub& hub() { return hub_; }
   const StaticFiles& files() const { return files_; }
   const Limits& limits() const { return limits_; }
-  void track(Conn* c) { conns_.insert(c); }
-  void untrack(Conn* c) { conns_.erase(c); }
+  void track(Conn* c);
+  void untrack(Conn* c);
   std::size_t connections() const { return conns_.size(); }
+  std::size_t wsConnections() const;
+  /// A WebSocket upgrade from `peer`: true if there is room (making room by
+  /// closing the oldest WebSocket of a peer holding more than its share).
+  bool admitWebSocket(const std::string& peer);
+  /// The peer key of an address (IPv4-mapped IPv6 as IPv4).
+  static std::string peerOf(const boost::asio::ip::address& a);
+  /// Rate limit of refusal log lines: at most 10 per 10 s (the rest counted).
+  bool logAllowed();
 
  private:
   void doAccept();
+  bool admit(const std::string& peer);  ///< a new TCP connection: rate, per-peer cap, reserve
+  /// Closes the oldest connection of `peer` (idle HTTP first; WebSockets only
+  /// if `ws_too`); false if it has none to close.
+  bool evictOldest(const std::string& peer, bool ws_only, bool ws_too);
+  /// The peer with the most connections (WebSockets only if `ws_only`) when
+  /// that is more than its fair share of `cap` among the peers present plus
+  /// `newcomer`; "" if none.
+  std::string overShare(const std::string& newcomer, std::size_t cap, bool ws_only) const;
+  struct Peer {
+    std::size_t conns = 0;
+    double tokens = 0.0;
+    std::chrono::steady_clock::time_point refilled{};
+  };
+  std::map<std::string, Peer> peers_;
+  std::uint64_t next_seq_ = 0;
   boost::asio::io_context& io_;
   Hub& hub_;
   const StaticFiles& files_;
@@ -60,6 +117,8 @@ class Server {
   boost::asio::ip::tcp::acceptor acceptor_;
   std::set<Conn*> conns_;
   bool stopped_ = false;
+  std::chrono::steady_clock::time_point log_window_{};
+  std::size_t log_lines_ = 0, log_suppressed_ = 0;
 };
 
 }  // namespace hoist::dash

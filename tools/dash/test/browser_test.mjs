@@ -37,6 +37,8 @@ const browser = await puppeteer.launch({
 });
 const page = await browser.newPage();
 const errors = [];
+const dialogs = [];
+page.on("dialog", async (d) => { dialogs.push(d.message()); await d.accept(); });
 page.on("pageerror", (e) => errors.push(String(e)));
 page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
 const t0 = Date.now();
@@ -61,6 +63,8 @@ await page.click('tr.alarm[data-kind="CAGE_POS_Y"][data-active="true"] button[da
 const tAck = Date.now();
 await page.waitForSelector('tr.alarm[data-kind="CAGE_POS_Y"][data-acked="true"]', { timeout: 5000 });
 check(true, `alarm turned acknowledged ${Date.now() - tAck} ms after pressing Acknowledge`);
+check(dialogs.length === 1 && /^Acknowledge CAGE_POS_Y WARNING \(active since /.test(dialogs[0]),
+      `the confirmation named the alarm ("${dialogs[0]}")`);
 // 5. The read-only server's page: the alarm, but no command buttons.
 const page2 = await browser.newPage();
 await page2.goto(ro.url, { waitUntil: "load" });
@@ -152,7 +156,9 @@ const log = readLog(path.join(dir, "run.lcm"), dir, { undecodable: 1 });  // the
 const cage = log.HOIST_CAGE || [];
 const row = cage.find((r) => Number(r.utime) === shown.utime);
 if (!row) fail(`no HOIST_CAGE with utime ${shown.utime} in lcm-logger's log (${cage.length} rows)`);
-const l2 = Number(row.l).toFixed(2), y2 = (Number(row.y_c) * 1e3).toFixed(2);
+// (the page never shows a negative zero: "-0.00" is "0.00")
+const noNegZero = (t) => (/^-0\.?0*$/.test(t) ? t.slice(1) : t);
+const l2 = noNegZero(Number(row.l).toFixed(2)), y2 = noNegZero((Number(row.y_c) * 1e3).toFixed(2));
 check(l2 === shown.l && y2 === shown.y_c, `displayed depth ${shown.l} m and sway ${shown.y_c} mm equal HOIST_CAGE (l=${row.l}, y_c=${row.y_c}) to display rounding`);
 const acks = log.HOIST_ALARM_ACK || [];
 check(acks.some((a) => a.kind === "CAGE_POS_Y" && Number(a.action) === 1 && a.user === "test-operator"),

@@ -85,7 +85,8 @@ export async function waitFor(fn, timeoutMs, what) {
 
 /// hoist-dash on a free port; resolves with { proc, port, url } once it serves.
 export async function startDash(dir, lcm, extra = [], name = "hoist-dash") {
-  const p = start(name, path.join(binDir, "hoist-dash"), ["--port", "0", "--lcm-url", lcm, ...extra], dir);
+  const port = extra.includes("--port") ? [] : ["--port", "0"];  // a given --port wins
+  const p = start(name, path.join(binDir, "hoist-dash"), [...port, "--lcm-url", lcm, ...extra], dir);
   const line = await waitFor(() => {
     if (p.exitCode !== null) fail(`${name} exited: ${fs.readFileSync(path.join(dir, name + ".log"), "utf8")}`);
     return /serving (http:\/\/[^ ]+)/.exec(p.out);

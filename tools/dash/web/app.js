@@ -6,9 +6,10 @@
 
 (() => {
   const SUBPROTOCOL = "foxglove.websocket.v1";
-  const SUFFIXES = ["HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM_ACK", "HOIST_ALARM", "HOIST_HEALTH",
+  const SUFFIXES = ["HOIST_CAGE/history", "HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM_ACK", "HOIST_ALARM", "HOIST_HEALTH",
                     "HOIST_FORECAST", "HOIST_TRIP_PLAN", "HOIST_WINDER", "HOIST_CAGE"];
-  const SUBSCRIBE = new Set(["HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM", "HOIST_HEALTH", "HOIST_FORECAST"]);
+  const SUBSCRIBE = new Set(["HOIST_CAGE/history", "HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM", "HOIST_HEALTH",
+                             "HOIST_FORECAST", "HOIST_TRIP_PLAN"]);
   const STALE_AFTER_MS = 1500;     // STALE shown within 2 s of silence
   const KEEP_S = 300;              // longest trend window
   const LEVELS = ["NONE", "WARNING", "CRITICAL"];
@@ -24,6 +25,12 @@
     for (const k of kids) e.append(k);
     return e;
   };
+  // A number with d decimals, never "-0.0" (a value that rounds to zero is zero).
+  const fix = (x, d) => {
+    const t = Number(x).toFixed(d);
+    return /^-0\.?0*$/.test(t) ? t.slice(1) : t;
+  };
+  const clock = (utime) => new Date(utime / 1000).toLocaleTimeString([], { hour12: false });
   const toast = (msg, err = false) => {
     const d = el("div", { class: err ? "err" : "" }, msg);
     $("#toast").append(d);
@@ -34,8 +41,38 @@
   const state = {
     ws: null, readOnly: true, meta: {}, channels: new Map(), subs: new Map(), nextSub: 1,
     shafts: new Map(), selected: null, ackChannels: new Map(), nextClientChan: 1,
-    windowS: 60,
+    windowS: 60, notices: new Map(),
   };
+
+  // Persistent server statuses (Foxglove status with an id, until removeStatus):
+  // a full shaft table, two prefixes with one shaft name.
+  function setNotice(id, text, level) {
+    let d = state.notices.get(id);
+    if (!d) {
+      d = el("div", { class: "notice", "data-status-id": id });
+      state.notices.set(id, d);
+      $("#notices").append(d);
+    }
+    d.className = `notice lvl-${level}`;
+    d.textContent = text;
+  }
+
+  // Channels withdrawn by the server (a discovered prefix that aged out): a
+  // shaft with none left leaves the page.
+  function onUnadvertise(ids) {
+    for (const id of ids) {
+      state.channels.delete(id);
+      for (const [sid, sub] of state.subs) if (sub.channelId === id) state.subs.delete(sid);
+    }
+    const live = new Set([...state.channels.values()].map((c) => splitTopic(c.topic)[0]));
+    for (const [prefix, s] of state.shafts) {
+      if (live.has(prefix)) continue;
+      s.root.remove(); s.tab.remove();
+      state.shafts.delete(prefix);
+      state.ackChannels.delete(prefix);
+      if (state.selected === prefix) { state.selected = null; const first = state.shafts.keys().next(); if (!first.done) select(first.value); }
+    }
+  }
   const userInput = $("#user");
   userInput.value = localStorage.getItem("hoist-dash-user") || "";
   userInput.addEventListener("change", () => localStorage.setItem("hoist-dash-user", userInput.value.trim()));
@@ -97,7 +134,7 @@
           const shaft = getShaft(prefix);
           if (SUBSCRIBE.has(suffix)) {
             const id = state.nextSub++;
-            state.subs.set(id, { shaft, suffix });
+            state.subs.set(id, { shaft, suffix, channelId: ch.id });
             subs.push({ id, channelId: ch.id });
           }
           if (suffix === "HOIST_ALARM_ACK" && !state.readOnly) {
@@ -109,9 +146,13 @@
         if (subs.length) send({ op: "subscribe", subscriptions: subs });
         break;
       }
-      case "unadvertise": break;
+      case "unadvertise": onUnadvertise(m.channelIds || []); break;
       case "status":
-        toast(m.message, m.level >= 2);
+        if (typeof m.id === "string" && m.id) setNotice(m.id, m.message, m.level);
+        else toast(m.message, m.level >= 2);
+        break;
+      case "removeStatus":
+        for (const id of m.statusIds || []) state.notices.get(id)?.remove(), state.notices.delete(id);
         break;
       default: break;
     }
@@ -127,7 +168,9 @@
     const s = sub.shaft;
     s.lastMsg = performance.now();
     switch (sub.suffix) {
+      case "HOIST_CAGE/history": onHistory(s, msg); break;
       case "HOIST_CAGE/decimated": onCage(s, msg); break;
+      case "HOIST_TRIP_PLAN": s.plan = msg; s.dirty = true; break;
       case "HOIST_GUIDE_SHAPE": s.shape = msg; s.dirty = true; break;
       case "HOIST_ALARM": onAlarm(s, msg); break;
       case "HOIST_HEALTH": s.health = msg; renderHealth(s); break;
@@ -187,39 +230,110 @@
   }
 
   // ---- trends -------------------------------------------------------------------
-  function chartSize(host) { return { width: Math.max(300, host.clientWidth || 600), height: 112 }; }
+  function chartSize(host) { return { width: Math.max(300, host.clientWidth || 600), height: 132 }; }
+
+  // Y ranges that suit the data: a minimum span around a flat signal (so the
+  // axis has at least three distinct labels), forces from 0, the speed from 0
+  // (or -vmax) to the trip's vmax.
+  const spanAtLeast = (min, max, span) => {
+    if (!isFinite(min) || !isFinite(max)) return [-span / 2, span / 2];
+    if (max - min >= span) { const pad = 0.05 * (max - min); return [min - pad, max + pad]; }
+    const c = (min + max) / 2;
+    return [c - span / 2, c + span / 2];
+  };
+  // Ticks: the smallest "nice" step (1, 2, 2.5, 5 x 10^k) of at least a
+  // fifth of the range -- 3 to 6 ticks on every axis -- labelled with as
+  // many decimals as they need to be exact, hence distinct.
+  const niceStep = (span) => {
+    const raw = span / 5, p = Math.pow(10, Math.floor(Math.log10(raw)));
+    for (const m of [1, 2, 2.5, 5, 10]) if (m * p >= raw * (1 - 1e-9)) return m * p;
+    return 10 * p;
+  };
+  const splits = (u, axisIdx, min, max) => {
+    if (!(max > min) || !isFinite(min) || !isFinite(max)) return [min];
+    const step = niceStep(max - min);
+    const out = [];
+    for (let k = Math.ceil(min / step - 1e-9); k * step <= max + 1e-9 * step; k++) out.push(k === 0 ? 0 : k * step);
+    return out;
+  };
+  const ticks = (u, vals) => {
+    let d = 0;
+    while (d < 8 && vals.some((v) => Math.abs(v * 10 ** d - Math.round(v * 10 ** d)) > 1e-6 * Math.max(1, Math.abs(v * 10 ** d)))) d++;
+    return vals.map((v) => fix(v, d));
+  };
+  function speedRange(s, min, max) {
+    const seen = Math.max(Math.abs(isFinite(min) ? min : 0), Math.abs(isFinite(max) ? max : 0));
+    const vmax = s.plan && s.plan.vmax > 0 ? Math.max(s.plan.vmax, seen) : Math.max(1, seen * 1.1);
+    return [isFinite(min) && min < -0.05 * vmax ? -vmax : 0, vmax];
+  }
 
   function makeCharts(s, host) {
     const D = s.data;
     const defs = [
-      ["sway y_c [mm]", [["y_c", "#60a5fa"]]],
-      ["tilt θ [mrad]", [["theta", "#a78bfa"]]],
-      ["guide-sleeve forces λ1..λ4 [N]", [["l1", "#f87171", "λ1"], ["l2", "#fbbf24", "λ2"], ["l3", "#34d399", "λ3"], ["l4", "#60a5fa", "λ4"]]],
-      ["hoisting-rope force λ0 [kN]", [["l0", "#e5e7eb", "λ0"], ["slk", "#ef4444", "ROPE_SLACK", [6, 4]], ["ovl", "#ef4444", "ROPE_OVERLOAD", [2, 4]]]],
-      ["min clearance [mm]", [["clr", "#2fbf71", "min clearance"], ["warn", "#f0b429", "WARNING", [6, 4]], ["crit", "#ef4444", "CRITICAL", [6, 4]]]],
-      ["speed v [m/s] and depth l [m]", [["v", "#93c5fd", "v"], ["l", "#fca5a5", "l", null, "l"]]],
+      ["sway y_c [mm]", [["y_c", "#60a5fa"]], (u, lo, hi) => spanAtLeast(lo, hi, 2)],
+      ["tilt θ [mrad]", [["theta", "#a78bfa"]], (u, lo, hi) => spanAtLeast(lo, hi, 0.02)],
+      ["guide-sleeve forces λ1..λ4 [N]", [["l1", "#f87171", "λ1"], ["l2", "#fbbf24", "λ2"], ["l3", "#34d399", "λ3"], ["l4", "#60a5fa", "λ4"]],
+       (u, lo, hi) => [Math.min(0, isFinite(lo) ? lo : 0), Math.max(10, isFinite(hi) ? hi * 1.1 : 10)]],
+      ["hoisting-rope force λ0 [kN]", [["l0", "#e5e7eb", "λ0"], ["slk", "#ef4444", "ROPE_SLACK", [6, 4]], ["ovl", "#ef4444", "ROPE_OVERLOAD", [2, 4]]],
+       (u, lo, hi) => spanAtLeast(lo, hi, 1)],
+      ["min clearance [mm]", [["clr", "#2fbf71", "min clearance"], ["warn", "#f0b429", "WARNING", [6, 4]], ["crit", "#ef4444", "CRITICAL", [6, 4]]],
+       (u, lo, hi) => spanAtLeast(lo, hi, 2)],
+      ["speed v [m/s] and depth l [m]", [["v", "#93c5fd", "v"], ["l", "#fca5a5", "l", null, "l"]], (u, lo, hi) => speedRange(s, lo, hi)],
     ];
-    for (const [title, series] of defs) {
+    for (const [title, series, yrange] of defs) {
       const box = el("div", { class: "trend" }, el("h3", {}, title));
       const plotEl = el("div");
       box.append(plotEl);
       host.append(box);
-      const scales = { x: { time: true } };
+      const scales = { x: { time: true }, y: { range: yrange } };
       const hms = (u, vals) => vals.map((v) => new Date(v * 1000).toLocaleTimeString([], { hour12: false }));
       const axes = [{ stroke: "#8a96a3", grid: { stroke: "#252c34" }, values: hms, size: 24, space: 90 },
-                    { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60 }];
+                    { stroke: "#8a96a3", grid: { stroke: "#252c34" }, size: 60, splits, values: ticks }];
       if (series.some((sr) => sr[4] === "l")) {
-        scales.l = {};
-        axes.push({ scale: "l", side: 1, stroke: "#fca5a5", grid: { show: false }, size: 50 });
+        scales.l = { range: (u, lo, hi) => spanAtLeast(lo, hi, 2) };
+        axes.push({ scale: "l", side: 1, stroke: "#fca5a5", grid: { show: false }, size: 50, splits, values: ticks });
       }
       const opts = {
-        ...chartSize(plotEl), scales, axes, legend: { show: true },
+        ...chartSize(plotEl), scales, axes, legend: { show: true, live: false },
         cursor: { drag: { x: false, y: false } },
         series: [{}, ...series.map(([k, c, label, dash, scale]) => ({ label: label || k, stroke: c, width: 1.2, dash: dash || undefined, scale: scale || "y", points: { show: false } }))],
       };
       const u = new uPlot(opts, [D.x, ...series.map(([k]) => D[k])], plotEl);
-      s.charts.push({ u, keys: series.map(([k]) => k), el: plotEl });
+      s.charts.push({ u, keys: series.map(([k]) => k), el: plotEl, title });
     }
+  }
+
+  // The server's history (HOIST_CAGE/history, sent once on subscribe): the
+  // trends start with what happened before the page opened.
+  function onHistory(s, h) {
+    const F = h.fields || [];
+    const obj = (row) => {
+      const o = { lambdas: [NaN, NaN, NaN, NaN, NaN] };
+      F.forEach((f, i) => {
+        const v = row[i] === null || row[i] === undefined ? NaN : row[i];
+        if (f.startsWith("lambdas.")) o.lambdas[Number(f.slice(8))] = v; else o[f] = v;
+      });
+      return o;
+    };
+    const old = s.data;
+    const fresh = Object.fromEntries(Object.keys(old).map((k) => [k, []]));
+    const n = (h.first_utime || []).length;
+    for (let i = 0; i < n; i++) {
+      const t0 = h.first_utime[i] / 1e6, t1 = h.last_utime[i] / 1e6;
+      const add = (x, v) => { fresh.x.push(x); for (const k of Object.keys(v)) fresh[k].push(v[k]); };
+      if (t1 > t0) { add(t0, cageVals(obj(h.min[i]), s)); add(t1, cageVals(obj(h.max[i]), s)); }
+      else add(t1, cageVals(obj(h.max[i]), s));
+    }
+    const last = fresh.x.length ? fresh.x[fresh.x.length - 1] : -Infinity;
+    for (let i = 0; i < old.x.length; i++) {
+      if (old.x[i] <= last) continue;
+      for (const k of Object.keys(old)) fresh[k].push(old[k][i]);
+    }
+    for (const k of Object.keys(old)) { old[k].length = 0; old[k].push(...fresh[k]); }
+    s.historyPoints = n;
+    s.root.dataset.historyPoints = String(n);
+    s.root.dataset.historyFrom = n ? String(h.first_utime[0]) : "";
+    s.dirty = true;
   }
 
   function pushPoint(s, x, vals) {
@@ -233,9 +347,12 @@
     const [w, c] = thresholds(s);
     // The rope-force alarms' thresholds as the daemon publishes them (issue 17; absent from older daemons).
     const kN = (x) => (typeof x === "number" && x > 0 ? x / 1e3 : NaN);
-    return { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
-             slk: kN(m.rope_slack_threshold), ovl: kN(m.rope_overload_threshold),
-             clr: m.min_clearance * 1e3, warn: w, crit: c, v: m.v, l: m.l };
+    const v = { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
+                slk: kN(m.rope_slack_threshold), ovl: kN(m.rope_overload_threshold),
+                clr: m.min_clearance * 1e3, warn: w, crit: c, v: m.v, l: m.l };
+    // uPlot's gaps are null: a NaN would spoil the axis range of its chart.
+    for (const k of Object.keys(v)) if (!(typeof v[k] === "number" && isFinite(v[k]))) v[k] = null;
+    return v;
   }
 
   function onCage(s, d) {
@@ -291,12 +408,12 @@
       if (cls !== undefined) e.className = "v " + cls;
     };
     s.ro.dataset.utime = String(m.utime);
-    set("t", m.t.toFixed(2));
-    set("l", m.l.toFixed(2));
-    set("y_c", (m.y_c * 1e3).toFixed(2));
-    set("theta", (m.theta * 1e3).toFixed(3));
-    set("v", m.v.toFixed(2));
-    set("min_clearance", (m.min_clearance * 1e3).toFixed(1));
+    set("t", fix(m.t, 2));
+    set("l", fix(m.l, 2));
+    set("y_c", fix(m.y_c * 1e3, 2));
+    set("theta", fix(m.theta * 1e3, 3));
+    set("v", fix(m.v, 2));
+    set("min_clearance", fix(m.min_clearance * 1e3, 1));
     set("alarm_level", LEVELS[m.alarm_level] || String(m.alarm_level), "lvl" + m.alarm_level);
     set("degraded", m.degraded ? "DEGRADED" : "no", m.degraded ? "lvl2" : "");
     s.tab.querySelector(".dot").style.background = ["#2fbf71", "#f0b429", "#ef4444"][m.alarm_level] || "#8a96a3";
@@ -306,7 +423,16 @@
   function onAlarm(s, a) {
     for (const k of ["active", "acked", "shelved", "latched"]) a[k] = Boolean(a[k]);
     if ((a.kind === "CAGE_POS_Y" || a.kind === "CAGE_NEG_Y") && a.threshold > 0) s.thr[`${a.kind}/${a.level}`] = a.threshold;
-    s.alarms.set(`${a.kind}/${a.level}`, a);
+    const key = `${a.kind}/${a.level}`;
+    // The activation: hoist-dash's (kept across re-announces), else the page's own record.
+    const prev = s.alarms.get(key);
+    a.serverIdentity = a.dash_activation_utime > 0;
+    if (!a.serverIdentity) {
+      a.dash_activation_utime = a.event_type === 1 || !prev ? a.utime : prev.dash_activation_utime;
+      a.dash_activation_t = a.event_type === 1 || !prev ? a.t : prev.dash_activation_t;
+      a.dash_activation_known = a.event_type === 1 || Boolean(prev && prev.dash_activation_known);
+    }
+    s.alarms.set(key, a);
     renderAlarms(s);
   }
 
@@ -320,34 +446,44 @@
 
   function fmtVal(a) {
     if (a.kind === "INPUT_STALE" || a.kind === "MODEL_FAULT") return a.value >= 0.5 ? "on" : "off";
-    if (a.kind === "ROPE_SLACK" || a.kind === "ROPE_OVERLOAD") return `${(a.value / 1e3).toFixed(2)} kN / ${(a.threshold / 1e3).toFixed(2)} kN`;
-    return `${(a.value * 1e3).toFixed(1)} mm / ${(a.threshold * 1e3).toFixed(1)} mm`;
+    if (a.kind === "ROPE_SLACK" || a.kind === "ROPE_OVERLOAD") return `${fix(a.value / 1e3, 2)} kN / ${fix(a.threshold / 1e3, 2)} kN`;
+    return `${fix(a.value * 1e3, 1)} mm / ${fix(a.threshold * 1e3, 1)} mm`;
   }
+
+  // Stable order: priority (CRITICAL first), then activation time (oldest
+  // first: a new alarm is added below, rows above never move), then kind.
+  function alarmOrder(a, b) {
+    return (b.level - a.level) || (a.dash_activation_utime - b.dash_activation_utime) || (a.kind < b.kind ? -1 : a.kind > b.kind ? 1 : 0);
+  }
+  const alarmName = (a) => `${a.kind} ${LEVELS[a.level] || a.level}`;
+  const activeSince = (a) => `${a.dash_activation_known === false ? "before " : ""}${clock(a.dash_activation_utime)}`;
 
   function renderAlarms(s) {
     const body = s.alarmsBody;
     body.textContent = "";
-    const rows = [...s.alarms.values()]
-      .filter((a) => a.active || !a.acked || a.shelved)
-      .sort((a, b) => (b.level - a.level) || (b.utime - a.utime));
+    const rows = [...s.alarms.values()].filter((a) => a.active || !a.acked || a.shelved).sort(alarmOrder);
     $("[data-role=no-alarms]", s.root).hidden = rows.length > 0;
     for (const a of rows) {
       const tr = el("tr", {
         class: `alarm lvl-${a.level} ${a.active ? "active" : ""} ${a.acked ? "acked" : "unacked"} ${a.shelved ? "shelved" : ""}`,
         "data-kind": a.kind, "data-level": String(a.level), "data-active": String(a.active), "data-acked": String(a.acked),
         "data-shelved": String(a.shelved), "data-latched": String(a.latched),
+        "data-activation": String(a.dash_activation_utime),
       });
-      const when = new Date(a.utime / 1000);
+      const re = a.dash_reannounce_utime > 0 ? el("span", { class: "reann", "data-field": "reannounce" }, ` re-announced ${clock(a.dash_reannounce_utime)}`) : "";
       tr.append(el("td", { class: "lv" }, LEVELS[a.level] || String(a.level)),
         el("td", { title: a.message }, a.kind),
         el("td", { class: "state" }, stateText(a)),
-        el("td", {}, `${when.toLocaleTimeString()} (t=${a.t.toFixed(1)} s)`),
+        el("td", { "data-field": "activation" }, `${activeSince(a)} (t=${fix(a.dash_activation_t, 1)} s)`, re),
         el("td", {}, fmtVal(a)),
         el("td", {}, a.user || ""));
       const btns = el("td", { class: "btns cmd" });
       if (!state.readOnly) {
+        // Each button carries its alarm's identity (kind, level, activation),
+        // never a row position.
+        const ident = { kind: a.kind, level: a.level, activation: a.dash_activation_utime, server: a.serverIdentity, name: alarmName(a), since: activeSince(a) };
         const mk = (label, action, enabled) => el("button", { "data-action": label.toLowerCase(), ...(enabled ? {} : { disabled: "" }),
-          onclick: () => command(s, a, action) }, label);
+          onclick: () => command(s, ident, action, label) }, label);
         btns.append(mk("Acknowledge", 1, !a.acked && !a.shelved), mk("Shelve", 2, !a.shelved), mk("Unshelve", 3, a.shelved));
       }
       tr.append(btns);
@@ -355,14 +491,18 @@
     }
   }
 
-  function command(s, a, action) {
+  function command(s, ident, action, label) {
     const user = userInput.value.trim();
     if (!user) { toast("Enter your name (Operator) before acknowledging or shelving.", true); userInput.focus(); return; }
     const cid = state.ackChannels.get(s.prefix);
     if (cid === undefined) { toast("No command channel for this shaft (read-only server?)", true); return; }
     const shelve = Number($("[data-role=shelve-s]", s.root).value);
-    const payload = new TextEncoder().encode(JSON.stringify({
-      utime: 0, kind: a.kind, level: a.level, action, shelve_duration: action === 2 ? shelve : 0, user }));
+    const what = action === 2 ? `${label} ${ident.name} (active since ${ident.since}) for ${shelve / 60} min?` : `${label} ${ident.name} (active since ${ident.since})?`;
+    if (!window.confirm(what)) return;
+    const cmd = { utime: 0, kind: ident.kind, level: ident.level, action, shelve_duration: action === 2 ? shelve : 0, user };
+    // The server refuses the command if this alarm changed since the page drew it.
+    if (ident.server) cmd.activation_utime = ident.activation;
+    const payload = new TextEncoder().encode(JSON.stringify(cmd));
     const buf = new Uint8Array(5 + payload.length);
     buf[0] = 1;
     new DataView(buf.buffer).setUint32(1, cid, true);
@@ -377,10 +517,10 @@
     dl.textContent = "";
     const rows = [
       ["clock / rate", `${h.clock} / ${h.rate} Hz`],
-      ["step time p50 / p99 / max", `${h.step_p50_us.toFixed(1)} / ${h.step_p99_us.toFixed(1)} / ${h.step_max_us.toFixed(1)} µs`],
-      ["tick lateness p50 / p99 / max", `${h.late_p50_us.toFixed(1)} / ${h.late_p99_us.toFixed(1)} / ${h.late_max_us.toFixed(1)} µs`],
+      ["step time p50 / p99 / max", `${fix(h.step_p50_us, 1)} / ${fix(h.step_p99_us, 1)} / ${fix(h.step_max_us, 1)} µs`],
+      ["tick lateness p50 / p99 / max", `${fix(h.late_p50_us, 1)} / ${fix(h.late_p99_us, 1)} / ${fix(h.late_max_us, 1)} µs`],
       ["deadline misses", String(h.deadline_misses)],
-      ["input age", h.input_age < 0 ? "no input yet" : `${h.input_age.toFixed(2)} s`],
+      ["input age", h.input_age < 0 ? "no input yet" : `${fix(h.input_age, 2)} s`],
       ["inputs accepted / lost (seq gaps)", `${h.accepted} / ${h.seq_gaps}`],
       ["rejected inputs", String(h.rejected_total)],
     ];
@@ -388,7 +528,7 @@
     rows.push(["alarms active / unacked / shelved", `${h.alarms_active} / ${h.alarms_unacked} / ${h.alarms_shelved}`],
               ["model faults / resets", `${h.model_faults} / ${h.model_resets}`],
               ["publish failures", String(h.publish_failures)],
-              ["uptime", `${h.uptime.toFixed(0)} s`]);
+              ["uptime", `${fix(h.uptime, 0)} s`]);
     for (const [k, v] of rows) dl.append(el("dt", {}, k), el("dd", {}, v));
     dl.append(el("dt", {}, "degraded"), el("dd", { "data-field": "health-degraded" },
       el("span", { class: h.degraded ? "degraded-yes" : "" }, h.degraded ? "DEGRADED" : "no")));
@@ -402,7 +542,7 @@
   // ROPE_OVERLOAD).  Every string from the network goes in as text.
   const SCN_COLORS = ["#f87171", "#60a5fa", "#34d399", "#fbbf24", "#a78bfa", "#f472b6", "#22d3ee", "#a3e635"];
   const STATUS = ["ok", "left the shaft", "non-finite"];
-  const ahead = (t) => (typeof t === "number" && t >= 0 ? `${t.toFixed(1)} s` : "none");
+  const ahead = (t) => (typeof t === "number" && t >= 0 ? `${fix(t, 1)} s` : "none");
 
   function renderForecast(s) {
     const box = $("[data-role=forecast]", s.root);
@@ -412,9 +552,9 @@
     const f = s.forecast;
     const scns = Array.isArray(f.scenarios) ? f.scenarios.slice(0, 8) : [];
     body.append(el("p", { class: "fc-note", "data-field": "forecast-from" },
-      `from t=${Number(f.t_start).toFixed(2)} s, l=${Number(f.l).toFixed(1)} m` +
+      `from t=${fix(f.t_start, 2)} s, l=${fix(f.l, 1)} m` +
       (f.plan_seq >= 0 ? `, trip plan #${f.plan_seq}` : ", no trip plan") +
-      ` (${(Number(f.compute_time) * 1e3).toFixed(0)} ms)`));
+      ` (${fix(Number(f.compute_time) * 1e3, 0)} ms)`));
     const tbl = el("table", { class: "fc" }, el("thead", {}, el("tr", {},
       ...["Scenario", "Worst clearance", "CRITICAL in", "WARNING in", "λ0 min…max [kN]"].map((h) => el("th", {}, h)))));
     const tb = el("tbody");
@@ -423,11 +563,11 @@
       const tr = el("tr", { class: crit ? "lvl-2" : warn ? "lvl-1" : "", "data-scenario": String(sc.name),
                             "data-t-critical": String(sc.t_critical), "data-t-warning": String(sc.t_warning) },
         el("td", {}, el("span", { class: "swatch", style: `background:${SCN_COLORS[i]}` }), String(sc.name),
-           sc.status ? ` (stopped at ${Number(sc.t_reached).toFixed(1)} s: ${STATUS[sc.status] || "status " + sc.status})` : ""),
-        el("td", { "data-field": "worst" }, `${(sc.min_clearance * 1e3).toFixed(1)} mm at +${Number(sc.t_min_clearance).toFixed(1)} s`),
+           sc.status ? ` (stopped at ${fix(sc.t_reached, 1)} s: ${STATUS[sc.status] || "status " + sc.status})` : ""),
+        el("td", { "data-field": "worst" }, `${fix(sc.min_clearance * 1e3, 1)} mm at +${fix(sc.t_min_clearance, 1)} s`),
         el("td", { "data-field": "t-critical", class: crit ? "lvl2" : "" }, ahead(sc.t_critical)),
         el("td", { "data-field": "t-warning", class: warn ? "lvl1" : "" }, ahead(sc.t_warning)),
-        el("td", {}, `${(sc.lambda0_min / 1e3).toFixed(2)} … ${(sc.lambda0_max / 1e3).toFixed(2)}`));
+        el("td", {}, `${fix(sc.lambda0_min / 1e3, 2)} … ${fix(sc.lambda0_max / 1e3, 2)}`));
       tb.append(tr);
     });
     tbl.append(tb);
@@ -465,7 +605,7 @@
       g.beginPath(); g.moveTo(ml, Y(v)); g.lineTo(W - mr, Y(v)); g.stroke();
       g.fillText(v.toPrecision(3), 2, Y(v) + 3);
     }
-    for (let k = 0; k <= 4; k++) g.fillText(`${(tmax * k / 4).toFixed(0)}`, X(tmax * k / 4) - 4, H - 6);
+    for (let k = 0; k <= 4; k++) g.fillText(`${fix(tmax * k / 4, 0)}`, X(tmax * k / 4) - 4, H - 6);
     for (const [v, col] of thr) {
       if (!isFinite(v)) continue;
       g.strokeStyle = col; g.setLineDash([6, 4]); g.beginPath(); g.moveTo(ml, Y(v)); g.lineTo(W - mr, Y(v)); g.stroke();
@@ -502,11 +642,12 @@
     const cx = w / 2, half = 40;                      // guide ropes drawn 80 px apart
     const Y = (x) => top + x * vs;
     $("[data-role=scale]", s.root).textContent =
-      `depth to scale 0…${L.toFixed(0)} m; lateral ×${mag.toFixed(0)} (gap ${(gap * 1e3).toFixed(1)} mm = 40 px)`;
+      `depth to scale 0…${fix(L, 0)} m; lateral ×${fix(mag, 0)} (${fix(gap * 1e3, 1)} mm = 40 px); gap ` +
+      (s.gap ? `+y ${fix(s.gap.pos * 1e3, 1)} mm, −y ${fix(s.gap.neg * 1e3, 1)} mm` : "unknown (no cage state yet)");
     g.font = "10px system-ui"; g.fillStyle = "#8a96a3"; g.strokeStyle = "#222a33"; g.lineWidth = 1;
     for (let d = 0; d <= L + 1e-9; d += L > 200 ? 50 : 20) {
       g.beginPath(); g.moveTo(18, Y(d)); g.lineTo(w, Y(d)); g.stroke();
-      g.fillText(`${d.toFixed(0)}`, 0, Y(d) + 3);
+      g.fillText(`${fix(d, 0)}`, 0, Y(d) + 3);
     }
     // Clearance limits (cage sides): the gap (CRITICAL at the wall), WARNING dashed.
     if (s.gap) {
@@ -543,7 +684,7 @@
       // Hoisting rope from the head sheave.
       g.strokeStyle = "#9ca3af"; g.beginPath(); g.moveTo(cx, top - 10); g.lineTo(yt, Y(c.l)); g.stroke();
       g.fillStyle = "#fff";
-      g.fillText(`${c.l.toFixed(1)} m`, yt + half + 4, Y(c.l) + 10);
+      g.fillText(`${fix(c.l, 1)} m`, yt + half + 4, Y(c.l) + 10);
     }
   }
 
@@ -556,7 +697,7 @@
       s.banner.dataset.state = st;
       s.banner.textContent = st === "nodata"
         ? `NO DATA: no cage state from ${s.prefix || "the default shaft"}${s.health && age <= STALE_AFTER_MS ? " (the daemon is up, waiting for winder input)" : ""}`
-        : st === "stale" ? `STALE: no data for ${s.lastMsg < 0 ? "—" : (age / 1000).toFixed(1) + " s"}; values below are old` : "";
+        : st === "stale" ? `STALE: no data for ${s.lastMsg < 0 ? "—" : fix(age / 1000, 1) + " s"}; values below are old` : "";
       const was = s.root.classList.contains("stale");
       s.root.classList.toggle("stale", st !== "ok");
       if (was !== (st !== "ok")) s.dirty = true;
