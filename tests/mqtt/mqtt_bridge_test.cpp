@@ -112,8 +112,8 @@ class Client {
   }
   bool connected() const { return connect_ok_ && connected_; }
   void subscribe(const std::string& topic) { mosquitto_subscribe(m_, nullptr, topic.c_str(), 1); }
-  void publish(const std::string& topic, const std::string& payload) {
-    mosquitto_publish(m_, nullptr, topic.c_str(), static_cast<int>(payload.size()), payload.data(), 1, false);
+  void publish(const std::string& topic, const std::string& payload, bool retain = false) {
+    mosquitto_publish(m_, nullptr, topic.c_str(), static_cast<int>(payload.size()), payload.data(), 1, retain);
   }
   std::vector<Msg> messages() {
     std::lock_guard<std::mutex> lk(mu_);
@@ -354,6 +354,9 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
   EXPECT_EQ((*acked)["last_event"], "ACK");
   EXPECT_FALSE((*acked)["unacked"].get<bool>());
   EXPECT_TRUE((*acked)["active"].get<bool>());
+  // The daemon's log is written by its own thread: give it a moment.
+  for (int i = 0; i < 100 && readFile(log("twind.log")).find("operator 'scada-op': acknowledge") == std::string::npos; ++i)
+    std::this_thread::sleep_for(20ms);
   EXPECT_NE(readFile(log("twind.log")).find("operator 'scada-op': acknowledge"), std::string::npos);
 
   // Stop: the bridge says it is offline (retained) and exits 0.
@@ -388,7 +391,8 @@ TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
   Process replay({HOIST_REPLAY, "--profile", "rest:t_end=60", "--lcm-url", url}, log("replay.log"));
   // The alarm comes up while the broker is down.
   ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("HOIST_ALARM") > 0; }, 10s)) << readFile(log("twind.log"));
-  lcm.pump(2s);
+  // A discovered shaft is bridged once its health has kept coming (3 messages over >= 1 s): then > 2 s of buffering.
+  lcm.pump(4s);
   ASSERT_TRUE(bridge.running()) << readFile(log("bridge.log"));
   std::string blog = readFile(log("bridge.log"));
   EXPECT_EQ(countOf(blog, "cannot connect to the broker"), 1u) << "log once per state change:\n" << blog;
@@ -430,7 +434,9 @@ TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
   auto h2 = c2.waitJson("hoist/_bridge/bridge-b/health", [](const json& j, bool) { return j["connection"]["connects"] == 2; }, 5s);
   ASSERT_TRUE(h2);
   EXPECT_EQ((*h2)["connection"]["disconnects"], 1);
-  // Commands work on the new connection (re-subscribed).
+  // Commands work on the new connection (re-subscribed).  (Drain the LCM
+  // socket first: unread for seconds, it is full and would drop the ack.)
+  lcm.pump(300ms);
   const std::size_t acks_before = lcm.count("HOIST_ALARM_ACK");
   c2.publish("hoist/default/cmd/ack", R"({"kind":"*","level":0,"action":1})");
   EXPECT_TRUE(lcm.waitFor([&] { return lcm.count("HOIST_ALARM_ACK") > acks_before; }, 5s));
@@ -557,4 +563,98 @@ TEST_F(MqttBridge, TlsWithPasswordFile) {
   bad.signal(SIGTERM);
   EXPECT_EQ(good.wait(5s), 0);
   EXPECT_EQ(bad.wait(5s), 0);
+}
+
+// The command path (issue: retained replays, floods, ambiguous JSON, control
+// characters): a retained command is never executed, neither when the bridge
+// starts nor when it restarts, and the bridge deletes it from the broker; a
+// flood from one user is cut to the per-user burst while another user still
+// gets through; a payload with a key given twice, a user with control
+// characters (C0, DEL, C1) and a stale client utime are refused, counted by
+// reason and never reach LCM.
+TEST_F(MqttBridge, RetainedFloodedAndAmbiguousCommandsAreRefused) {
+  dir_ = testDir("mqtt_cmd_hardening");
+  const std::string url = urlFor(7935);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  // A retained "shelve everything for an hour", left on the broker before the bridge starts.
+  c.publish("hoist/east/cmd/ack", R"({"kind":"*","level":0,"action":2,"shelve_duration":3600,"user":"evil"})", true);
+  std::this_thread::sleep_for(300ms);
+
+  Listener lcm(url);
+  lcm.subscribe("east/HOIST_ALARM_ACK");
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\ncommand_rate = 0.5\ncommand_burst = 5\n";
+  std::vector<std::string> argv{HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url,
+                                "--channel-prefix", "east/", "--client-id", "bridge-h"};
+  auto bridge = std::make_unique<Process>(argv, log("bridge.log"));
+  auto h = c.waitJson("hoist/_bridge/bridge-h/health",
+                      [](const json& j, bool) { return j["commands"]["rejected_by_reason"]["retained"] == 1; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge.log"));
+  EXPECT_EQ((*h)["commands"]["forwarded"], 0);
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("east/HOIST_ALARM_ACK"), 0u) << "a retained command was executed";
+  // Restarted: the retained command is gone (deleted by the bridge), so nothing is replayed.
+  bridge->signal(SIGTERM);
+  EXPECT_EQ(bridge->wait(5s), 0);
+  bridge = std::make_unique<Process>(argv, log("bridge2.log"));
+  h = c.waitJson("hoist/_bridge/bridge-h/health", [](const json& j, bool) { return j["uptime"].get<double>() > 0.5 &&
+                                                                                 j["commands"]["received"] == 0; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge2.log"));
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("east/HOIST_ALARM_ACK"), 0u);
+  {
+    Client late(broker.port(), "late");
+    ASSERT_TRUE(late.connected());
+    late.subscribe("hoist/east/cmd/#");
+    std::this_thread::sleep_for(500ms);
+    for (const auto& m : late.messages()) EXPECT_FALSE(m.retain) << m.topic << ": " << m.payload;
+  }
+
+  // Ambiguous or unsafe payloads: refused by reason.
+  const auto now_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                          std::chrono::system_clock::now().time_since_epoch()).count();
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"duplicate_key", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"kind":"*"})"},
+      {"duplicate_key", R"({"kind":"*","level":0,"action":3,"action":2,"shelve_duration":60})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\u001b[2J"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\nAUDIT operator 'x'"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\u007f"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\u009b31m"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":""})"},
+      {"stale_utime", R"({"kind":"*","level":0,"action":1,"utime":)" + std::to_string(now_us - 3'600'000'000LL) + "}"},
+  };
+  for (const auto& [why, p] : bad) c.publish("hoist/east/cmd/ack", p);
+  h = c.waitJson("hoist/_bridge/bridge-h/health",
+                 [&](const json& j, bool) { return j["commands"]["rejected"].get<std::size_t>() >= bad.size(); }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge2.log"));
+  EXPECT_EQ((*h)["commands"]["rejected_by_reason"]["duplicate_key"], 2);
+  EXPECT_EQ((*h)["commands"]["rejected_by_reason"]["bad_user"], 5);
+  EXPECT_EQ((*h)["commands"]["rejected_by_reason"]["stale_utime"], 1);
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("east/HOIST_ALARM_ACK"), 0u);
+  EXPECT_EQ(readFile(log("bridge2.log")).find('\x1b'), std::string::npos) << "a control character reached the log";
+
+  // A flood from one user: at most its burst (5) and what the rate refills
+  // (0.5/s) is forwarded; another user still gets through.
+  for (int i = 0; i < 40; ++i)
+    c.publish("hoist/east/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":3,"user":"flooder"})");
+  h = c.waitJson("hoist/_bridge/bridge-h/health",
+                 [&](const json& j, bool) { return j["commands"]["received"].get<int>() >= int(bad.size()) + 40; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge2.log"));
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("east/HOIST_ALARM_ACK") >= 5; }, 5s));
+  lcm.pump(300ms);
+  const auto flooded = lcm.count("east/HOIST_ALARM_ACK");
+  EXPECT_GE(flooded, 5u);
+  EXPECT_LE(flooded, 8u) << "a 40-command flood from one user must be cut near its burst of 5";
+  EXPECT_GE((*h)["commands"]["rejected_by_reason"]["rate_limited"].get<int>(), 32);
+  c.publish("hoist/east/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":3,"user":"operator-2"})");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("east/HOIST_ALARM_ACK") > flooded; }, 5s))
+      << "another user's command was blocked by one user's flood";
+  EXPECT_EQ(lcm.decoded<hoist::alarm_ack_t>("east/HOIST_ALARM_ACK").back().user, "operator-2");
+  bridge->signal(SIGTERM);
+  EXPECT_EQ(bridge->wait(5s), 0);
 }

@@ -138,7 +138,14 @@ void BridgeConfig::validate() const {
   range("bridge.cage_rate", cage_rate, 0.0, 1000.0, true);
   range("bridge.health_period", health_period, 0.1, 3600.0);
   range("bridge.max_shafts", max_shafts, 1, 10000);
+  range("bridge.discovery_timeout", discovery_timeout, 1.0, 3600.0);
+  if (static_cast<int>(channel_prefixes.size()) > max_shafts)
+    bad("bridge.channel_prefixes", std::to_string(channel_prefixes.size()) + " prefixes > bridge.max_shafts = " +
+                                       std::to_string(max_shafts));
   range("bridge.max_command_bytes", max_command_bytes, 64, 65536);
+  range("bridge.command_rate", command_rate, 0.0, 1000.0, true);
+  range("bridge.command_burst", command_burst, 1, 10000);
+  range("bridge.max_command_age", max_command_age, 0.0, 86400.0);
   range("buffer.max_messages", max_messages, 1, 1000000);
   range("buffer.max_alarm_events", max_alarm_events, 1, 1000000);
 }
@@ -257,7 +264,11 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   r.num("bridge", "cage_rate", c.cage_rate);
   r.num("bridge", "health_period", c.health_period);
   r.integer("bridge", "max_shafts", c.max_shafts);
+  r.num("bridge", "discovery_timeout", c.discovery_timeout);
   r.integer("bridge", "max_command_bytes", c.max_command_bytes);
+  r.num("bridge", "command_rate", c.command_rate);
+  r.integer("bridge", "command_burst", c.command_burst);
+  r.num("bridge", "max_command_age", c.max_command_age);
   r.integer("buffer", "max_messages", c.max_messages);
   r.integer("buffer", "max_alarm_events", c.max_alarm_events);
   r.run(root);

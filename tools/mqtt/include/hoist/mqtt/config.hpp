@@ -4,7 +4,8 @@
 //             password_env, reconnect_min, reconnect_max, connect_timeout
 //   [tls]     ca_file, ca_path, cert_file, key_file, insecure, version
 //   [bridge]  lcm_url, channel_prefixes, commands, cage_rate, health_period,
-//             max_shafts, max_command_bytes
+//             max_shafts, discovery_timeout, max_command_bytes, command_rate, command_burst,
+//             max_command_age
 //   [buffer]  max_messages, max_alarm_events
 //
 // Every key is optional.  Rejected with hoist::io::ConfigError
@@ -55,8 +56,12 @@ struct BridgeConfig {
   bool commands = true;                    ///< accept hoist/<shaft>/cmd/ack
   double cage_rate = 10.0;                 ///< cage states per second per shaft [Hz], (0, 1000]
   double health_period = 5.0;              ///< the bridge's own health topic period [s]
-  int max_shafts = 64;                     ///< discovered shafts at most
+  int max_shafts = 64;                     ///< shafts bridged at most (configured + discovered)
+  double discovery_timeout = 5.0;          ///< a discovered prefix silent this long ages out / may be replaced [s]
   int max_command_bytes = 1024;            ///< larger command payloads are rejected
+  double command_rate = 2.0;               ///< commands per second per user and shaft (token bucket) [1/s]
+  int command_burst = 10;                  ///< ... with this many at once; a shaft's total is 4x both
+  double max_command_age = 60.0;           ///< a client's utime must be within this of the bridge's clock [s]; 0 = off
 
   // [buffer] (while the broker is unreachable or the socket is congested)
   int max_messages = 1000;       ///< cage and health messages buffered (oldest cage states dropped first)
