@@ -17,7 +17,9 @@
 #include "lcm_fixtures.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
+#include "hoist/cage_state_t.hpp"
 #include "hoist/forecast_t.hpp"
+#include "hoist/health_t.hpp"
 
 using namespace hoist::test;
 using json = nlohmann::json;
@@ -657,4 +659,142 @@ TEST_F(MqttBridge, RetainedFloodedAndAmbiguousCommandsAreRefused) {
   EXPECT_EQ(lcm.decoded<hoist::alarm_ack_t>("east/HOIST_ALARM_ACK").back().user, "operator-2");
   bridge->signal(SIGTERM);
   EXPECT_EQ(bridge->wait(5s), 0);
+}
+
+namespace {
+hoist::health_t forgedHealth(std::int64_t instance) {
+  hoist::health_t h{};
+  h.utime = 1;
+  h.instance_id = instance;
+  h.clock = "wall";
+  return h;
+}
+}  // namespace
+
+// Discovery cannot be poisoned: one forged north_HOIST_HEALTH sent before the
+// real north/ daemon, and 70 forged prefixes (single datagrams), bind nothing
+// for good: the real daemon's shaft is bridged, its commands go to
+// north/HOIST_ALARM_ACK.  A second prefix claiming "north" at the health rate
+// is reported with the first (discovery.conflicts) and commands are refused
+// while it lasts.  A full table (max_shafts) is a log line and
+// discovery.table_full while it lasts.
+TEST_F(MqttBridge, DiscoveryIsNotPoisoned) {
+  dir_ = testDir("mqtt_discovery");
+  const std::string url = urlFor(7936);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  lcm.subscribe("north.HOIST_(HEALTH|ALARM_ACK)");
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\ndiscovery_timeout = 2.0\nmax_shafts = 64\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-d"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-d/status", [](const json& j, bool) { return j.value("online", false); }, 10s));
+  // The forgeries: north_ once, then 70 prefixes once each (health with an instance id, and a cage state).
+  auto h = forgedHealth(666);
+  lcm.lcm().publish("north_HOIST_HEALTH", &h);
+  hoist::cage_state_t cage{};
+  for (int i = 0; i < 70; ++i) {
+    const std::string p = "forged" + std::to_string(i) + "/";
+    h.instance_id = 1000 + i;
+    lcm.lcm().publish(p + "HOIST_HEALTH", &h);
+    lcm.lcm().publish(p + "HOIST_CAGE", &cage);
+  }
+  lcm.pump(300ms);
+  // The real daemon.
+  auto twind = startDaemonAndWait(lcm, {HOIST_TWIND, "--config", daemonConfig(dir_, "north/"), "--lcm-url", url},
+                                  log("twind.log"), "north/HOIST_HEALTH");
+  const auto real_instance = lcm.decoded<hoist::health_t>("north/HOIST_HEALTH").back().instance_id;
+  auto mh = c.waitJson("hoist/north/health", [&](const json& j, bool) { return j["instance_id"] == real_instance; }, 10s);
+  ASSERT_TRUE(mh) << "the real shaft was not bridged:\n" << readFile(log("bridge.log"));
+  for (const auto& m : c.on("hoist/north/health"))
+    EXPECT_EQ(json::parse(m.payload)["instance_id"], real_instance) << "a forged health was published as north's";
+  for (const auto& m : c.messages()) EXPECT_EQ(m.topic.rfind("hoist/forged", 0), std::string::npos) << m.topic;
+  auto bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) {
+    return j["shafts"].size() == 1 && j["discovery"]["candidates"] == 0; }, 10s);  // the forgeries aged out
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["shafts"][0]["channel_prefix"], "north/");
+  EXPECT_GE((*bh)["discovery"]["aged_out"].get<int>(), 71);
+  // A command for north goes to the real daemon's channel.
+  lcm.pump(200ms);
+  c.publish("hoist/north/cmd/ack", R"({"kind":"*","level":0,"action":3,"user":"op"})");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("north/HOIST_ALARM_ACK") == 1; }, 5s)) << readFile(log("bridge.log"));
+  EXPECT_EQ(lcm.count("north_HOIST_ALARM_ACK"), 0u);
+
+  // Another prefix claims "north" at the health rate: both reported, commands refused while it lasts.
+  auto claim = [&](const std::vector<std::string>& prefixes, std::chrono::milliseconds d) {
+    const auto end = std::chrono::steady_clock::now() + d;
+    while (std::chrono::steady_clock::now() < end) {
+      for (std::size_t i = 0; i < prefixes.size(); ++i) {
+        auto f = forgedHealth(777 + static_cast<std::int64_t>(i));
+        lcm.lcm().publish(prefixes[i] + "HOIST_HEALTH", &f);
+      }
+      lcm.pump(250ms);
+    }
+  };
+  claim({"north_"}, 2000ms);
+  bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) { return !j["discovery"]["conflicts"].empty(); }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["shaft"], "north");
+  EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["bridged_prefix"], "north/");
+  EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["prefixes"], json::array({"north/", "north_"}));
+  c.publish("hoist/north/cmd/ack", R"({"kind":"*","level":0,"action":3,"user":"op"})");
+  bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) {
+    return j["commands"]["rejected_by_reason"]["ambiguous_shaft"] == 1; }, 3s);
+  EXPECT_TRUE(bh);
+  EXPECT_NE(readFile(log("bridge.log")).find("shaft name 'north' is already bridged from prefix 'north/'"),
+            std::string::npos) << readFile(log("bridge.log"));
+  lcm.pump(2500ms);  // the claim stops: it ages out
+  bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) { return j["discovery"]["conflicts"].empty(); }, 3s);
+  EXPECT_TRUE(bh);
+  stopDaemonCleanly(*twind, log("twind.log"));
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}
+
+// A full shaft table is loud: a log line and discovery.table_full (with the
+// refused prefix) while it lasts, and room again once a shaft's health stops.
+TEST_F(MqttBridge, DiscoveryFullTableIsReported) {
+  dir_ = testDir("mqtt_discovery_full");
+  const std::string url = urlFor(7937);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\ndiscovery_timeout = 1.5\nmax_shafts = 2\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-f"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-f/status", [](const json& j, bool) { return j.value("online", false); }, 10s));
+  auto beat = [&](const std::vector<std::string>& prefixes, std::chrono::milliseconds d) {
+    const auto end = std::chrono::steady_clock::now() + d;
+    while (std::chrono::steady_clock::now() < end) {
+      for (std::size_t i = 0; i < prefixes.size(); ++i) {
+        auto f = forgedHealth(500 + static_cast<std::int64_t>(i));
+        lcm.lcm().publish(prefixes[i] + "HOIST_HEALTH", &f);
+      }
+      lcm.pump(250ms);
+    }
+  };
+  beat({"a/", "b/"}, 1800ms);
+  beat({"a/", "b/", "c/"}, 1800ms);
+  auto bh = c.waitJson("hoist/_bridge/bridge-f/health", [](const json& j, bool) { return j["discovery"]["table_full"] == true; }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["discovery"]["refused"], json::array({"c/"}));
+  EXPECT_EQ((*bh)["shafts"].size(), 2u);
+  EXPECT_NE(readFile(log("bridge.log")).find("the shaft table is full"), std::string::npos) << readFile(log("bridge.log"));
+  // b/ stops: c/ takes its slot; the table has room for no one else but refuses no one.
+  beat({"a/", "c/"}, 3000ms);
+  bh = c.waitJson("hoist/_bridge/bridge-f/health", [](const json& j, bool) { return j["discovery"]["table_full"] == false; }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  std::vector<std::string> names;
+  for (const auto& s : (*bh)["shafts"]) names.push_back(s["name"]);
+  EXPECT_EQ(names, (std::vector<std::string>{"a", "c"}));
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
 }
