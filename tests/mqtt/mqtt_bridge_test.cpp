@@ -798,3 +798,113 @@ TEST_F(MqttBridge, DiscoveryFullTableIsReported) {
   bridge.signal(SIGTERM);
   EXPECT_EQ(bridge.wait(5s), 0);
 }
+
+namespace {
+hoist::alarm_t alarmEvent(const std::string& kind, int event, bool active) {
+  hoist::alarm_t a{};
+  a.utime = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  a.kind = kind;
+  a.level = hoist::alarm_t::LEVEL_WARNING;
+  a.event_type = static_cast<std::int8_t>(event);
+  a.active = active;
+  a.message = "test";
+  a.user = "";
+  return a;
+}
+}  // namespace
+
+// Every command is answered on hoist/<shaft>/cmd/result: accepted (forwarded),
+// or refused and why; an acknowledge that matches no active, unacknowledged
+// alarm is logged, answered and not forwarded.  After an outage the buffered
+// cage states arrive marked "stale", the alarm transitions of the outage all
+// arrive, and live cage states are not marked.
+TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
+  dir_ = testDir("mqtt_results");
+  const std::string url = urlFor(7938);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  lcm.subscribe("west/HOIST_ALARM_ACK");
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[broker]\nreconnect_min = 1.0\nreconnect_max = 1.0\n"
+                         "[bridge]\nhealth_period = 0.3\nalarm_sync_time = 0.5\n[buffer]\nstale_after = 0.5\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--channel-prefix",
+                  "west/", "--client-id", "bridge-r"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-r/status", [](const json& j, bool) { return j.value("online", false); }, 10s));
+  auto raise = alarmEvent("CAGE_POS_Y", hoist::alarm_t::EVENT_RAISE, true);
+  lcm.lcm().publish("west/HOIST_ALARM", &raise);
+  ASSERT_TRUE(c.waitJson("hoist/west/alarm/CAGE_POS_Y", [](const json& j, bool) { return j["active"] == true; }, 5s));
+  std::this_thread::sleep_for(600ms);  // alarm_sync_time
+
+  auto result = [&](const std::string& user) {
+    return c.waitJson("hoist/west/cmd/result", [&](const json& j, bool) {
+      return j.contains("command") ? j["command"]["user"] == user : j["detail"].get<std::string>().find(user) != std::string::npos; }, 5s);
+  };
+  c.publish("hoist/west/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"user":"op-ok"})");
+  auto r = result("op-ok");
+  ASSERT_TRUE(r) << readFile(log("bridge.log"));
+  EXPECT_EQ((*r)["result"], "accepted");
+  EXPECT_EQ((*r)["reason"], "forwarded");
+  EXPECT_EQ((*r)["command"]["kind"], "CAGE_POS_Y");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("west/HOIST_ALARM_ACK") == 1; }, 5s));
+
+  c.publish("hoist/west/cmd/ack", R"({"kind":"GUIDE_ROPE","level":0,"action":1,"user":"op-none"})");
+  r = result("op-none");
+  ASSERT_TRUE(r) << readFile(log("bridge.log"));
+  EXPECT_EQ((*r)["result"], "refused");
+  EXPECT_EQ((*r)["reason"], "no_matching_alarm");
+  c.publish("hoist/west/cmd/ack", R"({"kind":"CAGE_POS_Y","level":2,"action":1,"user":"op-crit"})");
+  r = result("op-crit");
+  ASSERT_TRUE(r);
+  EXPECT_EQ((*r)["reason"], "no_matching_alarm") << "no CRITICAL CAGE_POS_Y is active";
+  c.publish("hoist/west/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"user":"op-dup","user":"x"})");
+  auto dup = c.waitJson("hoist/west/cmd/result", [](const json& j, bool) { return j["reason"] == "duplicate_key"; }, 5s);
+  ASSERT_TRUE(dup);
+  EXPECT_EQ((*dup)["result"], "refused");
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("west/HOIST_ALARM_ACK"), 1u) << "a refused command was forwarded";
+  EXPECT_NE(readFile(log("bridge.log")).find("matches no alarm"), std::string::npos) << readFile(log("bridge.log"));
+  for (const auto& m : c.on("hoist/west/cmd/result")) EXPECT_FALSE(m.retain);
+
+  // An outage: cage states and alarm transitions while the broker is down.
+  broker.stop();
+  hoist::cage_state_t cage{};
+  for (int i = 0; i < 30; ++i) {
+    cage.seq = i;
+    lcm.lcm().publish("west/HOIST_CAGE", &cage);
+    if (i == 10) {
+      auto clear = alarmEvent("CAGE_POS_Y", hoist::alarm_t::EVENT_CLEAR, false);
+      lcm.lcm().publish("west/HOIST_ALARM", &clear);
+    }
+    if (i == 20) {
+      auto tilt = alarmEvent("CAGE_TILT", hoist::alarm_t::EVENT_RAISE, true);
+      lcm.lcm().publish("west/HOIST_ALARM", &tilt);
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  broker.start();
+  Client c2(broker.port(), "c2");  // subscribed before the bridge's next attempt (1 s)
+  ASSERT_TRUE(c2.connected());
+  c2.subscribe("hoist/#");
+  auto clear = c2.waitJson("hoist/west/alarm/CAGE_POS_Y", [](const json& j, bool) { return j["last_event"] == "CLEAR"; }, 10s);
+  EXPECT_TRUE(clear) << "an alarm transition of the outage was not sent";
+  EXPECT_TRUE(c2.waitJson("hoist/west/alarm/CAGE_TILT", [](const json& j, bool) { return j["active"] == true; }, 5s));
+  auto stale = c2.waitJson("hoist/west/cage", [](const json& j, bool) { return j.value("stale", false); }, 5s);
+  ASSERT_TRUE(stale) << "the backlog's cage states are not marked stale:\n" << readFile(log("bridge.log"));
+  EXPECT_GE((*stale)["stale_age"].get<double>(), 0.5);
+  // Live again: new cage states are not marked.
+  cage.seq = 1000;
+  for (int i = 0; i < 5; ++i) {
+    lcm.lcm().publish("west/HOIST_CAGE", &cage);
+    std::this_thread::sleep_for(150ms);
+  }
+  auto live = c2.waitJson("hoist/west/cage", [](const json& j, bool) { return j["seq"] == 1000; }, 5s);
+  ASSERT_TRUE(live);
+  EXPECT_FALSE(live->contains("stale")) << live->dump();
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}

@@ -142,6 +142,8 @@ struct Bridge::Impl {
     // until its health, with one non-zero instance id, has kept coming; only
     // then may it take a slot and its shaft name ("confirmed").
     bool configured = false, confirmed = false, bound = false;
+    std::string t_result;          // hoist/<shaft>/cmd/result
+    Clock::time_point bound_since{};
     Clock::time_point first_seen{}, last_seen{}, streak_start{}, last_refused_log{};
     std::int64_t streak_instance = 0;
     int streak = 0;                // health messages of streak_instance, gaps <= discovery_timeout
@@ -187,6 +189,8 @@ struct Bridge::Impl {
   std::map<std::string, std::uint64_t> decode_errors;  // "cage/truncated" -> n
   std::uint64_t published = 0, publish_errors = 0;
   std::uint64_t cmd_received = 0, cmd_forwarded = 0, cmd_rejected = 0, cmd_lcm_failures = 0;
+  std::uint64_t results_published = 0, results_dropped = 0, stale_marked = 0, stale_dropped = 0;
+  TokenBucket result_budget;  // cmd/result messages: at most 20/s (bursts of 50), so a flood is not echoed
   std::array<std::uint64_t, kCommandRejects> cmd_by_reason{};
   LogLimiter cmd_log, lcm_log;
 
@@ -290,6 +294,7 @@ struct Bridge::Impl {
     s.t_health = base + "health";
     s.t_alarm = base + "alarm/";
     s.t_cmd = base + "cmd/ack";
+    s.t_result = base + "cmd/result";
     s.t_forecast = base + "forecast";
     s.configured = configured;
     s.first_seen = s.last_seen = Clock::now();
@@ -307,6 +312,7 @@ struct Bridge::Impl {
                    printable(s.prefix), printable(old->second));
     }
     s.bound = true;
+    s.bound_since = Clock::now();
     s.refused = false;
     bound[s.name] = s.prefix;
     cmd_topics[s.t_cmd] = s.prefix;
@@ -623,9 +629,30 @@ struct Bridge::Impl {
     return false;
   }
 
+  /// Buffered cage states older than [buffer] stale_after are marked
+  /// "stale": true (with their age), or dropped with drop_stale; alarm
+  /// transitions and the rest are sent as they are.
   void flushOutbox() {
+    const auto now = Clock::now();
     while (conn == Conn::Connected && !outbox.empty() && !mosquitto_want_write(mosq)) {
-      if (!send(outbox.front())) return;
+      const OutMsg& m = outbox.front();
+      if (m.cls == MsgClass::Cage && seconds(now - m.queued) > cfg.stale_after) {
+        if (cfg.drop_stale) {
+          ++stale_dropped;
+          outbox.pop();
+          continue;
+        }
+        OutMsg marked = m;
+        if (!marked.payload.empty() && marked.payload.back() == '}') {
+          marked.payload.pop_back();
+          marked.payload += fmt::format(",\"stale\":true,\"stale_age\":{:.3f}}}", seconds(now - m.queued));
+        }
+        if (!send(marked)) return;
+        ++stale_marked;
+        outbox.pop();
+        continue;
+      }
+      if (!send(m)) return;
       outbox.pop();
     }
   }
@@ -669,6 +696,7 @@ struct Bridge::Impl {
                 {"alarm_rejected", alarm_rejected},
                 {"ignored_channels", ignored_channels}};
     j["mqtt"] = {{"published", published}, {"publish_errors", publish_errors}};
+    j["stale_cage"] = {{"marked", stale_marked}, {"dropped", stale_dropped}};
     j["buffer"] = {{"queued", outbox.size()},
                    {"queued_alarms", outbox.queuedAlarms()},
                    {"max_messages", cfg.max_messages},
@@ -683,6 +711,8 @@ struct Bridge::Impl {
                      {"forwarded", cmd_forwarded},
                      {"rejected", cmd_rejected},
                      {"rejected_by_reason", by_reason},
+                     {"results_published", results_published},
+                     {"results_dropped", results_dropped},
                      {"lcm_publish_failures", cmd_lcm_failures}};
     json sh = json::array();
     json conflicts = json::array(), refused = json::array();
@@ -845,11 +875,47 @@ struct Bridge::Impl {
     return true;
   }
 
-  void refuse(Shaft& s, CommandReject why, const std::string& detail, int payloadlen, bool may_log) {
+  /// The command's answer on hoist/<shaft>/cmd/result (QoS 1, not retained).
+  void answer(Shaft& s, const char* result, const char* reason, const std::string& detail,
+              const hoist::alarm_ack_t* ack) {
+    if (!result_budget.take(Clock::now(), 20.0, 50.0)) return void(++results_dropped);
+    json j = json::object();
+    j["utime"] = hoist::bus::wallUtime();
+    j["shaft"] = s.name;
+    j["result"] = result;
+    j["reason"] = reason;
+    j["detail"] = detail;
+    if (ack) {
+      j["command"] = {{"kind", ack->kind.empty() ? std::string("*") : printable(ack->kind, 32)},
+                      {"level", int(ack->level)},
+                      {"action", int(ack->action)},
+                      {"user", printable(ack->user)},
+                      {"utime", ack->utime}};
+      if (ack->action == hoist::alarm_ack_t::ACTION_SHELVE) j["command"]["shelve_duration"] = ack->shelve_duration;
+    }
+    ++results_published;
+    publish({s.t_result, j.dump(), 1, false, MsgClass::Health});
+  }
+
+  void refuse(Shaft& s, CommandReject why, const std::string& detail, int payloadlen, bool may_log,
+              const hoist::alarm_ack_t* ack = nullptr) {
     ++cmd_rejected;
     ++cmd_by_reason[static_cast<int>(why)];
     if (may_log)
       spdlog::warn("rejected command on {} ({} bytes): {}: {}", s.t_cmd, payloadlen, toString(why), detail);
+    answer(s, "refused", toString(why), detail, ack);
+  }
+
+  /// An acknowledge matches an active, unacknowledged alarm the bridge knows of.
+  bool ackMatches(const Shaft& s, const hoist::alarm_ack_t& ack) const {
+    const bool any_kind = ack.kind.empty() || ack.kind == "*";
+    for (const auto& [kind, a] : s.alarms) {
+      if (!any_kind && kind != ack.kind) continue;
+      for (int lv = 1; lv <= 2; ++lv)
+        if ((ack.level == 0 || ack.level == lv) && a.by_level[lv] && a.by_level[lv]->active && !a.by_level[lv]->acked)
+          return true;
+    }
+    return false;
   }
 
   void onMqttMessage(const struct mosquitto_message* m) {
@@ -877,25 +943,46 @@ struct Bridge::Impl {
                                         static_cast<std::size_t>(cfg.max_command_bytes), hoist::bus::wallUtime(),
                                         cfg.max_command_age);
       if (r.reject != CommandReject::None) return refuse(s, r.reject, r.detail, m->payloadlen, may_log);
+      const hoist::alarm_ack_t* cmd = &r.ack;
       for (const auto& rp : rivals(s))
         if (const Shaft& o = shafts.at(rp); o.refused && !silent(o, now))
           return refuse(s, CommandReject::AmbiguousShaft,
                         fmt::format("shaft '{}' is claimed by LCM prefixes '{}' and '{}'", s.name, printable(s.prefix),
                                     printable(rp)),
-                        m->payloadlen, may_log);
+                        m->payloadlen, may_log, cmd);
       if (!rateAllows(s, r.ack.user, now))
         return refuse(s, CommandReject::RateLimited,
                       fmt::format("user '{}' over {} commands/s (burst {}) on shaft '{}'", printable(r.ack.user),
                                   cfg.command_rate, cfg.command_burst, s.name),
-                      m->payloadlen, may_log);
+                      m->payloadlen, may_log, cmd);
+      // An acknowledge for no alarm: answered (the daemon would do nothing).
+      // Until the daemon has re-announced its active alarms since the shaft
+      // was bridged, the bridge's view may be incomplete: forwarded then.
+      const bool view_complete = seconds(now - s.bound_since) >= cfg.alarm_sync_time;
+      std::string note;
+      if (r.ack.action == hoist::alarm_ack_t::ACTION_ACK && !ackMatches(s, r.ack)) {
+        if (view_complete) {
+          ++cmd_rejected;
+          ++cmd_by_reason[static_cast<int>(CommandReject::NoMatchingAlarm)];
+          const std::string why = fmt::format("no active, unacknowledged alarm {} (level {}) on shaft '{}'",
+                                              r.ack.kind.empty() || r.ack.kind == "*" ? std::string("of any kind")
+                                                                                      : printable(r.ack.kind, 32),
+                                              int(r.ack.level), s.name);
+          spdlog::info("acknowledge on {} from '{}' matches no alarm: {}", s.t_cmd, printable(r.ack.user), why);
+          return answer(s, "refused", toString(CommandReject::NoMatchingAlarm), why, cmd);
+        }
+        note = "no matching alarm known yet (the bridge has not yet heard the daemon re-announce its alarms); "
+               "forwarded, the daemon decides";
+      }
       const std::string channel = hoist::bus::channel(s.prefix, kChannelAlarmAck);
       if (lcm.publish(channel, &r.ack) != 0) {
         ++cmd_lcm_failures;
         if (may_log) spdlog::error("command on {}: LCM publish on {} failed", s.t_cmd, channel);
-        return;
+        return answer(s, "refused", "lcm_publish_failed", "LCM publish on " + channel + " failed", cmd);
       }
       ++cmd_forwarded;
       ++s.commands;
+      answer(s, "accepted", "forwarded", note.empty() ? "forwarded to " + channel : note, cmd);
       if (may_log)
         spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", s.t_cmd, printable(r.ack.user),
                      int(r.ack.action), r.ack.kind.empty() ? "*" : printable(r.ack.kind, 32), int(r.ack.level),

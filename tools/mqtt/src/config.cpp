@@ -146,6 +146,8 @@ void BridgeConfig::validate() const {
   range("bridge.command_rate", command_rate, 0.0, 1000.0, true);
   range("bridge.command_burst", command_burst, 1, 10000);
   range("bridge.max_command_age", max_command_age, 0.0, 86400.0);
+  range("bridge.alarm_sync_time", alarm_sync_time, 0.0, 3600.0);
+  range("buffer.stale_after", stale_after, 0.0, 3600.0, true);
   range("buffer.max_messages", max_messages, 1, 1000000);
   range("buffer.max_alarm_events", max_alarm_events, 1, 1000000);
 }
@@ -269,8 +271,11 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   r.num("bridge", "command_rate", c.command_rate);
   r.integer("bridge", "command_burst", c.command_burst);
   r.num("bridge", "max_command_age", c.max_command_age);
+  r.num("bridge", "alarm_sync_time", c.alarm_sync_time);
   r.integer("buffer", "max_messages", c.max_messages);
   r.integer("buffer", "max_alarm_events", c.max_alarm_events);
+  r.num("buffer", "stale_after", c.stale_after);
+  r.boolean("buffer", "drop_stale", c.drop_stale);
   r.run(root);
   try {
     c.validate();

@@ -5,8 +5,8 @@
 //   [tls]     ca_file, ca_path, cert_file, key_file, insecure, version
 //   [bridge]  lcm_url, channel_prefixes, commands, cage_rate, health_period,
 //             max_shafts, discovery_timeout, max_command_bytes, command_rate, command_burst,
-//             max_command_age
-//   [buffer]  max_messages, max_alarm_events
+//             max_command_age, alarm_sync_time
+//   [buffer]  max_messages, max_alarm_events, stale_after, drop_stale
 //
 // Every key is optional.  Rejected with hoist::io::ConfigError
 // ("file:line: section.key: reason", exit status 2): TOML syntax errors,
@@ -62,10 +62,13 @@ struct BridgeConfig {
   double command_rate = 2.0;               ///< commands per second per user and shaft (token bucket) [1/s]
   int command_burst = 10;                  ///< ... with this many at once; a shaft's total is 4x both
   double max_command_age = 60.0;           ///< a client's utime must be within this of the bridge's clock [s]; 0 = off
+  double alarm_sync_time = 12.0;           ///< a shaft bridged this long: its alarm states are complete (re-announce 10 s) [s]
 
   // [buffer] (while the broker is unreachable or the socket is congested)
   int max_messages = 1000;       ///< cage and health messages buffered (oldest cage states dropped first)
   int max_alarm_events = 10000;  ///< alarm transitions buffered (never dropped for cage states)
+  double stale_after = 1.0;      ///< a buffered cage state older than this when sent carries "stale": true [s]
+  bool drop_stale = false;       ///< ... or is dropped (counted); alarm transitions are always sent
 
   bool wantsTls() const;
   /// Throws std::invalid_argument("section.key: reason").
