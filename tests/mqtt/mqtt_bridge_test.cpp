@@ -908,3 +908,44 @@ TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
   bridge.signal(SIGTERM);
   EXPECT_EQ(bridge.wait(5s), 0);
 }
+
+// The unit's credentials (LoadCredential=mqtt-password:...): the bridge runs
+// as a dynamic user that cannot read the 0600 password file named in its
+// configuration; systemd hands the password over in $CREDENTIALS_DIRECTORY
+// and the bridge connects with it.  Without the credential the unreadable
+// file is a configuration error (exit 2), as before.
+TEST_F(MqttBridge, PasswordFromSystemdCredential) {
+  dir_ = testDir("mqtt_credentials");
+  auto path = [&](const char* f) { return (dir_ / f).string(); };
+  ASSERT_EQ(runProcess({HOIST_MOSQUITTO_PASSWD, "-b", "-c", path("passwd"), "hoist", "cr3d-pw"}, path("pw.log"), 30s), 0);
+  const int port = freePort(), plain = freePort();
+  std::ofstream(path("mosquitto.conf")) << "per_listener_settings true\npersistence false\nlog_dest stdout\n"
+                                        << "listener " << plain << " 127.0.0.1\nallow_anonymous true\n"
+                                        << "listener " << port << " 127.0.0.1\nallow_anonymous false\n"
+                                        << "password_file " << path("passwd") << "\n";
+  Process broker({HOIST_MOSQUITTO, "-c", path("mosquitto.conf")}, path("mosquitto.log"));
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (!(tcpOpen(port) && tcpOpen(plain)) && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(tcpOpen(port)) << readFile(path("mosquitto.log"));
+  Client c(plain, "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/_bridge/#");
+  std::ofstream(path("bridge.toml")) << "[broker]\nurl = \"mqtt://127.0.0.1:" << port << "\"\nusername = \"hoist\"\n"
+                                     << "password_file = \"/etc/hoist-twin/mqtt/no-such-site.password\"\n";
+  // Without the credential: the unreadable file is bad configuration.
+  EXPECT_EQ(runProcess({HOIST_MQTT, "--config", path("bridge.toml"), "--lcm-url", urlFor(7941)}, path("nocred.log"), 10s), 2);
+  EXPECT_NE(readFile(path("nocred.log")).find("broker.password_file"), std::string::npos) << readFile(path("nocred.log"));
+  // With it (as systemd passes it: a directory in $CREDENTIALS_DIRECTORY).
+  std::filesystem::create_directories(dir_ / "creds");
+  std::ofstream(path("creds/mqtt-password")) << "cr3d-pw\n";
+  std::ofstream(path("creds/mqtt-tls-key")) << "\n";  // blank: the unit's default when no key file exists
+  Process bridge({"/usr/bin/env", "CREDENTIALS_DIRECTORY=" + path("creds"), HOIST_MQTT, "--config", path("bridge.toml"),
+                  "--lcm-url", urlFor(7941), "--client-id", "bridge-cred"},
+                 path("bridge.log"));
+  auto st = c.waitJson("hoist/_bridge/bridge-cred/status", [](const json& j, bool) { return j.value("online", false); }, 10s);
+  ASSERT_TRUE(st) << readFile(path("bridge.log")) << readFile(path("mosquitto.log"));
+  EXPECT_NE(readFile(path("bridge.log")).find("using the systemd credential mqtt-password"), std::string::npos);
+  EXPECT_EQ(readFile(path("bridge.log")).find("cr3d-pw"), std::string::npos) << "the password must never be logged";
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}

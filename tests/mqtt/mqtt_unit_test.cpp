@@ -304,3 +304,32 @@ TEST(MqttConfig, CommandRateKeys) {
   EXPECT_NE(configError("[bridge]\ncommand_burst = 0\n").find("bridge.command_burst"), std::string::npos);
   EXPECT_NE(configError("[bridge]\nmax_command_age = -1\n").find("bridge.max_command_age"), std::string::npos);
 }
+
+TEST(MqttConfig, SystemdCredentialsReplaceTheFiles) {
+  const auto dir = std::filesystem::temp_directory_path() / "hoist_mqtt_creds_unit";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  BridgeConfig c;
+  c.password = "inline";
+  c.password_file = "/etc/hoist-twin/mqtt/site1.password";
+  c.key_file = "/etc/hoist-twin/mqtt/site1.key";
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+  EXPECT_TRUE(applyCredentials(c).empty());
+  EXPECT_EQ(c.password_file, "/etc/hoist-twin/mqtt/site1.password");
+  // Empty credentials (the unit's SetCredential= default): nothing changes.
+  std::ofstream(dir / "mqtt-password") << "\n";
+  std::ofstream(dir / "mqtt-tls-key").close();
+  ::setenv("CREDENTIALS_DIRECTORY", dir.c_str(), 1);
+  EXPECT_TRUE(applyCredentials(c).empty());
+  EXPECT_EQ(c.key_file, "/etc/hoist-twin/mqtt/site1.key");
+  std::ofstream(dir / "mqtt-password") << "s3cret\n";
+  std::ofstream(dir / "mqtt-tls-key") << "-----BEGIN PRIVATE KEY-----\n";
+  EXPECT_EQ(applyCredentials(c), (std::vector<std::string>{"mqtt-password", "mqtt-tls-key"}));
+  EXPECT_EQ(c.password_file, (dir / "mqtt-password").string());
+  EXPECT_EQ(c.password, "");
+  EXPECT_EQ(c.key_file, (dir / "mqtt-tls-key").string());
+  c.username = "hoist";
+  EXPECT_EQ(resolvePassword(c, "x"), "s3cret");
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+  std::filesystem::remove_all(dir);
+}

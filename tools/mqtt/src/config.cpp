@@ -1,6 +1,7 @@
 // hoist-mqtt configuration: see hoist/mqtt/config.hpp.
 #include "hoist/mqtt/config.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -277,6 +278,7 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   r.num("buffer", "stale_after", c.stale_after);
   r.boolean("buffer", "drop_stale", c.drop_stale);
   r.run(root);
+  applyCredentials(c);  // before the files are checked: a credential replaces an unreadable file
   try {
     c.validate();
   } catch (const std::invalid_argument& e) {
@@ -316,6 +318,31 @@ std::string resolvePassword(const BridgeConfig& cfg, const std::string& source) 
   if (!cfg.password_env.empty())
     if (const char* v = std::getenv(cfg.password_env.c_str()); v && *v) return v;
   return {};
+}
+
+std::vector<std::string> applyCredentials(BridgeConfig& cfg) {
+  std::vector<std::string> used;
+  const char* dir = std::getenv("CREDENTIALS_DIRECTORY");
+  if (!dir || !*dir) return used;
+  // Blank (only white space): the unit's SetCredential= default, i.e. no credential.
+  auto nonEmpty = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char ch = 0;
+    for (int n = 0; in.get(ch) && n < 4096; ++n)
+      if (!std::isspace(static_cast<unsigned char>(ch))) return true;
+    return false;
+  };
+  const std::string pw = std::string(dir) + "/mqtt-password", key = std::string(dir) + "/mqtt-tls-key";
+  if (nonEmpty(pw)) {
+    cfg.password.clear();
+    cfg.password_file = pw;
+    used.push_back("mqtt-password");
+  }
+  if (nonEmpty(key)) {
+    cfg.key_file = key;
+    used.push_back("mqtt-tls-key");
+  }
+  return used;
 }
 
 std::string shaftName(const std::string& prefix) {

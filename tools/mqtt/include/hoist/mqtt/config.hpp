@@ -85,6 +85,13 @@ void applyBridgeToml(const std::string& text, const std::string& source, BridgeC
 /// hoist::io::ConfigError (key broker.password_file) if the file is unreadable.
 std::string resolvePassword(const BridgeConfig& cfg, const std::string& source);
 
+/// systemd credentials: when $CREDENTIALS_DIRECTORY is set and holds a
+/// non-blank `mqtt-password` (`mqtt-tls-key`), password_file (key_file)
+/// becomes that file (and `password` is cleared).  A blank credential (the
+/// unit's SetCredential= default when the file is absent) changes nothing.
+/// Returns the credentials used.
+std::vector<std::string> applyCredentials(BridgeConfig& cfg);
+
 /// MQTT shaft name of an LCM channel prefix: the prefix without one trailing
 /// separator ('/', '_', '-', '.'), or "default" for the empty prefix.
 std::string shaftName(const std::string& prefix);
