@@ -1,29 +1,33 @@
 #!/usr/bin/env bash
 # The live twin in an MQTT client (scripts/demo.sh --mqtt): builds the project
-# (scripts/setup.sh), uses the MQTT broker on 127.0.0.1:1883 or starts a
-# private mosquitto if none answers there, starts hoist-twind
-# (service/config/demo.toml: tight gaps, so alarms show), the bridge
-# hoist-mqtt, and `mosquitto_sub -v -t 'hoist/#'`, then replays the paper's
-# trip.  At the end it acknowledges the alarms through MQTT
-# (hoist/default/cmd/ack) and lists the retained alarm states a late SCADA
-# client would get.  Everything is stopped at the end (or on Ctrl-C).
+# (scripts/setup.sh), starts a private mosquitto on a free loopback port (never
+# a broker that is already running: the demo publishes an acknowledge-all),
+# hoist-twind (service/config/demo.toml: tight gaps, so alarms show), the
+# bridge hoist-mqtt, and `mosquitto_sub -v -t 'hoist/#'`, then replays the
+# paper's trip.  At the end it acknowledges the alarms through MQTT
+# (hoist/default/cmd/ack), shows the bridge's answer (cmd/result) and lists
+# the retained alarm states a late SCADA client would get.  Everything it
+# started is stopped at the end (or on Ctrl-C), and the script returns.
 #
-#   scripts/demo-mqtt.sh [--no-setup] [--speed X] [--broker-port N] [--port N]
+#   scripts/demo-mqtt.sh [--no-setup] [--speed X] [--quick] [--broker-port N] [--port N]
 #
 #   --no-setup       skip scripts/setup.sh (the build must exist)
 #   --speed X        replay speed (default 3: the 60-s trip in 20 s)
-#   --broker-port N  MQTT port on 127.0.0.1 (default 1883)
+#   --quick          speed 30 and short pauses (about 6 s in all; for tests)
+#   --broker-port N  the private broker's port on 127.0.0.1 (default: a free one);
+#                    exit 2 if N is taken
 #   --port N         UDP port of the private LCM URL (default 7691)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-setup=1 speed=3 bport=1883 port=7691
+setup=1 speed=3 bport="" port=7691 pause=1.5
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --no-setup) setup=0; shift ;;
     --speed) speed="$2"; shift 2 ;;
+    --quick) speed=30; pause=0.5; shift ;;
     --broker-port) bport="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo-mqtt.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -35,6 +39,8 @@ done
 for c in mosquitto_sub mosquitto_pub; do
   command -v "$c" >/dev/null || { echo "demo-mqtt.sh: $c not found (apt-get install mosquitto-clients)" >&2; exit 2; }
 done
+mosq="$(command -v mosquitto || echo /usr/sbin/mosquitto)"
+[[ -x "$mosq" ]] || { echo "demo-mqtt.sh: mosquitto not installed (apt-get install mosquitto)" >&2; exit 2; }
 
 url="udpm://239.255.76.67:${port}?ttl=0"
 logdir="$(mktemp -d "${TMPDIR:-/tmp}/hoist-mqtt-demo.XXXXXX")"
@@ -48,18 +54,32 @@ cleanup() {
 trap cleanup EXIT
 trap 'echo; echo "demo-mqtt.sh: interrupted"; cleanup; exit 130' INT TERM
 
-broker="mqtt://127.0.0.1:$bport"
-if mosquitto_pub -h 127.0.0.1 -p "$bport" -t hoist/_demo/probe -n 2>/dev/null; then
-  echo "== using the MQTT broker already on 127.0.0.1:$bport"
+port_taken() { (exec 3<>"/dev/tcp/127.0.0.1/$1") 2>/dev/null; }
+if [[ -n "$bport" ]]; then
+  if port_taken "$bport"; then
+    echo "demo-mqtt.sh: --broker-port $bport: something already listens on 127.0.0.1:$bport (the demo runs its own broker)" >&2
+    exit 2
+  fi
+  candidates=("$bport")
 else
-  mosq="$(command -v mosquitto || echo /usr/sbin/mosquitto)"
-  [[ -x "$mosq" ]] || { echo "demo-mqtt.sh: no broker on 127.0.0.1:$bport and mosquitto not installed" >&2; exit 2; }
-  printf 'listener %s 127.0.0.1\nallow_anonymous true\npersistence false\n' "$bport" > "$logdir/mosquitto.conf"
-  "$mosq" -c "$logdir/mosquitto.conf" > "$logdir/mosquitto.log" 2>&1 &
-  pids+=($!)
-  for _ in $(seq 50); do mosquitto_pub -h 127.0.0.1 -p "$bport" -t hoist/_demo/probe -n 2>/dev/null && break; sleep 0.1; done
-  echo "== started a private mosquitto on 127.0.0.1:$bport (log: $logdir/mosquitto.log)"
+  candidates=()
+  for _ in $(seq 20); do candidates+=($((20000 + RANDOM % 30000))); done
 fi
+started=0
+for bp in "${candidates[@]}"; do
+  port_taken "$bp" && continue
+  printf 'listener %s 127.0.0.1\nallow_anonymous true\npersistence false\n' "$bp" > "$logdir/mosquitto.conf"
+  "$mosq" -c "$logdir/mosquitto.conf" > "$logdir/mosquitto.log" 2>&1 &
+  mpid=$!
+  for _ in $(seq 50); do port_taken "$bp" && break; kill -0 "$mpid" 2>/dev/null || break; sleep 0.1; done
+  if kill -0 "$mpid" 2>/dev/null && port_taken "$bp"; then
+    pids+=("$mpid"); bport="$bp"; started=1; break
+  fi
+  kill "$mpid" 2>/dev/null || true; wait "$mpid" 2>/dev/null || true
+done
+[[ $started -eq 1 ]] || { echo "demo-mqtt.sh: could not start mosquitto (log: $logdir/mosquitto.log)" >&2; exit 1; }
+broker="mqtt://127.0.0.1:$bport"
+echo "== started a private mosquitto on 127.0.0.1:$bport (log: $logdir/mosquitto.log)"
 
 echo "== LCM $url; logs in $logdir"
 "$bin/hoist-twind" --config "$here/service/config/demo.toml" --clock input --lcm-url "$url" 2> "$logdir/hoist-twind.log" &
@@ -67,17 +87,21 @@ pids+=($!)
 "$bin/hoist-mqtt" --broker "$broker" --lcm-url "$url" --cage-rate 1 --client-id hoist-mqtt-demo 2> "$logdir/hoist-mqtt.log" &
 pids+=($!)
 echo "== mosquitto_sub -v -t 'hoist/#'  (cage states at 1 Hz for the demo; payloads cut to 160 characters)"
-mosquitto_sub -h 127.0.0.1 -p "$bport" -v -t 'hoist/#' | cut -c1-160 &
+# The subscriber's own pid is kept (not a pipeline's last element), so it is
+# stopped at the end; the cut behind it ends at its EOF.  (A pipeline in the
+# background left mosquitto_sub running, holding the terminal's output open.)
+mosquitto_sub -h 127.0.0.1 -p "$bport" -v -t 'hoist/#' > >(cut -c1-160) &
 pids+=($!)
-sleep 1.5
+sleep "$pause"
 echo "== replay: the paper's trip at speed $speed"
 "$bin/hoist-replay" --lcm-url "$url" --profile paper --speed "$speed" -q
 echo "== an operator acknowledges every alarm over MQTT:"
-echo "   mosquitto_pub -t hoist/default/cmd/ack -m '{\"kind\":\"*\",\"level\":0,\"action\":1,\"user\":\"demo\"}'"
+echo "   mosquitto_pub -p $bport -t hoist/default/cmd/ack -m '{\"kind\":\"*\",\"level\":0,\"action\":1,\"user\":\"demo\"}'"
 mosquitto_pub -h 127.0.0.1 -p "$bport" -q 1 -t hoist/default/cmd/ack -m '{"kind":"*","level":0,"action":1,"user":"demo"}'
-sleep 1.5
+sleep "$pause"
 echo "== what a SCADA client connecting now gets at once (retained): mosquitto_sub --retained-only -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status'"
-mosquitto_sub -h 127.0.0.1 -p "$bport" -v --retained-only -W 2 -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status' 2>/dev/null | cut -c1-200 || true
+timeout 5 mosquitto_sub -h 127.0.0.1 -p "$bport" -v --retained-only -W 2 -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status' \
+  2>/dev/null < /dev/null | cut -c1-200 || true
 cleanup
 echo "== bridge log:"
 cat "$logdir/hoist-mqtt.log"

@@ -17,7 +17,9 @@
 #include "lcm_fixtures.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
+#include "hoist/cage_state_t.hpp"
 #include "hoist/forecast_t.hpp"
+#include "hoist/health_t.hpp"
 
 using namespace hoist::test;
 using json = nlohmann::json;
@@ -112,8 +114,8 @@ class Client {
   }
   bool connected() const { return connect_ok_ && connected_; }
   void subscribe(const std::string& topic) { mosquitto_subscribe(m_, nullptr, topic.c_str(), 1); }
-  void publish(const std::string& topic, const std::string& payload) {
-    mosquitto_publish(m_, nullptr, topic.c_str(), static_cast<int>(payload.size()), payload.data(), 1, false);
+  void publish(const std::string& topic, const std::string& payload, bool retain = false) {
+    mosquitto_publish(m_, nullptr, topic.c_str(), static_cast<int>(payload.size()), payload.data(), 1, retain);
   }
   std::vector<Msg> messages() {
     std::lock_guard<std::mutex> lk(mu_);
@@ -354,6 +356,9 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
   EXPECT_EQ((*acked)["last_event"], "ACK");
   EXPECT_FALSE((*acked)["unacked"].get<bool>());
   EXPECT_TRUE((*acked)["active"].get<bool>());
+  // The daemon's log is written by its own thread: give it a moment.
+  for (int i = 0; i < 100 && readFile(log("twind.log")).find("operator 'scada-op': acknowledge") == std::string::npos; ++i)
+    std::this_thread::sleep_for(20ms);
   EXPECT_NE(readFile(log("twind.log")).find("operator 'scada-op': acknowledge"), std::string::npos);
 
   // Stop: the bridge says it is offline (retained) and exits 0.
@@ -388,7 +393,8 @@ TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
   Process replay({HOIST_REPLAY, "--profile", "rest:t_end=60", "--lcm-url", url}, log("replay.log"));
   // The alarm comes up while the broker is down.
   ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("HOIST_ALARM") > 0; }, 10s)) << readFile(log("twind.log"));
-  lcm.pump(2s);
+  // A discovered shaft is bridged once its health has kept coming (3 messages over >= 1 s): then > 2 s of buffering.
+  lcm.pump(4s);
   ASSERT_TRUE(bridge.running()) << readFile(log("bridge.log"));
   std::string blog = readFile(log("bridge.log"));
   EXPECT_EQ(countOf(blog, "cannot connect to the broker"), 1u) << "log once per state change:\n" << blog;
@@ -430,7 +436,9 @@ TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
   auto h2 = c2.waitJson("hoist/_bridge/bridge-b/health", [](const json& j, bool) { return j["connection"]["connects"] == 2; }, 5s);
   ASSERT_TRUE(h2);
   EXPECT_EQ((*h2)["connection"]["disconnects"], 1);
-  // Commands work on the new connection (re-subscribed).
+  // Commands work on the new connection (re-subscribed).  (Drain the LCM
+  // socket first: unread for seconds, it is full and would drop the ack.)
+  lcm.pump(300ms);
   const std::size_t acks_before = lcm.count("HOIST_ALARM_ACK");
   c2.publish("hoist/default/cmd/ack", R"({"kind":"*","level":0,"action":1})");
   EXPECT_TRUE(lcm.waitFor([&] { return lcm.count("HOIST_ALARM_ACK") > acks_before; }, 5s));
@@ -557,4 +565,387 @@ TEST_F(MqttBridge, TlsWithPasswordFile) {
   bad.signal(SIGTERM);
   EXPECT_EQ(good.wait(5s), 0);
   EXPECT_EQ(bad.wait(5s), 0);
+}
+
+// The command path (issue: retained replays, floods, ambiguous JSON, control
+// characters): a retained command is never executed, neither when the bridge
+// starts nor when it restarts, and the bridge deletes it from the broker; a
+// flood from one user is cut to the per-user burst while another user still
+// gets through; a payload with a key given twice, a user with control
+// characters (C0, DEL, C1) and a stale client utime are refused, counted by
+// reason and never reach LCM.
+TEST_F(MqttBridge, RetainedFloodedAndAmbiguousCommandsAreRefused) {
+  dir_ = testDir("mqtt_cmd_hardening");
+  const std::string url = urlFor(7935);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  // A retained "shelve everything for an hour", left on the broker before the bridge starts.
+  c.publish("hoist/east/cmd/ack", R"({"kind":"*","level":0,"action":2,"shelve_duration":3600,"user":"evil"})", true);
+  std::this_thread::sleep_for(300ms);
+
+  Listener lcm(url);
+  lcm.subscribe("east/HOIST_ALARM_ACK");
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\ncommand_rate = 0.5\ncommand_burst = 5\n";
+  std::vector<std::string> argv{HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url,
+                                "--channel-prefix", "east/", "--client-id", "bridge-h"};
+  auto bridge = std::make_unique<Process>(argv, log("bridge.log"));
+  auto h = c.waitJson("hoist/_bridge/bridge-h/health",
+                      [](const json& j, bool) { return j["commands"]["rejected_by_reason"]["retained"] == 1; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge.log"));
+  EXPECT_EQ((*h)["commands"]["forwarded"], 0);
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("east/HOIST_ALARM_ACK"), 0u) << "a retained command was executed";
+  // Restarted: the retained command is gone (deleted by the bridge), so nothing is replayed.
+  bridge->signal(SIGTERM);
+  EXPECT_EQ(bridge->wait(5s), 0);
+  bridge = std::make_unique<Process>(argv, log("bridge2.log"));
+  h = c.waitJson("hoist/_bridge/bridge-h/health", [](const json& j, bool) { return j["uptime"].get<double>() > 0.5 &&
+                                                                                 j["commands"]["received"] == 0; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge2.log"));
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("east/HOIST_ALARM_ACK"), 0u);
+  {
+    Client late(broker.port(), "late");
+    ASSERT_TRUE(late.connected());
+    late.subscribe("hoist/east/cmd/#");
+    std::this_thread::sleep_for(500ms);
+    for (const auto& m : late.messages()) EXPECT_FALSE(m.retain) << m.topic << ": " << m.payload;
+  }
+
+  // Ambiguous or unsafe payloads: refused by reason.
+  const auto now_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                          std::chrono::system_clock::now().time_since_epoch()).count();
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"duplicate_key", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"kind":"*"})"},
+      {"duplicate_key", R"({"kind":"*","level":0,"action":3,"action":2,"shelve_duration":60})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\u001b[2J"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\nAUDIT operator 'x'"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\u007f"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":"op\u009b31m"})"},
+      {"bad_user", R"({"kind":"*","level":0,"action":1,"user":""})"},
+      {"stale_utime", R"({"kind":"*","level":0,"action":1,"utime":)" + std::to_string(now_us - 3'600'000'000LL) + "}"},
+  };
+  for (const auto& [why, p] : bad) c.publish("hoist/east/cmd/ack", p);
+  h = c.waitJson("hoist/_bridge/bridge-h/health",
+                 [&](const json& j, bool) { return j["commands"]["rejected"].get<std::size_t>() >= bad.size(); }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge2.log"));
+  EXPECT_EQ((*h)["commands"]["rejected_by_reason"]["duplicate_key"], 2);
+  EXPECT_EQ((*h)["commands"]["rejected_by_reason"]["bad_user"], 5);
+  EXPECT_EQ((*h)["commands"]["rejected_by_reason"]["stale_utime"], 1);
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("east/HOIST_ALARM_ACK"), 0u);
+  EXPECT_EQ(readFile(log("bridge2.log")).find('\x1b'), std::string::npos) << "a control character reached the log";
+
+  // A flood from one user: at most its burst (5) and what the rate refills
+  // (0.5/s) is forwarded; another user still gets through.
+  for (int i = 0; i < 40; ++i)
+    c.publish("hoist/east/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":3,"user":"flooder"})");
+  h = c.waitJson("hoist/_bridge/bridge-h/health",
+                 [&](const json& j, bool) { return j["commands"]["received"].get<int>() >= int(bad.size()) + 40; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge2.log"));
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("east/HOIST_ALARM_ACK") >= 5; }, 5s));
+  lcm.pump(300ms);
+  const auto flooded = lcm.count("east/HOIST_ALARM_ACK");
+  EXPECT_GE(flooded, 5u);
+  EXPECT_LE(flooded, 8u) << "a 40-command flood from one user must be cut near its burst of 5";
+  EXPECT_GE((*h)["commands"]["rejected_by_reason"]["rate_limited"].get<int>(), 32);
+  c.publish("hoist/east/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":3,"user":"operator-2"})");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("east/HOIST_ALARM_ACK") > flooded; }, 5s))
+      << "another user's command was blocked by one user's flood";
+  EXPECT_EQ(lcm.decoded<hoist::alarm_ack_t>("east/HOIST_ALARM_ACK").back().user, "operator-2");
+  bridge->signal(SIGTERM);
+  EXPECT_EQ(bridge->wait(5s), 0);
+}
+
+namespace {
+hoist::health_t forgedHealth(std::int64_t instance) {
+  hoist::health_t h{};
+  h.utime = 1;
+  h.instance_id = instance;
+  h.clock = "wall";
+  return h;
+}
+}  // namespace
+
+// Discovery cannot be poisoned: one forged north_HOIST_HEALTH sent before the
+// real north/ daemon, and 70 forged prefixes (single datagrams), bind nothing
+// for good: the real daemon's shaft is bridged, its commands go to
+// north/HOIST_ALARM_ACK.  A second prefix claiming "north" at the health rate
+// is reported with the first (discovery.conflicts) and commands are refused
+// while it lasts.  A full table (max_shafts) is a log line and
+// discovery.table_full while it lasts.
+TEST_F(MqttBridge, DiscoveryIsNotPoisoned) {
+  dir_ = testDir("mqtt_discovery");
+  const std::string url = urlFor(7936);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  lcm.subscribe("north.HOIST_(HEALTH|ALARM_ACK)");
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\ndiscovery_timeout = 2.0\nmax_shafts = 64\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-d"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-d/status", [](const json& j, bool) { return j.value("online", false); }, 10s));
+  // The forgeries: north_ once, then 70 prefixes once each (health with an instance id, and a cage state).
+  auto h = forgedHealth(666);
+  lcm.lcm().publish("north_HOIST_HEALTH", &h);
+  hoist::cage_state_t cage{};
+  for (int i = 0; i < 70; ++i) {
+    const std::string p = "forged" + std::to_string(i) + "/";
+    h.instance_id = 1000 + i;
+    lcm.lcm().publish(p + "HOIST_HEALTH", &h);
+    lcm.lcm().publish(p + "HOIST_CAGE", &cage);
+  }
+  lcm.pump(300ms);
+  // The real daemon.
+  auto twind = startDaemonAndWait(lcm, {HOIST_TWIND, "--config", daemonConfig(dir_, "north/"), "--lcm-url", url},
+                                  log("twind.log"), "north/HOIST_HEALTH");
+  const auto real_instance = lcm.decoded<hoist::health_t>("north/HOIST_HEALTH").back().instance_id;
+  auto mh = c.waitJson("hoist/north/health", [&](const json& j, bool) { return j["instance_id"] == real_instance; }, 10s);
+  ASSERT_TRUE(mh) << "the real shaft was not bridged:\n" << readFile(log("bridge.log"));
+  for (const auto& m : c.on("hoist/north/health"))
+    EXPECT_EQ(json::parse(m.payload)["instance_id"], real_instance) << "a forged health was published as north's";
+  for (const auto& m : c.messages()) EXPECT_EQ(m.topic.rfind("hoist/forged", 0), std::string::npos) << m.topic;
+  auto bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) {
+    return j["shafts"].size() == 1 && j["discovery"]["candidates"] == 0; }, 10s);  // the forgeries aged out
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["shafts"][0]["channel_prefix"], "north/");
+  EXPECT_GE((*bh)["discovery"]["aged_out"].get<int>(), 71);
+  // A command for north goes to the real daemon's channel.
+  lcm.pump(200ms);
+  c.publish("hoist/north/cmd/ack", R"({"kind":"*","level":0,"action":3,"user":"op"})");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("north/HOIST_ALARM_ACK") == 1; }, 5s)) << readFile(log("bridge.log"));
+  EXPECT_EQ(lcm.count("north_HOIST_ALARM_ACK"), 0u);
+
+  // Another prefix claims "north" at the health rate: both reported, commands refused while it lasts.
+  auto claim = [&](const std::vector<std::string>& prefixes, std::chrono::milliseconds d) {
+    const auto end = std::chrono::steady_clock::now() + d;
+    while (std::chrono::steady_clock::now() < end) {
+      for (std::size_t i = 0; i < prefixes.size(); ++i) {
+        auto f = forgedHealth(777 + static_cast<std::int64_t>(i));
+        lcm.lcm().publish(prefixes[i] + "HOIST_HEALTH", &f);
+      }
+      lcm.pump(250ms);
+    }
+  };
+  claim({"north_"}, 2000ms);
+  bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) { return !j["discovery"]["conflicts"].empty(); }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["shaft"], "north");
+  EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["bridged_prefix"], "north/");
+  EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["prefixes"], json::array({"north/", "north_"}));
+  c.publish("hoist/north/cmd/ack", R"({"kind":"*","level":0,"action":3,"user":"op"})");
+  bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) {
+    return j["commands"]["rejected_by_reason"]["ambiguous_shaft"] == 1; }, 3s);
+  EXPECT_TRUE(bh);
+  EXPECT_NE(readFile(log("bridge.log")).find("shaft name 'north' is already bridged from prefix 'north/'"),
+            std::string::npos) << readFile(log("bridge.log"));
+  lcm.pump(2500ms);  // the claim stops: it ages out
+  bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) { return j["discovery"]["conflicts"].empty(); }, 3s);
+  EXPECT_TRUE(bh);
+  stopDaemonCleanly(*twind, log("twind.log"));
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}
+
+// A full shaft table is loud: a log line and discovery.table_full (with the
+// refused prefix) while it lasts, and room again once a shaft's health stops.
+TEST_F(MqttBridge, DiscoveryFullTableIsReported) {
+  dir_ = testDir("mqtt_discovery_full");
+  const std::string url = urlFor(7937);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\ndiscovery_timeout = 1.5\nmax_shafts = 2\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-f"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-f/status", [](const json& j, bool) { return j.value("online", false); }, 10s));
+  auto beat = [&](const std::vector<std::string>& prefixes, std::chrono::milliseconds d) {
+    const auto end = std::chrono::steady_clock::now() + d;
+    while (std::chrono::steady_clock::now() < end) {
+      for (std::size_t i = 0; i < prefixes.size(); ++i) {
+        auto f = forgedHealth(500 + static_cast<std::int64_t>(i));
+        lcm.lcm().publish(prefixes[i] + "HOIST_HEALTH", &f);
+      }
+      lcm.pump(250ms);
+    }
+  };
+  beat({"a/", "b/"}, 1800ms);
+  beat({"a/", "b/", "c/"}, 1800ms);
+  auto bh = c.waitJson("hoist/_bridge/bridge-f/health", [](const json& j, bool) { return j["discovery"]["table_full"] == true; }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["discovery"]["refused"], json::array({"c/"}));
+  EXPECT_EQ((*bh)["shafts"].size(), 2u);
+  EXPECT_NE(readFile(log("bridge.log")).find("the shaft table is full"), std::string::npos) << readFile(log("bridge.log"));
+  // b/ stops: c/ takes its slot; the table has room for no one else but refuses no one.
+  beat({"a/", "c/"}, 3000ms);
+  bh = c.waitJson("hoist/_bridge/bridge-f/health", [](const json& j, bool) { return j["discovery"]["table_full"] == false; }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  std::vector<std::string> names;
+  for (const auto& s : (*bh)["shafts"]) names.push_back(s["name"]);
+  EXPECT_EQ(names, (std::vector<std::string>{"a", "c"}));
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}
+
+namespace {
+hoist::alarm_t alarmEvent(const std::string& kind, int event, bool active) {
+  hoist::alarm_t a{};
+  a.utime = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  a.kind = kind;
+  a.level = hoist::alarm_t::LEVEL_WARNING;
+  a.event_type = static_cast<std::int8_t>(event);
+  a.active = active;
+  a.message = "test";
+  a.user = "";
+  return a;
+}
+}  // namespace
+
+// Every command is answered on hoist/<shaft>/cmd/result: accepted (forwarded),
+// or refused and why; an acknowledge that matches no active, unacknowledged
+// alarm is logged, answered and not forwarded.  After an outage the buffered
+// cage states arrive marked "stale", the alarm transitions of the outage all
+// arrive, and live cage states are not marked.
+TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
+  dir_ = testDir("mqtt_results");
+  const std::string url = urlFor(7938);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  lcm.subscribe("west/HOIST_ALARM_ACK");
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[broker]\nreconnect_min = 1.0\nreconnect_max = 1.0\n"
+                         "[bridge]\nhealth_period = 0.3\nalarm_sync_time = 0.5\n[buffer]\nstale_after = 0.5\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--channel-prefix",
+                  "west/", "--client-id", "bridge-r"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-r/status", [](const json& j, bool) { return j.value("online", false); }, 10s));
+  auto raise = alarmEvent("CAGE_POS_Y", hoist::alarm_t::EVENT_RAISE, true);
+  lcm.lcm().publish("west/HOIST_ALARM", &raise);
+  ASSERT_TRUE(c.waitJson("hoist/west/alarm/CAGE_POS_Y", [](const json& j, bool) { return j["active"] == true; }, 5s));
+  std::this_thread::sleep_for(600ms);  // alarm_sync_time
+
+  auto result = [&](const std::string& user) {
+    return c.waitJson("hoist/west/cmd/result", [&](const json& j, bool) {
+      return j.contains("command") ? j["command"]["user"] == user : j["detail"].get<std::string>().find(user) != std::string::npos; }, 5s);
+  };
+  c.publish("hoist/west/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"user":"op-ok"})");
+  auto r = result("op-ok");
+  ASSERT_TRUE(r) << readFile(log("bridge.log"));
+  EXPECT_EQ((*r)["result"], "accepted");
+  EXPECT_EQ((*r)["reason"], "forwarded");
+  EXPECT_EQ((*r)["command"]["kind"], "CAGE_POS_Y");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("west/HOIST_ALARM_ACK") == 1; }, 5s));
+
+  c.publish("hoist/west/cmd/ack", R"({"kind":"GUIDE_ROPE","level":0,"action":1,"user":"op-none"})");
+  r = result("op-none");
+  ASSERT_TRUE(r) << readFile(log("bridge.log"));
+  EXPECT_EQ((*r)["result"], "refused");
+  EXPECT_EQ((*r)["reason"], "no_matching_alarm");
+  c.publish("hoist/west/cmd/ack", R"({"kind":"CAGE_POS_Y","level":2,"action":1,"user":"op-crit"})");
+  r = result("op-crit");
+  ASSERT_TRUE(r);
+  EXPECT_EQ((*r)["reason"], "no_matching_alarm") << "no CRITICAL CAGE_POS_Y is active";
+  c.publish("hoist/west/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"user":"op-dup","user":"x"})");
+  auto dup = c.waitJson("hoist/west/cmd/result", [](const json& j, bool) { return j["reason"] == "duplicate_key"; }, 5s);
+  ASSERT_TRUE(dup);
+  EXPECT_EQ((*dup)["result"], "refused");
+  lcm.pump(300ms);
+  EXPECT_EQ(lcm.count("west/HOIST_ALARM_ACK"), 1u) << "a refused command was forwarded";
+  EXPECT_NE(readFile(log("bridge.log")).find("matches no alarm"), std::string::npos) << readFile(log("bridge.log"));
+  for (const auto& m : c.on("hoist/west/cmd/result")) EXPECT_FALSE(m.retain);
+
+  // An outage: cage states and alarm transitions while the broker is down.
+  broker.stop();
+  hoist::cage_state_t cage{};
+  for (int i = 0; i < 30; ++i) {
+    cage.seq = i;
+    lcm.lcm().publish("west/HOIST_CAGE", &cage);
+    if (i == 10) {
+      auto clear = alarmEvent("CAGE_POS_Y", hoist::alarm_t::EVENT_CLEAR, false);
+      lcm.lcm().publish("west/HOIST_ALARM", &clear);
+    }
+    if (i == 20) {
+      auto tilt = alarmEvent("CAGE_TILT", hoist::alarm_t::EVENT_RAISE, true);
+      lcm.lcm().publish("west/HOIST_ALARM", &tilt);
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  broker.start();
+  Client c2(broker.port(), "c2");  // subscribed before the bridge's next attempt (1 s)
+  ASSERT_TRUE(c2.connected());
+  c2.subscribe("hoist/#");
+  auto clear = c2.waitJson("hoist/west/alarm/CAGE_POS_Y", [](const json& j, bool) { return j["last_event"] == "CLEAR"; }, 10s);
+  EXPECT_TRUE(clear) << "an alarm transition of the outage was not sent";
+  EXPECT_TRUE(c2.waitJson("hoist/west/alarm/CAGE_TILT", [](const json& j, bool) { return j["active"] == true; }, 5s));
+  auto stale = c2.waitJson("hoist/west/cage", [](const json& j, bool) { return j.value("stale", false); }, 5s);
+  ASSERT_TRUE(stale) << "the backlog's cage states are not marked stale:\n" << readFile(log("bridge.log"));
+  EXPECT_GE((*stale)["stale_age"].get<double>(), 0.5);
+  // Live again: new cage states are not marked.
+  cage.seq = 1000;
+  for (int i = 0; i < 5; ++i) {
+    lcm.lcm().publish("west/HOIST_CAGE", &cage);
+    std::this_thread::sleep_for(150ms);
+  }
+  auto live = c2.waitJson("hoist/west/cage", [](const json& j, bool) { return j["seq"] == 1000; }, 5s);
+  ASSERT_TRUE(live);
+  EXPECT_FALSE(live->contains("stale")) << live->dump();
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}
+
+// The unit's credentials (LoadCredential=mqtt-password:...): the bridge runs
+// as a dynamic user that cannot read the 0600 password file named in its
+// configuration; systemd hands the password over in $CREDENTIALS_DIRECTORY
+// and the bridge connects with it.  Without the credential the unreadable
+// file is a configuration error (exit 2), as before.
+TEST_F(MqttBridge, PasswordFromSystemdCredential) {
+  dir_ = testDir("mqtt_credentials");
+  auto path = [&](const char* f) { return (dir_ / f).string(); };
+  ASSERT_EQ(runProcess({HOIST_MOSQUITTO_PASSWD, "-b", "-c", path("passwd"), "hoist", "cr3d-pw"}, path("pw.log"), 30s), 0);
+  const int port = freePort(), plain = freePort();
+  std::ofstream(path("mosquitto.conf")) << "per_listener_settings true\npersistence false\nlog_dest stdout\n"
+                                        << "listener " << plain << " 127.0.0.1\nallow_anonymous true\n"
+                                        << "listener " << port << " 127.0.0.1\nallow_anonymous false\n"
+                                        << "password_file " << path("passwd") << "\n";
+  Process broker({HOIST_MOSQUITTO, "-c", path("mosquitto.conf")}, path("mosquitto.log"));
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (!(tcpOpen(port) && tcpOpen(plain)) && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(tcpOpen(port)) << readFile(path("mosquitto.log"));
+  Client c(plain, "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/_bridge/#");
+  std::ofstream(path("bridge.toml")) << "[broker]\nurl = \"mqtt://127.0.0.1:" << port << "\"\nusername = \"hoist\"\n"
+                                     << "password_file = \"/etc/hoist-twin/mqtt/no-such-site.password\"\n";
+  // Without the credential: the unreadable file is bad configuration.
+  EXPECT_EQ(runProcess({HOIST_MQTT, "--config", path("bridge.toml"), "--lcm-url", urlFor(7941)}, path("nocred.log"), 10s), 2);
+  EXPECT_NE(readFile(path("nocred.log")).find("broker.password_file"), std::string::npos) << readFile(path("nocred.log"));
+  // With it (as systemd passes it: a directory in $CREDENTIALS_DIRECTORY).
+  std::filesystem::create_directories(dir_ / "creds");
+  std::ofstream(path("creds/mqtt-password")) << "cr3d-pw\n";
+  std::ofstream(path("creds/mqtt-tls-key")) << "\n";  // blank: the unit's default when no key file exists
+  Process bridge({"/usr/bin/env", "CREDENTIALS_DIRECTORY=" + path("creds"), HOIST_MQTT, "--config", path("bridge.toml"),
+                  "--lcm-url", urlFor(7941), "--client-id", "bridge-cred"},
+                 path("bridge.log"));
+  auto st = c.waitJson("hoist/_bridge/bridge-cred/status", [](const json& j, bool) { return j.value("online", false); }, 10s);
+  ASSERT_TRUE(st) << readFile(path("bridge.log")) << readFile(path("mosquitto.log"));
+  EXPECT_NE(readFile(path("bridge.log")).find("using the systemd credential mqtt-password"), std::string::npos);
+  EXPECT_EQ(readFile(path("bridge.log")).find("cr3d-pw"), std::string::npos) << "the password must never be logged";
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
 }

@@ -260,3 +260,76 @@ TEST(MqttCommand, SameValidationAsTheDaemon) {
     EXPECT_STRNE(hoist::contract::toString(static_cast<hoist::contract::CommandError>(i)), "?");
   for (int i = 0; i < kCommandRejects; ++i) EXPECT_STRNE(toString(static_cast<CommandReject>(i)), "?");
 }
+
+TEST(MqttCommand, RefusesDuplicateKeysBadUsersAndStaleUtimes) {
+  // A key given twice (nlohmann would keep the last): refused, wherever it is.
+  EXPECT_EQ(parse(R"({"kind":"CAGE_POS_Y","level":0,"action":1,"kind":"*"})").reject, CommandReject::DuplicateKey);
+  EXPECT_EQ(parse(R"({"action":3,"kind":"*","level":0,"action":2,"shelve_duration":9})").reject,
+            CommandReject::DuplicateKey);
+  EXPECT_EQ(parse(R"({"kind":"*","level":0,"action":1,"user":"a","user":"b"})").reject, CommandReject::DuplicateKey);
+  // The same key in two objects is not a duplicate (then refused for its shape).
+  EXPECT_EQ(parse(R"({"kind":"*","level":0,"action":1,"x":{"kind":1}})").reject, CommandReject::BadFields);
+  // hoist-dash's rule for `user`, plus the C1 controls.
+  for (const char* u : {R"("")", R"("op\u001b[31m")", R"("op\nAUDIT")", R"("op\t")",
+                        R"("op\u007f")", R"("op\u0085")", R"("op\u009b")"}) {
+    const auto r = parse(std::string(R"({"kind":"*","level":0,"action":1,"user":)") + u + "}");
+    EXPECT_EQ(r.reject, CommandReject::BadUser) << u;
+    EXPECT_EQ(r.detail.find('\x1b'), std::string::npos);
+  }
+  EXPECT_EQ(parse(R"({"kind":"*","level":0,"action":1,"user":")" + std::string(65, 'a') + "\"}").reject,
+            CommandReject::BadUser);
+  EXPECT_EQ(parse(R"({"kind":"*","level":0,"action":1,"user":")" + std::string(64, 'a') + "\"}").reject,
+            CommandReject::None);
+  EXPECT_EQ(parse(R"({"kind":"*","level":0,"action":1,"user":"Jürgen Åström"})").reject, CommandReject::None);
+  EXPECT_EQ(checkUser("op1"), "");
+  EXPECT_NE(checkUser("op\x1b"), "");
+  // A client's utime must be near the bridge's clock when max_age is set.
+  const std::string cmd = R"({"kind":"*","level":0,"action":1,"utime":)";
+  const std::int64_t now = 1'700'000'000'000'000;
+  auto at = [&](std::int64_t utime, double max_age) {
+    const std::string s = cmd + std::to_string(utime) + "}";
+    return parseAckCommand(s.data(), s.size(), 1024, now, max_age).reject;
+  };
+  EXPECT_EQ(at(now - 5'000'000, 60.0), CommandReject::None);
+  EXPECT_EQ(at(now - 61'000'000, 60.0), CommandReject::StaleUtime);
+  EXPECT_EQ(at(now + 61'000'000, 60.0), CommandReject::StaleUtime);
+  EXPECT_EQ(at(now - 3'600'000'000, 0.0), CommandReject::None);  // 0 = no check
+  const std::string no_utime = R"({"kind":"*","level":0,"action":1})";
+  EXPECT_EQ(parseAckCommand(no_utime.data(), no_utime.size(), 1024, now, 60.0).reject, CommandReject::None);
+}
+
+TEST(MqttConfig, CommandRateKeys) {
+  EXPECT_EQ(configError("[bridge]\ncommand_rate = 1.5\ncommand_burst = 3\nmax_command_age = 0\n"), "");
+  EXPECT_NE(configError("[bridge]\ncommand_rate = 0\n").find("bridge.command_rate"), std::string::npos);
+  EXPECT_NE(configError("[bridge]\ncommand_burst = 0\n").find("bridge.command_burst"), std::string::npos);
+  EXPECT_NE(configError("[bridge]\nmax_command_age = -1\n").find("bridge.max_command_age"), std::string::npos);
+}
+
+TEST(MqttConfig, SystemdCredentialsReplaceTheFiles) {
+  const auto dir = std::filesystem::temp_directory_path() / "hoist_mqtt_creds_unit";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  BridgeConfig c;
+  c.password = "inline";
+  c.password_file = "/etc/hoist-twin/mqtt/site1.password";
+  c.key_file = "/etc/hoist-twin/mqtt/site1.key";
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+  EXPECT_TRUE(applyCredentials(c).empty());
+  EXPECT_EQ(c.password_file, "/etc/hoist-twin/mqtt/site1.password");
+  // Empty credentials (the unit's SetCredential= default): nothing changes.
+  std::ofstream(dir / "mqtt-password") << "\n";
+  std::ofstream(dir / "mqtt-tls-key").close();
+  ::setenv("CREDENTIALS_DIRECTORY", dir.c_str(), 1);
+  EXPECT_TRUE(applyCredentials(c).empty());
+  EXPECT_EQ(c.key_file, "/etc/hoist-twin/mqtt/site1.key");
+  std::ofstream(dir / "mqtt-password") << "s3cret\n";
+  std::ofstream(dir / "mqtt-tls-key") << "-----BEGIN PRIVATE KEY-----\n";
+  EXPECT_EQ(applyCredentials(c), (std::vector<std::string>{"mqtt-password", "mqtt-tls-key"}));
+  EXPECT_EQ(c.password_file, (dir / "mqtt-password").string());
+  EXPECT_EQ(c.password, "");
+  EXPECT_EQ(c.key_file, (dir / "mqtt-tls-key").string());
+  c.username = "hoist";
+  EXPECT_EQ(resolvePassword(c, "x"), "s3cret");
+  ::unsetenv("CREDENTIALS_DIRECTORY");
+  std::filesystem::remove_all(dir);
+}

@@ -72,6 +72,12 @@ int main(int argc, char** argv) {
     if (no_commands) cfg.commands = false;
     if (cage_rate > 0.0) cfg.cage_rate = cage_rate;
     if (!lcm_url.empty()) cfg.lcm_url = lcm_url;
+    // systemd credentials (LoadCredential=, hoist-mqtt@.service): a non-empty
+    // mqtt-password / mqtt-tls-key in $CREDENTIALS_DIRECTORY replaces
+    // [broker] password_file / [tls] key_file, so those files can stay
+    // root-only (mode 0600) while the bridge runs as a dynamic user.
+    for (const auto& cred : hoist::mqtt::applyCredentials(cfg))
+      spdlog::info("using the systemd credential {}", cred);
     try {
       cfg.validate();
     } catch (const std::invalid_argument& e) {

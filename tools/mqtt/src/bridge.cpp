@@ -60,6 +60,24 @@ bool validKind(const std::string& k) {
 /// The names of alarm_t's levels and events (generated from alarm_t.lcm).
 namespace alarm_names = hoist::msg::enums::alarm_t;
 
+/// A token bucket: `rate` tokens per second, at most `burst`.
+struct TokenBucket {
+  double tokens = 0.0;
+  Clock::time_point last{};
+  bool take(Clock::time_point now, double rate, double burst) {
+    if (last == Clock::time_point{}) tokens = burst;
+    else tokens = std::min(burst, tokens + seconds(now - last) * rate);
+    last = now;
+    if (tokens < 1.0) return false;
+    tokens -= 1.0;
+    return true;
+  }
+  bool full(Clock::time_point now, double rate, double burst) const {
+    return tokens + seconds(now - last) * rate >= burst;
+  }
+};
+constexpr std::size_t kMaxUsersPerShaft = 256;  // rate-limit buckets kept per shaft
+
 }  // namespace
 
 struct Bridge::Impl {
@@ -85,16 +103,32 @@ struct Bridge::Impl {
     std::string prefix, name;
     std::string t_cage, t_health, t_alarm, t_cmd, t_forecast;
     bool subscribed = false;       // command topic subscribed on the current connection
+    // Discovery (hoist/mqtt/bridge.hpp): a discovered prefix is a candidate
+    // until its health, with one non-zero instance id, has kept coming; only
+    // then may it take a slot and its shaft name ("confirmed").
+    bool configured = false, confirmed = false, bound = false;
+    std::string t_result;          // hoist/<shaft>/cmd/result
+    Clock::time_point bound_since{};
+    Clock::time_point first_seen{}, last_seen{}, streak_start{}, last_refused_log{};
+    std::int64_t streak_instance = 0;
+    int streak = 0;                // health messages of streak_instance, gaps <= discovery_timeout
+    bool refused = false;          // confirmed-quality but no slot (table full) or its name is taken
     bool cage_new = false;
     hoist::cage_state_t cage{};
     std::map<std::string, AlarmState> alarms;  // by kind
     std::int64_t instance_id = 0;
     std::uint64_t cage_in = 0, cage_out = 0, health_in = 0, alarms_in = 0, commands = 0, forecasts_in = 0;
+    TokenBucket cmd_total;                         // the shaft's commands, all users
+    std::map<std::string, TokenBucket> cmd_users;  // per user (bounded: kMaxUsersPerShaft)
     Clock::time_point last_health{};
   };
-  std::map<std::string, Shaft> shafts;           // by prefix
-  std::map<std::string, std::string> cmd_topics;  // command topic -> prefix
+  std::map<std::string, Shaft> shafts;           // by prefix: configured, confirmed and candidate prefixes
+  std::map<std::string, std::string> cmd_topics;  // command topic -> prefix bound to its shaft name
+  std::map<std::string, std::string> bound;       // shaft name -> the prefix published under it
   bool discover = false;
+  std::uint64_t refused_total = 0, evicted_candidates = 0, aged_out = 0;
+  bool table_full_logged = false;
+  Clock::time_point last_discovery_sweep{};
 
   // ---- MQTT --------------------------------------------------------------------
   struct mosquitto* mosq = nullptr;
@@ -120,6 +154,8 @@ struct Bridge::Impl {
   std::map<std::string, std::uint64_t> decode_errors;  // "cage/truncated" -> n
   std::uint64_t published = 0, publish_errors = 0;
   std::uint64_t cmd_received = 0, cmd_forwarded = 0, cmd_rejected = 0, cmd_lcm_failures = 0;
+  std::uint64_t results_published = 0, results_dropped = 0, stale_marked = 0, stale_dropped = 0;
+  TokenBucket result_budget;  // cmd/result messages: at most 20/s (bursts of 50), so a flood is not echoed
   std::array<std::uint64_t, kCommandRejects> cmd_by_reason{};
   /// A few log lines per 10 s for commands and for LCM input, then counted
   /// (hoist/rt/log_rate_limiter.hpp).
@@ -149,7 +185,7 @@ struct Bridge::Impl {
     bridge_health_topic = "hoist/_bridge/" + client_id + "/health";
 
     discover = cfg.channel_prefixes.empty();
-    for (const auto& p : cfg.channel_prefixes) addShaft(p);
+    for (const auto& p : cfg.channel_prefixes) addShaft(p, true);
     std::string why;
     rx = hoist::bus::openUdpmReceiver(lcm_url, why);
     if (!why.empty()) throw std::runtime_error(why);
@@ -219,7 +255,7 @@ struct Bridge::Impl {
 
   // ---- shafts ------------------------------------------------------------------
 
-  Shaft* addShaft(const std::string& prefix) {
+  Shaft* addShaft(const std::string& prefix, bool configured) {
     Shaft s;
     s.prefix = prefix;
     s.name = shaftName(prefix);
@@ -228,34 +264,191 @@ struct Bridge::Impl {
     s.t_health = base + "health";
     s.t_alarm = base + "alarm/";
     s.t_cmd = base + "cmd/ack";
+    s.t_result = base + "cmd/result";
     s.t_forecast = base + "forecast";
+    s.configured = configured;
+    s.first_seen = s.last_seen = Clock::now();
     auto [it, fresh] = shafts.emplace(prefix, std::move(s));
-    cmd_topics[it->second.t_cmd] = prefix;
-    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST}} -> {}{{cage,health,alarm/<KIND>,forecast}}{}",
-                 it->second.name,
-                 prefix, base,
-                 cfg.commands ? ", " + it->second.t_cmd + " -> " + hoist::bus::channel(prefix, kChannelAlarmAck) : "");
-    if (conn == Conn::Connected) subscribeCommands(it->second);
+    if (configured) bind(it->second);
     return &it->second;
   }
 
-  /// The shaft of `prefix`, discovering it if allowed (from any of its
-  /// channels: an alarm may come before the first health message is heard).
+  /// Publishes the shaft under its name: topics, command subscription, its alarm states.
+  void bind(Shaft& s) {
+    if (auto old = bound.find(s.name); old != bound.end() && old->second != s.prefix) {
+      auto o = shafts.find(old->second);
+      if (o != shafts.end()) o->second.bound = false;
+      spdlog::warn("shaft '{}': now bridged from LCM prefix '{}' (was '{}', whose health stopped)", s.name,
+                   printable(s.prefix), printable(old->second));
+    }
+    s.bound = true;
+    s.bound_since = Clock::now();
+    s.refused = false;
+    bound[s.name] = s.prefix;
+    cmd_topics[s.t_cmd] = s.prefix;
+    const std::string base = "hoist/" + s.name + "/";
+    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST}} -> {}{{cage,health,alarm/<KIND>,forecast}}{}{}",
+                 s.name, s.prefix, base,
+                 cfg.commands ? ", " + s.t_cmd + " -> " + hoist::bus::channel(s.prefix, kChannelAlarmAck) : "",
+                 s.configured ? "" : fmt::format(" (discovered: daemon instance {})", s.streak_instance));
+    if (conn == Conn::Connected) subscribeCommands(s);
+    for (const auto& [kind, a] : s.alarms) publishAlarmState(s, kind, a);
+  }
+
+  std::size_t slotsUsed() const {
+    std::size_t n = 0;
+    for (const auto& [p, s] : shafts) n += (s.configured || s.confirmed) ? 1 : 0;
+    return n;
+  }
+
+  double healthTimeout() const { return cfg.discovery_timeout; }
+
+  /// Health silent for longer than discovery_timeout.
+  bool silent(const Shaft& s, Clock::time_point now) const {
+    return seconds(now - (s.health_in ? s.last_health : s.last_seen)) > healthTimeout();
+  }
+
+  /// A candidate has shown a daemon's health at the health rate: give it a
+  /// slot and its name, if it can have them.
+  void tryConfirm(Shaft& s, Clock::time_point now) {
+    if (s.confirmed || s.configured) return;
+    if (s.streak < 3 || seconds(now - s.streak_start) < 1.0) return;
+    // Its name: free, or held by a prefix whose health has stopped.
+    auto b = bound.find(s.name);
+    Shaft* holder = nullptr;
+    if (b != bound.end())
+      if (auto h = shafts.find(b->second); h != shafts.end()) holder = &h->second;
+    if (holder && (holder->configured || !silent(*holder, now))) {
+      refuseLog(s, now, fmt::format("shaft name '{}' is already bridged from prefix '{}'{}: both are reported in the "
+                                    "bridge's health (discovery.conflicts) and commands to hoist/{}/cmd/ack are "
+                                    "refused until one stops; list the plant's shafts with --channel-prefix",
+                                    s.name, printable(holder->prefix), holder->configured ? " (configured)" : "",
+                                    s.name));
+      return;
+    }
+    if (!holder && slotsUsed() >= static_cast<std::size_t>(cfg.max_shafts)) {
+      // Table full: a confirmed shaft whose health has stopped makes room.
+      Shaft* victim = nullptr;
+      for (auto& [p, o] : shafts)
+        if (o.confirmed && !o.configured && silent(o, now) && (!victim || o.last_health < victim->last_health))
+          victim = &o;
+      if (!victim) {
+        refuseLog(s, now, fmt::format("the shaft table is full ({} shafts, [bridge] max_shafts): prefix '{}' is not "
+                                      "bridged; list the plant's shafts with --channel-prefix",
+                                      cfg.max_shafts, printable(s.prefix)));
+        return;
+      }
+      spdlog::warn("shaft '{}' (prefix '{}'): its health stopped; its slot goes to prefix '{}'", victim->name,
+                   printable(victim->prefix), printable(s.prefix));
+      forget(victim->prefix);
+    }
+    s.confirmed = true;
+    bind(s);
+  }
+
+  void refuseLog(Shaft& s, Clock::time_point now, const std::string& why) {
+    if (!s.refused) ++refused_total;
+    const bool first = !s.refused;
+    s.refused = true;
+    if (first || now - s.last_refused_log > std::chrono::seconds(60)) {
+      s.last_refused_log = now;
+      std::int64_t suppressed = 0;
+      if (log_limit.allow(kLcmLog, sinceStart(now), suppressed)) spdlog::warn("discovery: {}", why);
+    }
+  }
+
+  void forget(const std::string& prefix) {
+    auto it = shafts.find(prefix);
+    if (it == shafts.end()) return;
+    if (it->second.bound) {
+      bound.erase(it->second.name);
+      cmd_topics.erase(it->second.t_cmd);
+      if (conn == Conn::Connected && it->second.subscribed)
+        mosquitto_unsubscribe(mosq, nullptr, it->second.t_cmd.c_str());
+    }
+    shafts.erase(it);
+  }
+
+  /// Candidates that stopped talking age out (a single forged datagram never
+  /// holds a slot for long).
+  void sweepDiscovery(Clock::time_point now) {
+    if (!discover || now - last_discovery_sweep < std::chrono::milliseconds(250)) return;
+    last_discovery_sweep = now;
+    for (auto it = shafts.begin(); it != shafts.end();) {
+      const Shaft& s = it->second;
+      if (!s.configured && !s.confirmed && seconds(now - s.last_seen) > healthTimeout()) {
+        ++aged_out;
+        it = shafts.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    if (table_full_logged && !tableFull()) {
+      table_full_logged = false;
+      spdlog::info("discovery: the shaft table has room again");
+    }
+  }
+
+  bool tableFull() const {
+    if (slotsUsed() < static_cast<std::size_t>(cfg.max_shafts)) return false;
+    for (const auto& [p, s] : shafts)
+      if (s.refused) return true;
+    return false;
+  }
+
+  /// The slot of `prefix`: a configured or known one, else (discovery) a new
+  /// candidate.  Candidates are bounded (4 x max_shafts); when full, the
+  /// weakest one (shortest health streak, then least recently heard) goes.
   Shaft* shaftFor(const std::string& prefix) {
-    if (auto it = shafts.find(prefix); it != shafts.end()) return &it->second;
+    if (auto it = shafts.find(prefix); it != shafts.end()) {
+      it->second.last_seen = Clock::now();
+      return &it->second;
+    }
     if (!discover) return nullptr;
     std::string why;
     if (!validChannelPrefix(prefix, &why)) return nullptr;
-    const std::string name = shaftName(prefix);
-    for (const auto& [p, s] : shafts)
-      if (s.name == name) return nullptr;  // another prefix already maps to this name
-    if (static_cast<int>(shafts.size()) >= cfg.max_shafts) {
-      if (!logged_too_many_shafts)
-        spdlog::warn("more than {} shafts discovered ([bridge] max_shafts): ignoring the others", cfg.max_shafts);
-      logged_too_many_shafts = true;
-      return nullptr;
+    std::size_t candidates = 0;
+    Shaft* weakest = nullptr;
+    for (auto& [p, s] : shafts) {
+      if (s.configured || s.confirmed) continue;
+      ++candidates;
+      if (!weakest || s.streak < weakest->streak || (s.streak == weakest->streak && s.last_seen < weakest->last_seen))
+        weakest = &s;
     }
-    return addShaft(prefix);
+    if (candidates >= 4 * static_cast<std::size_t>(cfg.max_shafts) && weakest) {
+      ++evicted_candidates;
+      forget(weakest->prefix);
+    }
+    return addShaft(prefix, false);
+  }
+
+  void onHealth(Shaft& s, const hoist::health_t& m) {
+    const auto now = Clock::now();
+    const bool continues = s.streak > 0 && m.instance_id == s.streak_instance &&
+                           seconds(now - s.last_health) <= healthTimeout();
+    if (m.instance_id == 0) {
+      s.streak = 0;
+    } else if (continues) {
+      ++s.streak;
+    } else {
+      s.streak = 1;
+      s.streak_instance = m.instance_id;
+      s.streak_start = now;
+    }
+    ++s.health_in;
+    s.last_health = now;
+    if (!s.bound) return tryConfirm(s, now);
+    if (s.instance_id != 0 && m.instance_id != s.instance_id) daemonRestarted(s, m);
+    s.instance_id = m.instance_id;
+    publish({s.t_health, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
+  }
+
+  /// Prefixes other than the bound one that map to `name` (reported, never silently dropped).
+  std::vector<std::string> rivals(const Shaft& s) const {
+    std::vector<std::string> out;
+    for (const auto& [p, o] : shafts)
+      if (&o != &s && o.name == s.name) out.push_back(p);
+    return out;
   }
 
   // ---- LCM side ------------------------------------------------------------------
@@ -282,7 +475,7 @@ struct Bridge::Impl {
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
         if (st != hoist::msg::DecodeStatus::ok) return decodeError("cage_state_t", st, channel);
         s->cage = m;
-        s->cage_new = true;
+        s->cage_new = s->bound;
         ++s->cage_in;
       } else if (ends(kChannelHealth)) {
         Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelHealth.size()));
@@ -290,11 +483,7 @@ struct Bridge::Impl {
         hoist::health_t m;
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
         if (st != hoist::msg::DecodeStatus::ok) return decodeError("health_t", st, channel);
-        ++s->health_in;
-        s->last_health = Clock::now();
-        if (s->instance_id != 0 && m.instance_id != s->instance_id) daemonRestarted(*s, m);
-        s->instance_id = m.instance_id;
-        publish({s->t_health, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
+        onHealth(*s, m);
       } else if (ends(kChannelAlarm)) {
         Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelAlarm.size()));
         if (!s) return void(++ignored_channels);
@@ -311,7 +500,7 @@ struct Bridge::Impl {
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
         if (st != hoist::msg::DecodeStatus::ok) return decodeError("forecast_t", st, channel);
         ++s->forecasts_in;
-        publish({s->t_forecast, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
+        if (s->bound) publish({s->t_forecast, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
       }
     } catch (const std::exception& e) {  // nothing may escape an LCM callback
       ++decode_errors["exception"];
@@ -338,7 +527,7 @@ struct Bridge::Impl {
     it->second.by_level[m.level] = m;
     it->second.last = m;
     ++s.alarms_in;
-    publishAlarmState(s, it->first, it->second);
+    if (s.bound) publishAlarmState(s, it->first, it->second);
   }
 
   /// A new daemon process: alarm states from before its start are void (the
@@ -410,16 +599,37 @@ struct Bridge::Impl {
     return false;
   }
 
+  /// Buffered cage states older than [buffer] stale_after are marked
+  /// "stale": true (with their age), or dropped with drop_stale; alarm
+  /// transitions and the rest are sent as they are.
   void flushOutbox() {
+    const auto now = Clock::now();
     while (conn == Conn::Connected && !outbox.empty() && !mosquitto_want_write(mosq)) {
-      if (!send(outbox.front())) return;
+      const OutMsg& m = outbox.front();
+      if (m.cls == MsgClass::Cage && seconds(now - m.queued) > cfg.stale_after) {
+        if (cfg.drop_stale) {
+          ++stale_dropped;
+          outbox.pop();
+          continue;
+        }
+        OutMsg marked = m;
+        if (!marked.payload.empty() && marked.payload.back() == '}') {
+          marked.payload.pop_back();
+          marked.payload += fmt::format(",\"stale\":true,\"stale_age\":{:.3f}}}", seconds(now - m.queued));
+        }
+        if (!send(marked)) return;
+        ++stale_marked;
+        outbox.pop();
+        continue;
+      }
+      if (!send(m)) return;
       outbox.pop();
     }
   }
 
   void publishCages() {
     for (auto& [p, s] : shafts) {
-      if (!s.cage_new) continue;
+      if (!s.cage_new || !s.bound) continue;
       s.cage_new = false;
       ++s.cage_out;
       publish({s.t_cage, hoist::msg::toJson(s.cage).dump(), 0, false, MsgClass::Cage});
@@ -456,6 +666,7 @@ struct Bridge::Impl {
                 {"alarm_rejected", alarm_rejected},
                 {"ignored_channels", ignored_channels}};
     j["mqtt"] = {{"published", published}, {"publish_errors", publish_errors}};
+    j["stale_cage"] = {{"marked", stale_marked}, {"dropped", stale_dropped}};
     j["buffer"] = {{"queued", outbox.size()},
                    {"queued_alarms", outbox.queuedAlarms()},
                    {"max_messages", cfg.max_messages},
@@ -470,9 +681,23 @@ struct Bridge::Impl {
                      {"forwarded", cmd_forwarded},
                      {"rejected", cmd_rejected},
                      {"rejected_by_reason", by_reason},
+                     {"results_published", results_published},
+                     {"results_dropped", results_dropped},
                      {"lcm_publish_failures", cmd_lcm_failures}};
     json sh = json::array();
+    json conflicts = json::array(), refused = json::array();
+    std::size_t candidates = 0;
     for (const auto& [p, s] : shafts) {
+      if (s.refused && refused.size() < 16) refused.push_back(p);
+      if (!s.bound) {
+        candidates += s.confirmed ? 0 : 1;
+        continue;
+      }
+      if (auto r = rivals(s); !r.empty()) {
+        json ps = json::array({p});
+        for (const auto& x : r) ps.push_back(x);
+        conflicts.push_back({{"shaft", s.name}, {"bridged_prefix", p}, {"prefixes", ps}});
+      }
       int active = 0;
       for (const auto& [k, a] : s.alarms)
         for (const auto& lv : a.by_level) active += lv && lv->active ? 1 : 0;
@@ -488,6 +713,16 @@ struct Bridge::Impl {
                     {"commands", s.commands}});
     }
     j["shafts"] = sh;
+    j["discovery"] = {{"enabled", discover},
+                      {"slots_used", slotsUsed()},
+                      {"max_shafts", cfg.max_shafts},
+                      {"table_full", tableFull()},
+                      {"candidates", candidates},
+                      {"refused", refused},
+                      {"refused_total", refused_total},
+                      {"conflicts", conflicts},
+                      {"aged_out", aged_out},
+                      {"evicted_candidates", evicted_candidates}};
     return j;
   }
 
@@ -559,13 +794,15 @@ struct Bridge::Impl {
     const std::string online =
         json{{"online", true}, {"client_id", client_id}, {"since_utime", connected_since_utime}}.dump();
     send({status_topic, online, 1, true, MsgClass::Alarm});
-    for (auto& [p, s] : shafts) subscribeCommands(s);
+    for (auto& [p, s] : shafts)
+      if (s.bound) subscribeCommands(s);
     flushOutbox();
     // The broker may have restarted without its retained messages: republish
     // every alarm's current state (after the buffered transitions, so the
     // retained message ends up being the current state).
     for (const auto& [p, s] : shafts)
-      for (const auto& [kind, a] : s.alarms) publishAlarmState(s, kind, a);
+      if (s.bound)
+        for (const auto& [kind, a] : s.alarms) publishAlarmState(s, kind, a);
     publishBridgeHealth();
   }
 
@@ -586,35 +823,136 @@ struct Bridge::Impl {
 
   // ---- MQTT side: commands -------------------------------------------------------
 
+  /// Rate limit per user and shaft ([bridge] command_rate, command_burst),
+  /// and 4x that for the shaft's total (so many user names gain nothing).
+  bool rateAllows(Shaft& s, const std::string& user, Clock::time_point now) {
+    const double rate = cfg.command_rate, burst = cfg.command_burst;
+    auto it = s.cmd_users.find(user);
+    if (it == s.cmd_users.end()) {
+      if (s.cmd_users.size() >= kMaxUsersPerShaft)
+        for (auto u = s.cmd_users.begin(); u != s.cmd_users.end();)  // forget idle users
+          u = u->second.full(now, rate, burst) ? s.cmd_users.erase(u) : std::next(u);
+      if (s.cmd_users.size() >= kMaxUsersPerShaft) return false;
+      it = s.cmd_users.emplace(user, TokenBucket{}).first;
+    }
+    TokenBucket probe = it->second;
+    if (!probe.take(now, rate, burst)) {
+      it->second = probe;
+      return false;
+    }
+    if (!s.cmd_total.take(now, 4.0 * rate, 4.0 * burst)) return false;
+    it->second = probe;
+    return true;
+  }
+
+  /// The command's answer on hoist/<shaft>/cmd/result (QoS 1, not retained).
+  void answer(Shaft& s, const char* result, const char* reason, const std::string& detail,
+              const hoist::alarm_ack_t* ack) {
+    if (!result_budget.take(Clock::now(), 20.0, 50.0)) return void(++results_dropped);
+    json j = json::object();
+    j["utime"] = hoist::bus::wallUtime();
+    j["shaft"] = s.name;
+    j["result"] = result;
+    j["reason"] = reason;
+    j["detail"] = detail;
+    if (ack) {
+      j["command"] = {{"kind", ack->kind.empty() ? std::string("*") : printable(ack->kind, 32)},
+                      {"level", int(ack->level)},
+                      {"action", int(ack->action)},
+                      {"user", printable(ack->user)},
+                      {"utime", ack->utime}};
+      if (ack->action == hoist::alarm_ack_t::ACTION_SHELVE) j["command"]["shelve_duration"] = ack->shelve_duration;
+    }
+    ++results_published;
+    publish({s.t_result, j.dump(), 1, false, MsgClass::Health});
+  }
+
+  void refuse(Shaft& s, CommandReject why, const std::string& detail, int payloadlen, bool may_log,
+              const hoist::alarm_ack_t* ack = nullptr) {
+    ++cmd_rejected;
+    ++cmd_by_reason[static_cast<int>(why)];
+    if (may_log)
+      spdlog::warn("rejected command on {} ({} bytes): {}: {}", s.t_cmd, payloadlen, toString(why), detail);
+    answer(s, "refused", toString(why), detail, ack);
+  }
+
+  /// An acknowledge matches an active, unacknowledged alarm the bridge knows of.
+  bool ackMatches(const Shaft& s, const hoist::alarm_ack_t& ack) const {
+    const bool any_kind = ack.kind.empty() || ack.kind == "*";
+    for (const auto& [kind, a] : s.alarms) {
+      if (!any_kind && kind != ack.kind) continue;
+      for (int lv = 1; lv <= 2; ++lv)
+        if ((ack.level == 0 || ack.level == lv) && a.by_level[lv] && a.by_level[lv]->active && !a.by_level[lv]->acked)
+          return true;
+    }
+    return false;
+  }
+
   void onMqttMessage(const struct mosquitto_message* m) {
     try {
       if (!m || !m->topic) return;
       auto it = cmd_topics.find(m->topic);
       if (it == cmd_topics.end() || !cfg.commands) return;
       Shaft& s = shafts.at(it->second);
+      if (m->payloadlen == 0) return;  // an empty payload deletes a retained message: nothing to do
       ++cmd_received;
       const auto now = Clock::now();
       std::int64_t suppressed = 0;
       const bool may_log = log_limit.allow(kCmdLog, sinceStart(now), suppressed);
       if (may_log && suppressed) spdlog::warn("{} command log lines suppressed", suppressed);
-      CommandResult r = parseAckCommand(m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
-                                        static_cast<std::size_t>(cfg.max_command_bytes), hoist::bus::wallUtime());
-      if (r.reject != CommandReject::None) {
-        ++cmd_rejected;
-        ++cmd_by_reason[static_cast<int>(r.reject)];
-        if (may_log)
-          spdlog::warn("rejected command on {} ({} bytes): {}: {}", s.t_cmd, m->payloadlen, toString(r.reject),
-                       r.detail);
+      if (m->retain) {
+        // A retained command would be executed again on every (re)subscription:
+        // never executed; the bridge deletes it from the broker (empty retained message).
+        refuse(s, CommandReject::Retained,
+               "retained messages are never executed (publish commands with retain=false); deleting it", m->payloadlen,
+               may_log);
+        mosquitto_publish(mosq, nullptr, m->topic, 0, nullptr, 1, true);
         return;
+      }
+      CommandResult r = parseAckCommand(m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
+                                        static_cast<std::size_t>(cfg.max_command_bytes), hoist::bus::wallUtime(),
+                                        cfg.max_command_age);
+      if (r.reject != CommandReject::None) return refuse(s, r.reject, r.detail, m->payloadlen, may_log);
+      const hoist::alarm_ack_t* cmd = &r.ack;
+      for (const auto& rp : rivals(s))
+        if (const Shaft& o = shafts.at(rp); o.refused && !silent(o, now))
+          return refuse(s, CommandReject::AmbiguousShaft,
+                        fmt::format("shaft '{}' is claimed by LCM prefixes '{}' and '{}'", s.name, printable(s.prefix),
+                                    printable(rp)),
+                        m->payloadlen, may_log, cmd);
+      if (!rateAllows(s, r.ack.user, now))
+        return refuse(s, CommandReject::RateLimited,
+                      fmt::format("user '{}' over {} commands/s (burst {}) on shaft '{}'", printable(r.ack.user),
+                                  cfg.command_rate, cfg.command_burst, s.name),
+                      m->payloadlen, may_log, cmd);
+      // An acknowledge for no alarm: answered (the daemon would do nothing).
+      // Until the daemon has re-announced its active alarms since the shaft
+      // was bridged, the bridge's view may be incomplete: forwarded then.
+      const bool view_complete = seconds(now - s.bound_since) >= cfg.alarm_sync_time;
+      std::string note;
+      if (r.ack.action == hoist::alarm_ack_t::ACTION_ACK && !ackMatches(s, r.ack)) {
+        if (view_complete) {
+          ++cmd_rejected;
+          ++cmd_by_reason[static_cast<int>(CommandReject::NoMatchingAlarm)];
+          const std::string why = fmt::format("no active, unacknowledged alarm {} (level {}) on shaft '{}'",
+                                              r.ack.kind.empty() || r.ack.kind == "*" ? std::string("of any kind")
+                                                                                      : printable(r.ack.kind, 32),
+                                              int(r.ack.level), s.name);
+          spdlog::info("acknowledge on {} from '{}' matches no alarm: {}", s.t_cmd, printable(r.ack.user), why);
+          return answer(s, "refused", toString(CommandReject::NoMatchingAlarm), why, cmd);
+        }
+        note = "no matching alarm known yet (the bridge has not yet heard the daemon re-announce its alarms); "
+               "forwarded, the daemon decides";
       }
       const std::string channel = hoist::bus::channel(s.prefix, kChannelAlarmAck);
       if (lcm.publish(channel, &r.ack) != 0) {
         ++cmd_lcm_failures;
         if (may_log) spdlog::error("command on {}: LCM publish on {} failed", s.t_cmd, channel);
-        return;
+        return answer(s, "refused", "lcm_publish_failed", "LCM publish on " + channel + " failed", cmd);
       }
       ++cmd_forwarded;
       ++s.commands;
+      answer(s, "accepted", "forwarded", note.empty() ? "forwarded to " + channel : note, cmd);
       if (may_log)
         spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", s.t_cmd, printable(r.ack.user),
                      int(r.ack.action), r.ack.kind.empty() ? "*" : printable(r.ack.kind, 32), int(r.ack.level),
@@ -679,6 +1017,13 @@ struct Bridge::Impl {
       flushOutbox();
 
       now = Clock::now();
+      sweepDiscovery(now);
+      if (!table_full_logged && tableFull()) {
+        table_full_logged = true;
+        spdlog::warn("discovery: the shaft table is full ({} of [bridge] max_shafts = {}) and a prefix was refused; "
+                     "see discovery.refused in the bridge's health",
+                     slotsUsed(), cfg.max_shafts);
+      }
       if (now >= next_cage) {
         publishCages();
         next_cage += cage_period;

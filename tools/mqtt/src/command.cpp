@@ -1,6 +1,11 @@
 // Alarm commands from MQTT: see hoist/mqtt/command.hpp.
 #include "hoist/mqtt/command.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "hoist/msg/codec.hpp"
@@ -19,11 +24,31 @@ const char* toString(CommandReject r) {
     case CommandReject::BadLevel: return "bad_level";
     case CommandReject::BadAction: return "bad_action";
     case CommandReject::BadShelveDuration: return "bad_shelve_duration";
+    case CommandReject::DuplicateKey: return "duplicate_key";
+    case CommandReject::BadUser: return "bad_user";
+    case CommandReject::StaleUtime: return "stale_utime";
+    case CommandReject::Retained: return "retained";
+    case CommandReject::RateLimited: return "rate_limited";
+    case CommandReject::NoMatchingAlarm: return "no_matching_alarm";
+    case CommandReject::AmbiguousShaft: return "ambiguous_shaft";
   }
   return "?";
 }
 
-CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime) {
+std::string checkUser(const std::string& user) {
+  if (user.empty() || user.size() > 64) return "user must have 1..64 characters";
+  for (std::size_t i = 0; i < user.size(); ++i) {
+    const auto ch = static_cast<unsigned char>(user[i]);
+    if (ch < 0x20 || ch == 0x7f) return "user may not contain control characters";
+    // C1 controls U+0080..U+009F are C2 80..C2 9F in UTF-8 (the JSON parser has checked UTF-8).
+    if (ch == 0xc2 && i + 1 < user.size() && static_cast<unsigned char>(user[i + 1]) <= 0x9f)
+      return "user may not contain control characters";
+  }
+  return "";
+}
+
+CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime,
+                              double max_age_s) {
   CommandResult r;
   try {
     if (size > max_bytes) {
@@ -32,7 +57,27 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
       return r;
     }
     const auto* p = static_cast<const char*>(data);
-    nlohmann::json j = nlohmann::json::parse(p, p + (data ? size : 0), nullptr, /*allow_exceptions=*/false);
+    // Keys seen per open object: a key given twice is refused (nlohmann keeps the last).
+    std::vector<std::vector<std::string>> open_objects;
+    std::string duplicate;
+    nlohmann::json::parser_callback_t cb = [&](int, nlohmann::json::parse_event_t ev, nlohmann::json& parsed) {
+      using E = nlohmann::json::parse_event_t;
+      if (ev == E::object_start) {
+        open_objects.emplace_back();
+      } else if (ev == E::object_end) {
+        if (!open_objects.empty()) open_objects.pop_back();
+      } else if (ev == E::key && !open_objects.empty() && parsed.is_string()) {
+        auto& keys = open_objects.back();
+        const auto& k = parsed.get_ref<const std::string&>();
+        if (std::find(keys.begin(), keys.end(), k) != keys.end()) {
+          if (duplicate.empty()) duplicate = k;
+        } else {
+          keys.push_back(k);
+        }
+      }
+      return true;
+    };
+    nlohmann::json j = nlohmann::json::parse(p, p + (data ? size : 0), cb, /*allow_exceptions=*/false);
     if (j.is_discarded()) {
       r.reject = CommandReject::NotJson;
       r.detail = std::to_string(size) + " bytes of invalid JSON";
@@ -43,8 +88,14 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
       r.detail = std::string("a JSON ") + j.type_name() + ", expected an object";
       return r;
     }
+    if (!duplicate.empty()) {
+      r.reject = CommandReject::DuplicateKey;
+      r.detail = "key '" + printable(duplicate, 32) + "' given twice";
+      return r;
+    }
     // Conveniences for SCADA clients; everything else is the codec's strict rule.
-    if (!j.contains("utime")) j["utime"] = now_utime;
+    const bool client_utime = j.contains("utime");
+    if (!client_utime) j["utime"] = now_utime;
     if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
     if (!j.contains("user")) j["user"] = "mqtt";
     std::string error;
@@ -52,6 +103,22 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
       r.reject = CommandReject::BadFields;
       r.detail = printable(error, 120);
       return r;
+    }
+    if (const std::string why = checkUser(r.ack.user); !why.empty()) {
+      r.reject = CommandReject::BadUser;
+      r.detail = why + " ('" + printable(r.ack.user, 32) + "')";
+      return r;
+    }
+    if (client_utime && max_age_s > 0.0 && r.ack.utime > 0) {
+      const double age = static_cast<double>(now_utime - r.ack.utime) * 1e-6;
+      if (std::abs(age) > max_age_s) {
+        r.reject = CommandReject::StaleUtime;
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "utime is %.1f s %s the bridge's clock (at most %g s)", std::abs(age),
+                      age > 0 ? "behind" : "ahead of", max_age_s);
+        r.detail = buf;
+        return r;
+      }
     }
     hoist::contract::AlarmCommand cmd;
     switch (hoist::contract::validateAlarmCommand(r.ack.kind, r.ack.level, r.ack.action, r.ack.shelve_duration, cmd)) {

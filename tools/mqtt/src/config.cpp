@@ -1,6 +1,7 @@
 // hoist-mqtt configuration: see hoist/mqtt/config.hpp.
 #include "hoist/mqtt/config.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -138,7 +139,16 @@ void BridgeConfig::validate() const {
   range("bridge.cage_rate", cage_rate, 0.0, 1000.0, true);
   range("bridge.health_period", health_period, 0.1, 3600.0);
   range("bridge.max_shafts", max_shafts, 1, 10000);
+  range("bridge.discovery_timeout", discovery_timeout, 1.0, 3600.0);
+  if (static_cast<int>(channel_prefixes.size()) > max_shafts)
+    bad("bridge.channel_prefixes", std::to_string(channel_prefixes.size()) + " prefixes > bridge.max_shafts = " +
+                                       std::to_string(max_shafts));
   range("bridge.max_command_bytes", max_command_bytes, 64, 65536);
+  range("bridge.command_rate", command_rate, 0.0, 1000.0, true);
+  range("bridge.command_burst", command_burst, 1, 10000);
+  range("bridge.max_command_age", max_command_age, 0.0, 86400.0);
+  range("bridge.alarm_sync_time", alarm_sync_time, 0.0, 3600.0);
+  range("buffer.stale_after", stale_after, 0.0, 3600.0, true);
   range("buffer.max_messages", max_messages, 1, 1000000);
   range("buffer.max_alarm_events", max_alarm_events, 1, 1000000);
 }
@@ -257,10 +267,18 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   r.num("bridge", "cage_rate", c.cage_rate);
   r.num("bridge", "health_period", c.health_period);
   r.integer("bridge", "max_shafts", c.max_shafts);
+  r.num("bridge", "discovery_timeout", c.discovery_timeout);
   r.integer("bridge", "max_command_bytes", c.max_command_bytes);
+  r.num("bridge", "command_rate", c.command_rate);
+  r.integer("bridge", "command_burst", c.command_burst);
+  r.num("bridge", "max_command_age", c.max_command_age);
+  r.num("bridge", "alarm_sync_time", c.alarm_sync_time);
   r.integer("buffer", "max_messages", c.max_messages);
   r.integer("buffer", "max_alarm_events", c.max_alarm_events);
+  r.num("buffer", "stale_after", c.stale_after);
+  r.boolean("buffer", "drop_stale", c.drop_stale);
   r.run(root);
+  applyCredentials(c);  // before the files are checked: a credential replaces an unreadable file
   try {
     c.validate();
   } catch (const std::invalid_argument& e) {
@@ -300,6 +318,31 @@ std::string resolvePassword(const BridgeConfig& cfg, const std::string& source) 
   if (!cfg.password_env.empty())
     if (const char* v = std::getenv(cfg.password_env.c_str()); v && *v) return v;
   return {};
+}
+
+std::vector<std::string> applyCredentials(BridgeConfig& cfg) {
+  std::vector<std::string> used;
+  const char* dir = std::getenv("CREDENTIALS_DIRECTORY");
+  if (!dir || !*dir) return used;
+  // Blank (only white space): the unit's SetCredential= default, i.e. no credential.
+  auto nonEmpty = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char ch = 0;
+    for (int n = 0; in.get(ch) && n < 4096; ++n)
+      if (!std::isspace(static_cast<unsigned char>(ch))) return true;
+    return false;
+  };
+  const std::string pw = std::string(dir) + "/mqtt-password", key = std::string(dir) + "/mqtt-tls-key";
+  if (nonEmpty(pw)) {
+    cfg.password.clear();
+    cfg.password_file = pw;
+    used.push_back("mqtt-password");
+  }
+  if (nonEmpty(key)) {
+    cfg.key_file = key;
+    used.push_back("mqtt-tls-key");
+  }
+  return used;
 }
 
 std::string shaftName(const std::string& prefix) {

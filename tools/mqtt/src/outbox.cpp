@@ -21,6 +21,7 @@ void Outbox::push(OutMsg m) {
     if (!dropOldest(MsgClass::Cage)) dropOldest(MsgClass::Health);
   }
   ++counter(m.cls);
+  if (m.queued == std::chrono::steady_clock::time_point{}) m.queued = std::chrono::steady_clock::now();
   q_.push_back(std::move(m));
 }
 

@@ -8,7 +8,14 @@
 // left out.  The JSON is converted by the codec's strict fromJson (unknown
 // keys, wrong types, out-of-range integers rejected) and then validated by
 // the daemon's own rule (hoist::contract::validateAlarmCommand), so the bridge
-// forwards exactly what hoist-twind would accept.
+// forwards exactly what hoist-twind would accept.  On top of that:
+//   * a key given twice anywhere in the payload is refused (no "last wins");
+//   * `user` follows hoist-dash's rule (1..64 bytes, no control character:
+//     bytes < 0x20, 0x7f, and the C1 controls U+0080..U+009F) -- refused, never forwarded;
+//   * with max_age_s > 0, a `utime` given by the client must be within
+//     max_age_s of the bridge's clock (a stale or replayed command is refused).
+// The bridge itself refuses retained messages, rate-limits per user and
+// shaft, and answers every command on hoist/<shaft>/cmd/result (bridge.hpp).
 #pragma once
 
 #include <cstddef>
@@ -31,8 +38,15 @@ enum class CommandReject : std::uint8_t {
   BadLevel,       ///< level not 0, 1 or 2
   BadAction,      ///< action not 1 (ack), 2 (shelve) or 3 (unshelve)
   BadShelveDuration,  ///< shelve without a finite duration > 0
+  DuplicateKey,   ///< a JSON key given twice
+  BadUser,        ///< user empty, longer than 64 bytes, or with a control character
+  StaleUtime,     ///< utime further than max_age_s from the bridge's clock
+  Retained,       ///< a retained MQTT message (never executed: it would replay on every resubscription)
+  RateLimited,    ///< over the per-user, per-shaft rate ([bridge] command_rate, command_burst)
+  NoMatchingAlarm,  ///< an acknowledge that matches no unacknowledged alarm the bridge knows of
+  AmbiguousShaft,   ///< two live prefixes claim the shaft's name (discovery): refused until one stops
 };
-inline constexpr int kCommandRejects = 9;
+inline constexpr int kCommandRejects = 16;
 const char* toString(CommandReject r);  ///< "ok", "oversized", "not_json", ...
 
 struct CommandResult {
@@ -41,8 +55,14 @@ struct CommandResult {
   hoist::alarm_ack_t ack{};  ///< valid when reject == None
 };
 
-/// Parses and validates one payload.  Never throws.
-CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime);
+/// Parses and validates one payload.  Never throws.  `max_age_s` > 0: a
+/// client-given utime must be within that many seconds of `now_utime`.
+CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime,
+                              double max_age_s = 0.0);
+
+/// hoist-dash's rule for an operator name (tools/dash validateAckFields),
+/// plus the C1 controls: "" if valid, else why.
+std::string checkUser(const std::string& user);
 
 /// printable(): the daemon's own, hoist/contract/alarm_command.hpp.
 using hoist::contract::printable;

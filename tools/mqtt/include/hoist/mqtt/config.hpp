@@ -4,8 +4,9 @@
 //             password_env, reconnect_min, reconnect_max, connect_timeout
 //   [tls]     ca_file, ca_path, cert_file, key_file, insecure, version
 //   [bridge]  lcm_url, channel_prefixes, commands, cage_rate, health_period,
-//             max_shafts, max_command_bytes
-//   [buffer]  max_messages, max_alarm_events
+//             max_shafts, discovery_timeout, max_command_bytes, command_rate, command_burst,
+//             max_command_age, alarm_sync_time
+//   [buffer]  max_messages, max_alarm_events, stale_after, drop_stale
 //
 // Every key is optional.  Rejected with hoist::io::ConfigError
 // ("file:line: section.key: reason", exit status 2): TOML syntax errors,
@@ -55,12 +56,19 @@ struct BridgeConfig {
   bool commands = true;                    ///< accept hoist/<shaft>/cmd/ack
   double cage_rate = 10.0;                 ///< cage states per second per shaft [Hz], (0, 1000]
   double health_period = 5.0;              ///< the bridge's own health topic period [s]
-  int max_shafts = 64;                     ///< discovered shafts at most
+  int max_shafts = 64;                     ///< shafts bridged at most (configured + discovered)
+  double discovery_timeout = 5.0;          ///< a discovered prefix silent this long ages out / may be replaced [s]
   int max_command_bytes = 1024;            ///< larger command payloads are rejected
+  double command_rate = 2.0;               ///< commands per second per user and shaft (token bucket) [1/s]
+  int command_burst = 10;                  ///< ... with this many at once; a shaft's total is 4x both
+  double max_command_age = 60.0;           ///< a client's utime must be within this of the bridge's clock [s]; 0 = off
+  double alarm_sync_time = 12.0;           ///< a shaft bridged this long: its alarm states are complete (re-announce 10 s) [s]
 
   // [buffer] (while the broker is unreachable or the socket is congested)
   int max_messages = 1000;       ///< cage and health messages buffered (oldest cage states dropped first)
   int max_alarm_events = 10000;  ///< alarm transitions buffered (never dropped for cage states)
+  double stale_after = 1.0;      ///< a buffered cage state older than this when sent carries "stale": true [s]
+  bool drop_stale = false;       ///< ... or is dropped (counted); alarm transitions are always sent
 
   bool wantsTls() const;
   /// Throws std::invalid_argument("section.key: reason").
@@ -76,6 +84,13 @@ void applyBridgeToml(const std::string& text, const std::string& source, BridgeC
 /// the environment variable `password_env` (if set); "" if none.  Throws
 /// hoist::io::ConfigError (key broker.password_file) if the file is unreadable.
 std::string resolvePassword(const BridgeConfig& cfg, const std::string& source);
+
+/// systemd credentials: when $CREDENTIALS_DIRECTORY is set and holds a
+/// non-blank `mqtt-password` (`mqtt-tls-key`), password_file (key_file)
+/// becomes that file (and `password` is cleared).  A blank credential (the
+/// unit's SetCredential= default when the file is absent) changes nothing.
+/// Returns the credentials used.
+std::vector<std::string> applyCredentials(BridgeConfig& cfg);
 
 /// MQTT shaft name of an LCM channel prefix: the prefix without one trailing
 /// separator ('/', '_', '-', '.'), or "default" for the empty prefix.

@@ -10,6 +10,7 @@
 // republishes every alarm's current state anyway.  Order is preserved.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <string>
@@ -24,6 +25,7 @@ struct OutMsg {
   int qos = 0;
   bool retain = false;
   MsgClass cls = MsgClass::Cage;
+  std::chrono::steady_clock::time_point queued{};  ///< set by Outbox::push (age at sending: stale cage states)
 };
 
 class Outbox {
