@@ -134,7 +134,12 @@ TEST_F(EstimateCli, SimMeasurementsFollowTheSensorModelAndTheSeed) {
   EXPECT_NEAR(stdOf("f_y"), 0.002, 0.0002);
   EXPECT_NEAR(stdOf("omega"), 1e-4, 1e-5);
 
+  // --write-profile does not end the run when measurements are asked for.
+  ASSERT_EQ(sim({"--config", cfg, "--profile", prof, "--write-profile", path("p.csv"), "--write-measurements",
+                 path("n3.csv"), "-q"}).status, 0);
+  EXPECT_EQ(lines("n3.csv"), lines("n1.csv"));
   // Bad options are bad input.
+  EXPECT_EQ(sim({"--profile", prof, "--out", path("x.csv"), "--seed", "3"}).status, 2) << "--seed alone";
   for (const std::vector<std::string>& bad :
        {std::vector<std::string>{"--sensor-noise", "1,2"}, {"--sensor-noise", "1,-2,3"}, {"--sensor-noise", "a,b,c"},
         {"--method", "paper", "--static-correction", "off"}}) {

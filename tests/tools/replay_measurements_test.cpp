@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "hoist/bus/channels.hpp"
 #include "hoist/cage_imu_t.hpp"
 #include "hoist/rope_load_t.hpp"
 #include "hoist/winder_t.hpp"
@@ -89,6 +90,14 @@ TEST_F(ReplayMeasurements, PublishesWinderAndSensorChannels) {
     EXPECT_NE(k % 3, 0);
     EXPECT_NEAR(m.force, 10000.0 + k, 1e-9);
   }
+}
+
+TEST(SensorChannels, NamesAndPrefix) {
+  const hoist::bus::Channels ch("N_");
+  EXPECT_EQ(ch.cage_imu, "N_HOIST_CAGE_IMU");
+  EXPECT_EQ(ch.rope_load, "N_HOIST_ROPE_LOAD");
+  EXPECT_EQ(ch.estimate, "N_HOIST_ESTIMATE");
+  EXPECT_EQ(hoist::bus::Channels().estimate, "HOIST_ESTIMATE");
 }
 
 TEST_F(ReplayMeasurements, BadFileExitsTwoBeforePublishing) {

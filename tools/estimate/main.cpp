@@ -13,7 +13,9 @@
 // [alarms], [forecast], [sensors], [estimator] are accepted; [estimator]
 // enabled is not needed here).  The substep length is --max-step, else the
 // file's [service] max_step, else 0.0025 s (the daemon's default), so that
-// the live and offline estimators agree.
+// the live and offline estimators agree.  The NIS window is sized for the
+// file's rate: [estimator] max_rate is raised to the fastest row rate when
+// that is higher (the daemon sizes it for its own rate).
 // Output: one row per measurement row (kOutputHeader); a value that is not
 // observed (sigma < 0 in the estimate, or its sensor not seen yet:
 // fa_observed / moment_observed) is written as nan with its sigma.

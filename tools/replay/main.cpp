@@ -202,12 +202,6 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string prefix = prefixes.empty() ? std::string() : prefixes.front();
-  lcm::LCM lcm(url);
-  if (!lcm.good()) {
-    std::cerr << "hoist-replay: cannot open LCM at " << hoist::bus::describeLcmUrl(url) << "\n";
-    return 1;
-  }
-  const std::string channel = hoist::bus::channel(prefix, hoist::bus::kChannelWinder);
   // --measurements: read (and validate) the whole file before anything is published.
   std::vector<hoist::MeasurementSample> meas;
   if (!meas_path.empty()) {
@@ -218,6 +212,12 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::cerr << "hoist-replay: cannot open LCM at " << hoist::bus::describeLcmUrl(url) << "\n";
+    return 1;
+  }
+  const std::string channel = hoist::bus::channel(prefix, hoist::bus::kChannelWinder);
   struct sigaction sa {};
   sa.sa_handler = onSignal;  // no SA_RESTART: interrupt the sleep
   sigaction(SIGINT, &sa, nullptr);

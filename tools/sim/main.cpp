@@ -268,9 +268,9 @@ int run(const Options& o) {
   const auto t_load = Clock::now();
   // ---- load -------------------------------------------------------------
   hoist::ShaftParams p;
-  // A daemon configuration (shaft + [service]/[alarms]) is accepted as well;
-  // hoist-twind validates those sections.
-  // [sensors] gives --write-measurements' default noise.
+  // A daemon configuration (shaft + [service]/[alarms]/...) is accepted as
+  // well; hoist-twind validates those sections, except [sensors] and
+  // [estimator], read here: [sensors] is --write-measurements' default noise.
   hoist::SensorNoise noise;
   if (!o.config.empty()) {
     const toml::table tbl = hoist::io::loadTomlFile(o.config);
@@ -330,7 +330,7 @@ int run(const Options& o) {
     hoist::io::writeProfileCsv(pf, profile);
     pf.close();
     if (!o.quiet) std::cerr << "hoist-sim: profile written to " << o.write_profile << "\n";
-    if (o.out.empty()) return 0;
+    if (o.out.empty() && o.write_measurements.empty()) return 0;
   }
   if (o.out.empty() && o.write_measurements.empty())
     throw UsageError("--out FILE.csv is required (or --write-measurements, or --write-profile / --print-config alone)");
@@ -604,14 +604,15 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(1e-6, 1e6));
   app.add_option("--write-profile", o.write_profile, "also write the profile used as CSV t,l,v,a");
-  app.add_option("--write-measurements", o.write_measurements,
-                 "also write what a cage IMU and a rope load cell read on this run (t,l,v,a,f_y,omega,rope_load; "
-                 "input of hoist-estimate): the sensor model on the response plus seeded Gaussian noise; "
-                 "--out may then be left out");
+  auto* write_meas = app.add_option(
+      "--write-measurements", o.write_measurements,
+      "also write what a cage IMU and a rope load cell read on this run (t,l,v,a,f_y,omega,rope_load; input of "
+      "hoist-estimate): the sensor model on the response plus seeded Gaussian noise; --out may then be left out");
   app.add_option("--sensor-noise", o.sensor_noise,
                  "A,W,F: noise standard deviations of f_y [m/s^2], omega [rad/s] and rope_load [N] for "
-                 "--write-measurements (default: the config's [sensors], else 0.002,0.0001,20)");
-  app.add_option("--seed", o.seed, "seed of --write-measurements' noise (default 1)");
+                 "--write-measurements (default: the config's [sensors], else 0.002,0.0001,20)")
+      ->needs(write_meas);
+  app.add_option("--seed", o.seed, "seed of --write-measurements' noise (default 1)")->needs(write_meas);
   app.add_flag("--print-config", o.print_config, "print the effective shaft configuration as TOML and exit");
   app.add_flag("-q,--quiet", o.quiet, "no progress, estimate or summary");
   app.add_flag("--progress", o.progress,
