@@ -120,7 +120,8 @@ const burst = await Promise.all(Array.from({ length: 40 }, () => new Promise((re
 })));
 await sleep(500);
 const refused = burst.filter((s) => s.gone).length;
-check(refused >= 40 - 2 * 5 - 3 && refused <= 40 - 2 * 5 + 3,
+// (at most 30: the burst of 10 is admitted; a slow machine refills a few tokens meanwhile)
+check(refused >= 40 - 2 * 5 - 8 && refused <= 40 - 2 * 5,
       `40 connections at once from 127.0.0.20 with --max-peer-rate 5: ${refused} refused (the burst of ${2 * 5} admitted)`);
 check(await getFrom("127.0.0.21", slow.port) === 200, "another peer is not affected (200)");
 st = await stats(slow.url);

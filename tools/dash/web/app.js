@@ -41,8 +41,23 @@
   const state = {
     ws: null, readOnly: true, meta: {}, channels: new Map(), subs: new Map(), nextSub: 1,
     shafts: new Map(), selected: null, ackChannels: new Map(), nextClientChan: 1,
-    windowS: 60, notices: new Map(),
+    windowS: 60, notices: new Map(), historyQueue: [], historyPending: false,
   };
+
+  // Subscribe the next queued history once the previous one has arrived.
+  function nextHistory() {
+    if (state.historyPending) return;
+    while (state.historyQueue.length) {
+      const h = state.historyQueue.shift();
+      if (!state.subs.has(h.id)) continue;  // withdrawn meanwhile
+      state.historyPending = true;
+      send({ op: "subscribe", subscriptions: [h] });
+      // (a history dropped by the server, or a shaft withdrawn: go on after 3 s)
+      clearTimeout(state.historyTimer);
+      state.historyTimer = setTimeout(() => { state.historyPending = false; nextHistory(); }, 3000);
+      return;
+    }
+  }
 
   // Persistent server statuses (Foxglove status with an id, until removeStatus):
   // a full shaft table, two prefixes with one shaft name.
@@ -99,6 +114,7 @@
     ws.binaryType = "arraybuffer";
     state.ws = ws;
     state.channels.clear(); state.subs.clear(); state.ackChannels.clear();
+    state.historyQueue = []; state.historyPending = false;
     setConn("connecting…", "conn-wait", "connecting");
     ws.onopen = () => setConn("connected", "conn-ok", "connected");
     ws.onclose = () => {
@@ -135,7 +151,10 @@
           if (SUBSCRIBE.has(suffix)) {
             const id = state.nextSub++;
             state.subs.set(id, { shaft, suffix, channelId: ch.id });
-            subs.push({ id, channelId: ch.id });
+            // Histories one shaft at a time (each up to ~0.5 MB): all at once
+            // would overflow the server's send queue with many shafts.
+            if (suffix === "HOIST_CAGE/history") state.historyQueue.push({ id, channelId: ch.id });
+            else subs.push({ id, channelId: ch.id });
           }
           if (suffix === "HOIST_ALARM_ACK" && !state.readOnly) {
             const cid = state.nextClientChan++;
@@ -144,6 +163,7 @@
           }
         }
         if (subs.length) send({ op: "subscribe", subscriptions: subs });
+        nextHistory();
         break;
       }
       case "unadvertise": onUnadvertise(m.channelIds || []); break;
@@ -168,7 +188,7 @@
     const s = sub.shaft;
     s.lastMsg = performance.now();
     switch (sub.suffix) {
-      case "HOIST_CAGE/history": onHistory(s, msg); break;
+      case "HOIST_CAGE/history": onHistory(s, msg); clearTimeout(state.historyTimer); state.historyPending = false; nextHistory(); break;
       case "HOIST_CAGE/decimated": onCage(s, msg); break;
       case "HOIST_TRIP_PLAN": s.plan = msg; s.dirty = true; break;
       case "HOIST_GUIDE_SHAPE": s.shape = msg; s.dirty = true; break;
