@@ -41,6 +41,18 @@ dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./conffiles | grep -qx /etc/hoist-twin/
   fail "/etc/hoist-twin/mqtt/example.toml is not a conffile"
 dpkg-deb --ctrl-tarfile "$deb" | tar -t | grep -q prerm || fail "no prerm (removal would leave instances running)"
 dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./prerm | grep -q "systemctl stop" || fail "the prerm stops nothing"
+# The prerm disables enabled instances on removal (links in a scratch root), keeps them on upgrade.
+dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./prerm >"$work/prerm"
+mkdir -p "$work/droot/etc/systemd/system/multi-user.target.wants"
+for u in hoist-twind@north hoist-mqtt@site1 hoist-dash@site1 other; do
+  ln -sf /usr/lib/systemd/system/x.service "$work/droot/etc/systemd/system/multi-user.target.wants/$u.service"
+done
+DPKG_ROOT="$work/droot" sh "$work/prerm" upgrade 0.1.0 || fail "prerm upgrade failed"
+[ "$(ls "$work/droot/etc/systemd/system/multi-user.target.wants" | wc -l)" -eq 4 ] || fail "prerm upgrade removed links"
+DPKG_ROOT="$work/droot" sh "$work/prerm" remove || fail "prerm remove failed"
+[ "$(ls "$work/droot/etc/systemd/system/multi-user.target.wants")" = other.service ] ||
+  fail "prerm remove left: $(ls "$work/droot/etc/systemd/system/multi-user.target.wants")"
+echo "ok: prerm disables the enabled instances on removal only"
 dpkg-deb --contents "$deb" >"$work/contents.txt" || fail "dpkg-deb --contents"
 dpkg-deb --contents "$dev" >"$work/contents-dev.txt" || fail "dpkg-deb --contents (dev)"
 for f in ./usr/bin/hoist-twind ./usr/bin/hoist-sim ./usr/bin/hoist-alarm-ack ./etc/hoist-twin/example.toml \
