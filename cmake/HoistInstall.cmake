@@ -1,12 +1,20 @@
 # Installation, the exported CMake package and the Debian package.
 #
 #   cmake --install build [--prefix /usr]            # or: DESTDIR=/scratch cmake --install build --prefix /usr
-#   (cd build && cpack -G DEB)                        # build/hoist-twin_<version>_<arch>.deb
+#   (cd build && cpack -G DEB)                        # build/hoist-twin_<version>_<arch>.deb and hoist-twin-dev_...
+#
+# Two packages: hoist-twin (component "runtime", and "Unspecified" for the
+# install() calls of subdirectories that name none) and hoist-twin-dev
+# (component "dev": headers, static libraries, the CMake package, the .lcm
+# files).  Programs are stripped; with a build type that has debug
+# information (RelWithDebInfo, Debug) the symbols go to hoist-twin-dbgsym.
 #
 # What goes where (prefix P, /usr for the .deb):
 #   P/bin/                      the programs (hoist-twind, hoist-sim, ..., hoist-lcm-spy)
 #   /etc/hoist-twin/example.toml  the commented shaft template (a conffile; HOIST_CONFIG_DIR)
-#   P/lib/systemd/system/       hoist-twind@.service (paths filled in at install time)
+#   /etc/hoist-twin/mqtt/example.toml  the MQTT bridge's template (a conffile); /etc/hoist-twin/dash/
+#   P/lib/systemd/system/       hoist-twind@, hoist-mqtt@, hoist-dash@.service (paths filled in at install time)
+#   P/share/man/man1/           man pages made from each program's --help (help2man, when installed)
 #   P/share/hoist-twin/lcm/     the .lcm message definitions
 #   P/include/hoist/            model headers, generated C++ message headers, hoist/io, hoist/bus
 #   P/lib/<multiarch>/          libhoist_model.a, libhoist_io.a
@@ -54,16 +62,54 @@ install(CODE "
   set(HOIST_BIN_DIR \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}\")
   set(HOIST_CONFIG_DIR \"${HOIST_CONFIG_DIR}\")
   set(HOIST_DOC_DIR \"\${CMAKE_INSTALL_PREFIX}/${HOIST_DOC_SUBDIR}\")
-  foreach(unit hoist-twind@.service hoist-mqtt@.service)
+  foreach(unit hoist-twind@.service hoist-mqtt@.service hoist-dash@.service)
     configure_file(\"${PROJECT_SOURCE_DIR}/service/systemd/\${unit}.in\"
                    \"${CMAKE_BINARY_DIR}/install/\${unit}\" @ONLY)
     file(INSTALL \"${CMAKE_BINARY_DIR}/install/\${unit}\"
          DESTINATION \"\${CMAKE_INSTALL_PREFIX}/${HOIST_SYSTEMD_UNIT_DIR}\")
   endforeach()
 " COMPONENT runtime)
+# The MQTT bridge's template where hoist-mqtt@.service says (copy it to
+# /etc/hoist-twin/mqtt/<instance>.toml), and the dashboard's env directory.
+install(FILES ${PROJECT_SOURCE_DIR}/tools/mqtt/config/example.toml DESTINATION ${HOIST_CONFIG_DIR}/mqtt
+        COMPONENT runtime)
+install(DIRECTORY DESTINATION ${HOIST_CONFIG_DIR}/dash COMPONENT runtime)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${HOIST_DOC_SUBDIR} COMPONENT runtime)
+# Debian: copyright and changelog in each package's doc directory.
+configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/changelog.in ${CMAKE_BINARY_DIR}/debian/changelog @ONLY)
+execute_process(COMMAND gzip -9nf ${CMAKE_BINARY_DIR}/debian/changelog)
+foreach(pair "hoist-twin:runtime" "hoist-twin-dev:dev")
+  string(REPLACE ":" ";" pair "${pair}")
+  list(GET pair 0 _pkg)
+  list(GET pair 1 _comp)
+  install(FILES ${PROJECT_SOURCE_DIR}/cmake/debian/copyright ${CMAKE_BINARY_DIR}/debian/changelog.gz
+          DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/doc/${_pkg} COMPONENT ${_comp})
+endforeach()
+
+# ---- man pages: help2man from each program's --help and --version -------------------
+find_program(HOIST_HELP2MAN help2man)
+if(HOIST_HELP2MAN)
+  set(_hoist_man "")
+  foreach(p ${_hoist_programs} hoist-dash)
+    if(TARGET ${p})
+      set(_out ${CMAKE_BINARY_DIR}/man/${p}.1)
+      add_custom_command(
+        OUTPUT ${_out}.gz
+        COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/man
+        COMMAND ${HOIST_HELP2MAN} --no-info --no-discard-stderr --section=1
+                "--name=${p}, part of hoist-twin (digital twin of a mine-shaft hoist)" --output=${_out} $<TARGET_FILE:${p}>
+        COMMAND gzip -9nf ${_out}
+        DEPENDS ${p} VERBATIM)
+      list(APPEND _hoist_man ${_out}.gz)
+    endif()
+  endforeach()
+  add_custom_target(hoist_man ALL DEPENDS ${_hoist_man})
+  install(FILES ${_hoist_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT runtime)
+else()
+  message(STATUS "help2man not found: no man pages (apt-get install help2man)")
+endif()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${HOIST_DOC_SUBDIR}/docs COMPONENT runtime
-        PATTERN "*.json" EXCLUDE PATTERN "*.log" EXCLUDE PATTERN "*.csv" EXCLUDE PATTERN "*.gp" EXCLUDE)
+        PATTERN ".gitignore" EXCLUDE PATTERN "*.json" EXCLUDE PATTERN "*.log" EXCLUDE PATTERN "*.csv" EXCLUDE PATTERN "*.gp" EXCLUDE)
 install(FILES ${PROJECT_SOURCE_DIR}/service/config/demo.toml ${PROJECT_SOURCE_DIR}/service/config/example.toml
         DESTINATION ${HOIST_DOC_SUBDIR}/examples COMPONENT runtime)
 install(FILES ${PROJECT_SOURCE_DIR}/tools/mqtt/config/example.toml DESTINATION ${HOIST_DOC_SUBDIR}/examples
@@ -127,13 +173,14 @@ install(FILES ${CMAKE_BINARY_DIR}/install/hoistConfig.cmake ${CMAKE_BINARY_DIR}/
 # ---- the Debian package: cpack -G DEB ---------------------------------------------------
 set(CPACK_PACKAGE_NAME "hoist-twin")
 set(CPACK_PACKAGE_VENDOR "hoist-twin project")
-set(CPACK_PACKAGE_CONTACT "hoist-twin maintainers <hoist-twin@localhost>")
+set(CPACK_PACKAGE_CONTACT "hoist-twin maintainers <maintainers@hoist-twin.example.org>")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "real-time digital twin of a cable-guided mine-shaft hoist (advisory)")
 string(CONCAT CPACK_PACKAGE_DESCRIPTION
-    "hoist-twind follows the winder's speed over LCM with the Wang et al. (2016) vibration model\n"
-    "and publishes the cage's sway, tilt, guide-sleeve forces and clearance alarms.  One systemd\n"
-    "instance per shaft (hoist-twind@<shaft>.service).  Advisory only: never the shaft's protection.")
+    "hoist-twind follows the winder's speed over LCM with the Wang et al. (2016)\n"
+    "vibration model and publishes the cage's sway, tilt, guide-sleeve forces and\n"
+    "clearance alarms.  One systemd instance per shaft (hoist-twind@<shaft>), with\n"
+    "an MQTT bridge and a dashboard.  Advisory only: never the shaft's protection.")
 set(CPACK_GENERATOR "DEB")
 # install() runs with the package's prefix (/usr, whatever CMAKE_INSTALL_PREFIX
 # is) under a staging DESTDIR, so the unit written at install time names /usr/bin.
@@ -154,7 +201,37 @@ configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/postinst ${CMAKE_BINARY_DIR}/d
                FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE WORLD_READ WORLD_EXECUTE)
 configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/postrm ${CMAKE_BINARY_DIR}/debian/postrm COPYONLY
                FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE WORLD_READ WORLD_EXECUTE)
-set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
-    "${CMAKE_BINARY_DIR}/debian/conffiles;${CMAKE_BINARY_DIR}/debian/postinst;${CMAKE_BINARY_DIR}/debian/postrm")
+configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/prerm ${CMAKE_BINARY_DIR}/debian/prerm COPYONLY
+               FILE_PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE WORLD_READ WORLD_EXECUTE)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+
+# Components -> packages: runtime (+ Unspecified) -> hoist-twin, dev -> hoist-twin-dev.
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+set(CPACK_COMPONENTS_GROUPING ONE_PER_GROUP)
+set(CPACK_COMPONENTS_ALL runtime Unspecified dev)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME "hoist-twin")
+set(CPACK_DEBIAN_RUNTIME_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_SECTION "science")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA
+    "${CMAKE_BINARY_DIR}/debian/conffiles;${CMAKE_BINARY_DIR}/debian/postinst;${CMAKE_BINARY_DIR}/debian/prerm;${CMAKE_BINARY_DIR}/debian/postrm")
+set(CPACK_DEBIAN_DEV_PACKAGE_NAME "hoist-twin-dev")
+set(CPACK_DEBIAN_DEV_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_DEV_PACKAGE_SECTION "libdevel")
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "hoist-twin (= ${PROJECT_VERSION}), liblcm-dev, libeigen3-dev, libtomlplusplus-dev")
+set(CPACK_DEBIAN_DEV_PACKAGE_SHLIBDEPS OFF)
+string(CONCAT CPACK_DEBIAN_DEV_DESCRIPTION
+    "Development files of hoist-twin: the C++20 headers of the hoist model, the\n"
+    "generated LCM message types, hoist/io and hoist/bus, libhoist_model.a and\n"
+    "libhoist_io.a, and the CMake package (find_package(hoist): hoist::model,\n"
+    "hoist::io, hoist::msgs).")
+set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "${CPACK_PACKAGE_DESCRIPTION}")
+set(CPACK_STRIP_FILES ON)
+if(CMAKE_BUILD_TYPE MATCHES "^(RelWithDebInfo|Debug)$")
+  set(CPACK_DEBIAN_DEBUGINFO_PACKAGE ON)  # hoist-twin-dbgsym: the symbols stripped from the programs
+endif()
 include(CPack)
+cpack_add_component_group(runtime)
+cpack_add_component_group(dev)
+cpack_add_component(runtime GROUP runtime)
+cpack_add_component(Unspecified GROUP runtime)
+cpack_add_component(dev GROUP dev)

@@ -38,9 +38,10 @@ dashboard=(nodejs npm chromium fonts-dejavu-core)
 required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
 # Java bindings let lcm-spy decode the hoist channels (jchart2d draws its
 # plots; xvfb lets the test open its window headless); clang gives the
-# fuzzers; dpkg-dev gives dpkg-shlibdeps for the .deb (cpack -G DEB).
+# fuzzers; dpkg-dev gives dpkg-shlibdeps for the .deb (cpack -G DEB);
+# help2man makes the man pages from --help; lintian checks the .deb (tests/deploy).
 # ccache keeps recompiles (the sanitizer builds, CI's clean clone) cheap.
-optional=(ccache liblcm-java default-jdk-headless libjchart2d-java xvfb clang libclang-rt-14-dev dpkg-dev)
+optional=(ccache liblcm-java default-jdk-headless libjchart2d-java xvfb clang libclang-rt-14-dev dpkg-dev help2man lintian)
 installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 missing=()
 for p in "${required[@]}"; do installed "$p" || missing+=("$p"); done

@@ -45,7 +45,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-commands", no_commands, "do not subscribe to hoist/<shaft>/cmd/ack (read-only bridge)");
   app.add_option("--channel-prefix", prefixes,
                  "LCM channel prefix of a shaft (repeatable; MQTT shaft name = prefix without its trailing separator, "
-                 "\"default\" for none); without it, shafts are discovered from their HOIST_HEALTH, HOIST_CAGE and HOIST_ALARM channels");
+                 "\"default\" for none); without it, shafts are discovered (a prefix is bridged once its daemon's health "
+                 "keeps coming); a plant should list its shafts (docs/mqtt.md)");
   app.add_option("--cage-rate", cage_rate, "cage states per second per shaft (default 10, or [bridge] cage_rate)")
       ->check(CLI::Range(1e-3, 1000.0));
   app.add_option("--client-id", client_id, "MQTT client id (default hoist-mqtt-<hostname>)");
