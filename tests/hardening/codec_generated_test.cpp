@@ -292,7 +292,9 @@ TEST(CodecGenerated, ChannelsMatchBusChannels) {
       {"hoist.winder_t", bus::kChannelWinder},         {"hoist.cage_state_t", bus::kChannelCage},
       {"hoist.guide_shape_t", bus::kChannelGuideShape}, {"hoist.alarm_t", bus::kChannelAlarm},
       {"hoist.alarm_ack_t", bus::kChannelAlarmAck},    {"hoist.health_t", bus::kChannelHealth},
-      {"hoist.forecast_t", bus::kChannelForecast},     {"hoist.trip_plan_t", bus::kChannelTripPlan}};
+      {"hoist.forecast_t", bus::kChannelForecast},     {"hoist.trip_plan_t", bus::kChannelTripPlan},
+      {"hoist.cage_imu_t", bus::kChannelCageImu},      {"hoist.rope_load_t", bus::kChannelRopeLoad},
+      {"hoist.estimate_t", bus::kChannelEstimate}};
   std::map<std::string_view, std::string_view> gen;
   for (const ChannelInfo& c : kChannels) {
     EXPECT_NE(findByName(c.type), nullptr) << c.type;
