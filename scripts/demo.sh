@@ -10,7 +10,7 @@
 #
 #   scripts/demo.sh [--no-setup] [--speed X] [--profile SPEC|FILE]
 #                   [--config FILE] [--port N] [--with-length]
-#                   [--dash-port N] [--no-dash]
+#                   [--dash-port N] [--no-dash] [--mqtt [...]]
 #
 #   --no-setup     skip scripts/setup.sh (the build must exist)
 #   --speed X      replay X times faster than real time (default 1: 60 s).
@@ -46,7 +46,7 @@ while [[ $# -gt 0 ]]; do
     --dash-port) dash_port="$2"; shift 2 ;;
     --no-dash) dash=0; shift ;;
     --mqtt) shift; [[ $setup -eq 0 ]] && set -- --no-setup "$@"; exec "$here/scripts/demo-mqtt.sh" "$@" ;;
-    -h|--help) sed -n '2,26p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,/^[^#]/{/^#/p}' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;  # the whole header comment
     *) echo "demo.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
