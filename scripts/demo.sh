@@ -46,7 +46,7 @@ while [[ $# -gt 0 ]]; do
     --dash-port) dash_port="$2"; shift 2 ;;
     --no-dash) dash=0; shift ;;
     --mqtt) shift; [[ $setup -eq 0 ]] && set -- --no-setup "$@"; exec "$here/scripts/demo-mqtt.sh" "$@" ;;
-    -h|--help) sed -n '2,/^[^#]/{/^#/p}' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;  # the whole header comment
+    -h|--help) sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
