@@ -12,7 +12,6 @@ usage: readme_test.py README BIN_DIR SOURCE_DIR WORK_DIR
 """
 import os
 import re
-import shlex
 import shutil
 import subprocess
 import sys
@@ -32,6 +31,7 @@ def check(cond, what, detail=""):
 RUN = [
     r"^build/bin/hoist-sim (?!study )(?!.*--method paper)",
     r"^build/bin/hoist-study (sweep|preload|tension-difference|eccentric-load|mass)\b",
+    r"^build/bin/hoist-estimate ",
     r"^hoist-twind --config /etc/hoist-twin/\w+\.toml --print-config$",
 ]
 SKIP = [
@@ -59,7 +59,7 @@ def commands(text):
             block = line.strip() in ("```sh", "```bash", "```shell")
             cont = ""
             continue
-        if not block or not line.strip():
+        if not block or not line.strip() or (not cont and line.lstrip().startswith("#")):
             continue
         if cont:
             line = cont + " " + line.strip()
@@ -73,16 +73,6 @@ def commands(text):
     return out
 
 
-def strip_comment(cmd):
-    lex = shlex.shlex(cmd, posix=True, punctuation_chars=False)
-    lex.whitespace_split = True
-    lex.commenters = "#"
-    try:
-        return list(lex)
-    except ValueError:
-        return None
-
-
 text = open(readme, encoding="utf-8").read()
 cmds = commands(text)
 check(len(cmds) >= 20, f"{len(cmds)} README commands found")
@@ -91,6 +81,10 @@ shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
 env = dict(os.environ)
 env.pop("LCM_DEFAULT_URL", None)
+env["PATH"] = bin_dir + os.pathsep + env.get("PATH", "/usr/bin:/bin")
+os.symlink(os.path.dirname(os.path.abspath(bin_dir)), os.path.join(work, "build"))
+for d in ("service", "tools", "msgs"):
+    os.symlink(os.path.join(os.path.abspath(src_dir), d), os.path.join(work, d))
 sim = os.path.join(bin_dir, "hoist-sim")
 # The files the commands name: a shaft (the plant template) and a trip.
 shutil.copy(os.path.join(src_dir, "service/config/example.toml"), os.path.join(work, "shaft.toml"))
@@ -101,20 +95,14 @@ ran = 0
 for line, cmd in cmds:
     bare = re.sub(r"\s+#.*$", "", cmd).strip()
     if any(re.search(r, bare) for r in RUN):
-        argv = strip_comment(cmd)
-        if argv is None:
-            check(False, f"README:{line}: cannot parse: {cmd}")
-            continue
-        exe = argv[0]
-        if exe.startswith("build/bin/"):
-            exe = os.path.join(bin_dir, exe[len("build/bin/"):])
-        elif "/" not in exe:
-            exe = os.path.join(bin_dir, exe)
-        args = [a.replace("/etc/hoist-twin/north.toml", os.path.join(src_dir, "service/config/example.toml"))
-                for a in argv[1:]]
+        # As typed, through bash, from a directory that looks like the
+        # repository root (build/, service/, tools/, msgs/ link to the real
+        # ones); installed names (hoist-twind) found on PATH in BIN_DIR.
+        script = "set -o pipefail\n" + cmd.replace("/etc/hoist-twin/north.toml",
+                                                     os.path.join(src_dir, "service/config/example.toml"))
         t0 = time.monotonic()
         try:
-            r = subprocess.run([exe] + args, cwd=work, env=env, capture_output=True, text=True, timeout=180)
+            r = subprocess.run(["bash", "-c", script], cwd=work, env=env, capture_output=True, text=True, timeout=180)
             rc, out = r.returncode, r.stdout[-3000:] + r.stderr[-3000:]
         except subprocess.TimeoutExpired:
             rc, out = -1, "timed out after 180 s"
