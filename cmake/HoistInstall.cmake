@@ -124,18 +124,28 @@ install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/python/read_twin.py DESTINATION ${H
 # Include directories of the exported targets: the source/build paths for the
 # build tree, <prefix>/include once installed.  Set here, so the libraries'
 # own CMakeLists stay as they are.
+# Both the plain and the SYSTEM include directories (hoist_msgs' generated
+# headers are SYSTEM): no build-tree path may reach hoistTargets.cmake.
 function(hoist_export_includes target)
-  get_target_property(_dirs ${target} INTERFACE_INCLUDE_DIRECTORIES)
-  set(_new "")
-  foreach(d ${_dirs})
-    if(d MATCHES "^\\$<")
-      list(APPEND _new "${d}")
-    else()
-      list(APPEND _new "$<BUILD_INTERFACE:${d}>")
+  foreach(prop INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
+    get_target_property(_dirs ${target} ${prop})
+    if(NOT _dirs)
+      continue()
     endif()
+    set(_new "")
+    foreach(d ${_dirs})
+      if(d MATCHES "^\\$<")
+        list(APPEND _new "${d}")
+      else()
+        list(APPEND _new "$<BUILD_INTERFACE:${d}>")
+      endif()
+    endforeach()
+    # $<INSTALL_PREFIX>: exported as ${_IMPORT_PREFIX} (CMake prefixes a
+    # relative INSTALL_INTERFACE path only in INTERFACE_INCLUDE_DIRECTORIES).
+    list(APPEND _new "$<INSTALL_INTERFACE:$<INSTALL_PREFIX>/${CMAKE_INSTALL_INCLUDEDIR}>")
+    list(REMOVE_DUPLICATES _new)
+    set_target_properties(${target} PROPERTIES ${prop} "${_new}")
   endforeach()
-  list(APPEND _new "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
-  set_target_properties(${target} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_new}")
 endfunction()
 
 set(_hoist_exported "")
@@ -145,6 +155,9 @@ foreach(pair "hoist_model:model" "hoist_io:io" "hoist_msgs:msgs" "hoist_lcm:lcm"
   list(GET pair 1 name)
   if(TARGET ${t})
     hoist_export_includes(${t})
+    # The headers need C++20 (defaulted operator==, concepts): a downstream
+    # project that sets no standard gets it from the target.
+    target_compile_features(${t} INTERFACE cxx_std_20)
     set_target_properties(${t} PROPERTIES EXPORT_NAME ${name})
     list(APPEND _hoist_exported ${t})
   endif()

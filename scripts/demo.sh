@@ -10,7 +10,7 @@
 #
 #   scripts/demo.sh [--no-setup] [--speed X] [--profile SPEC|FILE]
 #                   [--config FILE] [--port N] [--with-length]
-#                   [--dash-port N] [--no-dash]
+#                   [--dash-port N] [--no-dash] [--mqtt [...]]
 #
 #   --no-setup     skip scripts/setup.sh (the build must exist)
 #   --speed X      replay X times faster than real time (default 1: 60 s).

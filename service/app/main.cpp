@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
                  "prepended to every channel name (default [service].channel_prefix; one shaft only)");
   app.add_option("--duration", duration, "stop after this many seconds (default: run until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off (default info)")
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
   app.add_flag("--force", force,

@@ -35,9 +35,37 @@ if [ -x "$root/usr/bin/hoist-lcm-spy" ]; then
   case "$cp" in *"$root/usr/bin/../share/java/hoist_msgs.jar"*) ;; *) fail "installed hoist-lcm-spy class path: $cp" ;; esac
   echo "ok: installed hoist-lcm-spy uses $cp"
 fi
-# The downstream project.
-cmake -S "$src/consumer" -B "$work/consumer" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$root/usr" \
+# Nothing installed names the build tree (hoistTargets.cmake carried
+# <build>/msgs/generated), in any text file of the staging root.
+build_abs=$(cd "$build" && pwd)
+named=$(grep -rIl -F "$build_abs" "$root" 2>/dev/null)
+[ -z "$named" ] || fail "installed files name the build tree $build_abs: $named"
+echo "ok: no installed text file names the build tree"
+# The downstream project, against a COPY of the staged install at another
+# path (a relocated prefix), so that nothing can reach the build tree's
+# generated headers; it sets no C++ standard (the targets carry cxx_std_20).
+grep -q "CMAKE_CXX_STANDARD *[0-9]" "$src/consumer/CMakeLists.txt" && fail "the consumer sets a C++ standard itself"
+targets="$(dirname "$cfg")/hoistTargets.cmake"
+grep -q "cxx_std_20" "$targets" || fail "hoistTargets.cmake: no cxx_std_20 on the targets"
+# Every include directory of the exported targets is under the install prefix.
+bad_inc=$(grep -E "INCLUDE_DIRECTORIES \"" "$targets" | tr ';' '\n' | sed 's/.*INCLUDE_DIRECTORIES "//; s/"$//' |
+          grep -v '^\${_IMPORT_PREFIX}/')
+[ -z "$bad_inc" ] || fail "hoistTargets.cmake: include directories outside the install prefix: $bad_inc"
+stage="$work/relocated"
+cp -a "$root" "$stage" || fail "copying the staged install"
+cmake -S "$src/consumer" -B "$work/consumer" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$stage/usr" \
+      -DCMAKE_EXPORT_COMPILE_COMMANDS=ON -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
       >"$work/consumer.log" 2>&1 || { cat "$work/consumer.log"; fail "configuring the consumer (find_package(hoist))"; }
+grep -q "$stage/usr/lib" "$work/consumer/CMakeCache.txt" || fail "the consumer did not find the relocated package"
 cmake --build "$work/consumer" >>"$work/consumer.log" 2>&1 || { tail -40 "$work/consumer.log"; fail "building the consumer"; }
+src_abs=$(cd "$src/../.." && pwd)
+for tree in "$build_abs" "$src_abs"; do
+  if grep -q -F "$tree/" "$work/consumer/compile_commands.json"; then
+    grep -o -F "$tree/[^ \"]*" "$work/consumer/compile_commands.json" | grep -v "/tests/deploy/consumer/" | head -3 >"$work/leak"
+    [ -s "$work/leak" ] && { cat "$work/leak"; fail "the consumer compiles with a path of $tree"; }
+  fi
+done
+grep -q -- "-std=c++20\|-std=gnu++20\|-std=c++2a\|-std=gnu++2a" "$work/consumer/compile_commands.json" ||
+  fail "the consumer is not compiled as C++20 (cxx_std_20 not carried by the targets)"
 "$work/consumer/hoist-consumer" || fail "running the consumer"
-echo "ok: find_package(hoist) from the install tree"
+echo "ok: find_package(hoist) from a relocated copy of the install tree, no C++ standard set downstream"

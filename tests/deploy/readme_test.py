@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""Every command of the README's shell blocks, so that the README cannot drift.
+
+Each command line of every ```sh block is either RUN (the fast ones: it must
+exit 0, run in a scratch directory with build/bin/ mapped to BIN_DIR and the
+files it names prepared) or SKIPPED by a rule below that says why (a live LCM
+session, minutes of run time, root, a GUI).  A command that no rule knows
+fails the test: add it to RUN or SKIP here when you add it to the README.
+Also checks that the options the README lists for a program are in its --help,
+that scripts/demo.sh --help lists --mqtt and hoist-twind's --log-level help every level.
+usage: readme_test.py README BIN_DIR SOURCE_DIR WORK_DIR
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+readme, bin_dir, src_dir, work = sys.argv[1:5]
+failures = []
+
+
+def check(cond, what, detail=""):
+    print(("ok   " if cond else "FAIL ") + what + ("" if cond or not detail else "\n" + detail))
+    if not cond:
+        failures.append(what)
+
+
+# (regex on the command, reason).  First match wins; RUN rules come first.
+RUN = [
+    r"^build/bin/hoist-sim (?!study )(?!.*--method paper)",
+    r"^build/bin/hoist-study (sweep|preload|tension-difference|eccentric-load|mass)\b",
+    r"^build/bin/hoist-estimate ",
+    r"^hoist-twind --config /etc/hoist-twin/\w+\.toml --print-config$",
+]
+SKIP = [
+    (r"^scripts/(demo|test)\.sh", "minutes of set-up and run time (CI runs scripts/test.sh; demo_* tests)"),
+    (r"^build/bin/hoist-sim .*--method paper", "the paper's literal method: slow (tests/model compare it)"),
+    (r"^build/bin/hoist-(sim study|study) ", "a study of several minute-long runs (tests/study)"),
+    (r"^export LCM_DEFAULT_URL=", "environment of the live session below"),
+    (r"^(build/bin/)?hoist-twind( &)?$|^lcm-logger |^lcm-logplayer |^build/bin/hoist-replay |^build/bin/hoist-log2csv run\.lcm",
+     "a live LCM session of minutes (tests/integration, deploy_python_reader)"),
+    (r"^build/bin/hoist-lcm-spy", "a GUI (deploy_lcm_spy opens it under Xvfb)"),
+    (r"^build/bin/hoist-dash ", "a server that runs until stopped (tests/dash)"),
+    (r"^lcm-gen -p |^PYTHONPATH=", "deploy_python_reader runs these against a live twin"),
+    (r"^bench/", "benchmarks of 10-20 minutes"),
+    (r"^cmake --build build -j && \(cd build && cpack", "the whole build and package (deploy_deb)"),
+    (r"# as root\b|^systemctl |^journalctl ", "root / systemd on the target machine (deploy_install, deploy_unit_verify)"),
+    (r"^hoist-replay --timing-test .*--duration 600", "a 10-minute timing test (timing_test_test runs short ones)"),
+]
+
+
+def commands(text):
+    """(line number, command with its trailing comment) of every ```sh block."""
+    out, block, start, cont = [], False, 0, ""
+    for i, line in enumerate(text.splitlines(), 1):
+        if line.startswith("```"):
+            block = line.strip() in ("```sh", "```bash", "```shell")
+            cont = ""
+            continue
+        if not block or not line.strip() or (not cont and line.lstrip().startswith("#")):
+            continue
+        if cont:
+            line = cont + " " + line.strip()
+        else:
+            start = i
+        if line.rstrip().endswith("\\") or re.search(r"\\\s+#", line):
+            cont = re.sub(r"\\(\s+#.*)?$", "", line.rstrip()).rstrip()
+            continue
+        cont = ""
+        out.append((start, line.strip()))
+    return out
+
+
+text = open(readme, encoding="utf-8").read()
+cmds = commands(text)
+check(len(cmds) >= 20, f"{len(cmds)} README commands found")
+
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+env = dict(os.environ)
+env.pop("LCM_DEFAULT_URL", None)
+env["PATH"] = bin_dir + os.pathsep + env.get("PATH", "/usr/bin:/bin")
+os.symlink(os.path.dirname(os.path.abspath(bin_dir)), os.path.join(work, "build"))
+for d in ("service", "tools", "msgs"):
+    os.symlink(os.path.join(os.path.abspath(src_dir), d), os.path.join(work, d))
+sim = os.path.join(bin_dir, "hoist-sim")
+# The files the commands name: a shaft (the plant template) and a trip.
+shutil.copy(os.path.join(src_dir, "service/config/example.toml"), os.path.join(work, "shaft.toml"))
+subprocess.run([sim, "--profile", "paper", "--write-profile", os.path.join(work, "trip.csv")],
+               check=True, capture_output=True, timeout=60)
+
+ran = 0
+for line, cmd in cmds:
+    bare = re.sub(r"\s+#.*$", "", cmd).strip()
+    if any(re.search(r, bare) for r in RUN):
+        # As typed, through bash, from a directory that looks like the
+        # repository root (build/, service/, tools/, msgs/ link to the real
+        # ones); installed names (hoist-twind) found on PATH in BIN_DIR.
+        script = "set -o pipefail\n" + cmd.replace("/etc/hoist-twin/north.toml",
+                                                     os.path.join(src_dir, "service/config/example.toml"))
+        t0 = time.monotonic()
+        try:
+            r = subprocess.run(["bash", "-c", script], cwd=work, env=env, capture_output=True, text=True, timeout=180)
+            rc, out = r.returncode, r.stdout[-3000:] + r.stderr[-3000:]
+        except subprocess.TimeoutExpired:
+            rc, out = -1, "timed out after 180 s"
+        check(rc == 0, f"README:{line}: exit {rc} in {time.monotonic() - t0:.1f} s: {bare}", out)
+        ran += 1
+        continue
+    why = next((reason for r, reason in SKIP if re.search(r, bare) or re.search(r, cmd)), None)
+    check(why is not None, f"README:{line}: classified: {bare}",
+          "a README command no rule of tests/deploy/readme_test.py knows: add it to RUN or SKIP")
+    if why:
+        print(f"     skipped ({why})")
+check(ran >= 6, f"{ran} README commands run")
+
+# The options the README names in its synopsis lines exist in each program's --help.
+for m in re.finditer(r"^(hoist-[a-z0-9-]+) (\[.*)$", text, re.M):
+    prog, rest = m.group(1), m.group(2)
+    exe = os.path.join(bin_dir, prog)
+    if not os.path.exists(exe):
+        continue
+    r = subprocess.run([exe, "--help"], capture_output=True, text=True, timeout=60, env=env)
+    for opt in sorted(set(re.findall(r"(--[a-z][a-z0-9-]+)", rest))):
+        check(opt in r.stdout + r.stderr, f"README synopsis: {prog} --help lists {opt}")
+
+# Help texts the README relies on (issue 24, section 6).
+r = subprocess.run(["bash", os.path.join(src_dir, "scripts/demo.sh"), "--help"], capture_output=True, text=True,
+                   timeout=60)
+check(r.returncode == 0 and "--mqtt" in r.stdout, "scripts/demo.sh --help lists --mqtt", r.stdout[-1500:])
+twind = os.path.join(bin_dir, "hoist-twind")
+if os.path.exists(twind):
+    out = subprocess.run([twind, "--help"], capture_output=True, text=True, timeout=60, env=env).stdout
+    m = re.search(r"--log-level[^\n]*(\n\s{20,}[^\n]*)*", out)
+    # The description (the lines under the option; CLI11's own {a,b,...} list is on the first).
+    desc = m.group(0).split("\n", 1)[1] if m and "\n" in m.group(0) else ""
+    check(all(l in desc for l in ("trace", "debug", "info", "warn", "error", "critical", "off")),
+          "hoist-twind --help: --log-level lists every level it accepts (critical too)", m.group(0) if m else out)
+
+print(f"{len(failures)} failure(s)")
+sys.exit(1 if failures else 0)
