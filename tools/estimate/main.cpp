@@ -276,16 +276,15 @@ int main(int argc, char** argv) {
       "writes such files.",
       "hoist-estimate"};
   app.name("hoist-estimate");
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-estimate ") + hoist::kVersionString);
   app.add_option("--config", o.config,
                  "shaft TOML or hoist-twind's configuration: the twin's shaft, [sensors] noise and [estimator] "
-                 "tuning (enabled is not needed here)")
-      ->required()
+                 "tuning (enabled is not needed here); required")
       ->check(CLI::ExistingFile);
-  app.add_option("--measurements", o.measurements, "measurement CSV (t,l,v,a[,f_y,omega,rope_load])")
-      ->required()
+  app.add_option("--measurements", o.measurements, "measurement CSV (t,l,v,a[,f_y,omega,rope_load]); required")
       ->check(CLI::ExistingFile);
-  app.add_option("--out", o.out, "estimate CSV to write (one row per measurement row)")->required();
+  app.add_option("--out", o.out, "estimate CSV to write (one row per measurement row); required");
   app.add_option("--modes", o.modes, "assumed modes per rope n (overrides model.modes)")
       ->check(CLI::Range(1, hoist::kMaxModes));
   app.add_option("--max-step", o.max_step,
@@ -300,6 +299,15 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
+  // Required, but checked after parsing: CLI11 reports a missing option
+  // before an unknown one, and an unknown option must be named.
+  for (const auto& [given, what] : {std::pair{!o.config.empty(), "--config"},
+                                    std::pair{!o.measurements.empty(), "--measurements"},
+                                    std::pair{!o.out.empty(), "--out"}})
+    if (!given) {
+      std::cerr << "hoist-estimate: " << what << " is required\nRun with --help for more information.\n";
+      return 2;
+    }
   try {
     return run(o);
   } catch (const hoist::io::InputError& e) {
