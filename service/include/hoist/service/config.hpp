@@ -69,7 +69,8 @@ struct ServiceConfig {
   /// time at full accuracy; a longer gap (the loop was late) is crossed with
   /// proportionally longer substeps, counted and flagged degraded, [1, 1000].
   int max_catchup_periods = 4;
-  /// Operator commands handled per tick; more are dropped and counted, [1, 1000].
+  /// Valid operator commands applied per tick; more are dropped and counted
+  /// (undecodable and invalid ones never count against it), [1, 1000].
   int max_commands_per_tick = 4;
 
   void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
