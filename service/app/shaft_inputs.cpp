@@ -227,7 +227,8 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   const trip_plan_t& m = plan_in_;
-  if (forecast_->hasPlan() && m.seq <= forecast_->planSeq()) {
+  const double t = ctx_.core.modelTime();
+  if (forecast_->hasPlan(t) && m.seq <= forecast_->planSeq()) {
     std::snprintf(text_, sizeof text_, "seq %lld is not newer than the plan in force (seq %lld)",
                   static_cast<long long>(m.seq), static_cast<long long>(forecast_->planSeq()));
     rejectPlan(PlanReject::OldSeq, text_);
@@ -246,8 +247,18 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     rejectPlan(planReject(pc.error), text_);
     return;
   }
+  // Physically plausible: within the winder's own limits (a plan with a jerk
+  // of 1e6 would forecast forces the shaft never sees, marked OK).
+  const ForecastConfig& fc = ctx_.cfg.forecast;
+  if (m.vmax > fc.vmax || m.amax > fc.amax || m.jerk > fc.jerk) {
+    std::snprintf(text_, sizeof text_, "seq %lld vmax %g amax %g jerk %g beyond the winder's limits "
+                  "(forecast.vmax %g m/s, amax %g m/s^2, jerk %g m/s^3)",
+                  static_cast<long long>(m.seq), m.vmax, m.amax, m.jerk, fc.vmax, fc.amax, fc.jerk);
+    rejectPlan(PlanReject::AboveLimits, text_);
+    return;
+  }
   ++ctx_.stats.plans_accepted;
-  if (forecast_->acceptPlan(p, m.seq))
+  if (forecast_->acceptPlan(p, m.seq, t))
     ctx_.log.info("{}trip plan accepted (seq {}): target {} m, vmax {} m/s, amax {} m/s^2, jerk {} m/s^3", ctx_.tag,
                   m.seq, m.target_length, m.vmax, m.amax, m.jerk);
 }
