@@ -21,11 +21,24 @@ void ForecastScheduler::setPool(ForecastPool* pool, double phase) {
   next_t_ = phase / ctx_.cfg.forecast.rate;
 }
 
-bool ForecastScheduler::acceptPlan(const TripPlan& plan, std::int64_t seq) {
+bool ForecastScheduler::hasPlan(double t) {
+  // Expired when not renewed within plan_timeout (either way: the model time
+  // restarts with a new winder stream).
+  if (have_plan_ && std::fabs(t - plan_t_) > ctx_.cfg.forecast.plan_timeout) {
+    have_plan_ = false;
+    ctx_.log.info("{}trip plan seq {} expired (not renewed for forecast.plan_timeout = {} s): the forecasts use the "
+                  "no-plan rule, any sequence number is accepted again",
+                  ctx_.tag, plan_seq_, ctx_.cfg.forecast.plan_timeout);
+  }
+  return have_plan_;
+}
+
+bool ForecastScheduler::acceptPlan(const TripPlan& plan, std::int64_t seq, double t) {
   const bool first = !have_plan_;
   have_plan_ = true;
   plan_ = plan;
   plan_seq_ = seq;
+  plan_t_ = t;
   return first;
 }
 
@@ -52,9 +65,9 @@ void ForecastScheduler::afterStep(std::int64_t utime) {
   fast_->saveState(snap.state);
   snap.utime = utime;
   snap.t_published = tp;
-  snap.has_plan = have_plan_;
+  snap.has_plan = hasPlan(core.modelTime());
   snap.plan = plan_;
-  snap.plan_seq = plan_seq_;
+  snap.plan_seq = snap.has_plan ? plan_seq_ : -1;
   if (core.clock() == ClockMode::Input || !pool_) {
     // Deterministic: the forecast runs here, at this instant, and its result
     // is published before the next input is read.

@@ -39,10 +39,13 @@ class ForecastScheduler {
   void pollResult();
 
   // ---- the trip plan in force (ShaftInputs decides what is accepted) ----
-  bool hasPlan() const { return have_plan_; }
+  /// Whether a plan is in force at model time `t`: one expires
+  /// [forecast] plan_timeout after it was accepted (logged once).
+  bool hasPlan(double t);
   std::int64_t planSeq() const { return plan_seq_; }
-  /// `plan` with sequence number `seq` is now in force.  True if it is the first.
-  bool acceptPlan(const TripPlan& plan, std::int64_t seq);
+  /// `plan` with sequence number `seq` is in force from model time `t`.
+  /// True if no plan was in force.
+  bool acceptPlan(const TripPlan& plan, std::int64_t seq, double t);
 
  private:
   void onResult(const ForecastResult& r);
@@ -59,6 +62,7 @@ class ForecastScheduler {
   bool have_plan_ = false;            ///< a trip plan is in force
   TripPlan plan_;                     ///< the trip plan in force
   std::int64_t plan_seq_ = -1;        ///< its sequence number
+  double plan_t_ = 0.0;               ///< model time it was accepted [s]
 };
 
 }  // namespace hoist::svc

@@ -19,6 +19,7 @@ using std::chrono::duration;
 ShaftInputs::ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast)
     : ctx_(ctx), in_(in), out_(out), forecast_(forecast) {
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
+  decode_budget_ = std::max(kMinDecodesPerTick, static_cast<int>(kDecodesPerSecond / ctx_.cfg.service.rate));
   routes_[kWinder] = {this, &ctx_.ch.winder, &ShaftInputs::handleWinder, "HOIST_WINDER"};
   routes_[kAck] = {this, &ctx_.ch.ack, &ShaftInputs::handleAck, "HOIST_ALARM_ACK"};
   routes_[kTripPlan] = {this, &ctx_.ch.trip_plan, &ShaftInputs::handleTripPlan, "HOIST_TRIP_PLAN"};
@@ -139,15 +140,21 @@ void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
 void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   // Operator commands are rare and outside the tick: decoding them into the
   // message's std::strings may allocate.  Anyone on the group can send
-  // commands (docs/security.md): at most max_commands_per_tick are handled
-  // per tick (the rest are dropped and counted); junk is logged under a rate
-  // limit; every EFFECTIVE command is audited (log line and the HOIST_ALARM
-  // events it causes carry the user) and never rate-limited.
+  // commands (docs/security.md), so junk must never take a genuine
+  // command's place:
+  //   * decoding is bounded on its own, at decode_budget_ datagrams per tick
+  //     (200 000 a second, at least 256 per tick); beyond it a datagram is
+  //     dropped undecoded and counted;
+  //   * only a VALID command counts against max_commands_per_tick: undecodable
+  //     or invalid ones cost their decode and are counted in commands_invalid;
+  //   * junk is logged under a rate limit; every EFFECTIVE command is audited
+  //     (log line and the HOIST_ALARM events it causes carry the user) and
+  //     never rate-limited.
   ShaftStats& st = ctx_.stats;
-  const int budget = ctx_.cfg.service.max_commands_per_tick;
-  if (++commands_this_tick_ > budget) {
+  if (++decodes_this_tick_ > decode_budget_) {
     ++st.commands_dropped;
-    logJunk(fmt::format("alarm command dropped: more than service.max_commands_per_tick = {} this tick", budget));
+    ++st.command_decodes_dropped;
+    logJunk(fmt::format("alarm command dropped undecoded: more than {} command datagrams this tick", decode_budget_));
     return;
   }
   hoist::alarm_ack_t ack;
@@ -166,6 +173,13 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   if (!cmd) {
     ++st.commands_invalid;
     logJunk(fmt::format("ignored alarm command from '{}' (kind '{}'): {}", user, printable(ack.kind), why));
+    return;
+  }
+  const int budget = ctx_.cfg.service.max_commands_per_tick;
+  if (++commands_this_tick_ > budget) {
+    ++st.commands_dropped;
+    logJunk(fmt::format("alarm command from '{}' dropped: more than service.max_commands_per_tick = {} valid "
+                        "commands this tick", user, budget));
     return;
   }
   const int n = ctx_.core.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
@@ -213,7 +227,8 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   const trip_plan_t& m = plan_in_;
-  if (forecast_->hasPlan() && m.seq <= forecast_->planSeq()) {
+  const double t = ctx_.core.modelTime();
+  if (forecast_->hasPlan(t) && m.seq <= forecast_->planSeq()) {
     std::snprintf(text_, sizeof text_, "seq %lld is not newer than the plan in force (seq %lld)",
                   static_cast<long long>(m.seq), static_cast<long long>(forecast_->planSeq()));
     rejectPlan(PlanReject::OldSeq, text_);
@@ -232,8 +247,18 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     rejectPlan(planReject(pc.error), text_);
     return;
   }
+  // Physically plausible: within the winder's own limits (a plan with a jerk
+  // of 1e6 would forecast forces the shaft never sees, marked OK).
+  const ForecastConfig& fc = ctx_.cfg.forecast;
+  if (m.vmax > fc.vmax || m.amax > fc.amax || m.jerk > fc.jerk) {
+    std::snprintf(text_, sizeof text_, "seq %lld vmax %g amax %g jerk %g beyond the winder's limits "
+                  "(forecast.vmax %g m/s, amax %g m/s^2, jerk %g m/s^3)",
+                  static_cast<long long>(m.seq), m.vmax, m.amax, m.jerk, fc.vmax, fc.amax, fc.jerk);
+    rejectPlan(PlanReject::AboveLimits, text_);
+    return;
+  }
   ++ctx_.stats.plans_accepted;
-  if (forecast_->acceptPlan(p, m.seq))
+  if (forecast_->acceptPlan(p, m.seq, t))
     ctx_.log.info("{}trip plan accepted (seq {}): target {} m, vmax {} m/s, amax {} m/s^2, jerk {} m/s^3", ctx_.tag,
                   m.seq, m.target_length, m.vmax, m.amax, m.jerk);
 }

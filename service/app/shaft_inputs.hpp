@@ -45,8 +45,15 @@ class ShaftInputs {
   void subscribe(bus::InputRouter* router, bool own_health);
   /// Watch our own HOIST_HEALTH through `router` (the output URL's socket).
   void watchOwnOutputs(bus::InputRouter* router);
-  /// Once per tick, at its start: a new command budget.
-  void beginTick() { commands_this_tick_ = 0; }
+  /// Once per tick, at its start: new command and decode budgets.
+  void beginTick() {
+    commands_this_tick_ = 0;
+    decodes_this_tick_ = 0;
+  }
+  /// Command datagrams decoded per tick at most: this many per second...
+  static constexpr double kDecodesPerSecond = 200000.0;
+  /// ... but at least this many per tick.
+  static constexpr int kMinDecodesPerTick = 256;
   /// Once per tick: the other publisher of our outputs is forgotten after
   /// three health periods without a word.
   void forgetSilentPublisher(double wall);
@@ -86,6 +93,8 @@ class ShaftInputs {
   static constexpr int kLogKeys = kRejectReasons + 3;             ///< number of keys
   LogRateLimiter<kLogKeys> log_limit_{5};  ///< rate limit of this room's warning lines
   int commands_this_tick_ = 0;      ///< valid commands applied or dropped this tick
+  int decodes_this_tick_ = 0;       ///< command datagrams decoded (or dropped undecoded) this tick
+  int decode_budget_ = kMinDecodesPerTick;  ///< command datagrams decoded per tick at most
   std::int64_t other_id_ = 0;       ///< another publisher's instance id
   double other_seen_wall_ = -1.0;   ///< when it was last seen (< 0: not seen)
   hoist::winder_t winder_in_;       ///< decode scratch of HOIST_WINDER

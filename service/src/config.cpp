@@ -95,6 +95,8 @@ void ForecastConfig::validate(double service_rate) const {
   checkRange("estop_jerk", estop_jerk, 0.0, 1000.0, true, f);
   checkRange("vmax", vmax, 0.0, 100.0, true, f);
   checkRange("amax", amax, 0.0, 50.0, true, f);
+  checkRange("jerk", jerk, 0.0, 1000.0, true, f);
+  checkRange("plan_timeout", plan_timeout, 0.0, 3600.0, true, f);
   checkRange("workers", workers, 1, 16, false, f);
   checkRange("series_points", series_points, 1, 64, false, f);
 }

@@ -97,6 +97,8 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   fr.number("estop_jerk", f.estop_jerk);
   fr.number("vmax", f.vmax);
   fr.number("amax", f.amax);
+  fr.number("jerk", f.jerk);
+  fr.number("plan_timeout", f.plan_timeout);
   fr.integer("workers", f.workers);
   fr.integer("series_points", f.series_points);
   fr.run();
@@ -160,6 +162,7 @@ std::string toToml(const TwinConfig& c) {
   os << "\n[forecast]\nenabled = " << (f.enabled ? "true" : "false") << "\nrate = " << Num{f.rate}
      << "\nhorizon = " << Num{f.horizon} << "\nestop_decel = " << Num{f.estop_decel}
      << "\nestop_jerk = " << Num{f.estop_jerk} << "\nvmax = " << Num{f.vmax} << "\namax = " << Num{f.amax}
+     << "\njerk = " << Num{f.jerk} << "\nplan_timeout = " << Num{f.plan_timeout}
      << "\nworkers = " << f.workers << "\nseries_points = " << f.series_points << "\n";
   return os.str();
 }

@@ -18,6 +18,7 @@ const char* toString(PlanReject r) {
     case PlanReject::OvershootsVmax: return "plan_overshoots_vmax";
     case PlanReject::OvershootsStop: return "plan_overshoots_stop";
     case PlanReject::Unreachable: return "plan_unreachable";
+    case PlanReject::AboveLimits: return "plan_above_limits";
   }
   return "plan_?";
 }

@@ -232,6 +232,7 @@ Kinematics TwinCore::integrate(const Kinematics& k0, double v1, double a1, doubl
 void TwinCore::acceptSample(const WinderSample& s, double wall_now) {
   validator_.accept(s);
   last_ = s;
+  if (s.has_length) length_unverified_ = false;  // the encoder anchors the length again
   last_input_wall_ = wall_now;
   have_input_ = true;
   stream_ = true;
@@ -382,7 +383,17 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
 }
 
 bool TwinCore::degradedNow() const {
-  return !have_input_ || stale_ || t_ < fault_until_ || domain_outside_ || t_ <= catchup_until_;
+  return !have_input_ || stale_ || t_ < fault_until_ || domain_outside_ || t_ <= catchup_until_ ||
+         length_unverified_;
+}
+
+void TwinCore::lostMotion(RejectReason r) {
+  // A replayed sample (duplicate or older) carries no motion the twin lacks;
+  // any other rejected input of a stream without an encoder might have.
+  if (!started_ || !have_input_ || last_.has_length) return;
+  if (r == RejectReason::DuplicateSeq || r == RejectReason::TimeBackwards) return;
+  length_unverified_ = true;
+  out_.degraded = true;
 }
 
 double TwinCore::periodStaleTimeout() const {
@@ -407,6 +418,7 @@ InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
   const Verdict v = validator_.check(s);
   if (!v.ok) {
     counters_.reject(v.reason);
+    if (!s.has_length) lostMotion(v.reason);
     // An encoder length outside the valid range is the MODEL_DOMAIN condition.
     if (v.reason == RejectReason::LengthRange) setDomain(true, s.length);
     InputResult res;
@@ -419,7 +431,10 @@ InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
   // network jitter); lost messages only make the estimate more lenient.
   const double period = new_stream ? 0.0 : static_cast<double>(s.utime - validator_.last().utime) * 1e-6;
   InputResult res = clock_->onInput(*this, s, new_stream, wall_now);
-  if (!res.accepted) return res;
+  if (!res.accepted) {
+    if (!s.has_length) lostMotion(res.reason);
+    return res;
+  }
   if (new_stream) period_est_ = 0.0;
   else if (period > 0.0) period_est_ = period_est_ > 0.0 ? 0.9 * period_est_ + 0.1 * period : period;
   ++counters_.accepted;

@@ -63,6 +63,7 @@ TwinConfig demoShaft(int n, ClockMode clock) {
   c.alarms.warning_fraction = 0.6;
   c.alarms.critical_fraction = 0.9;
   c.forecast.enabled = true;
+  c.forecast.plan_timeout = 3600.0;  // the feeders here send their plan once
   return c;
 }
 
@@ -484,6 +485,59 @@ TEST(ForecastPlans, BadPlansAreRejectedEachWithItsCountedReason) {
   EXPECT_EQ(fc.back().plan_seq, 18);
 }
 
+// A plan beyond the winder's own limits ([forecast] vmax, amax, jerk) is
+// refused and counted, and never forecast from; a plan with seq = INT64_MAX
+// locks genuine plans out only until it expires ([forecast] plan_timeout),
+// after which a sequence reset is accepted.  Port 7952.
+TEST(ForecastPlans, ImplausiblePlansAreRefusedAndAMaxSeqPlanExpires) {
+  TwinConfig c = demoShaft(6, ClockMode::Input);
+  c.forecast.rate = 1.0;
+  c.forecast.horizon = 1.0;
+  c.forecast.plan_timeout = 2.0;
+  Rig rig(7952, {c});
+  REQUIRE_MULTICAST(rig);
+  ASSERT_TRUE(rig.start({"HOIST_CAGE", "HOIST_HEALTH", "HOIST_FORECAST"})) << rig.logs();
+  const HoistProfile trip = HoistProfile::trapezoid();
+  long k = 0;
+  auto feedTo = [&](long last) {
+    for (; k <= last; ++k) {
+      rig.publishWinder("", kUtime0 + 10000 * k, k, trip.at(0.01 * static_cast<double>(k)));
+      const std::size_t want = static_cast<std::size_t>(k + 1);
+      ASSERT_TRUE(rig.pumpUntil([&] { return rig.listener().count("HOIST_CAGE") >= want; })) << rig.logs();
+    }
+  };
+  feedTo(1000);  // cruising down at 5 m/s
+  rig.publishPlan("", 1, 300.0, 5.0, 1e6, 1.0);   // amax 1e6
+  rig.publishPlan("", 2, 300.0, 5.0, 1.0, 1e6);   // jerk 1e6
+  rig.publishPlan("", 3, 300.0, 50.0, 1.0, 1.0);  // vmax 50
+  feedTo(1100);
+  rig.publishPlan("", std::numeric_limits<std::int64_t>::max(), 300.0, 5.0, 1.0, 1.0);  // forged, but plausible
+  feedTo(1150);
+  rig.publishPlan("", 4, 300.0, 5.0, 1.0, 1.0);   // locked out while the forged plan is in force
+  feedTo(1450);                                   // 3 s later: the forged plan expired
+  rig.publishPlan("", 5, 300.0, 5.0, 1.0, 1.0);   // a sequence reset is accepted
+  feedTo(1620);                                   // forecasts at 15 and 16 s follow it (it expires at 16.5 s)
+  const std::size_t h0 = rig.listener().count("HOIST_HEALTH");
+  ASSERT_TRUE(rig.pumpUntil([&] { return rig.listener().count("HOIST_HEALTH") >= h0 + 2; }));
+  const auto health = rig.listener().decoded<health_t>("HOIST_HEALTH");
+  ASSERT_FALSE(health.empty());
+  const health_t& h = health.back();
+  EXPECT_EQ(reasonCount(h, "plan_above_limits"), 3);
+  EXPECT_EQ(reasonCount(h, "plan_old_seq"), 1);
+  EXPECT_EQ(h.plans_accepted, 2);
+  EXPECT_EQ(h.plans_rejected, 4);
+  const std::string logs = rig.logs();
+  EXPECT_NE(logs.find("rejected trip plan (plan_above_limits): seq 1 vmax 5 amax 1e+06"), std::string::npos) << logs;
+  EXPECT_NE(logs.find("expired"), std::string::npos) << logs;
+  // No forecast ever followed an implausible plan; the last follows seq 5.
+  const auto fc = rig.listener().decoded<forecast_t>("HOIST_FORECAST");
+  ASSERT_FALSE(fc.empty());
+  for (const forecast_t& f : fc) EXPECT_TRUE(f.plan_seq == -1 || f.plan_seq == 5 ||
+                                             f.plan_seq == std::numeric_limits<std::int64_t>::max())
+      << f.plan_seq;
+  EXPECT_EQ(fc.back().plan_seq, 5);
+}
+
 // ---- several shafts ------------------------------------------------------------
 
 TEST(ForecastShafts, SeveralShaftsForecastOnTheOnePool) {
@@ -607,6 +661,8 @@ TEST(ForecastUsefulness, PredictedClearanceLeadsTheActualCriticalAlarm) {
   TwinConfig c = demoShaft(20, ClockMode::Input);
   c.forecast.rate = 1.0;
   c.forecast.horizon = 20.0;
+  c.forecast.vmax = 10.0;  // the winder's limits: the plan below runs at them
+  c.forecast.amax = 2.0;
   Rig rig(7975, {c});
   REQUIRE_MULTICAST(rig);
   ASSERT_TRUE(rig.start({"HOIST_CAGE", "HOIST_FORECAST", "HOIST_ALARM"})) << rig.logs();

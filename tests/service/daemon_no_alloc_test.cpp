@@ -66,6 +66,7 @@ TwinConfig shaftConfig(double rate, int n, const std::string& prefix) {
   c.forecast.enabled = true;
   c.forecast.rate = 5.0;
   c.forecast.horizon = 0.5;
+  c.forecast.amax = 1.5;  // the winder's limit: the feeder's plans use amax 1.5
   return c;
 }
 

@@ -260,6 +260,46 @@ TEST(TwinCoreInput, RejectionsLeaveTheModelUntouched) {
   EXPECT_LT(core.output().kin.l, cfg.shaft.maxRopeLength() - 0.05);
 }
 
+// Without an encoder the rope length is integrated from v and a: after a
+// rejected input that may have carried motion, the twin cannot know its
+// length matches the winder's, so it is flagged degraded -- on both clocks --
+// until an accepted input carries an encoder length; a replayed (duplicate)
+// sample carries no new motion and changes nothing.
+TEST(TwinCoreInput, RejectedInputWithoutEncoderIsDegradedUntilAnEncoderLength) {
+  for (const ClockMode clock : {ClockMode::Input, ClockMode::Wall}) {
+    SCOPED_TRACE(toString(clock));
+    TwinCore core(smallConfig(), clock);
+    const HoistProfile trip = HoistProfile::trapezoid();
+    const double dt = 0.01;
+    long k = 0;
+    auto feed = [&](long last, bool with_length) {
+      for (; k <= last; ++k) {
+        ASSERT_TRUE(core.onInput(sampleAt(trip, k, dt, with_length), 0.5 + dt * static_cast<double>(k)).accepted)
+            << "sample " << k;
+        if (clock == ClockMode::Wall) core.tick(dt * static_cast<double>(k + 1), 0.5 + dt * static_cast<double>(k));
+      }
+    };
+    feed(300, false);  // accelerating, no encoder
+    EXPECT_FALSE(core.degraded());
+    WinderSample dup = sampleAt(trip, k - 1, dt, false);  // a replay: rejected, no motion lost
+    EXPECT_EQ(core.onInput(dup, 3.5).reason, RejectReason::DuplicateSeq);
+    EXPECT_FALSE(core.degraded());
+    // Two samples with an impossible acceleration: rejected, their motion lost.
+    for (int i = 0; i < 2; ++i, ++k) {
+      WinderSample bad = sampleAt(trip, k, dt, false);
+      bad.a = 1e3;
+      EXPECT_EQ(core.onInput(bad, 0.5 + dt * static_cast<double>(k)).reason, RejectReason::AccelLimit);
+    }
+    EXPECT_TRUE(core.degraded());
+    feed(k + 200, false);  // accepted again, still no encoder: still degraded
+    EXPECT_TRUE(core.degraded());
+    EXPECT_TRUE(core.lengthUnverified());
+    feed(k + 1, true);  // an encoder length anchors the length again
+    EXPECT_FALSE(core.lengthUnverified());
+    EXPECT_FALSE(core.degraded());
+  }
+}
+
 TEST(TwinCoreWall, StaleInputHoldsAndRaisesAnAlarm) {
   TwinConfig cfg = smallConfig();
   cfg.service.stale_timeout = 0.5;

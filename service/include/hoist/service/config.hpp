@@ -69,7 +69,8 @@ struct ServiceConfig {
   /// time at full accuracy; a longer gap (the loop was late) is crossed with
   /// proportionally longer substeps, counted and flagged degraded, [1, 1000].
   int max_catchup_periods = 4;
-  /// Operator commands handled per tick; more are dropped and counted, [1, 1000].
+  /// Valid operator commands applied per tick; more are dropped and counted
+  /// (undecodable and invalid ones never count against it), [1, 1000].
   int max_commands_per_tick = 4;
 
   void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
@@ -88,6 +89,15 @@ struct ForecastConfig {
   double estop_jerk = 10.0;   ///< rate at which the e-stop deceleration builds up [m/s^3], (0, 1000]
   double vmax = 5.0;          ///< the winder's normal speed limit (no-plan rule) [m/s], (0, 100]
   double amax = 1.0;          ///< the winder's normal acceleration limit (no-plan rule) [m/s^2], (0, 50]
+  /// The winder's jerk limit [m/s^3], (0, 1000].  With vmax and amax it is
+  /// the physical bound of a trip plan: a plan whose vmax, amax or jerk
+  /// exceeds it is refused (plan_above_limits), never forecast from.
+  double jerk = 100.0;
+  /// A trip plan not renewed for this long [s of model time] expires; the
+  /// forecasts fall back to the no-plan rule and any sequence number is
+  /// accepted again (a sender that restarts, or a forged seq = INT64_MAX,
+  /// locks nothing out for longer), (0, 3600].
+  double plan_timeout = 10.0;
   int workers = 1;            ///< forecast threads per process, shared by all shafts, [1, 16]
   int series_points = 50;     ///< points of the decimated series in forecast_t, [1, 64]
 

@@ -14,7 +14,8 @@
 namespace hoist::svc {
 
 /// Reasons a HOIST_TRIP_PLAN message is rejected: undecodable, an old
-/// sequence number, then every hoist::PlanError (after None), in order.
+/// sequence number, then every hoist::PlanError (after None), in order, then
+/// limits beyond the winder's.
 enum class PlanReject : int {
   Decode = 0,
   OldSeq,
@@ -27,8 +28,9 @@ enum class PlanReject : int {
   OvershootsVmax,
   OvershootsStop,
   Unreachable,
+  AboveLimits,  ///< vmax, amax or jerk above the winder's ([forecast] vmax, amax, jerk)
 };
-inline constexpr int kPlanRejectReasons = 11;
+inline constexpr int kPlanRejectReasons = 12;
 /// "plan_decode", "plan_old_seq", "plan_not_finite", ... (HOIST_HEALTH reason names).
 const char* toString(PlanReject r);
 PlanReject planReject(PlanError e);

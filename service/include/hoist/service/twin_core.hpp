@@ -124,7 +124,15 @@ class TwinCore {
   /// A winder sample received at wall time `wall_now` [s].
   InputResult onInput(const WinderSample& s, double wall_now);
   /// An undecodable message (garbage, truncated, wrong fingerprint).
-  void rejectUndecodable() { counters_.reject(RejectReason::Decode); }
+  void rejectUndecodable() {
+    counters_.reject(RejectReason::Decode);
+    lostMotion(RejectReason::Decode);
+  }
+  /// Without an encoder the rope length is integrated from v and a: after a
+  /// rejected input that may have carried motion, the length is no longer
+  /// known to match the winder's, and the outputs are flagged degraded until
+  /// an accepted input carries an encoder length again.
+  bool lengthUnverified() const { return length_unverified_; }
   /// Test hook (fault injection): the state after the next model step or
   /// initialization is treated as non-finite, exercising the MODEL_FAULT
   /// path (alarm, re-initialization, degraded outputs) end to end.
@@ -210,6 +218,7 @@ class TwinCore {
   void setDomain(bool outside, double l);
   /// Make `s` the stream's latest accepted sample.
   void acceptSample(const WinderSample& s, double wall_now);
+  void lostMotion(RejectReason r);  ///< a rejected input: see lengthUnverified()
   /// The period-based staleness timeout (wall clock).
   double periodStaleTimeout() const;
   /// After a step or init: fault check, clearance, alarms, output.
@@ -243,6 +252,7 @@ class TwinCore {
   double period_est_ = 0.0;     // input period estimate (EWMA of utime steps) [s]
   double t_pub_offset_ = 0.0;   // wall clock: model time of the first input (published t counts from it)
   bool stale_ = false;
+  bool length_unverified_ = false;  // integrated length after lost input, no encoder since (degraded)
   double start_wall_ = -1.0;
   double fault_until_ = -1.0;   // degraded until this model time after a re-init
   bool fault_pending_clear_ = false;
