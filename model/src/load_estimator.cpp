@@ -41,6 +41,9 @@ constexpr double kMaxSpecificForce = 100.0;  // |f_y| [m/s^2] a cage IMU can rep
 constexpr double kMaxRate = 20.0;            // |omega| [rad/s]
 constexpr double kMaxRopeLoad = 1.0e8;       // |rope_load| [N]
 constexpr int kImuAccel = 0, kImuRate = 1, kRope = 2;
+// Time comparisons tolerate this much [s]: the same data timed by the CSV's t
+// (hoist-estimate) or by utime differences (the daemon) differ by an ulp.
+constexpr double kTimeEps = 1e-9;
 constexpr double kEnvelopeTime = 3.0;        // memory of the oscillation envelopes [s]
 constexpr double kStartTransientError = 0.1;  // rope-load model error after a start at a != 0, per N of m a
 constexpr double kJumpTransientError = 0.1;   // the same after a jump of a later on ...
@@ -374,7 +377,7 @@ const LoadEstimate& LoadEstimator::finish() {
   const std::size_t cap = ring_t_.size();
   while (count_ > 0) {
     const std::size_t tail = (head_ + cap - count_) % cap;
-    if (ring_t_[tail] > t_ - set_.nis_window) break;
+    if (ring_t_[tail] > t_ - set_.nis_window + kTimeEps) break;
     win_nis_ -= ring_nis_[tail];
     win_dof_ -= ring_dof_[tail];
     --count_;
@@ -410,7 +413,7 @@ const LoadEstimate& LoadEstimator::finish() {
   }
   // Constancy: the short-memory estimate against the whole history's.  With
   // a right model their difference has variance PF - P (nested estimates).
-  if (t_ - first_t_ >= set_.constancy_memory && have_update_) {
+  if (t_ - first_t_ + kTimeEps >= set_.constancy_memory && have_update_) {
     auto gap = [](double xf, double x, double PF, double P) {
       return std::abs(xf - x) / std::sqrt(std::max(PF - P, 1e-9 * (P + 1.0)));
     };
@@ -434,7 +437,7 @@ const LoadEstimate& LoadEstimator::finish() {
   } else {
     e.nis_lower = e.nis_upper = e.nis_bound = 0.0;
   }
-  const bool filled = have_update_ && t_ - first_t_ >= set_.min_window_fill * set_.nis_window;
+  const bool filled = have_update_ && t_ - first_t_ + kTimeEps >= set_.min_window_fill * set_.nis_window;
   // The alarm's bound: the chi-square quantile, and never below nis_margin
   // times the expectation (a model right to about 1 % leaves a systematic
   // residual that a test over thousands of samples resolves: significant,
@@ -450,7 +453,7 @@ const LoadEstimate& LoadEstimator::finish() {
   e.sensors = 0;
   const unsigned bits[3] = {kSensorImuAccel, kSensorImuRate, kSensorRopeLoad};
   for (int i = 0; i < 3; ++i)
-    if (t_ - last_upd_[i] <= set_.sensor_timeout) e.sensors |= bits[i];
+    if (t_ - last_upd_[i] <= set_.sensor_timeout + kTimeEps) e.sensors |= bits[i];
   e.fa_observed = seen_[kRope];
   e.moment_observed = seen_[kImuAccel] || seen_[kImuRate];
 

@@ -57,6 +57,15 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   m.forecasts_skipped = st.forecasts_skipped;
   m.plans_accepted = st.plans_accepted;
   m.plans_rejected = st.plansRejected();
+  m.sensor_accepted = st.sensor_accepted;
+  m.sensor_rejected = st.sensor_rejected;
+  if (const EstimatorCounters* ec = ctx_.core.estimatorCounters()) {
+    m.sensor_gated = ec->gated;
+    m.estimator_load_changes = ec->load_changes;
+  }
+  const LoadEstimate* est = ctx_.core.estimate();
+  m.estimator_sensors = est ? static_cast<int32_t>(est->sensors) : 0;
+  m.estimate_in_use = ctx_.core.estimateInUse();
   m.alarms_active = al.activeCount();
   m.alarms_unacked = al.unackedCount();
   m.alarms_shelved = al.shelvedCount();

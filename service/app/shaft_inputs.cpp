@@ -2,6 +2,7 @@
 #include "shaft_inputs.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -24,6 +25,8 @@ ShaftInputs::ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, For
   routes_[kAck] = {this, &ctx_.ch.ack, &ShaftInputs::handleAck, "HOIST_ALARM_ACK"};
   routes_[kTripPlan] = {this, &ctx_.ch.trip_plan, &ShaftInputs::handleTripPlan, "HOIST_TRIP_PLAN"};
   routes_[kOwnHealth] = {this, &ctx_.ch.health, &ShaftInputs::handleOwnHealth, "HOIST_HEALTH"};
+  routes_[kCageImu] = {this, &ctx_.ch.cage_imu, &ShaftInputs::handleCageImu, "HOIST_CAGE_IMU"};
+  routes_[kRopeLoad] = {this, &ctx_.ch.rope_load, &ShaftInputs::handleRopeLoad, "HOIST_ROPE_LOAD"};
   text_[0] = '\0';
 }
 
@@ -55,6 +58,10 @@ void ShaftInputs::subscribe(bus::InputRouter* router, bool own_health) {
   add(router, routes_[kAck]);
   if (forecast_) add(router, routes_[kTripPlan]);
   if (own_health) add(router, routes_[kOwnHealth]);
+  if (ctx_.core.estimatorEnabled()) {
+    add(router, routes_[kCageImu]);
+    add(router, routes_[kRopeLoad]);
+  }
 }
 
 void ShaftInputs::watchOwnOutputs(bus::InputRouter* router) { add(router, routes_[kOwnHealth]); }
@@ -282,6 +289,83 @@ void ShaftInputs::handleOwnHealth(const lcm::ReceiveBuffer* rbuf) {
   other_seen_wall_ = wall;
   ctx_.core.setDuplicatePublisher(true, static_cast<double>(id));
   out_.publishAlarmEvents();
+}
+
+}  // namespace hoist::svc
+
+namespace hoist::svc {
+
+// ---- the load estimator's sensors ----------------------------------------------
+// Decoded into flat scratch messages (no allocation), checked (finite, within
+// what such a sensor can report, sequence not going back), and handed to the
+// model room (TwinCore), which applies the latest sample at its next step.
+// The estimator itself gates outliers against its prediction and counts them.
+
+namespace {
+constexpr double kMaxSpecificForce = 100.0;  // |f_y| a cage IMU can report [m/s^2]
+constexpr double kMaxTiltRate = 20.0;        // |omega| [rad/s]
+constexpr double kMaxRopeLoad = 1.0e8;       // |force| [N]
+}  // namespace
+
+void ShaftInputs::rejectSensor(const char* channel, const char* detail) {
+  ++ctx_.stats.sensor_rejected;
+  std::int64_t suppressed = 0;
+  if (log_limit_.allow(kLogSensor, ctx_.wallNow(), suppressed))
+    ctx_.log.warn("{}rejected {} sample: {} [{} similar suppressed]", ctx_.tag, channel, detail, suppressed);
+}
+
+void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
+  const auto size = static_cast<std::size_t>(rbuf->data_size);
+  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, imu_in_); st != hoist::msg::DecodeStatus::ok) {
+    std::snprintf(text_, sizeof text_, "%zu bytes: %s", size, hoist::msg::toString(st));
+    rejectSensor("HOIST_CAGE_IMU", text_);
+    return;
+  }
+  const cage_imu_t& m = imu_in_;
+  const bool a_ok = std::isfinite(m.f_y) && std::abs(m.f_y) <= kMaxSpecificForce;
+  const bool w_ok = std::isfinite(m.omega) && std::abs(m.omega) <= kMaxTiltRate;
+  if (!a_ok && !w_ok) {
+    std::snprintf(text_, sizeof text_, "f_y %g m/s^2 and omega %g rad/s implausible (|f_y| <= %g, |omega| <= %g)",
+                  m.f_y, m.omega, kMaxSpecificForce, kMaxTiltRate);
+    rejectSensor("HOIST_CAGE_IMU", text_);
+    return;
+  }
+  if (ctx_.stats.imu_seq >= 0 && m.seq <= ctx_.stats.imu_seq && m.seq > ctx_.stats.imu_seq - 1000) {
+    std::snprintf(text_, sizeof text_, "seq %lld not after %lld", static_cast<long long>(m.seq),
+                  static_cast<long long>(ctx_.stats.imu_seq));
+    rejectSensor("HOIST_CAGE_IMU", text_);
+    return;
+  }
+  ctx_.stats.imu_seq = m.seq;
+  ctx_.stats.last_imu_wall = ctx_.wallNow();
+  ++ctx_.stats.sensor_accepted;
+  // A channel that is implausible on its own is left out of this sample.
+  ctx_.core.onCageImu(a_ok ? m.f_y : NAN, w_ok ? m.omega : NAN);
+}
+
+void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
+  const auto size = static_cast<std::size_t>(rbuf->data_size);
+  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, rope_in_); st != hoist::msg::DecodeStatus::ok) {
+    std::snprintf(text_, sizeof text_, "%zu bytes: %s", size, hoist::msg::toString(st));
+    rejectSensor("HOIST_ROPE_LOAD", text_);
+    return;
+  }
+  const rope_load_t& m = rope_in_;
+  if (!(std::isfinite(m.force) && std::abs(m.force) <= kMaxRopeLoad)) {
+    std::snprintf(text_, sizeof text_, "force %g N implausible (|force| <= %g)", m.force, kMaxRopeLoad);
+    rejectSensor("HOIST_ROPE_LOAD", text_);
+    return;
+  }
+  if (ctx_.stats.rope_seq >= 0 && m.seq <= ctx_.stats.rope_seq && m.seq > ctx_.stats.rope_seq - 1000) {
+    std::snprintf(text_, sizeof text_, "seq %lld not after %lld", static_cast<long long>(m.seq),
+                  static_cast<long long>(ctx_.stats.rope_seq));
+    rejectSensor("HOIST_ROPE_LOAD", text_);
+    return;
+  }
+  ctx_.stats.rope_seq = m.seq;
+  ctx_.stats.last_rope_wall = ctx_.wallNow();
+  ++ctx_.stats.sensor_accepted;
+  ctx_.core.onRopeLoad(m.force);
 }
 
 }  // namespace hoist::svc

@@ -21,6 +21,8 @@
 #include <string>
 
 #include "hoist/bus/udpm_receiver.hpp"
+#include "hoist/cage_imu_t.hpp"
+#include "hoist/rope_load_t.hpp"
 #include "hoist/trip_plan_t.hpp"
 #include "hoist/winder_t.hpp"
 #include "shaft_context.hpp"
@@ -69,12 +71,15 @@ class ShaftInputs {
     /// The guarded entry point (LCM's callback signature).
     void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   };
-  enum RouteId { kWinder, kAck, kTripPlan, kOwnHealth, kRoutes };
+  enum RouteId { kWinder, kAck, kTripPlan, kOwnHealth, kCageImu, kRopeLoad, kRoutes };
 
   void handleWinder(const lcm::ReceiveBuffer* rbuf);
   void handleAck(const lcm::ReceiveBuffer* rbuf);
   void handleTripPlan(const lcm::ReceiveBuffer* rbuf);
   void handleOwnHealth(const lcm::ReceiveBuffer* rbuf);
+  void handleCageImu(const lcm::ReceiveBuffer* rbuf);   // the load estimator's sensors ([estimator] enabled)
+  void handleRopeLoad(const lcm::ReceiveBuffer* rbuf);
+  void rejectSensor(const char* channel, const char* detail);
   void handlerFailed(const char* what, const char* channel);
   void logReject(RejectReason r, const char* detail);
   void rejectPlan(PlanReject r, const char* detail);
@@ -90,7 +95,8 @@ class ShaftInputs {
   static constexpr int kLogJunkCommand = kRejectReasons;          ///< invalid/ineffective/dropped commands
   static constexpr int kLogHandlerException = kRejectReasons + 1; ///< exceptions caught in handlers
   static constexpr int kLogPlan = kRejectReasons + 2;             ///< rejected trip plans
-  static constexpr int kLogKeys = kRejectReasons + 3;             ///< number of keys
+  static constexpr int kLogSensor = kRejectReasons + 3;           ///< rejected sensor samples
+  static constexpr int kLogKeys = kRejectReasons + 4;             ///< number of keys
   LogRateLimiter<kLogKeys> log_limit_{5};  ///< rate limit of this room's warning lines
   int commands_this_tick_ = 0;      ///< valid commands applied or dropped this tick
   int decodes_this_tick_ = 0;       ///< command datagrams decoded (or dropped undecoded) this tick
@@ -99,6 +105,8 @@ class ShaftInputs {
   double other_seen_wall_ = -1.0;   ///< when it was last seen (< 0: not seen)
   hoist::winder_t winder_in_;       ///< decode scratch of HOIST_WINDER
   hoist::trip_plan_t plan_in_;      ///< decode scratch of HOIST_TRIP_PLAN (flat: no allocation)
+  hoist::cage_imu_t imu_in_;        ///< decode scratch of HOIST_CAGE_IMU (flat)
+  hoist::rope_load_t rope_in_;      ///< decode scratch of HOIST_ROPE_LOAD (flat)
   MotionProfile plan_scratch_;      ///< checkPlan's workspace
   char text_[256];                  ///< the text of a rejection being logged
 };

@@ -5,61 +5,12 @@
 #include <cmath>
 
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/service/messages.hpp"
 
 namespace hoist::svc {
 
 namespace {
-
-bool finiteAll(const hoist::cage_state_t& m) {
-  bool ok = std::isfinite(m.t) && std::isfinite(m.l) && std::isfinite(m.v) && std::isfinite(m.a) &&
-            std::isfinite(m.x_c) && std::isfinite(m.y_c) && std::isfinite(m.theta) &&
-            std::isfinite(m.y_top) && std::isfinite(m.y_bottom) &&
-            std::isfinite(m.guide_deflection) && std::isfinite(m.clearance_pos_y) &&
-            std::isfinite(m.clearance_neg_y) && std::isfinite(m.clearance_guide) &&
-            std::isfinite(m.min_clearance) && std::isfinite(m.rope_slack_threshold) &&
-            std::isfinite(m.rope_overload_threshold);
-  for (double v : m.lambdas) ok = ok && std::isfinite(v);
-  return ok;
-}
-
-bool finiteAll(const hoist::guide_shape_t& m) {
-  bool ok = std::isfinite(m.t) && std::isfinite(m.l) && std::isfinite(m.h);
-  for (int i = 0; i < m.n; ++i)
-    ok = ok && std::isfinite(m.x[i]) && std::isfinite(m.y1[i]) && std::isfinite(m.y2[i]);
-  return ok;
-}
-
-bool finiteAll(const hoist::alarm_t& m) {
-  return std::isfinite(m.t) && std::isfinite(m.value) && std::isfinite(m.threshold) &&
-         std::isfinite(m.shelved_for);
-}
-
-bool finiteAll(const hoist::health_t& m) {
-  return std::isfinite(m.uptime) && std::isfinite(m.t) && std::isfinite(m.rate) &&
-         std::isfinite(m.window) && std::isfinite(m.step_p50_us) && std::isfinite(m.step_p99_us) &&
-         std::isfinite(m.step_max_us) && std::isfinite(m.late_p50_us) &&
-         std::isfinite(m.late_p99_us) && std::isfinite(m.late_max_us) && std::isfinite(m.input_age);
-}
-
-bool finiteAll(const hoist::forecast_t& m) {
-  bool ok = std::isfinite(m.t_start) && std::isfinite(m.l) && std::isfinite(m.v) && std::isfinite(m.a) &&
-            std::isfinite(m.compute_time);
-  for (int i = 0; i < m.num_scenarios; ++i) {
-    const hoist::forecast_scenario_t& s = m.scenarios[static_cast<std::size_t>(i)];
-    ok = ok && std::isfinite(s.horizon) && std::isfinite(s.t_reached) && std::isfinite(s.min_clearance) &&
-         std::isfinite(s.t_min_clearance) && std::isfinite(s.t_warning) && std::isfinite(s.t_critical) &&
-         std::isfinite(s.peak_y_c) && std::isfinite(s.peak_theta) && std::isfinite(s.lambda0_min) &&
-         std::isfinite(s.lambda0_max);
-    for (double v : s.peak_lambdas) ok = ok && std::isfinite(v);
-    for (int k = 0; k < s.num_points; ++k) {
-      const auto j = static_cast<std::size_t>(k);
-      ok = ok && std::isfinite(s.series_t[j]) && std::isfinite(s.series_min_clearance[j]) &&
-           std::isfinite(s.series_lambda0_min[j]) && std::isfinite(s.series_lambda0_max[j]);
-    }
-  }
-  return ok;
-}
 
 int divider(double rate, double sub_rate) {
   if (!(sub_rate > 0.0)) return 1;
@@ -114,6 +65,8 @@ ShaftOutputs::ShaftOutputs(ShaftContext& ctx, lcm::LCM& out) : ctx_(ctx), out_(o
   alarm_msg_.kind.reserve(64);
   alarm_msg_.user.reserve(kUserMax + 4);
   cage_msg_.instance_id = ctx_.instance_id;
+  estimate_msg_.instance_id = ctx_.instance_id;
+  estimate_buf_.resize(static_cast<std::size_t>(estimate_msg_.getEncodedSize()) + 64);
   health_msg_.instance_id = ctx_.instance_id;
   alarm_msg_.message.reserve(sizeof text_);
   cage_buf_.resize(static_cast<std::size_t>(cage_msg_.getEncodedSize()) + 64);
@@ -148,7 +101,7 @@ template <class Msg>
 bool ShaftOutputs::encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
                                     bool batch) {
   ShaftStats& st = ctx_.stats;
-  if (!finiteAll(msg)) {
+  if (!hoist::msg::allFinite(msg)) {  // generated from the .lcm files (hoist/msg/codec.hpp)
     ++st.nonfinite_blocked;
     std::int64_t suppressed = 0;
     if (log_limit_.allow(kLogPublish, ctx_.wallNow(), suppressed))
@@ -170,12 +123,16 @@ bool ShaftOutputs::encodeAndPublish(const std::string& channel, const Msg& msg, 
 }
 
 void ShaftOutputs::publishTick(std::int64_t k, std::int64_t utime) {
-  if (k % cage_div_ == 0) publishCage(utime, true);
+  if (k % cage_div_ == 0) {
+    publishCage(utime, true);
+    publishEstimate(utime, true);
+  }
   if (ctx_.cfg.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime, true);
 }
 
 void ShaftOutputs::publishStep(std::int64_t utime) {
   publishCage(utime);
+  publishEstimate(utime, false);
   const double rate = ctx_.cfg.service.shape_rate;
   const double t = ctx_.core.modelTime();
   if (rate > 0.0 && t - last_shape_t_ >= 1.0 / rate - 1e-9) {
@@ -189,6 +146,20 @@ void ShaftOutputs::publishCage(std::int64_t utime, bool batch) {
   cage_msg_.seq = cage_seq_++;
   toCageMessage(ctx_.core.output(), cage_msg_);
   encodeAndPublish(ctx_.ch.cage, cage_msg_, cage_buf_, batch);
+}
+
+void ShaftOutputs::publishEstimate(std::int64_t utime, bool batch) {
+  const LoadEstimate* e = ctx_.core.estimate();
+  if (!e) return;  // [estimator] disabled, or not stepped since the last refused step
+  estimate_msg_.utime = utime;
+  estimate_msg_.seq = estimate_seq_++;
+  const EstimatorCounters& c = *ctx_.core.estimatorCounters();
+  const double wall = ctx_.wallNow();
+  const ShaftStats& st = ctx_.stats;
+  toEstimateMessage(*e, c, ctx_.core.publishedTime(e->t), st.last_imu_wall < 0.0 ? -1.0 : wall - st.last_imu_wall,
+                    st.last_rope_wall < 0.0 ? -1.0 : wall - st.last_rope_wall, ctx_.core.estimateInUse(),
+                    estimate_msg_);
+  encodeAndPublish(ctx_.ch.estimate, estimate_msg_, estimate_buf_, batch);
 }
 
 void ShaftOutputs::publishShape(std::int64_t utime, bool batch) {
@@ -238,6 +209,7 @@ void ShaftOutputs::publishAlarmEvents() {
     alarm_msg_.value = e.value;
     alarm_msg_.threshold = e.threshold;
     alarm_msg_.shelved_for = e.shelved_for;
+    alarm_msg_.from_estimate = e.from_estimate;
     alarm_msg_.message.assign(text_);
     if (encodeAndPublish(ctx_.ch.alarm, alarm_msg_, alarm_buf_)) ++ctx_.stats.alarm_events;
     switch (e.type) {

@@ -17,6 +17,7 @@
 #include "forecast_pool.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
@@ -47,6 +48,8 @@ class ShaftOutputs {
   void publishStep(std::int64_t utime);
   /// HOIST_CAGE now (e.g. the held state of a rejected input, flagged degraded).
   void publishCage(std::int64_t utime, bool batch = false);
+  /// HOIST_ESTIMATE ([estimator] enabled), with every HOIST_CAGE.
+  void publishEstimate(std::int64_t utime, bool batch = false);
   /// Publishes and logs the model's pending alarm events (ctx.cause names
   /// who caused them), then clears them.
   void publishAlarmEvents();
@@ -75,6 +78,9 @@ class ShaftOutputs {
   std::int64_t alarm_id_ = 0;     ///< HOIST_ALARM.id of the next event
   std::int64_t forecast_seq_ = 0; ///< HOIST_FORECAST.seq of the next message
   hoist::cage_state_t cage_msg_;      ///< preallocated HOIST_CAGE
+  hoist::estimate_t estimate_msg_;    ///< preallocated HOIST_ESTIMATE (flat)
+  std::vector<std::uint8_t> estimate_buf_;  ///< encode buffer of estimate_msg_
+  std::int64_t estimate_seq_ = 0;     ///< HOIST_ESTIMATE.seq of the next message
   hoist::guide_shape_t shape_msg_;    ///< preallocated HOIST_GUIDE_SHAPE (sized to the shape's depths)
   hoist::alarm_t alarm_msg_;          ///< preallocated HOIST_ALARM (strings reserved)
   hoist::health_t health_msg_;        ///< preallocated HOIST_HEALTH (reason names set once)

@@ -38,6 +38,10 @@ struct ShaftStats {
   std::int64_t commands_invalid = 0;        ///< undecodable or invalid commands
   std::int64_t commands_applied = 0;        ///< effective commands (audited)
   std::int64_t plans_accepted = 0;          ///< trip plans accepted
+  std::int64_t sensor_accepted = 0;         ///< cage IMU and rope-load samples handed to the estimator
+  std::int64_t sensor_rejected = 0;         ///< ... refused (undecodable, implausible, old seq)
+  std::int64_t imu_seq = -1, rope_seq = -1; ///< the last accepted sample's seq of each sensor
+  double last_imu_wall = -1.0, last_rope_wall = -1.0;  ///< when (wall clock [s]; < 0: never)
   std::array<std::int64_t, kPlanRejectReasons> plan_rejects{};  ///< trip plans rejected, per reason
 
   // ---- outputs (ShaftOutputs) ----

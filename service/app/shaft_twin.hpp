@@ -19,7 +19,7 @@
 //     and one handle*() there that decodes and validates it and hands the
 //     sample to the room that uses it (never math in ShaftInputs);
 //   * a new OUTPUT message (e.g. HOIST_ESTIMATE): its preallocated message,
-//     buffer and one publish*() in ShaftOutputs (finiteAll covers it);
+//     buffer and one publish*() in ShaftOutputs (hoist::msg::allFinite covers it);
 //   * a new job (e.g. an estimator): its own room (class, files, one-line
 //     comment per field) owned here beside the others, constructed after
 //     ShaftOutputs, called from tick() or from its input handler; its

@@ -220,6 +220,7 @@ constexpr std::array<SlotRow, AlarmEngine::kSlots> kSlotTable{{
     {AlarmKind::RopeOverload, AlarmLevel::Critical, Rule::RopeHigh, nullptr},
     {AlarmKind::PredictedClearance, AlarmLevel::Warning, Rule::Prediction, nullptr},
     {AlarmKind::PredictedSlack, AlarmLevel::Warning, Rule::Prediction, nullptr},
+    {AlarmKind::ModelMismatch, AlarmLevel::Warning, Rule::Flag, nullptr},
 }};
 
 /// The slot of (kind, level), or -1 if there is no such alarm.
@@ -258,6 +259,7 @@ constexpr int kRopeSlack = slot(AlarmKind::RopeSlack, AlarmLevel::Critical);
 constexpr int kRopeOverload = slot(AlarmKind::RopeOverload, AlarmLevel::Critical);
 constexpr int kPredictedClearance = slot(AlarmKind::PredictedClearance, AlarmLevel::Warning);
 constexpr int kPredictedSlack = slot(AlarmKind::PredictedSlack, AlarmLevel::Warning);
+constexpr int kModelMismatch = slot(AlarmKind::ModelMismatch, AlarmLevel::Warning);
 
 /// The settings of `row` under `cfg`.
 AlarmSettings settingsOf(const SlotRow& row, const AlarmConfig& cfg) {
@@ -367,6 +369,11 @@ void AlarmEngine::setPredictedClearance(double now, bool predicted, double secon
 void AlarmEngine::setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out) {
   if (predicted) alarms_[kPredictedSlack].setDetail(seconds, horizon);
   alarms_[kPredictedSlack].update(now, predicted ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setModelMismatch(double now, bool mismatch, double statistic, double bound, AlarmEvents& out) {
+  if (mismatch) alarms_[kModelMismatch].setDetail(statistic, bound);
+  alarms_[kModelMismatch].update(now, mismatch ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

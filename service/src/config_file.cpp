@@ -1,6 +1,8 @@
 // Reading the daemon's configuration from TOML: see hoist/service/config_file.hpp.
 #include "hoist/service/config_file.hpp"
 
+#include "hoist/io/estimator_config.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -112,8 +114,11 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
 TwinConfig loadTwinConfig(const std::string& path) {
   const toml::table tbl = hoist::io::loadTomlFile(path);
   TwinConfig cfg;
-  cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, {"service", "alarms", "forecast"});
+  cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, hoist::io::daemonSections());
   parseServiceSections(tbl, path, cfg);
+  const hoist::io::EstimatorConfig e = hoist::io::estimatorConfigFromToml(tbl, path);
+  cfg.estimator.enabled = e.enabled;
+  cfg.estimator.settings = e.settings;
   return cfg;
 }
 
@@ -164,6 +169,7 @@ std::string toToml(const TwinConfig& c) {
      << "\nestop_jerk = " << Num{f.estop_jerk} << "\nvmax = " << Num{f.vmax} << "\namax = " << Num{f.amax}
      << "\njerk = " << Num{f.jerk} << "\nplan_timeout = " << Num{f.plan_timeout}
      << "\nworkers = " << f.workers << "\nseries_points = " << f.series_points << "\n";
+  os << "\n" << hoist::io::toToml(hoist::io::EstimatorConfig{c.estimator.enabled, c.estimator.settings});
   return os.str();
 }
 

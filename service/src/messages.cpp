@@ -32,6 +32,51 @@ void toCageMessage(const CageOutput& o, hoist::cage_state_t& m) {
   m.rope_overload_threshold = o.rope_overload_threshold;
 }
 
+void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double t, double imu_age,
+                       double rope_load_age, bool in_use, hoist::estimate_t& m) {
+  m.in_use = in_use;
+  m.t = t;
+  m.l = e.kin.l;
+  m.v = e.kin.v;
+  m.a = e.kin.a;
+  m.Fa = e.Fa;
+  m.sigma_Fa = e.sigma_Fa;
+  m.b = e.b;
+  m.sigma_b = e.sigma_b;
+  m.moment = e.moment;
+  m.sigma_moment = e.sigma_moment;
+  m.x_c = e.x_c;
+  m.sigma_x_c = e.sigma_x_c;
+  m.y_c = e.y_c;
+  m.sigma_y_c = e.sigma_y_c;
+  m.theta = e.theta;
+  m.sigma_theta = e.sigma_theta;
+  m.theta_open = e.theta_open;
+  for (int i = 0; i < 5; ++i) {
+    m.lambdas[i] = e.lambda[static_cast<std::size_t>(i)];
+    m.sigma_lambdas[i] = e.sigma_lambda[static_cast<std::size_t>(i)];
+  }
+  m.nis = e.nis;
+  m.nis_window = e.nis_window;
+  m.nis_dof = e.nis_dof;
+  m.nis_lower = e.nis_lower;
+  m.nis_upper = e.nis_upper;
+  m.nis_bound = e.nis_bound;
+  m.drift = e.drift;
+  m.mismatch = e.mismatch;
+  m.nis_exceeded = e.nis_exceeded;
+  m.drift_exceeded = e.drift_exceeded;
+  m.sensors = static_cast<int32_t>(e.sensors);
+  m.imu_age = imu_age;
+  m.rope_load_age = rope_load_age;
+  m.fa_observed = e.fa_observed;
+  m.moment_observed = e.moment_observed;
+  m.accepted = c.accepted;
+  m.gated = c.gated;
+  m.load_changes = c.load_changes;
+  m.implausible = c.implausible;
+}
+
 void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n) {
   if (n == 0) return;
   buf[0] = '\0';
@@ -56,8 +101,9 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
       std::snprintf(shelve, sizeof shelve, "shelved for %.0f s", e.shelved_for);
     verb = shelve;
   }
-  std::snprintf(state, sizeof state, "%s%s%s", e.latched ? " [latched until acknowledged]" : "",
-                e.shelved ? " [shelved]" : "", (e.active && !e.acked) ? " [unacknowledged]" : "");
+  std::snprintf(state, sizeof state, "%s%s%s%s", e.from_estimate ? " [from the load estimate]" : "",
+                e.latched ? " [latched until acknowledged]" : "", e.shelved ? " [shelved]" : "",
+                (e.active && !e.acked) ? " [unacknowledged]" : "");
   const char* kind = toString(e.kind);
   const char* level = toString(e.level);
   switch (e.kind) {
@@ -132,6 +178,15 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
         std::snprintf(buf, n, "%s %s %s: forecast scenario '%s' crosses the CRITICAL clearance threshold in %.1f s "
                       "(horizon %.0f s)%s",
                       kind, level, verb, ctx.predicted_clearance_scenario, e.value, e.threshold, state);
+      break;
+    case AlarmKind::ModelMismatch:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: the shaft behaves like its model again%s", kind, level, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: the shaft does not behave like its model (statistic %.4g, bound %.4g: the "
+                      "estimator's windowed NIS or its load drift, see HOIST_ESTIMATE); check guide-rope preloads, "
+                      "sleeves and the sensors (docs/estimation.md)%s",
+                      kind, level, verb, e.value, e.threshold, state);
       break;
     case AlarmKind::PredictedSlack:
       if (e.type == AlarmEventType::Clear)

@@ -217,6 +217,11 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
     throw std::invalid_argument("hoisting_rope.initial_length: " + std::to_string(cfg_.shaft.l0) +
                                 " m is outside the model's valid range [" + std::to_string(range_.lo) + ", " +
                                 std::to_string(range_.hi) + "] m (0.05 m from either end)");
+  if (cfg_.estimator.enabled) {
+    if (solver_->method() != Method::Fast)
+      throw std::invalid_argument("estimator.enabled: the load estimator needs the fast solver (method fast)");
+    est_ = std::make_unique<LoadEstimator>(cfg_.shaft, cfg_.estimator.settings);
+  }
   if (clock == ClockMode::Wall) {
     // The wall-clock twin runs from start-up: at rest at the initial length
     // until the winder speaks.
@@ -239,9 +244,44 @@ void TwinCore::acceptSample(const WinderSample& s, double wall_now) {
   if (stale_) setStale(false);
 }
 
+void TwinCore::onCageImu(double f_y, double omega) {
+  if (!est_) return;
+  if (std::isfinite(f_y)) {
+    imu_.f_y = f_y;
+    imu_.has_accel = true;
+  }
+  if (std::isfinite(omega)) {
+    imu_.omega = omega;
+    imu_.has_rate = true;
+  }
+}
+
+void TwinCore::onRopeLoad(double force) {
+  if (!est_ || !std::isfinite(force)) return;
+  rope_force_ = force;
+  rope_pending_ = true;
+}
+
+void TwinCore::estimatorStep(const CageResponse& r) {
+  // The same sequence as hoist::estimateRecorded (hoist-estimate): predict,
+  // the IMU, the rope load, finish.
+  est_->predict(r);
+  if (imu_.has_accel && imu_.has_rate) est_->updateImu(imu_.f_y, imu_.omega);
+  else if (imu_.has_accel) est_->updateImuAccel(imu_.f_y);
+  else if (imu_.has_rate) est_->updateImuRate(imu_.omega);
+  if (rope_pending_) est_->updateRopeLoad(rope_force_);
+  imu_ = {};
+  rope_pending_ = false;
+  est_->finish();
+}
+
 void TwinCore::initializeAt(double t, const Kinematics& k) {
   if (started_) ++resets_;
   solver_->initialize(t, k);
+  if (est_) {
+    est_->initialize(t, k);
+    est_synced_ = true;
+  }
   t_ = t;
   kin_ = k;
   started_ = true;
@@ -273,7 +313,15 @@ bool TwinCore::advance(double t, const Kinematics& k, double max_interval) {
     solver_->step(t, k);
   } catch (const std::domain_error&) {
     ++domain_errors_;
+    est_synced_ = false;  // until the next initialization
     return false;
+  }
+  if (est_ && est_synced_) {
+    try {
+      est_->advance(t, k, n);
+    } catch (const std::exception&) {
+      est_synced_ = false;
+    }
   }
   ++steps_;
   t_ = t;
@@ -350,9 +398,28 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
     }
     if (ok) {
       alarms_.setModelFault(t, false, events_);
+      // With the load estimator healthy, the clearance and rope-force alarms
+      // judge the state the estimated load implies (the guide-rope envelope
+      // stays the twin's); HOIST_CAGE keeps the open-loop state.
+      double lambda0 = out_.lambda[0];
+      est_in_use_ = false;
+      if (est_ && est_synced_) {
+        estimatorStep(solver_->response());
+        const LoadEstimate& e = est_->estimate();
+        est_in_use_ = e.sensors != 0 && !e.mismatch && std::isfinite(e.y_c) && std::isfinite(e.theta) &&
+                      std::isfinite(e.lambda[0]);
+        if (est_in_use_) {
+          out_.clearance = computeClearance(e.y_c, e.theta, h, out_.clearance.guide_deflection, cfg_.alarms);
+          lambda0 = e.lambda[0];
+        }
+        alarms_.setModelMismatch(t, e.mismatch, e.nis_exceeded ? e.nis_window : e.drift,
+                                 e.nis_exceeded ? e.nis_bound : est_->settings().drift_sigma, events_);
+      }
+      const std::size_t first = events_.size();
       alarms_.updateClearance(t, out_.clearance, events_);
-      // Rope force against the static force at this length (issue 17).
-      alarms_.updateRopeForce(t, out_.lambda[0], solver_->model().staticRopeForce(out_.kin.l), events_);
+      // Rope force against the static force at this length.
+      alarms_.updateRopeForce(t, lambda0, solver_->model().staticRopeForce(out_.kin.l), events_);
+      if (est_in_use_) events_.markFromEstimate(first);
       out_.rope_slack_threshold = alarms_.ropeSlackThreshold();
       out_.rope_overload_threshold = alarms_.ropeOverloadThreshold();
       out_.alarm_level = alarms_.highestActive();

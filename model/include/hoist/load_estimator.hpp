@@ -117,8 +117,10 @@ struct EstimatorSettings {
 /// Sensors of the estimate (bit mask).
 enum SensorBits : unsigned { kSensorImuAccel = 1u, kSensorImuRate = 2u, kSensorRopeLoad = 4u };
 
-/// The estimate after finish().  A sigma < 0 means "not observed" (the value is
-/// then the configured one, or 0 for b).
+/// The estimate after finish().  Fa and M always carry the filter's sigma
+/// (the prior's, growing with the random walk, until a sensor observes them:
+/// fa_observed, moment_observed); b is observed only with both, else b = 0
+/// and sigma_b = -1.
 struct LoadEstimate {
   double t = 0.0;
   Kinematics kin;

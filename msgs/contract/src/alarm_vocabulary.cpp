@@ -1,52 +1,28 @@
 // The alarm vocabulary: see hoist/contract/alarm_vocabulary.hpp.
 #include "hoist/contract/alarm_vocabulary.hpp"
 
+#include "hoist/msg/names.hpp"
+
 namespace hoist::contract {
 
-const char* toString(AlarmKind k) {
-  switch (k) {
-    case AlarmKind::CagePosY: return "CAGE_POS_Y";
-    case AlarmKind::CageNegY: return "CAGE_NEG_Y";
-    case AlarmKind::GuideRope: return "GUIDE_ROPE";
-    case AlarmKind::InputStale: return "INPUT_STALE";
-    case AlarmKind::ModelFault: return "MODEL_FAULT";
-    case AlarmKind::ModelDomain: return "MODEL_DOMAIN";
-    case AlarmKind::DuplicatePublisher: return "DUPLICATE_PUBLISHER";
-    case AlarmKind::RopeSlack: return "ROPE_SLACK";
-    case AlarmKind::RopeOverload: return "ROPE_OVERLOAD";
-    case AlarmKind::PredictedClearance: return "PREDICTED_CLEARANCE";
-    case AlarmKind::PredictedSlack: return "PREDICTED_SLACK";
-  }
-  return "?";
-}
+// The names are alarm_t.lcm's (KIND_*, LEVEL_*, EVENT_*), generated into
+// hoist/msg/names.hpp; the enums keep their values (checked here).
+namespace names = hoist::msg::enums::alarm_t;
+static_assert(names::kKindNames.size() == kAlarmKinds && names::kKindFirst == 0);
+static_assert(names::parseKind("CAGE_POS_Y") == static_cast<int>(AlarmKind::CagePosY) &&
+              names::parseKind("PREDICTED_SLACK") == static_cast<int>(AlarmKind::PredictedSlack));
+static_assert(names::parseLevel("CRITICAL") == static_cast<int>(AlarmLevel::Critical));
+static_assert(names::parseEvent("REANNOUNCE") == static_cast<int>(AlarmEventType::Reannounce));
 
-const char* toString(AlarmLevel l) {
-  switch (l) {
-    case AlarmLevel::None: return "NONE";
-    case AlarmLevel::Warning: return "WARNING";
-    case AlarmLevel::Critical: return "CRITICAL";
-  }
-  return "?";
-}
-
-const char* toString(AlarmEventType e) {
-  switch (e) {
-    case AlarmEventType::Raise: return "RAISE";
-    case AlarmEventType::Clear: return "CLEAR";
-    case AlarmEventType::Ack: return "ACK";
-    case AlarmEventType::Shelve: return "SHELVE";
-    case AlarmEventType::Unshelve: return "UNSHELVE";
-    case AlarmEventType::Reannounce: return "REANNOUNCE";
-  }
-  return "?";
-}
+// string_view::data() of the generated tables: string literals, NUL-terminated.
+const char* toString(AlarmKind k) { return names::kindName(static_cast<int>(k)).data(); }
+const char* toString(AlarmLevel l) { return names::levelName(static_cast<int>(l)).data(); }
+const char* toString(AlarmEventType e) { return names::eventName(static_cast<int>(e)).data(); }
 
 std::optional<AlarmKind> parseAlarmKind(std::string_view s) {
-  for (int i = 0; i < kAlarmKinds; ++i) {
-    const auto k = static_cast<AlarmKind>(i);
-    if (s == toString(k)) return k;
-  }
-  return std::nullopt;
+  const auto v = names::parseKind(s);
+  if (!v) return std::nullopt;
+  return static_cast<AlarmKind>(*v);
 }
 
 }  // namespace hoist::contract

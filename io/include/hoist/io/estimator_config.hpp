@@ -63,7 +63,7 @@ int* intOf(EstimatorSettings& s) { return &(s.*M); }
 }  // namespace detail
 
 /// Every key of [sensors] and [estimator] but `enabled`, in file order.
-inline constexpr std::array<EstimatorField, 18> kEstimatorFields = {{
+inline constexpr std::array<EstimatorField, 20> kEstimatorFields = {{
     {"sensors", "imu_accel_noise", &detail::noiseOf<&SensorNoise::imu_accel>, nullptr, "m/s^2",
      "IMU lateral specific force f_y: noise standard deviation per sample"},
     {"sensors", "imu_rate_noise", &detail::noiseOf<&SensorNoise::imu_rate>, nullptr, "rad/s",
@@ -90,9 +90,13 @@ inline constexpr std::array<EstimatorField, 18> kEstimatorFields = {{
      "consecutive gated samples that mean a load change (integer)"},
     {"estimator", "nis_window", &detail::realOf<&EstimatorSettings::nis_window>, nullptr, "s", "NIS window"},
     {"estimator", "nis_alpha", &detail::realOf<&EstimatorSettings::nis_alpha>, nullptr, "",
-     "MODEL_MISMATCH when the window's NIS exceeds its 1 - alpha quantile"},
+     "MODEL_MISMATCH when the window's NIS exceeds its 1 - alpha quantile ..."},
+    {"estimator", "nis_margin", &detail::realOf<&EstimatorSettings::nis_margin>, nullptr, "",
+     "... and nis_margin times its degrees of freedom"},
     {"estimator", "drift_sigma", &detail::realOf<&EstimatorSettings::drift_sigma>, nullptr, "sigma",
-     "MODEL_MISMATCH when a load estimate drifts more during a trip"},
+     "MODEL_MISMATCH when a load estimate drifts more during a trip, or its short-memory twin departs more"},
+    {"estimator", "constancy_memory", &detail::realOf<&EstimatorSettings::constancy_memory>, nullptr, "s",
+     "memory of the short-memory load estimates of the constancy test"},
     {"estimator", "min_window_fill", &detail::realOf<&EstimatorSettings::min_window_fill>, nullptr, "",
      "the NIS test needs the window at least this full (fraction)"},
     {"estimator", "max_rate", nullptr, &detail::intOf<&EstimatorSettings::max_rate>, "Hz",

@@ -117,6 +117,7 @@ struct AlarmEvent {
   bool shelved = false;
   bool latched = false;    ///< active only because of the latch
   double shelved_for = 0.0;  ///< remaining shelve time [s]
+  bool from_estimate = false;  ///< raised from the load estimator's state, not the open-loop twin's
 };
 
 /// Fixed-capacity event list (no allocation).  Events beyond the capacity
@@ -132,6 +133,10 @@ class AlarmEvents {
   bool empty() const { return n_ == 0; }
   std::size_t dropped() const { return dropped_; }
   const AlarmEvent& operator[](std::size_t i) const { return ev_[i]; }
+  /// Mark the events from index `first` on as raised from the estimate.
+  void markFromEstimate(std::size_t first) {
+    for (std::size_t i = first; i < n_; ++i) ev_[i].from_estimate = true;
+  }
   const AlarmEvent* begin() const { return ev_.data(); }
   const AlarmEvent* end() const { return ev_.data() + n_; }
 
@@ -220,7 +225,7 @@ class AlarmEngine {
  public:
   /// The number of binary alarms; which ones, in which order, is the slot
   /// table in alarms.cpp (kSlotTable).
-  static constexpr int kSlots = 14;
+  static constexpr int kSlots = 15;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
   const AlarmConfig& config() const { return cfg_; }
@@ -253,6 +258,11 @@ class AlarmEngine {
   /// (reported as the event's value and threshold).
   void setPredictedClearance(double now, bool predicted, double seconds, double horizon, AlarmEvents& out);
   void setPredictedSlack(double now, bool predicted, double seconds, double horizon, AlarmEvents& out);
+  /// MODEL_MISMATCH (the load estimator, docs/estimation.md): `mismatch`
+  /// true while the shaft does not behave like its model; `statistic` and
+  /// `bound` are reported (the window's NIS and its bound, or the load's
+  /// drift and drift_sigma).
+  void setModelMismatch(double now, bool mismatch, double statistic, double bound, AlarmEvents& out);
   /// Runs shelve expiry and re-announcement without a new value.
   void poll(double now, AlarmEvents& out);
 

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "hoist/load_estimator.hpp"
 #include "hoist/params.hpp"
 #include "hoist/service/alarms.hpp"
 
@@ -106,11 +107,19 @@ struct ForecastConfig {
   void validate(double service_rate) const;
 };
 
+/// [sensors] + [estimator]: the load estimator (hoist/load_estimator.hpp,
+/// docs/estimation.md).  Off by default: the twin then runs open loop.
+struct EstimatorConfig {
+  bool enabled = false;
+  EstimatorSettings settings;  ///< validated by EstimatorSettings::validate()
+};
+
 struct TwinConfig {
   ShaftParams shaft;
   ServiceConfig service;
   AlarmConfig alarms;
   ForecastConfig forecast;
+  EstimatorConfig estimator;
 };
 
 }  // namespace hoist::svc

@@ -13,6 +13,7 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/service/twin_core.hpp"
 
 namespace hoist::svc {
@@ -20,6 +21,13 @@ namespace hoist::svc {
 /// Fill `m` (preallocated) from the twin's output; utime, seq and
 /// instance_id are the caller's.
 void toCageMessage(const CageOutput& o, hoist::cage_state_t& m);
+
+/// Fill `m` from the load estimate (utime, seq and instance_id are the
+/// caller's).  `t` is the published time; the ages are seconds since each
+/// sensor's last accepted sample (< 0: never).  A value that is not observed
+/// (sigma < 0) is published as 0 with sigma -1, never as NaN.
+void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double t, double imu_age,
+                       double rope_load_age, bool in_use, hoist::estimate_t& m);
 
 /// What the alarm text needs besides the event.
 struct AlarmTextContext {

@@ -49,6 +49,7 @@
 #include "hoist/service/alarms.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/input_validator.hpp"
+#include "hoist/load_estimator.hpp"
 #include "hoist/plausibility.hpp"
 #include "hoist/solver.hpp"
 
@@ -205,6 +206,21 @@ class TwinCore {
   std::int64_t domainErrors() const { return domain_errors_; }
   const Solver& solver() const { return *solver_; }
 
+  // ---- load estimator ([estimator], hoist/load_estimator.hpp) ---------------
+  /// A validated cage IMU sample (f_y [m/s^2], omega [rad/s]; NaN = that
+  /// channel absent): applied at the next model step (input clock: the step of
+  /// the next winder input; wall clock: the next tick).  No-op when disabled.
+  void onCageImu(double f_y, double omega);
+  /// A validated rope-load sample [N], likewise.
+  void onRopeLoad(double force);
+  bool estimatorEnabled() const { return est_ != nullptr; }
+  /// The estimate after the last step (null when disabled or not yet started).
+  const LoadEstimate* estimate() const { return est_ && est_synced_ ? &est_->estimate() : nullptr; }
+  const EstimatorCounters* estimatorCounters() const { return est_ ? &est_->counters() : nullptr; }
+  /// The last step's clearance and rope-force alarms were judged on the
+  /// estimate (it has sensors in use and no MODEL_MISMATCH).
+  bool estimateInUse() const { return est_in_use_; }
+
  private:
   friend class InputClock;
   friend class WallClock;
@@ -258,6 +274,17 @@ class TwinCore {
   bool fault_pending_clear_ = false;
   bool inject_fault_ = false;
   std::int64_t steps_ = 0, faults_ = 0, resets_ = 0, domain_errors_ = 0, catchups_ = 0;
+  // load estimator ([estimator] enabled; docs/estimation.md)
+  std::unique_ptr<LoadEstimator> est_;  // null when disabled
+  bool est_synced_ = false;     // its sensitivities stepped exactly as the solver (false after a refused step)
+  bool est_in_use_ = false;     // the last step's alarms used the estimate (sensors in use, no mismatch)
+  struct PendingImu {
+    bool has_accel = false, has_rate = false;
+    double f_y = 0.0, omega = 0.0;
+  } imu_;                       // the latest cage IMU sample not yet applied
+  bool rope_pending_ = false;   // a rope-load sample not yet applied
+  double rope_force_ = 0.0;
+  void estimatorStep(const CageResponse& r);  // predict, apply the pending samples, finish
   double catchup_until_ = -1.0;   // degraded through this model time after a limited catch-up
   bool domain_outside_ = false;
   const char* fault_what_ = "";

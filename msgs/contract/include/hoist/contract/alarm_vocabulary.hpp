@@ -15,9 +15,10 @@ namespace hoist::contract {
 enum class AlarmKind : std::uint8_t {
   CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher,
   RopeSlack, RopeOverload,            // live rope-force alarms
-  PredictedClearance, PredictedSlack  // look-ahead forecasts
+  PredictedClearance, PredictedSlack,  // look-ahead forecasts
+  ModelMismatch                       // the load estimator: the shaft does not behave like its model
 };
-inline constexpr int kAlarmKinds = 11;
+inline constexpr int kAlarmKinds = 12;
 
 /// Values match alarm_t.LEVEL_*.
 enum class AlarmLevel : std::int8_t { None = 0, Warning = 1, Critical = 2 };

@@ -1,0 +1,122 @@
+// The live load estimator ([estimator] enabled in hoist-twind) against the
+// offline one (hoist-estimate) on the same data, over real UDP multicast on
+// loopback (port 7871): hoist-sim writes the measurements of a shaft whose
+// load differs from the config, hoist-replay --measurements publishes them,
+// the daemon runs --clock input, and every HOIST_ESTIMATE equals
+// hoist-estimate's row to 1e-12.  Also: the alarms say where they came from,
+// and HOIST_HEALTH counts the sensor samples.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "hoist/alarm_t.hpp"
+#include "hoist/estimate_t.hpp"
+#include "hoist/health_t.hpp"
+#include "lcm_fixtures.hpp"
+
+using namespace hoist::test;
+using namespace std::chrono_literals;
+
+namespace {
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string f;
+  while (std::getline(ss, f, ',')) out.push_back(f);
+  return out;
+}
+
+/// hoist-estimate's output: one map column -> value per row.
+std::vector<std::map<std::string, double>> readEstimateCsv(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, double>> rows;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header.empty()) {
+      header = split(line);
+      continue;
+    }
+    const auto f = split(line);
+    std::map<std::string, double> r;
+    for (std::size_t i = 0; i < f.size() && i < header.size(); ++i) r[header[i]] = std::strtod(f[i].c_str(), nullptr);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+class EstimatorDaemon : public LcmProcessTest {};
+
+}  // namespace
+
+TEST_F(EstimatorDaemon, LiveEstimateEqualsHoistEstimateOnTheSameData) {
+  start(7871, "EstimatorDaemon", {"HOIST_HEALTH"});
+  const std::string truth = (dir_ / "truth.toml").string(), cfg = (dir_ / "twin.toml").string();
+  {
+    std::ofstream t(truth);
+    t << "[load]\neccentric_force = 1500.0\noffset = 0.6\n[model]\nmodes = 25\n";
+    std::ofstream c(cfg);
+    c << "[model]\nmodes = 25\n[estimator]\nenabled = true\n";
+  }
+  const std::string meas = (dir_ / "meas.csv").string(), est = (dir_ / "est.csv").string();
+  // A short trip: 50 m -> 62 m in 10 s (1001 rows at 100 Hz).
+  ASSERT_EQ(runProcess({HOIST_SIM, "--config", truth, "--profile", "trapezoid:vmax=2,amax=1,travel=12,t_end=10",
+                        "--write-measurements", meas, "--sensor-noise", "0.002,0.0001,20", "--seed", "7", "-q"},
+                       (dir_ / "sim.log").string(), 60s),
+            0)
+      << readFile((dir_ / "sim.log").string());
+  ASSERT_EQ(runProcess({HOIST_ESTIMATE, "--config", cfg, "--measurements", meas, "--out", est},
+                       (dir_ / "estimate.log").string(), 60s),
+            0)
+      << readFile((dir_ / "estimate.log").string());
+  const auto offline = readEstimateCsv(est);
+  ASSERT_EQ(offline.size(), 1001u);
+
+  listener_->subscribe("HOIST_ESTIMATE|HOIST_ALARM");
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", cfg, "--clock", "input"};
+  auto d = startDaemonAndWait(*listener_, argv, (dir_ / "twind.log").string());
+  {
+    Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", meas, "--speed", "4", "-q"},
+              (dir_ / "replay.log").string());
+    listener_->waitFor([&] { return !r.running(); }, 30s);
+    ASSERT_EQ(r.wait(1s), 0) << readFile((dir_ / "replay.log").string());
+  }
+  EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_ESTIMATE") >= 1001; }, 10s));
+  // The health after the run counts every sensor sample.
+  const std::size_t h0 = listener_->count("HOIST_HEALTH");
+  EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > h0; }, 5s));
+  const auto health = listener_->decoded<hoist::health_t>("HOIST_HEALTH");
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+
+  const auto live = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
+  ASSERT_EQ(live.size(), offline.size()) << readFile((dir_ / "twind.log").string());
+  auto same = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
+  for (std::size_t i = 0; i < live.size(); ++i) {
+    const hoist::estimate_t& e = live[i];
+    const auto& o = offline[i];
+    ASSERT_TRUE(same(e.t, o.at("t"))) << "row " << i << ": t " << e.t << " vs " << o.at("t");
+    ASSERT_TRUE(same(e.Fa, o.at("Fa"))) << "row " << i << ": Fa " << e.Fa << " vs " << o.at("Fa");
+    ASSERT_TRUE(same(e.moment, o.at("moment"))) << "row " << i << ": M " << e.moment << " vs " << o.at("moment");
+    ASSERT_TRUE(same(e.sigma_moment, o.at("sigma_moment"))) << "row " << i;
+    ASSERT_TRUE(same(e.theta, o.at("theta"))) << "row " << i << ": theta " << e.theta << " vs " << o.at("theta");
+    ASSERT_TRUE(same(e.lambdas[0], o.at("lambda_0"))) << "row " << i;
+    ASSERT_TRUE(same(e.lambdas[1], o.at("lambda_1"))) << "row " << i;
+    ASSERT_TRUE(same(e.nis_window, o.at("nis_window"))) << "row " << i;
+    ASSERT_EQ(e.mismatch, o.at("mismatch") != 0.0) << "row " << i;
+  }
+  // It did estimate: the load the config does not know.
+  const hoist::estimate_t& last = live.back();
+  EXPECT_NEAR(last.Fa, 1500.0, 20.0);
+  EXPECT_NEAR(last.moment, 900.0, 90.0);
+  EXPECT_TRUE(last.in_use);
+  EXPECT_EQ(last.sensors, 7);
+  ASSERT_FALSE(health.empty());
+  EXPECT_EQ(health.back().sensor_accepted, 2 * 1001);
+  EXPECT_EQ(health.back().sensor_rejected, 0);
+  EXPECT_TRUE(health.back().estimate_in_use);
+}
