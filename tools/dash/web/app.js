@@ -523,7 +523,7 @@
   const SENSOR_IMU_ACCEL = 1, SENSOR_IMU_RATE = 2, SENSOR_ROPE_LOAD = 4;  // estimate_t.SENSOR_*
   const EST_ROWS = [["Fa", "payload Fa"], ["b", "offset b"], ["moment", "moment M = Fa b"], ["y_c", "sway y_c"],
                     ["theta", "tilt θ"], ["nis", "NIS window / bound"], ["sensors", "sensors in use"],
-                    ["counts", "updates / gated / refused"]];
+                    ["counts", "updates / gated / refused"], ["in_use", "alarms judge"]];
 
   function makeEstimateCard() {
     const dl = el("dl", { "data-role": "estimate-values" });
@@ -602,6 +602,10 @@
     set("sensors", used.length ? used.join("; ") : "none: the twin runs open loop");
     $('[data-field="est-sensors"]', box).dataset.sensors = String(e.sensors);
     set("counts", `${e.accepted} / ${e.gated} / ${e.implausible}`);
+    // Newer daemons say whether their alarms judge this estimate (estimate_t.in_use).
+    const inUse = $('[data-field="est-in_use"]', box);
+    inUse.previousSibling.hidden = inUse.hidden = typeof e.in_use !== "boolean";
+    inUse.textContent = e.in_use === true ? "the estimate" : e.in_use === false ? "the open-loop twin" : "";
     const badge = $('[data-field="est-mismatch"]', box);
     const on = Boolean(e.mismatch) || mismatchInInterval;
     badge.dataset.state = on ? "mismatch" : "ok";
