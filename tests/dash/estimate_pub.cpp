@@ -10,7 +10,9 @@
 // 306 over 300 degrees of freedom (bounds 253.9 .. 349.9, MODEL_MISMATCH
 // bound 372), both sensors in use.  MODE:
 //   normal    (default) as above;
-//   mismatch  NIS 450 over the bound: mismatch, nis_exceeded;
+//   mismatch  NIS 450 over the bound: mismatch, nis_exceeded; first one
+//             MODEL_MISMATCH WARNING RAISE on <prefix>HOIST_ALARM (value 450,
+//             threshold 372), as the daemon raises it;
 //   norope    the rope load cell is gone: Fa and b not observed (sigma -1),
 //             sensors = IMU only.
 #include <lcm/lcm-cpp.hpp>
@@ -22,6 +24,7 @@
 #include <string>
 #include <thread>
 
+#include "hoist/alarm_t.hpp"
 #include "hoist/estimate_t.hpp"
 
 int main(int argc, char** argv) {
@@ -87,6 +90,20 @@ int main(int argc, char** argv) {
       e.nis_window = 450.0;
       e.mismatch = 1;
       e.nis_exceeded = 1;
+      if (k == 0) {
+        hoist::alarm_t a{};
+        a.utime = e.utime;
+        a.t = e.t;
+        a.kind = "MODEL_MISMATCH";
+        a.level = hoist::alarm_t::LEVEL_WARNING;
+        a.event_type = hoist::alarm_t::EVENT_RAISE;
+        a.active = 1;
+        a.value = 450.0;
+        a.threshold = 372.0;
+        a.message = "MODEL_MISMATCH WARNING raised: the shaft does not behave like its model";
+        a.user = "";
+        lcm.publish(prefix + "HOIST_ALARM", &a);
+      }
     } else if (mode == "norope") {
       e.sigma_Fa = e.sigma_b = -1.0;
       e.Fa = 1500.0;  // the configured load: no estimate

@@ -10,7 +10,8 @@
 // the theta trend has points of the estimate, of its +-2 sigma band (upper
 // above, lower below the estimate, 2 sigma apart) and of the open-loop theta;
 // the NIS trend has points of the window's NIS and of its bounds; a mismatch
-// raises the MODEL_MISMATCH badge naming the NIS; without the rope load cell
+// raises the MODEL_MISMATCH badge naming the NIS, and the MODEL_MISMATCH alarm
+// row shows the NIS against its bound; without the rope load cell
 // Fa and b read "n/a"; the panel says STALE when the estimates stop.
 import fs from "node:fs";
 import path from "node:path";
@@ -117,6 +118,11 @@ await page.waitForFunction((sel) => document.querySelector(`${sel} [data-field="
 p = await panel();
 check(p.badgeVisible && p.badge === "MODEL_MISMATCH (NIS)", `MODEL_MISMATCH badge shown: "${p.badge}"`);
 check(p.nis.startsWith("450.0 / 372.0"), `NIS above its bound shown: "${p.nis}"`);
+// The daemon's MODEL_MISMATCH alarm: its value is a statistic (NIS) against the bound, not millimetres.
+const row = '[data-shaft="north/"] tr.alarm[data-kind="MODEL_MISMATCH"][data-active="true"]';
+await page.waitForSelector(row, { timeout: 3000 });
+const val = await page.$eval(`${row} [data-field="value"]`, (e) => e.textContent);
+check(val === "450.0 / 372.0", `MODEL_MISMATCH alarm row shows the NIS against its bound: "${val}"`);
 
 // 3. The rope load cell is gone: Fa and b are not observed.
 await publish("norope", 60);

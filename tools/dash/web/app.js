@@ -452,6 +452,8 @@
   function fmtVal(a) {
     if (a.kind === "INPUT_STALE" || a.kind === "MODEL_FAULT") return a.value >= 0.5 ? "on" : "off";
     if (a.kind === "ROPE_SLACK" || a.kind === "ROPE_OVERLOAD") return `${fix(a.value / 1e3, 2)} kN / ${fix(a.threshold / 1e3, 2)} kN`;
+    // The estimator's model check: its windowed NIS (or load drift) against the bound, no unit.
+    if (a.kind === "MODEL_MISMATCH") return `${Number(a.value).toPrecision(4)} / ${Number(a.threshold).toPrecision(4)}`;
     return `${fix(a.value * 1e3, 1)} mm / ${fix(a.threshold * 1e3, 1)} mm`;
   }
 
@@ -480,7 +482,9 @@
         el("td", { title: a.message }, a.kind),
         el("td", { class: "state" }, stateText(a)),
         el("td", { "data-field": "activation" }, `${activeSince(a)} (t=${fix(a.dash_activation_t, 1)} s)`, re),
-        el("td", {}, fmtVal(a)),
+        el("td", { "data-field": "value" }, fmtVal(a),
+           // Newer daemons say whether the alarm judged the load estimate (alarm_t.from_estimate).
+           a.from_estimate === true ? el("span", { class: "reann", "data-field": "from-estimate" }, "judged on the load estimate") : ""),
         el("td", {}, a.user || ""));
       const btns = el("td", { class: "btns cmd" });
       if (!state.readOnly) {
