@@ -125,13 +125,22 @@ TEST(ShowEstimate, Log2csvWritesEveryEstimateField) {
   // Every member of msgs/estimate_t.lcm, fixed arrays as NAME_0..NAME_4.
   const std::vector<std::string> members = {
       "utime", "seq", "instance_id", "t", "l", "v", "a", "Fa", "sigma_Fa", "b", "sigma_b", "moment", "sigma_moment",
-      "x_c", "sigma_x_c", "y_c", "sigma_y_c", "theta", "sigma_theta", "theta_open", "lambdas_0", "lambdas_4",
-      "sigma_lambdas_0", "sigma_lambdas_4", "nis", "nis_window", "nis_dof", "nis_lower", "nis_upper", "nis_bound",
+      "x_c", "sigma_x_c", "y_c", "sigma_y_c", "theta", "sigma_theta", "theta_open", "nis", "nis_window", "nis_dof", "nis_lower", "nis_upper", "nis_bound",
       "drift", "mismatch", "nis_exceeded", "drift_exceeded", "sensors", "imu_age", "rope_load_age", "fa_observed",
       "moment_observed", "accepted", "gated", "load_changes", "implausible"};
   std::map<std::string, std::size_t> col;
   for (std::size_t i = 0; i < head.size(); ++i) col[head[i]] = i;
   for (const auto& m : members) EXPECT_TRUE(col.count(m)) << "no column " << m << " in " << line;
+  // The arrays: NAME_0..NAME_4 (or, with `@csv lambdas lambda` in the .lcm as
+  // hoist-estimate names them, lambda_0..; either way all five).
+  auto arrayCol = [&](const std::string& name, const std::string& alt, int i) -> std::string {
+    const std::string a = name + "_" + std::to_string(i), b = alt + "_" + std::to_string(i);
+    return col.count(a) ? a : b;
+  };
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(col.count(arrayCol("lambdas", "lambda", i))) << "no column lambdas_" << i << " in " << line;
+    EXPECT_TRUE(col.count(arrayCol("sigma_lambdas", "sigma_lambda", i))) << "no column sigma_lambdas_" << i << " in " << line;
+  }
   std::vector<std::vector<std::string>> rows;
   while (std::getline(lines, line)) rows.push_back(splitCsv(line));
   ASSERT_EQ(rows.size(), 4u);
@@ -140,7 +149,8 @@ TEST(ShowEstimate, Log2csvWritesEveryEstimateField) {
   EXPECT_EQ(std::stod(rows[0][col["Fa"]]), 1502.4);
   EXPECT_EQ(std::stod(rows[0][col["sigma_b"]]), 0.0102);
   EXPECT_EQ(std::stod(rows[0][col["theta_open"]]), 8.3e-4);
-  EXPECT_EQ(std::stod(rows[0][col["sigma_lambdas_4"]]), 2.5);
+  EXPECT_EQ(std::stod(rows[0][col[arrayCol("sigma_lambdas", "sigma_lambda", 4)]]), 2.5);
+  EXPECT_EQ(std::stod(rows[0][col[arrayCol("lambdas", "lambda", 0)]]), 31000.0);
   EXPECT_EQ(std::stod(rows[2][col["t"]]), 12.02);
   EXPECT_EQ(std::stol(rows[0][col["nis_dof"]]), 300);
   EXPECT_EQ(std::stol(rows[2][col["accepted"]]), 1202);
