@@ -12,6 +12,7 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "attack_bytes.hpp"
@@ -87,7 +88,8 @@ TEST_F(HubTest, ServerInfoThenAdvertiseOfEveryHoistChannelWithJsonSchema) {
     EXPECT_EQ(schema["type"], "object") << ch["topic"];
   }
   for (const char* t : {"north/HOIST_WINDER", "north/HOIST_CAGE", "north/HOIST_GUIDE_SHAPE", "north/HOIST_ALARM",
-                        "north/HOIST_ALARM_ACK", "north/HOIST_HEALTH", "north/HOIST_CAGE/decimated"})
+                        "north/HOIST_ALARM_ACK", "north/HOIST_HEALTH", "north/HOIST_CAGE/decimated",
+                        "north/HOIST_ESTIMATE", "north/HOIST_ESTIMATE/decimated"})
     EXPECT_NE(std::find(topics.begin(), topics.end(), t), topics.end()) << t;
 }
 
@@ -228,6 +230,62 @@ TEST_F(HubTest, DecimatedChannelKeepsEachIntervalsMinAndMax) {
   EXPECT_FALSE(d["min"]["degraded"].get<bool>());
   hub.flushDecimated();  // nothing new: nothing sent
   EXPECT_EQ(c.data.size(), 1u);
+}
+
+// HOIST_ESTIMATE: advertised per shaft with its JSON Schema (field names as in
+// estimate_t.lcm), delivered whole on its own channel, and decimated like the
+// cage on HOIST_ESTIMATE/decimated (the page's load-estimate panel).
+TEST_F(HubTest, EstimateIsAdvertisedAndDecimatedLikeTheCage) {
+  Hub hub = make(false, {"north/"});
+  RecClient c;
+  hub.addClient(c);
+  const auto raw = channelId(c, "north/HOIST_ESTIMATE");
+  const auto dec = channelId(c, "north/HOIST_ESTIMATE/decimated");
+  ASSERT_NE(raw, 0u);
+  ASSERT_NE(dec, 0u);
+  for (const auto& ch : c.text[1]["channels"])
+    if (ch["topic"] == "north/HOIST_ESTIMATE") {
+      EXPECT_EQ(ch["schemaName"], "hoist.estimate_t");
+      const Json schema = Json::parse(ch["schema"].get<std::string>());
+      for (const char* f : {"Fa", "sigma_Fa", "b", "sigma_b", "theta_open", "nis_window", "nis_bound", "sigma_lambdas"})
+        EXPECT_TRUE(schema["properties"].contains(f)) << f;
+    }
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 3}, {"channelId", raw}}, {{"id", 4}, {"channelId", dec}}}}}.dump());
+  const double fa[] = {1499.0, 1504.5, 1501.0};  // Fa +- a few N
+  for (int i = 0; i < 3; ++i) {
+    estimate_t e{};
+    e.utime = 2000 + i;
+    e.t = 0.01 * i;
+    e.Fa = fa[i];
+    e.sigma_Fa = 3.0;
+    e.b = 0.6;
+    e.sigma_b = 0.01;
+    e.theta = 6.5e-4 + 1e-5 * i;
+    e.sigma_theta = 1e-5;
+    e.theta_open = 8.3e-4;
+    e.nis_window = 300.0 + 10.0 * i;
+    e.nis_bound = 372.0;
+    e.mismatch = i == 1;
+    const auto b = encode(e);
+    hub.onLcm("north/HOIST_ESTIMATE", b.data(), b.size());
+  }
+  ASSERT_EQ(c.data.size(), 3u);  // each estimate whole on HOIST_ESTIMATE
+  const Json first = Json::parse(c.data[0].substr(13));
+  EXPECT_DOUBLE_EQ(first["Fa"].get<double>(), 1499.0);
+  hub.flushDecimated();
+  ASSERT_EQ(c.data.size(), 4u);
+  std::uint32_t sub = 0;
+  std::memcpy(&sub, c.data[3].data() + 1, 4);
+  EXPECT_EQ(sub, 4u);
+  const Json d = Json::parse(c.data[3].substr(13));
+  EXPECT_EQ(d["count"], 3);
+  EXPECT_DOUBLE_EQ(d["max"]["Fa"].get<double>(), 1504.5);
+  EXPECT_DOUBLE_EQ(d["min"]["Fa"].get<double>(), 1499.0);
+  EXPECT_DOUBLE_EQ(d["max"]["nis_window"].get<double>(), 320.0);
+  EXPECT_TRUE(d["max"]["mismatch"].get<bool>());  // a mismatch within the interval is not lost
+  EXPECT_DOUBLE_EQ(d["last"]["Fa"].get<double>(), 1501.0);
+  hub.flushDecimated();
+  EXPECT_EQ(c.data.size(), 4u);
 }
 
 std::string clientMessage(std::uint32_t chan, const Json& j) {

@@ -18,6 +18,7 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 
@@ -946,6 +947,103 @@ TEST_F(MqttBridge, PasswordFromSystemdCredential) {
   ASSERT_TRUE(st) << readFile(path("bridge.log")) << readFile(path("mosquitto.log"));
   EXPECT_NE(readFile(path("bridge.log")).find("using the systemd credential mqtt-password"), std::string::npos);
   EXPECT_EQ(readFile(path("bridge.log")).find("cr3d-pw"), std::string::npos) << "the password must never be logged";
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+}
+
+// The load estimate (HOIST_ESTIMATE, published by the daemon at the cage rate)
+// on hoist/<shaft>/estimate: JSON with the .lcm's field names, QoS 0, not
+// retained, the latest one at [bridge] cage_rate like the cage state.  The
+// test publishes estimate_t itself (realistic values), 100 Hz for 2 s, into a
+// bridge with cage_rate = 5 (LCM port 7841, broker port 18900).
+TEST_F(MqttBridge, EstimateAtTheCageRateNotRetained) {
+  dir_ = testDir("mqtt_estimate");
+  const std::string url = urlFor(7841);
+  Broker broker(dir_, 18900);
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\ncage_rate = 5\nhealth_period = 0.5\nchannel_prefixes = [\"north/\"]\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-e"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-e/status", [](const json& j, bool) { return j.value("online", false); }, 10s))
+      << readFile(log("bridge.log"));
+  auto estimate = [](std::int64_t seq) {
+    hoist::estimate_t e{};
+    e.utime = 1'700'000'000'000'000 + seq * 10'000;
+    e.seq = seq;
+    e.t = 0.01 * static_cast<double>(seq);
+    e.l = 100.0 + 0.045 * static_cast<double>(seq);
+    e.v = 4.5;
+    e.Fa = 1500.0 + 0.01 * static_cast<double>(seq);
+    e.sigma_Fa = 3.0;
+    e.b = 0.6;
+    e.sigma_b = 0.01;
+    e.moment = e.Fa * e.b;
+    e.sigma_moment = 15.0;
+    e.theta = 6.5e-4;
+    e.sigma_theta = 1e-5;
+    e.theta_open = 8.3e-4;
+    for (int i = 0; i < 5; ++i) {
+      e.lambdas[i] = i == 0 ? 31000.0 : 40.0 * i;
+      e.sigma_lambdas[i] = 1.0 + i;
+    }
+    e.nis_dof = 300;
+    e.nis_window = 306.0;
+    e.nis_lower = 253.9;
+    e.nis_upper = 349.9;
+    e.nis_bound = 372.0;
+    e.sensors = 7;
+    e.imu_age = 0.004;
+    e.rope_load_age = 0.009;
+    e.fa_observed = 1;
+    e.moment_observed = 1;
+    return e;
+  };
+  const std::int64_t n = 200;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::int64_t i = 1; i <= n; ++i) {
+    auto e = estimate(i);
+    if (i == n) e.sigma_b = -1.0;  // the last one: b not observed
+    lcm.lcm().publish("north/HOIST_ESTIMATE", &e);
+    lcm.pump(10ms);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string topic = "hoist/north/estimate";
+  // The latest estimate arrives (within one cage period and a bit).
+  auto last = c.waitJson(topic, [&](const json& j, bool) { return j.value("seq", 0) == n; }, 5s);
+  ASSERT_TRUE(last) << readFile(log("bridge.log"));
+  EXPECT_DOUBLE_EQ((*last)["Fa"].get<double>(), 1500.0 + 0.01 * n);
+  EXPECT_DOUBLE_EQ((*last)["sigma_Fa"].get<double>(), 3.0);
+  EXPECT_LT((*last)["sigma_b"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ((*last)["theta_open"].get<double>(), 8.3e-4);
+  ASSERT_TRUE((*last)["lambdas"].is_array());
+  EXPECT_EQ((*last)["lambdas"].size(), 5u);
+  EXPECT_DOUBLE_EQ((*last)["sigma_lambdas"][4].get<double>(), 5.0);
+  EXPECT_EQ((*last)["nis_dof"].get<int>(), 300);
+  EXPECT_DOUBLE_EQ((*last)["nis_bound"].get<double>(), 372.0);
+  EXPECT_EQ((*last)["sensors"].get<int>(), 7);
+  const auto got = c.on(topic);
+  for (const auto& m : got) EXPECT_FALSE(m.retain) << m.payload;
+  // Rate handling as for the cage: at most about cage_rate per second, not every message.
+  EXPECT_GE(got.size(), 2u);
+  EXPECT_LE(static_cast<double>(got.size()), 5.0 * (seconds + 1.5) + 2.0) << got.size() << " in " << seconds << " s";
+  EXPECT_LT(got.size(), static_cast<std::size_t>(n / 4));
+  // Counted in the bridge's health.
+  auto bh = c.waitJson("hoist/_bridge/bridge-e/health", [&](const json& j, bool) {
+    return !j["shafts"].empty() && j["shafts"][0].value("estimates_in", 0) >= n - 5;
+  }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["shafts"][0]["estimates_out"].get<std::size_t>(), c.on(topic).size());
+  // Not retained: a late subscriber gets none.
+  Client late(broker.port(), "late");
+  ASSERT_TRUE(late.connected());
+  late.subscribe(topic);
+  std::this_thread::sleep_for(700ms);
+  EXPECT_TRUE(late.on(topic).empty());
   bridge.signal(SIGTERM);
   EXPECT_EQ(bridge.wait(5s), 0);
 }

@@ -27,6 +27,9 @@
 //                       hoist-sim --shape-out)
 //   hoist.alarm_t       the members (event_type in a column "event")
 //   hoist.alarm_ack_t, hoist.trip_plan_t  the members
+//   hoist.estimate_t    the members (lambdas_0..4, sigma_lambdas_0..4; the
+//                       booleans 0/1; a sigma < 0 means "not observed")
+//   hoist.cage_imu_t, hoist.rope_load_t  the members
 //   hoist.health_t      the members, then rejected_<reason> per reason
 //   hoist.forecast_t    one row per scenario: the forecast's columns with
 //                       num_scenarios replaced by the scenario's index
@@ -59,11 +62,14 @@
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
+#include "hoist/cage_imu_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/forecast_scenario_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/rope_load_t.hpp"
 #include "hoist/trip_plan_t.hpp"
 #include "hoist/io/checked_file.hpp"
 #include "hoist/io/lcm_log.hpp"
@@ -131,6 +137,9 @@ class Converter {
     if (name == "hoist.health_t") return table<hoist::health_t>(ev, "health_t", rejectedByReason);
     if (name == "hoist.forecast_t") return forecast(ev);
     if (name == "hoist.trip_plan_t") return table<hoist::trip_plan_t>(ev, "trip_plan_t");
+    if (name == "hoist.estimate_t") return table<hoist::estimate_t>(ev, "estimate_t");
+    if (name == "hoist.cage_imu_t") return table<hoist::cage_imu_t>(ev, "cage_imu_t");
+    if (name == "hoist.rope_load_t") return table<hoist::rope_load_t>(ev, "rope_load_t");
     ++unknown_[ev.channel];
     return false;
   }

@@ -17,6 +17,16 @@
 // smallest hoisting-rope force; a scenario stopped early says why.  Run one
 // monitor per shaft (--channel-prefix).
 //
+// Load estimate: when the daemon publishes HOIST_ESTIMATE ([estimator]
+// enabled), each line is followed by one "estimate" line with the latest
+// estimate: the payload Fa and its offset b with their standard deviations
+// ("n/a" when not observed: sigma < 0), the estimated tilt theta next to the
+// open-loop twin's, the sliding window's NIS per degree of freedom against
+// its MODEL_MISMATCH bound, the sensors in use, and [MISMATCH] (with its
+// cause) while the model check fails, e.g.
+//   estimate: Fa 1502+-3 N b 0.60+-0.01 m theta 6.5e-4 (open 8.3e-4) NIS 1.02/dof (bound 1.24) sensors imu+rope [MISMATCH: NIS]
+// The line says STALE like the cage line when HOIST_ESTIMATE stops.
+//
 // Hostile input (issue 12): every payload passes hoist::msg::checkedDecode
 // before it is decoded (undecodable ones are counted and shown), no exception
 // leaves an LCM callback, every string from the network is printed through
@@ -45,6 +55,7 @@
 
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/bus/channels.hpp"
@@ -100,6 +111,15 @@ class Monitor {
       last_forecast_ = Clock::now();
     });
   }
+  void onEstimate(const lcm::ReceiveBuffer* rb, const std::string&) {
+    guarded([&] {
+      hoist::estimate_t m;
+      if (!decode(rb, m)) return;
+      estimate_ = m;
+      have_estimate_ = true;
+      last_estimate_ = Clock::now();
+    });
+  }
   void onHealth(const lcm::ReceiveBuffer* rb, const std::string&) {
     guarded([&] {
       hoist::health_t m;
@@ -152,7 +172,50 @@ class Monitor {
                 cage_.y_c * 1e3, cage_.theta * 1e3, fmax, cage_.min_clearance * 1e3, alarms.c_str(),
                 stale.c_str(), bad.c_str());
     if (have_forecast_) std::printf("%s\n", forecastLine(Clock::now()).c_str());
+    if (have_estimate_) std::printf("%s\n", estimateLine(Clock::now()).c_str());
     std::fflush(stdout);
+  }
+
+  /// "  estimate: Fa 1502+-3 N b 0.60+-0.01 m theta 6.5e-4 (open 8.3e-4)
+  /// NIS 1.02/dof (bound 1.24) sensors imu+rope [MISMATCH: NIS]"
+  std::string estimateLine(Clock::time_point now) const {
+    const auto& e = estimate_;
+    char b[160];
+    auto withSigma = [&](const char* name, double v, double sigma, const char* fmt_v, const char* unit) {
+      std::string out = std::string(" ") + name + " ";
+      if (!(sigma >= 0.0) || !std::isfinite(v)) return out + "n/a";  // not observed (or NaN: nothing to show)
+      std::snprintf(b, sizeof b, fmt_v, v, sigma);
+      return out + b + " " + unit;
+    };
+    std::string out = "  estimate:";
+    out += withSigma("Fa", e.Fa, e.sigma_Fa, "%.0f+-%.0f", "N");
+    out += withSigma("b", e.b, e.sigma_b, "%.2f+-%.2f", "m");
+    if (e.sigma_theta >= 0.0) std::snprintf(b, sizeof b, " theta %.1e (open %.1e)", e.theta, e.theta_open);
+    else std::snprintf(b, sizeof b, " theta n/a (open %.1e)", e.theta_open);
+    out += b;
+    if (e.nis_dof > 0) {
+      std::snprintf(b, sizeof b, " NIS %.2f/dof (bound %.2f)", e.nis_window / e.nis_dof, e.nis_bound / e.nis_dof);
+      out += b;
+    } else {
+      out += " NIS n/a";
+    }
+    std::string sensors;
+    const int imu = int{hoist::estimate_t::SENSOR_IMU_ACCEL} | int{hoist::estimate_t::SENSOR_IMU_RATE};
+    if (e.sensors & imu) sensors = "imu";
+    if (e.sensors & int{hoist::estimate_t::SENSOR_ROPE_LOAD}) sensors += sensors.empty() ? "rope" : "+rope";
+    out += " sensors " + (sensors.empty() ? std::string("none (open loop)") : sensors);
+    if (e.mismatch) {
+      out += " [MISMATCH";
+      if (e.nis_exceeded) out += e.drift_exceeded ? ": NIS, drift" : ": NIS";
+      else if (e.drift_exceeded) out += ": drift";
+      out += "]";
+    }
+    const double age = std::chrono::duration<double>(now - last_estimate_).count();
+    if (age > stale_s_) {
+      std::snprintf(b, sizeof b, "  ** STALE: no HOIST_ESTIMATE for %.1f s **", age);
+      out += b;
+    }
+    return out;
   }
 
   /// "  forecast from t=20.00 s: estop: worst 31.0 mm at +4.25 s, CRITICAL
@@ -219,7 +282,9 @@ class Monitor {
   hoist::health_t health_{};
   hoist::forecast_t forecast_{};
   Clock::time_point last_forecast_{};
-  bool have_cage_ = false, have_health_ = false, have_forecast_ = false;
+  hoist::estimate_t estimate_{};
+  Clock::time_point last_estimate_{};
+  bool have_cage_ = false, have_health_ = false, have_forecast_ = false, have_estimate_ = false;
   std::map<std::string, bool> active_;
   long lines_ = 0;
 };
@@ -231,7 +296,8 @@ int main(int argc, char** argv) {
       "hoist-monitor: print the digital twin's cage state once a second (time, depth, speed,\n"
       "sway, tilt, largest sleeve force, minimum clearance, active alarms) and every alarm event;\n"
       "with HOIST_FORECAST, per scenario the worst forecast clearance and the time to violation\n"
-      "(seconds to the first CRITICAL / WARNING crossing)."};
+      "(seconds to the first CRITICAL / WARNING crossing); with HOIST_ESTIMATE, the estimated\n"
+      "load (Fa, b with their sigmas), theta estimated and open loop, the NIS and MODEL_MISMATCH."};
   app.name("hoist-monitor");  // usage lines name the program, not the path it was run by
   app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-monitor ") + hoist::kVersionString);
@@ -283,11 +349,13 @@ int main(int argc, char** argv) {
       rx->add(ch.alarm, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onAlarm(rb, c); });
       rx->add(ch.health, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onHealth(rb, c); });
       rx->add(ch.forecast, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onForecast(rb, c); });
+      rx->add(ch.estimate, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onEstimate(rb, c); });
     } else {
       lcm.subscribe(hoist::bus::regexEscape(ch.cage), &Monitor::onCage, &mon);
       lcm.subscribe(hoist::bus::regexEscape(ch.alarm), &Monitor::onAlarm, &mon);
       lcm.subscribe(hoist::bus::regexEscape(ch.health), &Monitor::onHealth, &mon);
       lcm.subscribe(hoist::bus::regexEscape(ch.forecast), &Monitor::onForecast, &mon);
+      lcm.subscribe(hoist::bus::regexEscape(ch.estimate), &Monitor::onEstimate, &mon);
     }
   }
   struct sigaction sa {};

@@ -31,7 +31,9 @@ const std::vector<std::pair<std::string, std::string>>& typeSuffixes() {
       {"hoist.health_t", std::string(kChannelHealth)},
       // INTERFACES.md "Additions": the forecast's channels, once their types exist.
       {"hoist.forecast_t", "HOIST_FORECAST"},
-      {"hoist.trip_plan_t", "HOIST_TRIP_PLAN"}};
+      {"hoist.trip_plan_t", "HOIST_TRIP_PLAN"},
+      // The load estimator's output ([estimator] enabled), at the cage rate.
+      {"hoist.estimate_t", std::string(kChannelEstimate)}};
   return v;
 }
 
@@ -198,31 +200,36 @@ void Hub::addPrefix(const std::string& prefix) {
     by_id_[stored.id] = &stored;
     if (suffix == "HOIST_ALARM" && !pending.empty()) stored.table = std::move(pending.mapped());
     added.push_back(&stored);
-    if (suffix == "HOIST_CAGE") {
-      // The decimated cage channel: min/max of every numeric field per interval.
-      Json cage_schema = Json::parse(stored.schema, nullptr, false);
+    // The decimated channels (cage state, load estimate): min/max of every
+    // numeric field per interval, at the display rate.
+    auto addDecimated = [&](const char* dsuffix, const std::string& name, const std::string& what) {
+      Json last_schema = Json::parse(stored.schema, nullptr, false);
       Channel d;
       d.id = next_id_++;
-      d.topic = prefix + kDecimatedSuffix;
+      d.topic = prefix + dsuffix;
       d.prefix = prefix;
-      d.suffix = kDecimatedSuffix;
-      d.schema_name = "hoist_dash.cage_decimated";
+      d.suffix = dsuffix;
+      d.schema_name = name;
       d.schema = Json{{"type", "object"},
-                      {"title", "hoist_dash.cage_decimated"},
+                      {"title", name},
                       {"description",
-                       "HOIST_CAGE decimated by hoist-dash to the display rate: per interval the message count, "
+                       what + " decimated by hoist-dash to the display rate: per interval the message count, "
                        "the first message's t and utime, the last message whole, and the smallest and largest "
                        "value of every numeric field (booleans: AND in min, OR in max)"},
                       {"properties",
                        {{"count", {{"type", "integer"}}},
                         {"first", {{"type", "object"}}},
-                        {"last", cage_schema},
+                        {"last", last_schema},
                         {"min", {{"type", "object"}}},
                         {"max", {{"type", "object"}}}}}}
                      .dump();
       auto& sd = channels_[d.topic] = std::move(d);
       by_id_[sd.id] = &sd;
       added.push_back(&sd);
+    };
+    if (suffix == bus::kChannelEstimate) addDecimated(kEstimateDecimatedSuffix, "hoist_dash.estimate_decimated", "HOIST_ESTIMATE");
+    if (suffix == "HOIST_CAGE") {
+      addDecimated(kDecimatedSuffix, "hoist_dash.cage_decimated", "HOIST_CAGE");
       // The trend history: sent whole on subscribe, then nothing (the
       // decimated channel carries the rest).
       Channel hc;
@@ -368,6 +375,7 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
     else count("alarm_table_full");
   }
   if (suffix == "HOIST_CAGE") decimators_[prefix].add(j);
+  if (suffix == bus::kChannelEstimate) estimate_decimators_[prefix].add(j);
   broadcast(*ch, payload);
 }
 
@@ -686,6 +694,7 @@ void Hub::removePrefix(const std::string& prefix) {
   prefix_list_.erase(pit);
   disc_.erase(prefix);
   decimators_.erase(prefix);
+  estimate_decimators_.erase(prefix);
   history_.erase(prefix);
   for (auto it = alarm_ids_.begin(); it != alarm_ids_.end();)
     it = it->first.compare(0, prefix.size() + 1, prefix + "\n") == 0 ? alarm_ids_.erase(it) : std::next(it);
@@ -726,6 +735,11 @@ void Hub::flushDecimated() {
     addHistory(prefix, d);
     const auto payload = std::make_shared<const std::string>(d.dump());
     if (Channel* ch = channelFor(prefix + kDecimatedSuffix)) broadcast(*ch, payload);
+  }
+  for (auto& [prefix, dec] : estimate_decimators_) {
+    if (dec.empty()) continue;
+    const auto payload = std::make_shared<const std::string>(dec.take().dump());
+    if (Channel* ch = channelFor(prefix + kEstimateDecimatedSuffix)) broadcast(*ch, payload);
   }
 }
 

@@ -6,7 +6,8 @@
 //
 // What it implements (docs/dashboard.md): serverInfo, status, advertise
 // (one channel per hoist LCM channel and shaft prefix, JSON encoding, JSON
-// Schema from the message codec, plus one decimated cage channel per shaft),
+// Schema from the message codec, plus one decimated cage channel and one
+// decimated load-estimate channel per shaft),
 // subscribe / unsubscribe with client-chosen ids, binary messageData, and
 // (unless read-only) clientPublish of HOIST_ALARM_ACK in JSON.
 #pragma once
@@ -122,6 +123,8 @@ class Hub {
   bool readOnly() const { return opt_.read_only; }
 
   static constexpr const char* kDecimatedSuffix = "HOIST_CAGE/decimated";
+  /// HOIST_ESTIMATE decimated like the cage (the page's load-estimate panel).
+  static constexpr const char* kEstimateDecimatedSuffix = "HOIST_ESTIMATE/decimated";
   /// The recent trend history of a shaft, sent whole on subscribe (docs/dashboard.md).
   static constexpr const char* kHistorySuffix = "HOIST_CAGE/history";
   /// The cage fields the history keeps (min and max per bucket); "lambdas.K" is lambdas[K].
@@ -179,6 +182,7 @@ class Hub {
   std::map<std::string, Channel> channels_;             // by topic
   std::map<std::uint32_t, Channel*> by_id_;
   std::map<std::string, MinMaxDecimator> decimators_;   // by prefix
+  std::map<std::string, MinMaxDecimator> estimate_decimators_;  // by prefix (HOIST_ESTIMATE)
   std::map<std::string, std::map<std::string, std::shared_ptr<const std::string>>> pending_alarms_;
   std::map<std::string, std::uint64_t> pending_since_;  // when each pending prefix was first heard (aged out)
   std::uint32_t next_id_ = 1;

@@ -26,6 +26,7 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/bus/udpm_receiver.hpp"
 #include "hoist/cage_state_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/mqtt/command.hpp"
@@ -43,6 +44,7 @@ using json = nlohmann::json;
 using hoist::bus::kChannelAlarm;
 using hoist::bus::kChannelAlarmAck;
 using hoist::bus::kChannelCage;
+using hoist::bus::kChannelEstimate;
 using hoist::bus::kChannelForecast;
 using hoist::bus::kChannelHealth;
 constexpr int kMaxKindsPerShaft = 32;
@@ -101,7 +103,7 @@ struct Bridge::Impl {
   };
   struct Shaft {
     std::string prefix, name;
-    std::string t_cage, t_health, t_alarm, t_cmd, t_forecast;
+    std::string t_cage, t_health, t_alarm, t_cmd, t_forecast, t_estimate;
     bool subscribed = false;       // command topic subscribed on the current connection
     // Discovery (hoist/mqtt/bridge.hpp): a discovered prefix is a candidate
     // until its health, with one non-zero instance id, has kept coming; only
@@ -115,6 +117,9 @@ struct Bridge::Impl {
     bool refused = false;          // confirmed-quality but no slot (table full) or its name is taken
     bool cage_new = false;
     hoist::cage_state_t cage{};
+    bool estimate_new = false;  // like the cage: the latest estimate at [bridge] cage_rate
+    hoist::estimate_t estimate{};
+    std::uint64_t estimates_in = 0, estimates_out = 0;
     std::map<std::string, AlarmState> alarms;  // by kind
     std::int64_t instance_id = 0;
     std::uint64_t cage_in = 0, cage_out = 0, health_in = 0, alarms_in = 0, commands = 0, forecasts_in = 0;
@@ -195,14 +200,16 @@ struct Bridge::Impl {
             auto ends = [&](std::string_view suffix) {
               return n.size() >= suffix.size() && n.substr(n.size() - suffix.size()) == suffix;
             };
-            return ends(kChannelCage) || ends(kChannelHealth) || ends(kChannelAlarm) || ends(kChannelForecast);
+            return ends(kChannelCage) || ends(kChannelHealth) || ends(kChannelAlarm) || ends(kChannelForecast) ||
+                   ends(kChannelEstimate);
           },
           [this](const lcm::ReceiveBuffer* rb, const std::string& channel) { onLcm(rb, channel); });
     } else {
-      // One subscription for every shaft: ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM|HOIST_FORECAST)"
-      // (LCM anchors it).
+      // One subscription for every shaft:
+      // ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM|HOIST_FORECAST|HOIST_ESTIMATE)" (LCM anchors it).
       lcm.subscribe(".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" +
-                        std::string(kChannelAlarm) + "|" + std::string(kChannelForecast) + ")",
+                        std::string(kChannelAlarm) + "|" + std::string(kChannelForecast) + "|" +
+                        std::string(kChannelEstimate) + ")",
                     &Impl::onLcm, this);
     }
 
@@ -266,6 +273,7 @@ struct Bridge::Impl {
     s.t_cmd = base + "cmd/ack";
     s.t_result = base + "cmd/result";
     s.t_forecast = base + "forecast";
+    s.t_estimate = base + "estimate";
     s.configured = configured;
     s.first_seen = s.last_seen = Clock::now();
     auto [it, fresh] = shafts.emplace(prefix, std::move(s));
@@ -287,7 +295,8 @@ struct Bridge::Impl {
     bound[s.name] = s.prefix;
     cmd_topics[s.t_cmd] = s.prefix;
     const std::string base = "hoist/" + s.name + "/";
-    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST}} -> {}{{cage,health,alarm/<KIND>,forecast}}{}{}",
+    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST,ESTIMATE}} -> "
+                 "{}{{cage,health,alarm/<KIND>,forecast,estimate}}{}{}",
                  s.name, s.prefix, base,
                  cfg.commands ? ", " + s.t_cmd + " -> " + hoist::bus::channel(s.prefix, kChannelAlarmAck) : "",
                  s.configured ? "" : fmt::format(" (discovered: daemon instance {})", s.streak_instance));
@@ -501,6 +510,17 @@ struct Bridge::Impl {
         if (st != hoist::msg::DecodeStatus::ok) return decodeError("forecast_t", st, channel);
         ++s->forecasts_in;
         if (s->bound) publish({s->t_forecast, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
+      } else if (ends(kChannelEstimate)) {
+        // The load estimate, at the cage rate; sent like the cage
+        // state (the latest one at [bridge] cage_rate, QoS 0, not retained).
+        Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelEstimate.size()));
+        if (!s) return void(++ignored_channels);
+        hoist::estimate_t m;
+        const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
+        if (st != hoist::msg::DecodeStatus::ok) return decodeError("estimate_t", st, channel);
+        s->estimate = m;
+        s->estimate_new = s->bound;
+        ++s->estimates_in;
       }
     } catch (const std::exception& e) {  // nothing may escape an LCM callback
       ++decode_errors["exception"];
@@ -634,6 +654,12 @@ struct Bridge::Impl {
       ++s.cage_out;
       publish({s.t_cage, hoist::msg::toJson(s.cage).dump(), 0, false, MsgClass::Cage});
     }
+    for (auto& [p, s] : shafts) {
+      if (!s.estimate_new || !s.bound) continue;
+      s.estimate_new = false;
+      ++s.estimates_out;
+      publish({s.t_estimate, hoist::msg::toJson(s.estimate).dump(), 0, false, MsgClass::Cage});
+    }
   }
 
   const char* connText() const {
@@ -708,6 +734,8 @@ struct Bridge::Impl {
                     {"cage_out", s.cage_out},
                     {"health_in", s.health_in},
                     {"forecasts_in", s.forecasts_in},
+                    {"estimates_in", s.estimates_in},
+                    {"estimates_out", s.estimates_out},
                     {"alarm_events_in", s.alarms_in},
                     {"alarms_active", active},
                     {"commands", s.commands}});

@@ -8,6 +8,8 @@
 //   <prefix>HOIST_CAGE    -> hoist/<shaft>/cage         QoS 0, latest state at [bridge] cage_rate
 //   <prefix>HOIST_HEALTH  -> hoist/<shaft>/health       QoS 0, every message
 //   <prefix>HOIST_ALARM   -> hoist/<shaft>/alarm/<KIND> QoS 1, RETAINED: the kind's current state
+//   <prefix>HOIST_FORECAST -> hoist/<shaft>/forecast    QoS 0, every message
+//   <prefix>HOIST_ESTIMATE -> hoist/<shaft>/estimate    QoS 0, latest estimate at [bridge] cage_rate
 // MQTT -> LCM (unless --no-commands):
 //   hoist/<shaft>/cmd/ack -> <prefix>HOIST_ALARM_ACK    (hoist/mqtt/command.hpp)
 // The bridge itself:
