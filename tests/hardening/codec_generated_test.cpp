@@ -254,7 +254,8 @@ TEST(CodecGenerated, NameTablesMatchTheLcmConstants) {
   EXPECT_EQ(names::eventName(alarm_t::EVENT_REANNOUNCE), "REANNOUNCE");
   EXPECT_EQ(names::kindName(alarm_t::KIND_CAGE_POS_Y), "CAGE_POS_Y");
   EXPECT_EQ(names::kindName(alarm_t::KIND_PREDICTED_SLACK), "PREDICTED_SLACK");
-  EXPECT_EQ(names::kKindNames.size(), 11u);
+  EXPECT_EQ(names::kindName(alarm_t::KIND_MODEL_MISMATCH), "MODEL_MISMATCH");
+  EXPECT_EQ(names::kKindNames.size(), 12u);
   EXPECT_EQ(names::levelName(3), "?");
   EXPECT_EQ(names::levelName(-1), "?");
   EXPECT_EQ(names::eventName(0), "?");

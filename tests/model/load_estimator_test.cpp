@@ -415,17 +415,3 @@ TEST(LoadEstimator, ChiSquareQuantiles) {
   EXPECT_NEAR(chiSquareQuantile(0.5, 1000), 999.33, 0.1);
 }
 
-TEST(LoadEstimatorDebug, ChannelNis) {
-  if (!std::getenv("HOIST_EST_DEBUG")) GTEST_SKIP();
-  const SensorNoise noise;
-  Truth tr = makeTruth(config(), HoistProfile::trapezoid(250.0, 5.0, 1.0, -200.0, 55.0), {600.0, -0.8}, 100, noise, 12);
-  for (unsigned bits : {unsigned(kSensorRopeLoad), unsigned(kSensorImuAccel), unsigned(kSensorImuRate)}) {
-    std::vector<MeasurementSample> m = tr.meas;
-    for (auto& s : m) s.present &= bits;
-    const EstRun run = estimate(config(), m);
-    for (const LoadEstimate& e : run.est)
-      if (std::fmod(e.t + 1e-9, 1.0) < 0.01 && (e.t > 36))
-        std::printf("bits %u t %.2f nisw %.0f dof %d bound %.0f drift %.2f\n", bits, e.t, e.nis_window, e.nis_dof,
-                    e.nis_bound, e.drift);
-  }
-}
