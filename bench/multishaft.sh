@@ -20,7 +20,9 @@
 # --daemon (repeatable; default this=build/bin/hoist-twind): the binaries to
 #   compare, each run side by side (interleaved) for every setting and N; extra
 #   key=value pairs go into the [service] section of its configs (e.g.
-#   envelope_tolerance=0).  The feeder (--feeder PATH; default this build's
+#   envelope_tolerance=0), except estimator=true, which turns the load
+#   estimator on ([estimator] enabled; the feeder sends no sensor samples, so
+#   this is the cost of its per-tick step without the O(1) updates).  The feeder (--feeder PATH; default this build's
 #   hoist-replay) is the same for every daemon.
 # Defaults: counts "100 200 300 400", 60 s each, 100 Hz, [service] max_step
 # 0.01 s (one model step per tick), outputs to [service] lcm_url_out on port
@@ -117,9 +119,14 @@ for setting in "${settings[@]}"; do
       spec="${d#*=}"
       bin="${spec%%,*}"
       extra=""
+      est_section=""
       if [[ "$spec" == *,* ]]; then
         IFS=',' read -r -a kvs <<< "${spec#*,}"
-        for kv in "${kvs[@]}"; do extra+="${kv%%=*} = ${kv#*=}"$'\n'; done
+        for kv in "${kvs[@]}"; do
+          # estimator=true: the load estimator on ([estimator] enabled, its own section)
+          if [[ "${kv%%=*}" == estimator ]]; then est_section="[estimator]"$'\n'"enabled = ${kv#*=}"$'\n'; continue; fi
+          extra+="${kv%%=*} = ${kv#*=}"$'\n'
+        done
       fi
       tag="n${modes}${corr}-N$N-$name"
       cfgdir="$raw/configs-$tag"
@@ -128,8 +135,8 @@ for setting in "${settings[@]}"; do
       outline=""
       [[ $same_url -eq 0 ]] && outline="lcm_url_out = \"$url_out\""$'\n'
       for ((i = 1; i <= N; i++)); do
-        printf '[model]\nmodes = %s\nstatic_correction = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n%s%s' \
-          "$modes" "$corr_toml" "$rate" "$max_step" "$i" "$outline" "$extra" > "$cfgdir/shaft$i.toml"
+        printf '[model]\nmodes = %s\nstatic_correction = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n%s%s%s' \
+          "$modes" "$corr_toml" "$rate" "$max_step" "$i" "$outline" "$extra" "$est_section" > "$cfgdir/shaft$i.toml"
         cfgs+=(--config "$cfgdir/shaft$i.toml")
       done
       echo "[multishaft] n = $modes (correction $corr), N = $N, daemon $name: daemon (all threads) on CPU $daemon_cpu, feeder on CPU $feeder_cpu, $seconds s ..." >&2
