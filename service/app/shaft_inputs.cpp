@@ -272,19 +272,38 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
 
 // ---- our own HOIST_HEALTH from another instance ------------------------------------
 
+namespace {
+/// Our own HOIST_HEALTH whose utime is this far from our clock [s] is a replay.
+constexpr double kReplaySkew = 5.0;
+}  // namespace
+
 void ShaftInputs::handleOwnHealth(const lcm::ReceiveBuffer* rbuf) {
   // instance_id is the first field after utime: read it without decoding
   // the whole message (8-byte fingerprint, int64 utime, int64 instance_id).
   if (rbuf->data_size < 24) return;
   const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
   std::int64_t fp = 0, id = 0;
+  std::uint64_t ut = 0;
   for (int i = 0; i < 8; ++i) fp = (fp << 8) | b[i];
+  for (int i = 8; i < 16; ++i) ut = (ut << 8) | b[i];
   for (int i = 16; i < 24; ++i) id = static_cast<std::int64_t>((static_cast<std::uint64_t>(id) << 8) | b[i]);
-  if (fp != static_cast<std::int64_t>(hoist::health_t::getHash()) || id == ctx_.instance_id) return;
+  if (fp != static_cast<std::int64_t>(hoist::health_t::getHash())) return;
+  // Our own instance id with a utime far from our clock is not us: a
+  // recording of this twin played back (lcm-logplayer) beside it, which
+  // would mix old and new states in every client.
+  const double skew = static_cast<double>(static_cast<std::int64_t>(ut) - bus::wallUtime()) * 1e-6;
+  const bool replayed = id == ctx_.instance_id && std::abs(skew) > kReplaySkew;
+  if (id == ctx_.instance_id && !replayed) return;
   const double wall = ctx_.wallNow();
-  if (!(other_seen_wall_ >= 0.0) || id != other_id_)
-    ctx_.log.error("{}another publisher (instance {}) on {}: a second twin with the same channels? "
-                   "(this one is instance {})", ctx_.tag, id, ctx_.ch.health, ctx_.instance_id);
+  if (!(other_seen_wall_ >= 0.0) || id != other_id_) {
+    if (replayed)
+      ctx_.log.error("{}a recording of this twin is being played on {} (our instance {}, utime {:.0f} s from our "
+                     "clock): replay beside a live twin on another LCM URL or channel prefix", ctx_.tag,
+                     ctx_.ch.health, id, skew);
+    else
+      ctx_.log.error("{}another publisher (instance {}) on {}: a second twin with the same channels? "
+                     "(this one is instance {})", ctx_.tag, id, ctx_.ch.health, ctx_.instance_id);
+  }
   other_id_ = id;
   other_seen_wall_ = wall;
   ctx_.core.setDuplicatePublisher(true, static_cast<double>(id));

@@ -120,3 +120,30 @@ TEST_F(EstimatorDaemon, LiveEstimateEqualsHoistEstimateOnTheSameData) {
   EXPECT_EQ(health.back().sensor_rejected, 0);
   EXPECT_TRUE(health.back().estimate_in_use);
 }
+
+// A recording of this very twin played back beside it (lcm-logplayer): its
+// HOIST_HEALTH carries our instance id but an old utime.  The daemon says so
+// (DUPLICATE_PUBLISHER, a log line naming the replay) instead of staying quiet.
+TEST_F(EstimatorDaemon, AReplayedRecordingOfThisTwinIsDetected) {
+  start(7872, "ReplayedOutputs", {"HOIST_HEALTH"});
+  listener_->subscribe("HOIST_ALARM");
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--clock", "wall"};
+  auto d = startDaemonAndWait(*listener_, argv, (dir_ / "twind.log").string());
+  auto health = listener_->decoded<hoist::health_t>("HOIST_HEALTH");
+  ASSERT_FALSE(health.empty());
+  hoist::health_t old = health.back();  // ours: same instance id
+  old.utime -= 3600LL * 1000000;        // recorded an hour ago
+  for (int i = 0; i < 3; ++i) {
+    listener_->lcm().publish("HOIST_HEALTH", &old);
+    listener_->waitFor([] { return false; }, 100ms);
+  }
+  auto raised = [&] {
+    for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
+      if (a.kind == "DUPLICATE_PUBLISHER" && a.active) return true;
+    return false;
+  };
+  EXPECT_TRUE(listener_->waitFor(raised, 5s)) << readFile((dir_ / "twind.log").string());
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+  EXPECT_NE(readFile((dir_ / "twind.log").string()).find("a recording of this twin is being played"),
+            std::string::npos);
+}

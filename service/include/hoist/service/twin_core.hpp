@@ -42,6 +42,7 @@
 // path, GuideRopeEnvelope and the fixed-size event buffer do not).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 
@@ -149,7 +150,11 @@ class TwinCore {
 
   const CageOutput& output() const { return out_; }
   /// Model time -> published time (seconds since the trip start; see above).
-  double publishedTime(double model_t) const { return model_t - t_pub_offset_; }
+  /// Round-off below a nanosecond is shown as 0 (never "-0.00 s" in logs and messages).
+  double publishedTime(double model_t) const {
+    const double t = model_t - t_pub_offset_;
+    return std::abs(t) < 1e-9 ? 0.0 : t;
+  }
   /// Why the last MODEL_FAULT was raised: "non-finite" or the implausible
   /// quantity ("y_c", "lambda_1", ...), with its value and bound.
   const char* lastFaultWhat() const { return fault_what_; }
