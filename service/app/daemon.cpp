@@ -139,7 +139,15 @@ bool Daemon::openInput() {
   std::string why;
   if (!parseUdpmUrl(opt_.lcm_url, udpm, why)) {
     for (auto& s : shafts_) s->subscribe();
-    lcm_fd_.assign(lcm_.getFileno());
+    // A provider that could not connect (tcpq:// with no server) has no
+    // descriptor: say which URL, instead of a bare "assign: Bad file descriptor".
+    const int fd = lcm_.getFileno();
+    if (fd < 0) {
+      out_->error("cannot receive from LCM at {}: the provider has no connection (is its server running?)",
+                  bus::describeLcmUrl(opt_.lcm_url));
+      return false;
+    }
+    lcm_fd_.assign(fd);
     return true;
   }
   receiver_ = std::make_unique<UdpmReceiver>();

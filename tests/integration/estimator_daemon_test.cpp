@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -146,4 +147,17 @@ TEST_F(EstimatorDaemon, AReplayedRecordingOfThisTwinIsDetected) {
   stopDaemonCleanly(*d, (dir_ / "twind.log").string());
   EXPECT_NE(readFile((dir_ / "twind.log").string()).find("a recording of this twin is being played"),
             std::string::npos);
+}
+
+// A tcpq:// URL with no server: one line naming the URL and the cause, exit 1
+// (not "fatal: assign: Bad file descriptor").
+TEST(DaemonLcmUrl, TcpqWithoutServerNamesTheUrl) {
+  const auto dir = std::filesystem::path(HOIST_TEST_WORK_DIR) / "DaemonLcmUrl";
+  std::filesystem::create_directories(dir);
+  const std::string log = (dir / "twind.log").string();
+  const int rc = runProcess({HOIST_TWIND, "--lcm-url", "tcpq://127.0.0.1:1"}, log, 20s);
+  EXPECT_EQ(rc, 1);
+  const std::string text = readFile(log);
+  EXPECT_NE(text.find("cannot receive from LCM at tcpq://127.0.0.1:1"), std::string::npos) << text;
+  EXPECT_EQ(text.find("Bad file descriptor"), std::string::npos) << text;
 }
