@@ -259,9 +259,9 @@ TEST(CodecGenerated, NameTablesMatchTheLcmConstants) {
   EXPECT_EQ(names::levelName(3), "?");
   EXPECT_EQ(names::levelName(-1), "?");
   EXPECT_EQ(names::eventName(0), "?");
-  EXPECT_EQ(names::parseLevel("CRITICAL"), std::optional<std::int64_t>(alarm_t::LEVEL_CRITICAL));
+  EXPECT_EQ(names::parseLevel("CRITICAL"), std::optional<std::int64_t>(+alarm_t::LEVEL_CRITICAL));
   EXPECT_EQ(names::parseLevel("critical"), std::nullopt);
-  EXPECT_EQ(names::parseKind("ROPE_OVERLOAD"), std::optional<std::int64_t>(alarm_t::KIND_ROPE_OVERLOAD));
+  EXPECT_EQ(names::parseKind("ROPE_OVERLOAD"), std::optional<std::int64_t>(+alarm_t::KIND_ROPE_OVERLOAD));
 
   // Every table against its type's constants in the JSON Schema: each const
   // PREFIX_<NAME> is in the table at its value, and nothing else is.
