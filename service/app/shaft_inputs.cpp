@@ -333,13 +333,30 @@ void ShaftInputs::rejectSensor(const char* channel, const char* detail) {
     ctx_.log.warn("{}rejected {} sample: {} [{} similar suppressed]", ctx_.tag, channel, detail, suppressed);
 }
 
-void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
+template <class Msg>
+bool ShaftInputs::decodeSensor(const lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel) {
   const auto size = static_cast<std::size_t>(rbuf->data_size);
-  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, imu_in_); st != hoist::msg::DecodeStatus::ok) {
-    std::snprintf(text_, sizeof text_, "%zu bytes: %s", size, hoist::msg::toString(st));
-    rejectSensor("HOIST_CAGE_IMU", text_);
-    return;
+  const auto st = hoist::msg::checkedDecode(rbuf->data, size, m);
+  if (st == hoist::msg::DecodeStatus::ok) return true;
+  std::snprintf(text_, sizeof text_, "%zu bytes: %s", size, hoist::msg::toString(st));
+  rejectSensor(channel, text_);
+  return false;
+}
+
+bool ShaftInputs::sensorSeqNewer(std::int64_t seq, std::int64_t& last, const char* channel) {
+  // A sequence that goes back (by less than a restart's jump) is an old or replayed sample.
+  if (last >= 0 && seq <= last && seq > last - 1000) {
+    std::snprintf(text_, sizeof text_, "seq %lld not after %lld", static_cast<long long>(seq),
+                  static_cast<long long>(last));
+    rejectSensor(channel, text_);
+    return false;
   }
+  last = seq;
+  return true;
+}
+
+void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
+  if (!decodeSensor(rbuf, imu_in_, "HOIST_CAGE_IMU")) return;
   const cage_imu_t& m = imu_in_;
   const bool a_ok = std::isfinite(m.f_y) && std::abs(m.f_y) <= kMaxSpecificForce;
   const bool w_ok = std::isfinite(m.omega) && std::abs(m.omega) <= kMaxTiltRate;
@@ -349,13 +366,7 @@ void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
     rejectSensor("HOIST_CAGE_IMU", text_);
     return;
   }
-  if (ctx_.stats.imu_seq >= 0 && m.seq <= ctx_.stats.imu_seq && m.seq > ctx_.stats.imu_seq - 1000) {
-    std::snprintf(text_, sizeof text_, "seq %lld not after %lld", static_cast<long long>(m.seq),
-                  static_cast<long long>(ctx_.stats.imu_seq));
-    rejectSensor("HOIST_CAGE_IMU", text_);
-    return;
-  }
-  ctx_.stats.imu_seq = m.seq;
+  if (!sensorSeqNewer(m.seq, ctx_.stats.imu_seq, "HOIST_CAGE_IMU")) return;
   ctx_.stats.last_imu_wall = ctx_.wallNow();
   ++ctx_.stats.sensor_accepted;
   // A channel that is implausible on its own is left out of this sample.
@@ -363,25 +374,14 @@ void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
 }
 
 void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
-  const auto size = static_cast<std::size_t>(rbuf->data_size);
-  if (const auto st = hoist::msg::checkedDecode(rbuf->data, size, rope_in_); st != hoist::msg::DecodeStatus::ok) {
-    std::snprintf(text_, sizeof text_, "%zu bytes: %s", size, hoist::msg::toString(st));
-    rejectSensor("HOIST_ROPE_LOAD", text_);
-    return;
-  }
+  if (!decodeSensor(rbuf, rope_in_, "HOIST_ROPE_LOAD")) return;
   const rope_load_t& m = rope_in_;
   if (!(std::isfinite(m.force) && std::abs(m.force) <= kMaxRopeLoad)) {
     std::snprintf(text_, sizeof text_, "force %g N implausible (|force| <= %g)", m.force, kMaxRopeLoad);
     rejectSensor("HOIST_ROPE_LOAD", text_);
     return;
   }
-  if (ctx_.stats.rope_seq >= 0 && m.seq <= ctx_.stats.rope_seq && m.seq > ctx_.stats.rope_seq - 1000) {
-    std::snprintf(text_, sizeof text_, "seq %lld not after %lld", static_cast<long long>(m.seq),
-                  static_cast<long long>(ctx_.stats.rope_seq));
-    rejectSensor("HOIST_ROPE_LOAD", text_);
-    return;
-  }
-  ctx_.stats.rope_seq = m.seq;
+  if (!sensorSeqNewer(m.seq, ctx_.stats.rope_seq, "HOIST_ROPE_LOAD")) return;
   ctx_.stats.last_rope_wall = ctx_.wallNow();
   ++ctx_.stats.sensor_accepted;
   ctx_.core.onRopeLoad(m.force);

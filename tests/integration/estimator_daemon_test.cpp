@@ -14,6 +14,8 @@
 #include <sstream>
 
 #include "hoist/alarm_t.hpp"
+#include "hoist/cage_imu_t.hpp"
+#include "hoist/rope_load_t.hpp"
 #include "hoist/estimate_t.hpp"
 #include "hoist/health_t.hpp"
 #include "lcm_fixtures.hpp"
@@ -88,6 +90,20 @@ TEST_F(EstimatorDaemon, LiveEstimateEqualsHoistEstimateOnTheSameData) {
     ASSERT_EQ(r.wait(1s), 0) << readFile((dir_ / "replay.log").string());
   }
   EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_ESTIMATE") >= 1001; }, 10s));
+  // Bad samples are refused and counted: an implausible IMU, an old rope-load seq.
+  {
+    hoist::cage_imu_t imu{};
+    imu.utime = 1;
+    imu.seq = 5000;
+    imu.f_y = std::nan("");
+    imu.omega = 1e9;
+    listener_->lcm().publish("HOIST_CAGE_IMU", &imu);
+    hoist::rope_load_t rope{};
+    rope.utime = 1;
+    rope.seq = 3;  // the replay's last was 1000
+    rope.force = 8000.0;
+    listener_->lcm().publish("HOIST_ROPE_LOAD", &rope);
+  }
   // The health after the run counts every sensor sample.
   const std::size_t h0 = listener_->count("HOIST_HEALTH");
   EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > h0; }, 5s));
@@ -118,7 +134,7 @@ TEST_F(EstimatorDaemon, LiveEstimateEqualsHoistEstimateOnTheSameData) {
   EXPECT_EQ(last.sensors, 7);
   ASSERT_FALSE(health.empty());
   EXPECT_EQ(health.back().sensor_accepted, 2 * 1001);
-  EXPECT_EQ(health.back().sensor_rejected, 0);
+  EXPECT_EQ(health.back().sensor_rejected, 2);
   EXPECT_TRUE(health.back().estimate_in_use);
 }
 
