@@ -160,6 +160,32 @@ void LoadEstimator::initialize(double t0, const Kinematics& k0) {
   predict(twin_resp_);
 }
 
+void LoadEstimator::restart(double t0, const Kinematics& k0) {
+  const double Fa = Fa_, PFa = PFa_, M = M_, PM = PM_, FaF = FaF_, PFaF = PFaF_, MF = MF_, PMF = PMF_;
+  double last[3];
+  bool seen[3];
+  for (int i = 0; i < 3; ++i) {
+    last[i] = last_upd_[i];
+    seen[i] = seen_[i];
+  }
+  const EstimatorCounters counts = counts_;
+  initialize(t0, k0);
+  Fa_ = Fa;
+  PFa_ = PFa;
+  M_ = M;
+  PM_ = PM;
+  FaF_ = FaF;
+  PFaF_ = PFaF;
+  MF_ = MF;
+  PMF_ = PMF;
+  for (int i = 0; i < 3; ++i) {
+    last_upd_[i] = last[i];
+    seen_[i] = seen[i];
+  }
+  counts_ = counts;
+  predict(CageResponse(twin_resp_));
+}
+
 bool LoadEstimator::moving() const {
   return std::abs(kin_.v) > set_.rest_speed || std::abs(kin_.a) > set_.rest_speed;
 }

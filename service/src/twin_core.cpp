@@ -279,7 +279,10 @@ void TwinCore::initializeAt(double t, const Kinematics& k) {
   if (started_) ++resets_;
   solver_->initialize(t, k);
   if (est_) {
-    est_->initialize(t, k);
+    // The first start takes the configured load as the prior; a restart
+    // (new stream, fault) keeps what the sensors taught.
+    if (started_) est_->restart(t, k);
+    else est_->initialize(t, k);
     est_synced_ = true;
   }
   t_ = t;

@@ -415,3 +415,38 @@ TEST(LoadEstimator, ChiSquareQuantiles) {
   EXPECT_NEAR(chiSquareQuantile(0.5, 1000), 999.33, 0.1);
 }
 
+
+// A restart of the twin (a new winder stream) keeps the load the sensors
+// taught, and its covariance; the sensitivities start again.
+TEST(LoadEstimator, RestartKeepsTheLoad) {
+  const SensorNoise noise;
+  Truth tr = makeTruth(config(), HoistProfile::trapezoid(), {1500.0, 0.6}, 50, noise, 61);
+  const ShaftParams cfg = config();
+  FastSolver twin(std::make_shared<const ShaftModel>(cfg));
+  LoadEstimator est(cfg, {});
+  twin.initialize(0.0, tr.meas[0].k);
+  est.initialize(0.0, tr.meas[0].k);
+  for (std::size_t i = 1; i < 3000; ++i) {
+    const MeasurementSample& m = tr.meas[i];
+    for (int j = 1; j <= 4; ++j) {
+      const double tj = tr.meas[i - 1].t + j * 0.0025;
+      twin.step(tj, interpolate(tr.meas[i - 1].k, m.k, 0.01, j / 4.0));
+    }
+    est.advance(m.t, m.k, 4);
+    est.predict(twin.response());
+    est.updateImu(m.z.f_y, m.z.omega);
+    est.updateRopeLoad(m.z.rope_load);
+    est.finish();
+  }
+  const LoadEstimate before = est.estimate();
+  ASSERT_NEAR(before.Fa, 1500.0, 15.0);
+  twin.initialize(30.0, tr.meas[3000].k);
+  est.restart(30.0, tr.meas[3000].k);
+  const LoadEstimate& after = est.finish();
+  EXPECT_EQ(after.Fa, before.Fa);
+  EXPECT_EQ(after.moment, before.moment);
+  EXPECT_EQ(after.sigma_Fa, before.sigma_Fa);
+  EXPECT_TRUE(after.fa_observed);
+  est.initialize(30.0, tr.meas[3000].k);
+  EXPECT_EQ(est.finish().Fa, cfg.Fa) << "initialize() returns to the prior";
+}

@@ -185,6 +185,11 @@ class LoadEstimator {
   /// solver starts as the twin does (its params().initial), the loads return
   /// to the prior.  Call after the twin's initialize().
   void initialize(double t0, const Kinematics& k0);
+  /// The twin was re-initialized (a new winder stream, a model fault): the
+  /// sensitivities start again with it, the NIS window and the trip's drift
+  /// start afresh, but the load estimates and their covariance, the sensors
+  /// seen and the counts stay (the load did not change).
+  void restart(double t0, const Kinematics& k0);
   /// Step the sensitivities to (t1, k1) in `substeps` equal substeps with
   /// hoist::interpolate -- exactly the twin's substeps -- and add the random
   /// walk's variance.  Throws std::domain_error as the solver does.
