@@ -29,7 +29,9 @@ FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model, Forcing forcing)
   Kd_.head(n) = model_->guideModalStiffness(1);
   Kd_.segment(n, n) = model_->guideModalStiffness(2);
   Kd_.tail(2).setZero();
-  F_(N - 1) = p.Fa * p.b;  // moment of the eccentric load; F(y_c) = 0 (Eq. 17)
+  fa_ = p.Fa;
+  moment_ = p.Fa * p.b;
+  F_(N - 1) = moment_;  // moment of the eccentric load; F(y_c) = 0 (Eq. 17)
   x_ = xd_ = xdd_ = xa_ = Sd_ = xhat_ = vhat_ = r_ = VectorXd::Zero(N);
   tmp_ = VectorXd::Zero(N);
   sa_ = sb_ = VectorXd::Zero(n);
@@ -181,10 +183,10 @@ void FastSolver::longitudinalLoads(const Kinematics& k) {
   const auto& H = model_->hoistingRope();
   // F0 + u * F(x_c): hoisting-rope load plus the cage load carried through x_c = u.q0
   if (forcing_ == Forcing::LoadOnly) {
-    F0_ = p.Fa * u_;
+    F0_ = fa_ * u_;
     return;
   }
-  const double Fxc = p.Fa + p.m * (p.g - k.a);
+  const double Fxc = fa_ + p.m * (p.g - k.a);
   F0_ = (-p.rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
 }
 
@@ -196,7 +198,7 @@ void FastSolver::updateResponse(double t, const Kinematics& k) {
   resp_.y_c = x_(N_ - 2);
   resp_.theta = x_(N_ - 1);
   const double xcdd = u_.dot(ydd_);
-  lambda0_ = forcing_ == Forcing::LoadOnly ? p.Fa - p.m * xcdd : p.Fa + p.m * (p.g - k.a) - p.m * xcdd;
+  lambda0_ = forcing_ == Forcing::LoadOnly ? fa_ - p.m * xcdd : fa_ + p.m * (p.g - k.a) - p.m * xcdd;
   resp_.lambda[0] = lambda0_;
   for (int i = 0; i < 4; ++i) resp_.lambda[i + 1] = lam_(i);
   resp_.x_c_ddot = xcdd;
@@ -459,6 +461,8 @@ void FastSolver::saveState(FastSolverState& s) const {
   s.ydd = ydd_;
   s.ya = ya_;
   s.lambda0 = lambda0_;
+  s.Fa = fa_;
+  s.moment = moment_;
   s.last_iters = last_iters_;
   s.fallbacks = fallbacks_;
   s.response = resp_;
@@ -486,6 +490,7 @@ void FastSolver::restoreState(const FastSolverState& s) {
   ydd_ = s.ydd;
   ya_ = s.ya;
   lambda0_ = s.lambda0;
+  setLoad(s.Fa, s.moment);
   last_iters_ = s.last_iters;
   fallbacks_ = s.fallbacks;
   resp_ = s.response;
@@ -495,6 +500,45 @@ void FastSolver::restoreState(const FastSolverState& s) {
   // restored l; Y_ and Ek_ are rebuilt by every step before use.
   h_cached_ = -1.0;
   fillConstraintRows(kin_.l);
+}
+
+void FastSolver::setLoad(double Fa, double moment) {
+  fa_ = Fa;
+  moment_ = moment;
+  F_(N_ - 1) = moment_;
+}
+
+bool addLoadResponse(FastSolverState& s, const FastSolverState& unit, double dFa, double dM) {
+  if (!s.valid || !unit.valid || s.modes() != unit.modes() || s.x.size() != unit.x.size()) return false;
+  if (!(std::abs(s.t - unit.t) <= 1e-9) || unit.Fa == 0.0 || unit.moment == 0.0) return false;
+  if (!std::isfinite(dFa) || !std::isfinite(dM)) return false;
+  const double cl = dFa / unit.Fa;     // longitudinal subsystem: driven by Fa only
+  const double cm = dM / unit.moment;  // lateral/torsional: driven by M only
+  s.x += cm * unit.x;
+  s.xd += cm * unit.xd;
+  s.xdd += cm * unit.xdd;
+  s.xa += cm * unit.xa;
+  s.lam += cm * unit.lam;
+  s.delta += cm * unit.delta;
+  s.lamS += cm * unit.lamS;
+  s.y += cl * unit.y;
+  s.yd += cl * unit.yd;
+  s.ydd += cl * unit.ydd;
+  s.ya += cl * unit.ya;
+  s.lambda0 += cl * unit.lambda0;
+  s.Fa += dFa;
+  s.moment += dM;
+  CageResponse& r = s.response;
+  const CageResponse& u = unit.response;
+  r.x_c += cl * u.x_c;
+  r.x_c_ddot += cl * u.x_c_ddot;
+  r.lambda[0] += cl * u.lambda[0];
+  r.y_c += cm * u.y_c;
+  r.theta += cm * u.theta;
+  r.y_c_ddot += cm * u.y_c_ddot;
+  r.theta_dot += cm * u.theta_dot;
+  for (int i = 1; i < 5; ++i) r.lambda[i] += cm * u.lambda[i];
+  return true;
 }
 
 // With the static correction the shape is y = U.(V z) + sum R(x, a_k) lam_k,

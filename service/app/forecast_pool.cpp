@@ -38,6 +38,9 @@ void ForecastJob::compute(const ForecastSnapshot& s, ForecastResult& r) {
   r.utime = s.utime;
   r.t_published = s.t_published;
   r.kin = st.kin;
+  r.from_estimate = s.from_estimate;
+  r.Fa = st.Fa;
+  r.moment = st.moment;
   r.plan_seq = -1;
   r.plan_error = PlanError::None;
   r.failed = false;

@@ -39,6 +39,7 @@ struct ForecastSnapshot {
   FastSolverState state;        ///< FastSolver::saveState (t, kinematics, every coordinate)
   std::int64_t utime = 0;       ///< utime of the state (as its HOIST_CAGE)
   double t_published = 0.0;     ///< published time of the state (HOIST_CAGE.t)
+  bool from_estimate = false;   ///< `state` is the load estimator's (hoist::addLoadResponse)
   bool has_plan = false;        ///< a validated trip plan is known
   TripPlan plan;
   std::int64_t plan_seq = -1;
@@ -57,6 +58,8 @@ struct ForecastResult {
   Kinematics kin;
   std::int64_t plan_seq = -1;        ///< plan followed by "continue" (-1: the no-plan rule)
   PlanError plan_error = PlanError::None;  ///< why a known plan could not be followed now
+  bool from_estimate = false;        ///< started from the estimator's state and load (ForecastSnapshot)
+  double Fa = 0.0, moment = 0.0;     ///< the load the forecasts assumed [N], [N m]
   bool failed = false;               ///< the engine threw (never expected; nothing is published)
   double compute_s = 0.0;            ///< wall time of both scenarios [s]
   ForecastSummary scenario[kScenarios];

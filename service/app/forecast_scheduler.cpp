@@ -12,6 +12,7 @@ ForecastScheduler::ForecastScheduler(ShaftContext& ctx, ShaftOutputs& out) : ctx
   fast_ = dynamic_cast<const FastSolver*>(&ctx_.core.solver());
   if (!fast_) throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
   job_ = std::make_unique<ForecastJob>(ctx_.core.solver().modelPtr(), ctx_.cfg);
+  if (ctx_.core.loadSensitivity()) unit_ = FastSolverState(ctx_.core.solver().model().n());
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
 }
 
@@ -63,6 +64,16 @@ void ForecastScheduler::afterStep(std::int64_t utime) {
   }
   ForecastSnapshot& snap = job_->snapshotSlot();
   fast_->saveState(snap.state);
+  // With the load estimator in use, forecast what the estimated load
+  // implies: the twin's state plus the estimated load change times the unit
+  // load's response (the model is linear in its load), continued under the
+  // estimated load.  Else the open-loop twin's state and configured load.
+  snap.from_estimate = false;
+  if (const LoadEstimate* e = core.estimate(); e && core.estimateInUse()) {
+    core.loadSensitivity()->saveState(unit_);
+    snap.from_estimate =
+        addLoadResponse(snap.state, unit_, e->Fa - snap.state.Fa, e->moment - snap.state.moment);
+  }
   snap.utime = utime;
   snap.t_published = tp;
   snap.has_plan = hasPlan(core.modelTime());
@@ -113,7 +124,8 @@ void ForecastScheduler::onResult(const ForecastResult& r) {
   const ForecastVerdict v = judgeForecast(sc, ForecastResult::kScenarios, cause.slack_threshold);
   cause.predicted_clearance_scenario = v.clearance ? ForecastResult::kNames[v.clearance_scenario] : "";
   cause.predicted_slack_scenario = v.slack ? ForecastResult::kNames[v.slack_scenario] : "";
-  ctx_.core.setPredictions(v.clearance, v.clearance_s, v.slack, v.slack_s, ctx_.cfg.forecast.horizon);
+  ctx_.core.setPredictions(v.clearance, v.clearance_s, v.slack, v.slack_s, ctx_.cfg.forecast.horizon,
+                           r.from_estimate);
   out_.publishForecast(r);
   out_.publishAlarmEvents();
 }

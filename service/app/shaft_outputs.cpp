@@ -237,6 +237,9 @@ void ShaftOutputs::publishForecast(const ForecastResult& r) {
   m.v = r.kin.v;
   m.a = r.kin.a;
   m.plan_seq = r.plan_seq;
+  m.from_estimate = r.from_estimate;
+  m.Fa = r.Fa;
+  m.moment = r.moment;
   m.compute_time = r.compute_s;
   for (int i = 0; i < ForecastResult::kScenarios; ++i) {
     const ForecastSummary& f = r.scenario[i];

@@ -347,9 +347,12 @@ void TwinCore::setDuplicatePublisher(bool seen, double other_id) {
   out_.alarm_level = alarms_.highestActive();
 }
 
-void TwinCore::setPredictions(bool clearance, double clearance_s, bool slack, double slack_s, double horizon) {
+void TwinCore::setPredictions(bool clearance, double clearance_s, bool slack, double slack_s, double horizon,
+                              bool from_estimate) {
+  const std::size_t first = events_.size();
   alarms_.setPredictedClearance(t_, clearance, clearance_s, horizon, events_);
   alarms_.setPredictedSlack(t_, slack, slack_s, horizon, events_);
+  if (from_estimate) events_.markFromEstimate(first);
   out_.alarm_level = alarms_.highestActive();
 }
 

@@ -372,7 +372,7 @@ namespace {
 // Offsets in sampleForecast()'s encoding.  forecast_t: fp 8, utime, seq,
 // instance_id, t_start, l, v, a, plan_seq, compute_time (9 x 8), then
 // num_scenarios (int8), then the scenarios WITHOUT fingerprints (lcm-gen's
-// _encodeNoHash).  forecast_scenario_t body: name (4 + len + 1), status (1),
+// _encodeNoHash), then from_estimate (1), Fa, moment (2 x 8).  forecast_scenario_t body: name (4 + len + 1), status (1),
 // horizon, t_reached, min_clearance, t_min_clearance, t_warning, t_critical,
 // peak_y_c, peak_theta (8 x 8), peak_lambdas (4 x 8), lambda0_min/max (16),
 // num_points (int16), then 4 x num_points doubles.
@@ -438,7 +438,9 @@ TEST(CodecNested, HugeNegativeAndLyingScenarioCounts) {
     EXPECT_TRUE(st == DecodeStatus::truncated || st == DecodeStatus::bad_string) << n << " " << toString(st);
   }
   {  // count x smallest scenario encoding > bytes left: truncated before walking any
+    // (the fields after the scenarios -- from_estimate, Fa, moment: 17 bytes -- kept)
     Bytes b(good.begin(), good.begin() + static_cast<long>(kFirstScenarioAt));
+    b.insert(b.end(), good.end() - 17, good.end());
     b[kNumScenariosAt] = 1;
     EXPECT_EQ(checkedDecode(b.data(), b.size(), d), DecodeStatus::truncated);
     b[kNumScenariosAt] = 0;

@@ -363,17 +363,17 @@ TEST(Log2Csv, ForecastOneRowPerScenarioAndTheSeries) {
   ASSERT_EQ(res.status, 0) << slurp(d / "f.log");
   const std::string csv = slurp(d / "out" / "HOIST_FORECAST.csv");
   EXPECT_EQ(csvRows(d / "out" / "HOIST_FORECAST.csv"), 4) << csv;  // 2 messages x 2 scenarios
-  EXPECT_EQ(csv.rfind("utime,seq,instance_id,t_start,l,v,a,plan_seq,compute_time,scenario,name,status,horizon,"
+  EXPECT_EQ(csv.rfind("utime,seq,instance_id,t_start,l,v,a,plan_seq,compute_time,scenario,from_estimate,Fa,moment,name,status,horizon,"
                       "t_reached,min_clearance,t_min_clearance,t_warning,t_critical,peak_y_c,peak_theta,"
                       "peak_lambda_1,peak_lambda_2,peak_lambda_3,peak_lambda_4,lambda0_min,lambda0_max,num_points\n",
                       0),
             0u)
       << csv;
-  EXPECT_NE(csv.find("1700000000000000,3,77,20,150,5,0,9,0.012,0,\"estop\",0,20,20,0.050000000000000003,4,-1,-1,0,0,"
+  EXPECT_NE(csv.find("1700000000000000,3,77,20,150,5,0,9,0.012,0,0,0,0,\"estop\",0,20,20,0.050000000000000003,4,-1,-1,0,0,"
                      "0,0,0,31.25,2400,15000,3\n"),
             std::string::npos)
       << csv;
-  EXPECT_NE(csv.find(",1,\"con,\"\"tinue\"\"\",0,20,20,"), std::string::npos) << csv;  // quoted name
+  EXPECT_NE(csv.find(",1,0,0,0,\"con,\"\"tinue\"\"\",0,20,20,"), std::string::npos) << csv;  // quoted name
   const std::string series = slurp(d / "out" / "HOIST_FORECAST.series.csv");
   EXPECT_EQ(csvRows(d / "out" / "HOIST_FORECAST.series.csv"), 10) << series;  // 2 x (3 + 2)
   EXPECT_NE(series.find("utime,seq,scenario,name,i,t,min_clearance,lambda0_min,lambda0_max\n"), std::string::npos);

@@ -17,6 +17,7 @@
 #include "hoist/cage_imu_t.hpp"
 #include "hoist/rope_load_t.hpp"
 #include "hoist/estimate_t.hpp"
+#include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "lcm_fixtures.hpp"
 
@@ -176,4 +177,78 @@ TEST(DaemonLcmUrl, TcpqWithoutServerNamesTheUrl) {
   const std::string text = readFile(log);
   EXPECT_NE(text.find("cannot receive from LCM at tcpq://127.0.0.1:1"), std::string::npos) << text;
   EXPECT_EQ(text.find("Bad file descriptor"), std::string::npos) << text;
+}
+
+// With the estimator in use, the forecasts start from the state the estimated
+// load implies and continue under that load: every HOIST_FORECAST says so
+// (from_estimate) and carries the load of the HOIST_ESTIMATE of the same
+// step; before any sensor sample they are the open-loop twin's, under the
+// configured load.  (That the shifted state is exactly the state under the
+// other load, and its forecast that load's forecast, is LoadSuperposition.*.)
+TEST_F(EstimatorDaemon, ForecastsStartFromTheEstimatedLoad) {
+  start(7873, "EstimatorForecast", {"HOIST_HEALTH"});
+  const std::string truth = (dir_ / "truth.toml").string(), cfg = (dir_ / "twin.toml").string();
+  {
+    // The true load leans the other way from the configured one (1000 N at +1 m).
+    std::ofstream t(truth);
+    t << "[load]\neccentric_force = 1500.0\noffset = -0.6\n[model]\nmodes = 16\n";
+    std::ofstream c(cfg);
+    c << "[model]\nmodes = 16\n[estimator]\nenabled = true\n[forecast]\nenabled = true\nrate = 5.0\nhorizon = 5.0\n";
+  }
+  const std::string meas = (dir_ / "meas.csv").string();
+  ASSERT_EQ(runProcess({HOIST_SIM, "--config", truth, "--profile", "trapezoid:vmax=2,amax=1,travel=12,t_end=10",
+                        "--write-measurements", meas, "--sensor-noise", "0.002,0.0001,20", "--seed", "11", "-q"},
+                       (dir_ / "sim.log").string(), 60s),
+            0)
+      << readFile((dir_ / "sim.log").string());
+  // The first second without sensors: open loop.
+  {
+    std::ifstream in(meas);
+    std::ofstream out((dir_ / "meas2.csv").string());
+    std::string line;
+    while (std::getline(in, line)) {
+      const auto f = split(line);
+      if (!line.empty() && line[0] != '#' && f.size() >= 7 && f[0] != "t" && std::strtod(f[0].c_str(), nullptr) < 1.0)
+        out << f[0] << ',' << f[1] << ',' << f[2] << ',' << f[3] << ",,,\n";
+      else
+        out << line << '\n';
+    }
+  }
+  listener_->subscribe("HOIST_ESTIMATE|HOIST_FORECAST");
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", cfg, "--clock", "input"};
+  auto d = startDaemonAndWait(*listener_, argv, (dir_ / "twind.log").string());
+  {
+    Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", (dir_ / "meas2.csv").string(), "--speed", "4", "-q"},
+              (dir_ / "replay.log").string());
+    listener_->waitFor([&] { return !r.running(); }, 30s);
+    ASSERT_EQ(r.wait(1s), 0) << readFile((dir_ / "replay.log").string());
+  }
+  EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_FORECAST") >= 48; }, 10s));
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+  const auto est = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
+  const auto fc = listener_->decoded<hoist::forecast_t>("HOIST_FORECAST");
+  ASSERT_GE(fc.size(), 48u) << readFile((dir_ / "twind.log").string());
+  std::map<std::int64_t, const hoist::estimate_t*> by_utime;
+  for (const auto& e : est) by_utime[e.utime] = &e;
+  int open = 0, shifted = 0;
+  for (const auto& f : fc) {
+    const auto it = by_utime.find(f.utime);
+    ASSERT_NE(it, by_utime.end()) << "a forecast at utime " << f.utime << " with no estimate of that step";
+    const hoist::estimate_t& e = *it->second;
+    ASSERT_EQ(f.from_estimate, e.in_use) << "t = " << f.t_start;
+    if (f.from_estimate) {
+      ++shifted;
+      EXPECT_NEAR(f.Fa, e.Fa, 1e-12 * std::abs(e.Fa)) << "t = " << f.t_start;
+      EXPECT_NEAR(f.moment, e.moment, 1e-12 * std::abs(e.moment)) << "t = " << f.t_start;
+    } else {
+      ++open;
+      EXPECT_EQ(f.Fa, 1000.0) << "t = " << f.t_start;
+      EXPECT_EQ(f.moment, 1000.0) << "t = " << f.t_start;
+    }
+  }
+  EXPECT_GE(open, 4);      // the first second, without sensors
+  EXPECT_GE(shifted, 40);  // then from the estimate
+  // By the end the forecasts assume (about) the true load, not the configured one.
+  EXPECT_NEAR(fc.back().Fa, 1500.0, 30.0);
+  EXPECT_NEAR(fc.back().moment, -900.0, 90.0);
 }

@@ -56,6 +56,9 @@ struct FastSolverState {
   // longitudinal: hoisting-rope modal coordinates (n)
   VectorXd y, yd, ydd, ya;   ///< state, rate, acceleration, pseudo-acceleration
   double lambda0 = 0.0;      ///< lambda_0 [N]
+  // the eccentric load the state was integrated under (FastSolver::setLoad)
+  double Fa = 0.0;           ///< force on x_c [N]
+  double moment = 0.0;       ///< moment Fa b on theta [N m]
   int last_iters = 0;        ///< diagnostics carried along
   long fallbacks = 0;
   CageResponse response;     ///< the response at t
@@ -66,6 +69,24 @@ struct FastSolverState {
   explicit FastSolverState(int n);
   int modes() const { return static_cast<int>(y.size()); }
 };
+
+/// The same trajectory under another eccentric load, by superposition.
+///
+/// For given kinematics the model is linear in its loads, and the load enters
+/// only as Fa on x_c (longitudinal) and as the moment M = Fa b on theta
+/// (lateral).  So if `unit` was saved from a FastSolver with Forcing::LoadOnly
+/// (load (unit.Fa, unit.moment), usually 1 N and 1 N m) that started as `s`'s
+/// solver did and took the same steps, then
+///   s_longitudinal += (dFa / unit.Fa) unit_longitudinal,
+///   s_lateral      += (dM / unit.moment) unit_lateral
+/// is, to round-off, the state `s`'s solver would have reached under the load
+/// (s.Fa + dFa, s.moment + dM); s.Fa and s.moment are updated, so restoring
+/// `s` continues under the new load.  The geometric terms (R, Rc, Zd) and the
+/// kinematics are kept.  This is how a forecast starts from the load
+/// estimator's state (hoist/load_estimator.hpp).  Allocation-free.  Returns
+/// false, leaving `s` unchanged, unless both are valid, have the same n and
+/// the same time (within 1e-9 s), and unit's loads are nonzero.
+bool addLoadResponse(FastSolverState& s, const FastSolverState& unit, double dFa, double dM);
 
 /// What drives the solver.  The model is linear in its loads for given
 /// kinematics, so the response to the eccentric load alone is the exact
@@ -89,6 +110,14 @@ class FastSolver final : public Solver {
   void residualSleeveLoads(SleeveLoads& out) const override;
   bool finite() const override;
   Method method() const override { return Method::Fast; }
+
+  /// The eccentric load: Fa on x_c [N] and the moment M = Fa b on theta
+  /// [N m].  Starts as the model's (params Fa and Fa b); setLoad overrides it
+  /// from the next step() on (a forecast from the load estimator's state).
+  /// initialize() does not reset it.  saveState/restoreState carry it.
+  void setLoad(double Fa, double moment);
+  double loadForce() const { return fa_; }
+  double loadMoment() const { return moment_; }
 
   // ---- snapshot (look-ahead forecasts) -------------------------------------
   /// Copies the integration state into `s` (no allocation when s was sized
@@ -179,6 +208,7 @@ class FastSolver final : public Solver {
   bool fused_ = true;
   Forcing forcing_ = Forcing::Full;
   double lambda0_ = 0.0;
+  double fa_ = 0.0, moment_ = 0.0;    // the eccentric load (setLoad)
 
   CageResponse resp_;
 

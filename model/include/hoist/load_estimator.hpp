@@ -211,6 +211,10 @@ class LoadEstimator {
   const EstimatorSettings& settings() const { return set_; }
   /// The sensitivity response (per N of Fa and per N m of M) at the last advance().
   const CageResponse& sensitivity() const { return sens_->response(); }
+  /// The solver behind sensitivity() (Forcing::LoadOnly, Fa = 1 N, M = 1 N m),
+  /// stepped exactly as the twin: its saved state turns the twin's state into
+  /// the estimate's with hoist::addLoadResponse (forecasts from the estimate).
+  const FastSolver& sensitivitySolver() const { return *sens_; }
 
  private:
   bool updateLateral(double f_y, double omega, unsigned which);

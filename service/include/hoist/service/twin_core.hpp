@@ -170,7 +170,8 @@ class TwinCore {
   void setDuplicatePublisher(bool seen, double other_id);
   /// The latest look-ahead forecast's verdicts (issue 17): PREDICTED_CLEARANCE
   /// and PREDICTED_SLACK (seconds to the crossing, horizon), at model time now.
-  void setPredictions(bool clearance, double clearance_s, bool slack, double slack_s, double horizon);
+  void setPredictions(bool clearance, double clearance_s, bool slack, double slack_s, double horizon,
+                      bool from_estimate = false);
   /// Alarm events since the last clearEvents() (the caller publishes them).
   const AlarmEvents& events() const { return events_; }
   void clearEvents() { events_.clear(); }
@@ -225,6 +226,10 @@ class TwinCore {
   /// The last step's clearance and rope-force alarms were judged on the
   /// estimate (it has sensors in use and no MODEL_MISMATCH).
   bool estimateInUse() const { return est_in_use_; }
+  /// The estimator's unit-load solver, stepped with the twin (null when the
+  /// estimator is disabled): with estimate() it gives the state the estimated
+  /// load implies (hoist::addLoadResponse), the forecasts' start.
+  const FastSolver* loadSensitivity() const { return est_ ? &est_->sensitivitySolver() : nullptr; }
 
  private:
   friend class InputClock;
