@@ -103,6 +103,7 @@ void ForecastScheduler::onResult(const ForecastResult& r) {
     return;
   }
   ++st.forecasts;
+  if (r.from_estimate) ++st.forecasts_from_estimate;
   const double us = r.compute_s * 1e6;
   st.forecast_hist.add(us);
   st.forecast_total.add(us);

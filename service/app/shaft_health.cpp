@@ -179,6 +179,7 @@ ShaftRunStats ShaftHealth::runStats() const {
   s.forecasts = st.forecasts;
   s.forecasts_dropped = st.forecasts_dropped;
   s.forecasts_skipped = st.forecasts_skipped;
+  s.forecasts_from_estimate = st.forecasts_from_estimate;
   s.plans_accepted = st.plans_accepted;
   s.plans_rejected = st.plansRejected();
   s.commands_applied = st.commands_applied;

@@ -31,6 +31,7 @@ struct ShaftRunStats {
   std::int64_t forecasts = 0;          ///< forecasts done
   std::int64_t forecasts_dropped = 0;  ///< snapshots the worker never took
   std::int64_t forecasts_skipped = 0;  ///< forecast instants skipped (degraded)
+  std::int64_t forecasts_from_estimate = 0;  ///< forecasts started from the load estimate
   std::int64_t plans_accepted = 0;     ///< trip plans accepted
   std::int64_t plans_rejected = 0;     ///< trip plans rejected
   std::int64_t commands_applied = 0;   ///< effective operator commands

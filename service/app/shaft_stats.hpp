@@ -54,6 +54,7 @@ struct ShaftStats {
   std::int64_t forecasts = 0;          ///< forecasts done
   std::int64_t forecasts_dropped = 0;  ///< snapshots replaced before the worker took them
   std::int64_t forecasts_skipped = 0;  ///< forecast instants skipped (degraded state)
+  std::int64_t forecasts_from_estimate = 0;  ///< forecasts started from the load estimate's state
   std::int64_t forecast_failures = 0;  ///< forecasts whose engine threw (nothing published)
   std::int64_t plan_unusable = 0;      ///< forecasts whose accepted plan no longer fit the motion
   LatencyHistogram forecast_hist;      ///< forecast compute time [us], this health window

@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "daemon.hpp"
+#include "hoist/cage_imu_t.hpp"
 #include "hoist/profile.hpp"
 #include "hoist/trip_plan_t.hpp"
 #include "hoist/winder_t.hpp"
@@ -67,6 +68,7 @@ TwinConfig shaftConfig(double rate, int n, const std::string& prefix) {
   c.forecast.rate = 5.0;
   c.forecast.horizon = 0.5;
   c.forecast.amax = 1.5;  // the winder's limit: the feeder's plans use amax 1.5
+  c.estimator.enabled = prefix.empty();  // shaft A: the load estimator too, fed by an IMU
   return c;
 }
 
@@ -97,6 +99,14 @@ class Feeder {
       m.length = kin.l;
       lcm_.publish("HOIST_WINDER", &m);
       lcm_.publish("B/HOIST_WINDER", &m);
+      if (k % 10 == 5) {  // the cage IMU of shaft A at 100 Hz: its estimator runs and its forecasts start from it
+        cage_imu_t imu{};
+        imu.utime = m.utime;
+        imu.seq = k;
+        imu.f_y = 0.0;
+        imu.omega = 0.0;
+        lcm_.publish("HOIST_CAGE_IMU", &imu);
+      }
       sent_ = seq;
       if (k % 100 == 50) {  // a trip plan every 0.1 s (it fits the motion: accepted)
         trip_plan_t p{};
@@ -208,6 +218,8 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   EXPECT_GT(a1.ns_publish - a0.ns_publish, 0);
   // Forecasts ran and came back through the loop in the window (5 Hz).
   EXPECT_GE(a1.forecasts - a0.forecasts, 8) << logs.str();
+  // ... some of them from the load estimate (its state shifted in the loop).
+  EXPECT_GE(a1.forecasts_from_estimate - a0.forecasts_from_estimate, 4) << logs.str();
   EXPECT_GE(b1.forecasts - b0.forecasts, 8) << logs.str();
   EXPECT_GE(a1.plans_accepted - a0.plans_accepted, 20);
   EXPECT_EQ(a1.plans_rejected, 0);
