@@ -394,7 +394,7 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
   function cageVals(m, s) {
     const lam = m.lambdas || [NaN, NaN, NaN, NaN, NaN];
     const [w, c] = thresholds(s);
-    // The rope-force alarms' thresholds as the daemon publishes them (issue 17; absent from older daemons).
+    // The rope-force alarms' thresholds as the daemon publishes them (absent from older daemons).
     const kN = (x) => (typeof x === "number" && x > 0 ? x / 1e3 : NaN);
     const v = { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
                 slk: kN(m.rope_slack_threshold), ovl: kN(m.rope_overload_threshold),
