@@ -15,7 +15,7 @@
 #                       [--same-url] [--no-watch] [--out FILE] [--port P]
 #
 # --setting (repeatable; default 50:off and 25:on: the paper's n without the
-#   static correction, and the converged setting with it, issue 13): n modes
+#   static correction, and the converged setting with it): n modes
 #   and [model] static_correction.
 # --daemon (repeatable; default this=build/bin/hoist-twind): the binaries to
 #   compare, each run side by side (interleaved) for every setting and N; extra
@@ -26,7 +26,7 @@
 #   hoist-replay) is the same for every daemon.
 # Defaults: counts "100 200 300 400", 60 s each, 100 Hz, [service] max_step
 # 0.01 s (one model step per tick), outputs to [service] lcm_url_out on port
-# P+1 (--same-url: on the input URL, as before issue 13), daemon on the last
+# P+1 (--same-url: on the input URL, as without lcm_url_out), daemon on the last
 # CPU with --mlockall --rt-priority 80 (reported, not fatal, when refused),
 # feeder on CPU 0 (--feeder-rt: with SCHED_FIFO 50, so that a busy CPU 0 does
 # not make it late: a late feeder's bunched inputs fail the daemon's

@@ -20,7 +20,7 @@
 #   P/lib/<multiarch>/          libhoist_model.a, libhoist_io.a
 #   P/lib/<multiarch>/cmake/hoist/  hoistConfig.cmake: find_package(hoist) -> hoist::model, hoist::io, hoist::msgs
 #   P/share/java/hoist_msgs.jar the Java message classes (lcm-spy, Java clients)
-#   P/share/doc/hoist-twin/     README, docs/, examples (demo.toml, read_twin.py)
+#   P/share/doc/hoist-twin/     README, CHANGELOG, docs/, examples (demo.toml, read_twin.py)
 #   P/share/hoist-twin/dash/web the dashboard's web files, when tools/dash/web exists
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -74,7 +74,7 @@ install(CODE "
 install(FILES ${PROJECT_SOURCE_DIR}/tools/mqtt/config/example.toml DESTINATION ${HOIST_CONFIG_DIR}/mqtt
         COMPONENT runtime)
 install(DIRECTORY DESTINATION ${HOIST_CONFIG_DIR}/dash COMPONENT runtime)
-install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${HOIST_DOC_SUBDIR} COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md DESTINATION ${HOIST_DOC_SUBDIR} COMPONENT runtime)
 # Debian: copyright and changelog in each package's doc directory.
 configure_file(${PROJECT_SOURCE_DIR}/cmake/debian/changelog.in ${CMAKE_BINARY_DIR}/debian/changelog @ONLY)
 execute_process(COMMAND gzip -9nf ${CMAKE_BINARY_DIR}/debian/changelog)

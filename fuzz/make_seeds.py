@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write the seed corpora of fuzz_msgs and fuzz_lcmlog (fuzz/corpus/msgs,
 fuzz/corpus/lcmlog) from msgs/*.lcm: a minimal and a filled valid encoding of
-every type, and the attack cases of issue 12 (string lengths 0, 0x80000000,
+every type, and the known attack cases (string lengths 0, 0x80000000,
 huge/negative counts, a log event with datalen 0x7fffffff, a corrupted event
 in the middle of a log).  Run from the repository root; re-run when a type
 changes (the committed seeds stay valid inputs either way)."""
@@ -84,7 +84,7 @@ def main():
                         st, overrides={cname: struct.pack(cfmt, v)})
             if m.nested and m.dims:
                 # Bad counts and strings inside the second nested element
-                # (issue 17: forecast_t.scenarios[1].num_points, .name).
+                # (forecast_t.scenarios[1].num_points, .name).
                 for x in m.struct.members:
                     if x.dims and x.dims[0][0] == 1:
                         cname = x.dims[0][1]

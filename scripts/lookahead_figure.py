@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The e-stop forecast's slack-rope margin along the paper trip (issue 17,
+"""The e-stop forecast's slack-rope margin along the paper trip (see
 docs/lookahead.md), as an SVG figure with no plotting library.
 
 Runs `hoist-forecast-table N EVERY` (the model's forecast engine along the

@@ -31,8 +31,9 @@ say() { printf '\033[1m[setup]\033[0m %s\n' "$*"; }
 required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev liblcm-bin
           libglib2.0-dev libspdlog-dev libgtest-dev libgmock-dev libbenchmark-dev libtomlplusplus-dev
           libcli11-dev gnuplot-nox python3 python3-jinja2 iproute2 libsystemd-dev nlohmann-json3-dev)
-# hoist-dash's page (uPlot from npm) and its browser tests (headless Chromium
-# driven by puppeteer-core, the @foxglove/ws-protocol client): Node, npm, Chromium.
+# hoist-dash's page (uPlot and the @foxglove/ws-protocol client, bundled by esbuild,
+# from npm) and its browser tests (headless Chromium driven by puppeteer-core, the
+# @foxglove/ws-protocol client): Node, npm, Chromium.
 dashboard=(nodejs npm chromium fonts-dejavu-core)
 # MQTT bridge (hoist-mqtt): the client library, and the broker, clients and openssl (TLS test) its tests and demo use.
 required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
@@ -87,11 +88,11 @@ fi
 dash="$here/tools/dash"
 if [[ -f "$dash/package-lock.json" ]]; then
   if ! command -v npm >/dev/null 2>&1; then
-    say "WARNING: npm not found: hoist-dash's page will have no charts and its browser tests are skipped"
+    say "WARNING: npm not found: hoist-dash's page will have no charts nor protocol client and its browser tests are skipped"
   elif [[ -f "$dash/node_modules/.package-lock.json" && "$dash/node_modules/.package-lock.json" -nt "$dash/package-lock.json" ]]; then
     say "npm packages (tools/dash): up to date"
   else
-    say "npm ci in tools/dash (uPlot, puppeteer-core, @foxglove/ws-protocol, ws)"
+    say "npm ci in tools/dash (uPlot, @foxglove/ws-protocol, esbuild, puppeteer-core, ws)"
     (cd "$dash" && npm ci --no-audit --no-fund --loglevel=error) ||
       { say "npm ci failed in $dash"; exit 1; }
   fi

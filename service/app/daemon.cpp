@@ -210,7 +210,7 @@ void Daemon::watchOutputGroup() {
         for (auto& s : shafts_) s->watchOwnOutputs(out_receiver_.get());
         // All our outputs arrive on that group: let the kernel drop all but
         // the HOIST_HEALTH channels, so that the loop does not wake for its
-        // own cage and shape messages (the point of lcm_url_out, issue 13).
+        // own cage and shape messages (the point of lcm_url_out).
         std::vector<std::size_t> lens;
         for (auto& s : shafts_) {
           const std::size_t P = s->channels().health.size() - bus::kChannelHealth.size();
@@ -374,7 +374,7 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   const auto deadline = start_ + g.k * g.period;
   // Between shafts the input socket is drained every kDrainEvery shafts: a
   // tick of hundreds of shafts takes milliseconds, during which the inputs
-  // of the next period arrive (issue 13: no input may be lost).  An empty
+  // of the next period arrive (no input may be lost).  An empty
   // socket costs one recvmsg.
   // The outputs queued by the shafts go out at the same points.
   const auto ns_rx0 = ns_receive_, ns_fl0 = ns_flush_;

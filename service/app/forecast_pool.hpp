@@ -1,4 +1,4 @@
-// Look-ahead forecasts off the real-time loop (issue 17, docs/lookahead.md).
+// Look-ahead forecasts off the real-time loop (docs/lookahead.md).
 //
 //   ForecastJob   one shaft's forecast machinery: the ForecastWorkspace (its
 //                 own solver, sized once), an input mailbox of state

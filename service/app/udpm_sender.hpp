@@ -1,7 +1,7 @@
 // udpm_sender.hpp -- hoist-twind's own publisher for LCM's UDP multicast
 // transport (udpm://), batching the per-tick outputs into sendmmsg calls.
 //
-// Why (issue 13): with hundreds of shafts, publishing HOIST_CAGE is one
+// Why: with hundreds of shafts, publishing HOIST_CAGE is one
 // sendmsg per shaft and tick, and on a virtual machine every system call is
 // expensive (the profile in docs/multishaft-report.md).  queue() keeps a
 // message (header + a pointer to the caller's encoded bytes, which must stay

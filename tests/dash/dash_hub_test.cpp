@@ -149,7 +149,7 @@ TEST_F(HubTest, GarbageAndWrongTypesFromLcmAreCountedNotForwarded) {
   EXPECT_EQ(decode_fail, 1u);
 }
 
-// Issue 12.1: the exact attack bytes (string lengths 0 and 0x80000000,
+// Hostile bytes: the exact attack bytes (string lengths 0 and 0x80000000,
 // huge and negative array counts) on the channels hoist-dash decodes are
 // counted as decode rejections before anything is allocated from them;
 // nothing reaches a client, nothing throws.
@@ -363,7 +363,7 @@ TEST_F(HubTest, BadClientMessagesGetAnErrorStatusAndAreCounted) {
   EXPECT_EQ(hub.counter("ws_rejected_unknown_binary_op"), 1u);
 }
 
-// ---- issue 23/24: discovery aging, alarm identity, history, optional command fields ----
+// ---- discovery aging, alarm identity, history, optional command fields ----
 
 class HubClockTest : public HubTest {
  protected:
@@ -582,7 +582,7 @@ TEST(ValidateAckTest, Fields) {
 }  // namespace
 }  // namespace hoist::dash
 
-// ---- issue 17: HOIST_FORECAST (forecast_t with nested scenarios) ---------------
+// ---- HOIST_FORECAST (forecast_t with nested scenarios) ---------------
 namespace hoist::dash {
 namespace {
 

@@ -1,6 +1,6 @@
 // Test helper (tests/dash, not installed): publishes synthetic forecast_t
 // messages on <prefix>HOIST_FORECAST, as hoist-twind will once its forecast
-// worker runs (issue 17), for the dashboard's Node tests.
+// worker runs), for the dashboard's Node tests.
 //
 //   hoist-test-forecast-pub LCM_URL [PREFIX] [COUNT] [PERIOD_MS]
 //

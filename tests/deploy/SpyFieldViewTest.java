@@ -1,5 +1,5 @@
 // Opens lcm-spy's field view of HOIST_CAGE, headless under Xvfb, and fails on
-// any exception (issue 15: the view crashed with NoClassDefFoundError
+// any exception (the view once crashed with NoClassDefFoundError
 // info/monitorenter/gui/chart/ITrace2D when jchart2d was off the class path).
 //
 // In package lcm.spy to reach Spy's package-private channel table and its

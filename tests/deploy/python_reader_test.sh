@@ -16,7 +16,7 @@ PYTHONPATH="$work/py" "$py" "$src/tools/python/read_twin.py" --lcm-url "$url" --
   >"$work/out.txt" 2>&1 &
 reader=$!
 sleep 0.5
-# Issue 12: hostile datagrams first -- an alarm_t whose message and kind carry
+# Hostile datagrams first -- an alarm_t whose message and kind carry
 # terminal escape sequences, a truncated alarm_t and garbage with the cage
 # fingerprint: the reader must neither die nor pass a control byte through.
 PYTHONPATH="$work/py" "$py" - "$url" <<'PYEOF' || exit 1

@@ -126,7 +126,7 @@ for m in re.finditer(r"^(hoist-[a-z0-9-]+) (\[.*)$", text, re.M):
     for opt in sorted(set(re.findall(r"(--[a-z][a-z0-9-]+)", rest))):
         check(opt in r.stdout + r.stderr, f"README synopsis: {prog} --help lists {opt}")
 
-# Help texts the README relies on (issue 24, section 6).
+# Help texts the README relies on.
 r = subprocess.run(["bash", os.path.join(src_dir, "scripts/demo.sh"), "--help"], capture_output=True, text=True,
                    timeout=60)
 check(r.returncode == 0 and "--mqtt" in r.stdout, "scripts/demo.sh --help lists --mqtt", r.stdout[-1500:])

@@ -1,4 +1,4 @@
-// Issue 12 sections 2-4 and issue 15.1, in process: the exact inputs of the
+// Adversarial classes (docs/hardening.md, 3b), in process: the exact inputs of the
 // attacks fed to TwinCore (the daemon's logic), asserting the counted
 // reason, the alarm and the published state.
 //   * physically impossible input: a against dv/dt, a v step, a sample
@@ -58,7 +58,7 @@ int countEvents(const TwinCore& c, AlarmKind k, AlarmEventType t) {
 }  // namespace
 
 TEST(Consistency, AccelerationContradictingTheVelocityIsRejected) {
-  // a = +5 m/s^2 while v stays at 2 m/s for 2 s, 100 Hz (issue 12: lambda_0
+  // a = +5 m/s^2 while v stays at 2 m/s for 2 s, 100 Hz (before the fix: lambda_0
   // fell by 66 % with degraded = 0).  A sample's a is only checked by the
   // next one (the step to a = 5 could have happened just before it), so the
   // first such sample passes; every later one is rejected (a_mismatch, or
@@ -102,7 +102,7 @@ TEST(Consistency, VelocityStepWithoutAccelerationIsRejected) {
 
 TEST(Consistency, LengthJumpHiddenBehindASampleWithoutLengthIsRejected) {
   // Encoder 100 m, then one sample without length, then encoder 200 m
-  // (issue 12: lambda_1 reached -359 kN and CRITICAL alarms latched).
+  // (before the fix: lambda_1 reached -359 kN and CRITICAL alarms latched).
   for (ClockMode clock : {ClockMode::Input, ClockMode::Wall}) {
     SCOPED_TRACE(toString(clock));
     TwinCore core(smallConfig(), clock);
@@ -122,7 +122,7 @@ TEST(Consistency, LengthJumpHiddenBehindASampleWithoutLengthIsRejected) {
 }
 
 TEST(ShaftEnds, EncoderLengthsMicrometresFromEitherEndAreOutsideTheValidRange) {
-  // Issue 12: y_c = -1e159 m, lambda = 1e211 N published with degraded = 0.
+  // Before the fix: y_c = -1e159 m, lambda = 1e211 N published with degraded = 0.
   const TwinConfig cfg = smallConfig();
   const double L2h = cfg.shaft.maxRopeLength();
   for (double l : {1e-7, 1e-3, L2h - 1e-6, L2h - 0.01}) {
@@ -148,7 +148,7 @@ TEST(ShaftEnds, EncoderLengthsMicrometresFromEitherEndAreOutsideTheValidRange) {
 }
 
 TEST(ShaftEnds, TripPastTheBottomRaisesModelDomainHoldsAndCountsRejections) {
-  // Issue 15.1: a 345 m trip from 50 m runs past L - 2h = 384 m.  The twin
+  // A 345 m trip from 50 m runs past L - 2h = 384 m.  The twin
   // must alarm (CRITICAL, naming the length and the limit), count the
   // rejected inputs, flag its outputs degraded and keep publishing the last
   // valid state.
@@ -248,7 +248,7 @@ TEST(Plausibility, FiniteButAbsurdStateIsAModelFaultAndReinitializes) {
 }
 
 TEST(Floods, TenThousandIdenticalShelveCommandsGiveOneEventPerAlarm) {
-  // Issue 12: 10k '*' SHELVE per second gave 44k HOIST_ALARM events.
+  // Before the fix: 10k '*' SHELVE per second gave 44k HOIST_ALARM events.
   TwinCore core(smallConfig(), ClockMode::Wall);
   int effective = 0;
   std::size_t events = 0;
@@ -289,7 +289,7 @@ class CountingSolver final : public Solver {
 }  // namespace
 
 TEST(Overload, CatchUpAfterAStallIsBoundedCountedAndDegraded) {
-  // Issue 12: with modes = 1000 at 1 kHz each slow tick integrated the whole
+  // Before the fix: with modes = 1000 at 1 kHz each slow tick integrated the whole
   // gap, so the next tick was longer still (74 s).  A tick now integrates at
   // most max_catchup_periods periods' worth of substeps.
   TwinConfig cfg = smallConfig();

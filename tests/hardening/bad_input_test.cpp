@@ -270,7 +270,7 @@ TEST(ToolsExitStatus, BadProfilesGiveStatus2NamingTheLine) {
 
 #ifdef HOIST_SIM
 TEST(ToolsExitStatus, SimProfileOutsideTheValidRangeIsRefusedUpFront) {
-  // Issue 12.2: `hoist-sim --profile "rest:t_end=3,l0=1e-7"` wrote 1e282 m and exited 0.
+  // Before the fix: `hoist-sim --profile "rest:t_end=3,l0=1e-7"` wrote 1e282 m and exited 0.
   const auto dir = workDir("tools_implausible");
   const ToolRun sim = run(HOIST_SIM, {"--profile", "rest:t_end=3,l0=1e-7", "--out", (dir / "o.csv").string(), "-q"});
   // Rejected before it runs (bad input, exit 2): the profile leaves the model's
@@ -296,7 +296,7 @@ TEST(ToolsExitStatus, CrlfBomProfileIsAcceptedByTheTools) {
   EXPECT_EQ(rep.status, 0) << rep.output;
 }
 
-// Issue 12 section 6: every file hoist-study writes (a run's CSV, the
+// Every file hoist-study writes (a run's CSV, the
 // summary, the shapes, a gnuplot script) is checked to its last byte; a full
 // disk gives exit status 1 naming the file, never a silent short file.
 TEST(ToolsExitStatus, StudyOnAFullDiskExitsOneNamingTheFile) {

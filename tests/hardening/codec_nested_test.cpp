@@ -1,4 +1,4 @@
-// lcm_codec_gen.py on nested types (issue 17), with TEST-ONLY types
+// lcm_codec_gen.py on nested types, with TEST-ONLY types
 // (tests/hardening/codec_nested/*.lcm, generated into this test's own
 // hoist_msgs_codec copy): a nested value, a fixed array and a variable array
 // of another type, two levels deep, maxima from a const by @max and by the

@@ -1,6 +1,6 @@
 // hoist_msgs_codec (msgs/codec/lcm_codec_gen.py): the generated checked
 // decoders, JSON conversion and schemas, for every type in msgs/ and for the
-// exact hostile payloads of issue 12 section 1.
+// exact hostile payloads that once crashed the programs.
 #include <gtest/gtest.h>
 
 #include <set>
@@ -207,7 +207,7 @@ TEST(Codec, EveryTypeFingerprintRoundTripTruncationSchema) {
   EXPECT_EQ(findByFingerprint(junk, 7), nullptr);
 }
 
-// Issue 12 section 1: the 37-byte alarm_ack_t with a string length of 0 and
+// The 37-byte alarm_ack_t with a string length of 0 and
 // of 0x80000000 (and other impossible lengths) are rejected, not decoded.
 TEST(Codec, AlarmAckStringLengthAttacks) {
   for (std::uint32_t len : {0u, 0x80000000u, 0xFFFFFFFFu, 0x7FFFFFFFu, 4097u, 1000u}) {
@@ -365,7 +365,7 @@ TEST(Codec, FromJsonArrays) {
   EXPECT_FALSE(fromJson(h, hh, err));
 }
 
-// ---- nested types (issue 17: forecast_t holds forecast_scenario_t[]) ------
+// ---- nested types (forecast_t holds forecast_scenario_t[]) ------
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Issue 12 sections 3-6 and issue 15.3/15.4 against the real daemon over LCM
+// Adversarial classes (docs/hardening.md, 3b) against the real daemon over LCM
 // (UDP multicast on loopback, ttl=0, ports 7851..7859, 7862-7863): the exact attacks,
 // asserting the daemon stays alive and what it publishes and logs.
 #include <gtest/gtest.h>
@@ -98,7 +98,7 @@ class DaemonAttack : public ::testing::Test {
 }  // namespace
 
 TEST_F(DaemonAttack, MillionDistinctChannelNamesKeepMemoryFlat) {
-  // Issue 12.3: LCM 1.3.1 caches a handler entry per channel name seen
+  // Channel-name spam: LCM 1.3.1 caches a handler entry per channel name seen
   // (11 MB per 100k names, never freed).  The daemon's own receive path
   // stores nothing per name: RSS growth < 2 MB after 1M distinct names.
   start(7851, "chanspam");
@@ -136,7 +136,7 @@ TEST_F(DaemonAttack, MillionDistinctChannelNamesKeepMemoryFlat) {
 }
 
 TEST_F(DaemonAttack, ChannelPrefixIsALiteralNotARegex) {
-  // Issue 12.5: prefixes "mine.1/" and "mine_1/" in one process; a feeder
+  // Look-alike prefixes: "mine.1/" and "mine_1/" in one process; a feeder
   // on mine.1/ drives only that shaft, "mineX1/" drives none, a shelve on
   // mine_1/ reaches only mine_1/.
   start(7852, "prefix");
@@ -164,7 +164,7 @@ TEST_F(DaemonAttack, ChannelPrefixIsALiteralNotARegex) {
 }
 
 TEST_F(DaemonAttack, SecondPublisherOnTheSameChannelsIsDetected) {
-  // Issue 12.5: two daemons with the same channels interleave contradictory
+  // Two daemons with the same channels interleave contradictory
   // states; each must notice the other (instance_id) and alarm.
   start(7853, "duplicate");
   auto d1 = startDaemon({}, "twind1.log");
@@ -187,7 +187,7 @@ TEST_F(DaemonAttack, SecondPublisherOnTheSameChannelsIsDetected) {
 }
 
 TEST_F(DaemonAttack, SignalsAndADeadLogReaderDoNotKill) {
-  // Issue 12.6: SIGHUP, SIGUSR1 and SIGPIPE killed the daemon at once.
+  // Before the fix: SIGHUP, SIGUSR1 and SIGPIPE killed the daemon at once.
   start(7854, "signals");
   // stderr into a pipe whose reader is gone: every log line hits EPIPE.
   int fds[2];
@@ -211,7 +211,7 @@ TEST_F(DaemonAttack, SignalsAndADeadLogReaderDoNotKill) {
 }
 
 TEST_F(DaemonAttack, ConfigsThatCannotRunAreRefusedAndForcedOnesStayResponsive) {
-  // Issue 12.4: modes = 1000 at 1 kHz and max_step = 1e-9 started in silence.
+  // Start-up budget: modes = 1000 at 1 kHz and max_step = 1e-9 started in silence.
   start(7855, "budget");
   const auto tiny = writeConfig("tiny.toml", "[service]\nmax_step = 1e-9\n");
   EXPECT_EQ(runProcess({HOIST_TWIND, "--config", tiny, "--lcm-url", url_}, (dir_ / "tiny.log").string(), 30s), 2);
@@ -243,7 +243,7 @@ TEST_F(DaemonAttack, ConfigsThatCannotRunAreRefusedAndForcedOnesStayResponsive) 
 }
 
 TEST_F(DaemonAttack, EffectiveCommandsAreAuditedWithTheirUser) {
-  // Issue 12.3: five invalid commands, then a '*' shelve from "mallory":
+  // Commands: five invalid commands, then a '*' shelve from "mallory":
   // the shelve is in HOIST_ALARM (user field) and the log, whatever the
   // junk limiter did.  A shelve beyond max_shelve states the clamp (15.4).
   start(7856, "audit");
@@ -279,7 +279,7 @@ TEST_F(DaemonAttack, EffectiveCommandsAreAuditedWithTheirUser) {
 }
 
 TEST_F(DaemonAttack, AlarmAndCageShareOneTimeOrigin) {
-  // Issue 15.3: HOIST_ALARM.t counted from daemon start, HOIST_CAGE.t from
+  // Before the fix: HOIST_ALARM.t counted from daemon start, HOIST_CAGE.t from
   // the first input.  Idle 2 s, 1 s of input, silence: INPUT_STALE comes
   // within a stale timeout of the last cage state, on the same clock.
   start(7857, "origin");
@@ -303,7 +303,7 @@ TEST_F(DaemonAttack, AlarmAndCageShareOneTimeOrigin) {
 }
 
 TEST_F(DaemonAttack, OutputsGoToLcmUrlOut) {
-  // Issue 13: [service] lcm_url_out -- the daemon publishes there and does
+  // [service] lcm_url_out -- the daemon publishes there and does
   // not receive its own outputs on its input socket.
   start(7858, "urlout");
   const std::string out_url = urlFor(7859);
@@ -327,7 +327,7 @@ TEST_F(DaemonAttack, OutputsGoToLcmUrlOut) {
 }
 
 TEST_F(DaemonAttack, SecondPublisherIsDetectedOnASeparateOutputUrl) {
-  // Issue 12.5 with [service] lcm_url_out on another group: the input socket
+  // Two daemons with [service] lcm_url_out on another group: the input socket
   // never sees the outputs, so the daemon watches its own HOIST_HEALTH on the
   // output URL with a receive-only socket.  One daemon alone raises nothing
   // (it sees only its own id there); a second one with the same prefix and
@@ -372,10 +372,10 @@ TEST_F(DaemonAttack, SecondPublisherIsDetectedOnASeparateOutputUrl) {
 }
 
 TEST(DaemonFiles, RunReportWriteFailureIsExitOneWithPathAndErrno) {
-  // Issue 12.6: every file a program writes is checked; hoist-twind's run
+  // Every file a program writes is checked; hoist-twind's run
   // report (--report) into a directory that does not exist: the option, the
-  // path and the errno text (memq://: no network needed).  Since issue 23
-  // section 5 this is found at start-up: exit 2 (bad input), before the run.
+  // path and the errno text (memq://: no network needed).  The path is
+  // checked at start-up: exit 2 (bad input), before the run.
   const auto dir = testDir("report_fail");
   const std::string report = (dir / "no" / "such" / "r.json").string();
   const std::string log = (dir / "twind.log").string();

@@ -1,4 +1,4 @@
-// Issue 12 s.1 and s.5 through real LCM (UDP multicast on loopback, ports 7751-7753):
+// Hostile bytes and look-alike prefixes through real LCM (UDP multicast on loopback, ports 7751-7753):
 //   * hoist-twind receives the 37-byte alarm_ack_t with a string length of 0
 //     and of 0x80000000 (it used to die), health_t/guide_shape_t payloads with
 //     huge and negative counts on its input channels, and truncations of a
@@ -11,7 +11,7 @@
 //     says STALE when the daemon goes quiet, and it exits 0 with bounded memory;
 //   * hoist-monitor --channel-prefix "mine.1/" does not show the look-alike
 //     shaft "mineX1/" (LCM's subscribe takes a regular expression).
-//   * hoist-monitor shows HOIST_FORECAST (issue 17, port 7757): per scenario
+//   * hoist-monitor shows HOIST_FORECAST (port 7757): per scenario
 //     the worst clearance and the time to violation, scenario names
 //     terminal-safe, a forecast with a lying nested count dropped and counted.
 #include <gtest/gtest.h>
@@ -74,7 +74,7 @@ TEST_F(DecodeAttack, DaemonSurvivesAndCountsHostileCommandsAndCounts) {
   ASSERT_TRUE(d->running());
 
   int n_cmd = 0, n_winder = 0;
-  // The issue's two 37-byte commands, several times each.
+  // The two 37-byte commands that killed the daemon, several times each.
   for (int i = 0; i < 5; ++i) {
     publish("HOIST_ALARM_ACK", atk::alarmAckStringLen(0)), ++n_cmd;
     publish("HOIST_ALARM_ACK", atk::alarmAckStringLen(0x80000000u)), ++n_cmd;
@@ -178,7 +178,7 @@ TEST_F(DecodeAttack, MonitorSanitizesStringsAndFlagsStaleData) {
 }
 
 TEST_F(DecodeAttack, MonitorPrefixIsALiteralNotARegex) {
-  // Issue 12.5 in hoist-monitor: its channels were regular expressions, so
+  // Look-alike prefixes in hoist-monitor: its channels were regular expressions, so
   // the prefix "mine.1/" also showed the cage of "mineX1/".
   start(7753, "decode_attack_monitor_prefix");
   const std::string out = (dir_ / "monitor.out").string();

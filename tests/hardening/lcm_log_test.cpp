@@ -1,4 +1,4 @@
-// Issue 12 s.1 and s.6: hostile and damaged LCM log files.
+// Hostile and damaged LCM log files.
 //   * hoist::io::LcmLogReader: a header claiming datalen 0x7fffffff (or any
 //     length beyond the file) allocates nothing and is skipped; a corrupted
 //     event in the middle is skipped by resynchronising on the next sync
@@ -125,7 +125,7 @@ TEST(LcmLogReader, CleanLogReadsEverything) {
   EXPECT_NE(missing.error().find("No such file"), std::string::npos) << missing.error();
 }
 
-// The issue's event: datalen = 0x7fffffff (liblcm mallocs it and segfaults).
+// The hostile event: datalen = 0x7fffffff (liblcm mallocs it and segfaults).
 TEST(LcmLogReader, HugeDataLengthAllocatesNothingAndIsSkipped) {
   const auto d = workDir("huge");
   Bytes log = winderLog(10);
@@ -237,7 +237,7 @@ TEST(LcmLogReader, SyncWordInsidePayload) {
   EXPECT_EQ(r.events[2].data, payload);
 }
 
-// hoist-log2csv on the issue's files: alive, bounded memory, exit status.
+// hoist-log2csv on the hostile files: alive, bounded memory, exit status.
 TEST(Log2Csv, HostileLogsExitNonZeroWithBoundedMemory) {
   const auto d = workDir("log2csv");
   // (a) datalen 0x7fffffff in the middle.
@@ -303,7 +303,7 @@ TEST(Log2Csv, FullDiskIsAnErrorNamingTheFile) {
   }
 }
 
-// Issue 17: HOIST_FORECAST (nested forecast_scenario_t) to CSV -- one row
+// HOIST_FORECAST (nested forecast_scenario_t) to CSV -- one row
 // per scenario in HOIST_FORECAST.csv, the series in HOIST_FORECAST.series.csv;
 // HOIST_TRIP_PLAN; HOIST_CAGE's appended threshold columns; a forecast with a
 // lying nested count is rejected by the checked decoder (exit 1, bad_count).

@@ -1,4 +1,4 @@
-// Issue 12.3 for the tools that subscribe to LCM (UDP multicast on loopback,
+// Channel-name spam against the tools that subscribe to LCM (UDP multicast on loopback,
 // port 7864): LCM 1.3.1 keeps a handler-table entry for every channel name
 // it ever receives and never frees it (about 11 MB per 100 000 names), so a
 // sender cycling names grew hoist-dash, hoist-mqtt, hoist-monitor and
@@ -6,7 +6,7 @@
 // the daemon, fixed before: DaemonAttack.MillionDistinctChannelNamesKeepMemoryFlat)
 // without bound.  They now read udpm:// through hoist/bus/udpm_receiver.hpp,
 // which stores nothing per name: 300 000 distinct names, RSS growth < 2 MB
-// each; then the issue-12 attack bytes on the channels they decode; they
+// each; then the hostile attack bytes on the channels they decode; they
 // stay up and still work (the monitor shows the next cage).
 #include <gtest/gtest.h>
 
@@ -70,7 +70,7 @@ TEST_F(ToolAttack, ChannelNameSpamKeepsToolMemoryFlat) {
       if (i % 1000 == 999) std::this_thread::sleep_until(t0 + std::chrono::microseconds(10 * (i + 1)));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));
-    // The issue-12 attack bytes on the channels they decode (issue 12.1).
+    // The hostile attack bytes (attack_bytes.hpp) on the channels they decode.
     namespace atk = hoist::test::attack;
     auto raw = [&](const char* ch, const atk::Bytes& b) { pub.publish(ch, b.data(), static_cast<unsigned>(b.size())); };
     for (std::int32_t n : {0x7fffffff, -1, INT32_MIN}) {

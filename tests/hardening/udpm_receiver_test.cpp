@@ -1,5 +1,5 @@
 // hoist/bus/udpm_receiver.hpp, the project's own udpm:// receive path (the
-// LCM 1.3.1 workaround of issue 12.3, used by hoist-twind, hoist-dash,
+// LCM 1.3.1 workaround against channel-name spam, used by hoist-twind, hoist-dash,
 // hoist-mqtt and hoist-monitor): URL parsing, exact and matching routes, and
 // what it drops.  Real multicast on loopback, ports 7866 and 7877 (the datagrams are
 // LCM's own, sent by lcm::LCM::publish, and hand-made ones).

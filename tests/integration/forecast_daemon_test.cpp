@@ -1,4 +1,4 @@
-// Look-ahead forecasts in the running daemon (issue 17): the daemon's loop
+// Look-ahead forecasts in the running daemon: the daemon's loop
 // in-process (Daemon, as hoist-twind runs it), over real UDP multicast on
 // loopback (ttl=0, ports 7971-7975), fed by this test in lock-step.
 //

@@ -200,7 +200,7 @@ TEST_F(SimCli, HelpDescribesTheOptions) {
     EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
 }
 
-// Issue 17: `hoist-sim --estop-at T` is the same run as the look-ahead
+// `hoist-sim --estop-at T` is the same run as the look-ahead
 // forecast's "estop" scenario made from the twin's state at T.
 TEST_F(SimCli, EstopAtIsTheForecastsEstopScenario) {
   const SimRun r = sim({"--profile", "paper", "--modes", "20", "--estop-at", "20", "--estop-decel", "2.5",
@@ -253,9 +253,9 @@ TEST_F(SimCli, EstopAtIsTheForecastsEstopScenario) {
   EXPECT_EQ(sim({"--estop-at", "20", "--estop-decel", "0", "-q", "--out", path("x.csv")}).status, 2);
 }
 
-// ---- issue 12: hostile and careless runs ------------------------------------
+// ---- hostile and careless runs ------------------------------------
 
-// Issue 12.2: a state that leaves the plausible range stops the run with exit
+// A state that leaves the plausible range stops the run with exit
 // status 1, naming the time and the quantity.  A real input reaches it: a
 // 200 kN eccentric load on the paper's 800-kg cage (accepted: the load has no
 // upper bound) applied as a step (rest start) tilts the cage so far that its
@@ -273,7 +273,7 @@ TEST_F(SimCli, ImplausibleStateExitsOneNamingTimeAndQuantity) {
   EXPECT_NEAR(t.rows.back()[0], 0.09, 1e-12);
 }
 
-// Issue 12.6: rows are streamed, so --t-end no longer sizes a vector
+// Rows are streamed, so --t-end no longer sizes a vector
 // (--t-end 1e9 died with std::bad_alloc); runs that cannot fit are refused
 // up front, naming the option.
 TEST_F(SimCli, HugeTEndIsRefusedNamingTheOptionNotBadAlloc) {
@@ -297,7 +297,7 @@ TEST_F(SimCli, HugeTEndIsRefusedNamingTheOptionNotBadAlloc) {
 
 using hoist::test::vmRssKb;
 
-// Issue 12.6: a long run (1e8 rows, to /dev/null) states its estimated rows,
+// A long run (1e8 rows, to /dev/null) states its estimated rows,
 // size and time before it starts, and its memory stays flat while it runs
 // (it used to keep every row: 9.6 GB for these 1e8 rows).
 TEST_F(SimCli, LongRunStatesItsSizeAndStreamsWithFlatMemory) {
@@ -339,7 +339,7 @@ TEST_F(SimCli, ProgressLinesWithoutATerminal) {
   EXPECT_EQ(r.output, "");
 }
 
-// Issue 12.6: every file written to its last byte, or exit 1 naming the
+// Every file written to its last byte, or exit 1 naming the
 // option, the path and the errno text (the streaming writer included).
 TEST_F(SimCli, FullDiskAndUnwritablePathsExitOneNamingTheFile) {
   // The full disk: a 64 KiB file size limit (runCapturedWithFileSizeLimit;
@@ -370,7 +370,7 @@ TEST_F(SimCli, FullDiskAndUnwritablePathsExitOneNamingTheFile) {
   }
 }
 
-// Issue 12.6: out of memory is exit 1 with the options of the run, never an
+// Out of memory is exit 1 with the options of the run, never an
 // uncaught std::bad_alloc (abort, exit 134).  The address space is limited
 // below what n = 1000 modes need (not under a sanitizer: its shadow memory
 // needs the address space).

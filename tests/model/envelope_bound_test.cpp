@@ -1,4 +1,4 @@
-// GuideRopeEnvelope::evaluateBounded (issue 13, cost per twin): the deflection
+// GuideRopeEnvelope::evaluateBounded (cost per twin): the deflection
 // envelope without the samples x n product on most steps.  Along whole trips
 // (static start and from rest, with and without the static correction, n =
 // 10..50, equal and unequal guide-rope tensions) the bounded value must never

@@ -1,4 +1,4 @@
-// Look-ahead forecasts (issue 17, model side): the solver snapshot, the
+// Look-ahead forecasts (model side): the solver snapshot, the
 // scenario kinematics against closed forms, and the forecast engine against
 // the equivalent full simulation (what hoist-sim --estop-at runs).
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // The one kinematics of the project (hoist/profile.hpp): interpolation inside
 // a sampling interval, the rope length integrated from v and a (with the
 // h^2 (a0 - a1)/12 term), the substep count.  Each against a closed form,
-// with a != 0 (issue 11: the daemon had dropped the acceleration term and
+// with a != 0 (the daemon once dropped the acceleration term and
 // its test used a = 0, so nothing noticed).
 #include <gtest/gtest.h>
 
@@ -117,7 +117,7 @@ TEST(Plausibility, ValidRangeAndBoundsOfThePaperShaft) {
   double v = 0, lim = 0;
   EXPECT_EQ(implausible(ok, p.h, b, v, lim), nullptr);
   CageResponse bad = ok;
-  bad.y_c = -1e159;  // issue 12: published with degraded = 0
+  bad.y_c = -1e159;  // once published with degraded = 0
   ASSERT_NE(implausible(bad, p.h, b, v, lim), nullptr);
   EXPECT_STREQ(implausible(bad, p.h, b, v, lim), "y_c");
   EXPECT_DOUBLE_EQ(lim, 1.0);

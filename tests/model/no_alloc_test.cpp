@@ -38,7 +38,7 @@ TEST(NoAlloc, FastStepAndEnvelopeAllocateNothing) {
       const double t = k * 0.01;
       s.step(t, prof.at(t));
       acc += env.evaluate(s);
-      acc += bounded.evaluateBounded(s, 3e-4);  // issue 13: the bounded envelope, exact and bounded calls
+      acc += bounded.evaluateBounded(s, 3e-4);  // the bounded envelope, exact and bounded calls
     }
     EXPECT_GT(bounded.boundedEvaluations(), 0) << "n = " << n;
     EXPECT_GT(bounded.exactEvaluations(), 0) << "n = " << n;
@@ -77,7 +77,7 @@ TEST(NoAlloc, ReinitializeAllocatesNothing) {
 }
 
 TEST(NoAlloc, SnapshotAndForecastAllocateNothing) {
-  // Issue 17: the loop saves a snapshot (into a preallocated state), the
+  // Look-ahead: the loop saves a snapshot (into a preallocated state), the
   // worker builds the scenarios and runs the forecasts: none of it allocates
   // once the workspace is set up.
   for (int n : {10, 50}) {

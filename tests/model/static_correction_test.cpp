@@ -39,7 +39,7 @@ TEST(StaticCorrection, IsTheDefault) {
 }
 
 TEST(StaticCorrection, StaticsMatchTheExactContinuumSolutionForEveryN) {
-  // y_c, theta, lambda_1..4 within 0.5 % of the exact solution (issue 13);
+  // y_c, theta, lambda_1..4 within 0.5 % of the exact solution (the accuracy target);
   // the correction makes the discrete statics exact, so the tolerance is met
   // with orders of magnitude to spare.  Without it, n = 5 is 60 % off in theta.
   std::printf("   n      l   dTb   theta/exact  y_c/exact   max|lam/exact-1|   (uncorrected theta/exact)\n");
@@ -363,7 +363,7 @@ std::array<double, 6> checkAgainstConverged(const std::string& cs, const Table& 
 }
 
 TEST(StaticCorrection, PaperStaticStartAtTwentyModesMatchesTheConvergedModel) {
-  // Issue 13's tolerances: 1 % on y_c and theta, 2 % on lambda_1..4 (measured
+  // The accuracy targets: 1 % on y_c and theta, 2 % on lambda_1..4 (measured
   // 6e-4, 7e-4, 2e-4; without the correction theta is 33 % off).
   const auto off = checkAgainstConverged("c1-paper", staticReference(), InitialState::Static, 20, {0.01, 0.01, 0.02});
   EXPECT_GT(off[1], 0.2) << "the uncorrected n = 20 tilt is far off";
@@ -407,7 +407,7 @@ TEST(StaticCorrection, PaperRestStartMatchesTheConvergedModelInTheModelsBand) {
   // 3.9 Hz) and the rope ends reflect the waves back.  The converged response
   // carries 1.2 % (theta) and 3.2 % (lambda) of its nRMS above the top mode
   // of a 20-mode rope (f_20 = 3.1 Hz), a band no 20-mode model has modes for:
-  // issue 13's 1 % (theta) / 2 % (lambda) over the whole signal are not
+  // the targets' 1 % (theta) / 2 % (lambda) over the whole signal are not
   // attainable at n = 20 (docs/model.md, docs/figures/convergence).  Below
   // f_20 the corrected n = 20 model meets them (measured 0.86 % theta, 0.96 %
   // lambda, 0.14 % y_c); over the whole signal it is held at its measured level (theta
@@ -427,12 +427,12 @@ TEST(StaticCorrection, PaperRestStartMatchesTheConvergedModelInTheModelsBand) {
   for (int c = 0; c < 6; ++c) {
     ::testing::Test::RecordProperty(std::string("rest_n20_nrms_") + kLat[c], std::to_string(e.raw[c]));
     ::testing::Test::RecordProperty(std::string("rest_n20_band_nrms_") + kLat[c], std::to_string(e.band[c]));
-    // In the model's band: the issue's tolerances.
+    // In the model's band: the accuracy targets.
     EXPECT_LE(e.band[c], c < 2 ? 0.01 : 0.02) << kLat[c];
     // Whole signal: the measured level plus a margin.
     EXPECT_LE(e.raw[c], c == 0 ? 0.005 : c == 1 ? 0.022 : 0.042) << kLat[c];
   }
-  // What no 20-mode model can reproduce exceeds the issue's tolerances ...
+  // What no 20-mode model can reproduce exceeds the accuracy targets ...
   EXPECT_GT(e.above[1], 0.01);
   for (int c = 2; c < 6; ++c) EXPECT_GT(e.above[c], 0.025) << kLat[c];
   // ... and the correction is what brings the tilt into line.

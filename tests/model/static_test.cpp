@@ -173,8 +173,8 @@ TEST(Static, FastPathAccurateAtTheShaftEnds) {
 
 }  // namespace
 
-// ShaftModel::staticRopeForce (the reference of ROPE_SLACK / ROPE_OVERLOAD,
-// issue 17) against the solver's static solve: lambda_0 = m g + Fa at every
+// ShaftModel::staticRopeForce (the reference of ROPE_SLACK / ROPE_OVERLOAD)
+// against the solver's static solve: lambda_0 = m g + Fa at every
 // length, for both methods and several shafts -- the rope's own weight
 // (rho1 g l) does not pass through g0.  Then a rest start settles to it, and
 // a constant deceleration shifts it by m a as the cage's equation says.

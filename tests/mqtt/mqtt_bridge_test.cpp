@@ -250,7 +250,7 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
   EXPECT_EQ((*health)["clock"], "wall");
   EXPECT_TRUE((*health)["reject_reason"].is_array());
 
-  // Forecast (issue 17): a forecast_t on north/HOIST_FORECAST (synthetic: the
+  // Forecast: a forecast_t on north/HOIST_FORECAST (synthetic: the
   // daemon's forecast worker is elsewhere) -> hoist/north/forecast as JSON
   // with its nested scenarios, not retained.
   {
@@ -568,7 +568,7 @@ TEST_F(MqttBridge, TlsWithPasswordFile) {
   EXPECT_EQ(bad.wait(5s), 0);
 }
 
-// The command path (issue: retained replays, floods, ambiguous JSON, control
+// The command path (threats: retained replays, floods, ambiguous JSON, control
 // characters): a retained command is never executed, neither when the bridge
 // starts nor when it restarts, and the bridge deletes it from the broker; a
 // flood from one user is cut to the per-user burst while another user still

@@ -294,7 +294,7 @@ TEST(AlarmNames, RoundTrip) {
   EXPECT_FALSE(parseAlarmKind("NOPE"));
 }
 
-// ---- issue 17: live rope-force alarms ----------------------------------------
+// ---- live rope-force alarms ----------------------------------------
 
 TEST(BinaryAlarm, LowAlarmRaisesAtOrBelowAndClearsAboveThresholdPlusDeadband) {
   AlarmSettings s = settings(100.0, 10.0);

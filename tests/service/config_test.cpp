@@ -205,7 +205,7 @@ TEST(ForecastConfig, BadValuesNameTheKeyAndLine) {
   expectKey("[forecast]\nhorizn = 20\n", "forecast.horizn");
 }
 
-// Issue 17: the rope-force alarm keys are validated like every key; the
+// The rope-force alarm keys are validated like every key; the
 // error names file:line and the key.
 TEST(ServiceConfig, RopeForceAlarmKeysAreValidated) {
   const TwinConfig d = parse("");

@@ -9,7 +9,7 @@
 // stream over real UDP multicast (loopback, ttl=0) that moves the cage (the
 // clearance alarms raise and clear) and pauses (INPUT_STALE raises and
 // clears), so every event path runs inside the watched window.  Both shafts
-// run look-ahead forecasts (issue 17): the loop saves the solver state into
+// run look-ahead forecasts: the loop saves the solver state into
 // the preallocated mailbox slot and hands it to the worker pool, takes the
 // results, publishes HOIST_FORECAST and feeds PREDICTED_* alarms; trip plans
 // arrive on HOIST_TRIP_PLAN -- all inside the watched window.
@@ -163,7 +163,7 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   DaemonOptions opt;
   opt.shafts = {shaftConfig(1000.0, 50, ""), shaftConfig(100.0, 20, "B/")};
   opt.labels = {"A", "B"};
-  // Issue 13: 15 more (unfed, default gaps) shafts at 100 Hz, so that the
+  // Many shafts: 15 more (unfed, default gaps) shafts at 100 Hz, so that the
   // loop drains its input socket between shafts within a tick (every
   // Daemon::kDrainEvery = 16 shafts) and the bounded envelope runs.
   for (int i = 1; i <= 15; ++i) {

@@ -1,4 +1,4 @@
-// The deflection alarm with the bounded envelope (issue 13, cost per twin:
+// The deflection alarm with the bounded envelope (cost per twin:
 // [service] envelope_tolerance, GuideRopeEnvelope::evaluateBounded) against
 // the exact envelope every step (envelope_tolerance = 0), over the paper's
 // whole trip with the demo shaft's tight gaps (scripts/demo.sh), where

@@ -1,4 +1,4 @@
-// The daemon's look-ahead rules (issue 17), pure parts: the single-slot
+// The daemon's look-ahead rules, pure parts: the single-slot
 // mailbox (newest wins, drops counted, safe across two threads -- this test
 // also runs under ThreadSanitizer), trip-plan checks with their reasons, the
 // verdict behind PREDICTED_CLEARANCE / PREDICTED_SLACK, the alarms and their

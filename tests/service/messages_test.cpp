@@ -46,7 +46,7 @@ TEST(Messages, CageMappingCopiesEveryField) {
   EXPECT_EQ(m.min_clearance, o.clearance.min_clearance);
   EXPECT_EQ(m.alarm_level, 1);
   EXPECT_TRUE(m.degraded);
-  EXPECT_EQ(m.rope_slack_threshold, 4424.0);  // issue 17: appended fields
+  EXPECT_EQ(m.rope_slack_threshold, 4424.0);  // appended for the rope-force alarms
   EXPECT_EQ(m.rope_overload_threshold, 13272.0);
 }
 
@@ -95,7 +95,7 @@ TEST(Messages, AlarmTextNamesWhatTheOperatorNeeds) {
                                   "range [0.050, 383.950] m (limit 383.950 m)"),
             std::string::npos)
       << buf;
-  // A shelve clamped to max_shelve says so (issue 15.4).
+  // A shelve clamped to max_shelve says so.
   e = AlarmEvent{};
   e.kind = AlarmKind::GuideRope;
   e.type = AlarmEventType::Shelve;

@@ -160,7 +160,7 @@ TEST(TwinCoreInput, FollowsTheEncoderAndIntegratesWithoutIt) {
 }
 
 TEST(TwinCoreInput, IntegratedLengthMatchesTheClosedFormOfATripWithAcceleration) {
-  // Issue 11: the twin dropped the h^2 (a0 - a1)/12 term and its test used
+  // Before the fix: the twin dropped the h^2 (a0 - a1)/12 term and its test used
   // a = 0.  A winder without encoder, 100 Hz, on an S-curve trip (constant
   // jerk phases: the corrected trapezoid is exact) and at 10 Hz on a
   // trapezoid whose corners fall inside intervals (bounded by h^2/12 per
@@ -423,7 +423,7 @@ TEST(TwinCoreAlarms, TightGapRaisesAClearanceWarning) {
   EXPECT_NEAR(core.output().clearance.min_clearance, core.output().clearance.clearance_pos, 1e-15);
 }
 
-// ---- issue 17: live rope-force alarms through TwinCore ------------------------
+// ---- live rope-force alarms through TwinCore ------------------------
 
 namespace {
 

@@ -1,4 +1,4 @@
-// attack_bytes.hpp -- the exact hostile payloads of issue 12, section 1, as
+// attack_bytes.hpp -- the exact hostile payloads that once crashed the programs, as
 // bytes (shared by codec_test, decode_attack_test, lcm_log_test, tool_attack_test
 // and dash_hub_test; fuzz/make_seeds.py writes the same cases as seeds).
 //
@@ -64,7 +64,7 @@ inline Bytes healthCount(std::int32_t n) {
 }
 
 /// A guide_shape_t header with count `n` and no samples: 44 bytes (the
-/// issue's 70-byte event is this plus the log-event header).
+/// 70-byte event that took 780 MB is this plus the log-event header).
 inline Bytes guideShapeCount(std::int32_t n) {
   Bytes b;
   be(b, static_cast<std::uint64_t>(hoist::guide_shape_t::getHash()), 8);

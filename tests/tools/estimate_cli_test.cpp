@@ -50,7 +50,7 @@ constexpr const char* kContract =
 
 }  // namespace
 
-// The end-to-end case: the truth at n = 100 with Fa 1500 N at
+// The end-to-end case: the truth at n = 100 with Fa 1500 N at
 // b 0.6 m (the paper config says 1000 N at 1 m), estimated at n = 25 with the
 // paper config written as hoist-twind's configuration.
 TEST_F(EstimateCli, SimMeasurementsOfAnotherLoadAreRecovered) {

@@ -9,7 +9,7 @@
 // remaining clearance and the active alarms.  Alarm events are printed as
 // they arrive.  Stops on SIGINT/SIGTERM or after --duration.
 //
-// Look-ahead (issue 17): when the daemon publishes HOIST_FORECAST, each line
+// Look-ahead: when the daemon publishes HOIST_FORECAST, each line
 // is followed by one "forecast" line for the shaft: the time the latest
 // forecast starts from and, per scenario, its worst (smallest) clearance and
 // when, and the time to violation -- seconds until the first CRITICAL and
@@ -27,7 +27,7 @@
 //   estimate: Fa 1502+-3 N b 0.60+-0.01 m theta 6.5e-4 (open 8.3e-4) NIS 1.02/dof (bound 1.24) sensors imu+rope [MISMATCH: NIS]
 // The line says STALE like the cage line when HOIST_ESTIMATE stops.
 //
-// Hostile input (issue 12): every payload passes hoist::msg::checkedDecode
+// Hostile input: every payload passes hoist::msg::checkedDecode
 // before it is decoded (undecodable ones are counted and shown), no exception
 // leaves an LCM callback, every string from the network is printed through
 // hoist::msg::terminalSafe (no control characters or escape sequences reach

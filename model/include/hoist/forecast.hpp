@@ -1,4 +1,4 @@
-// hoist/forecast.hpp -- look-ahead forecast (issue 17): from a copy of the
+// hoist/forecast.hpp -- look-ahead forecast: from a copy of the
 // twin's solver state, integrate one scenario (a winder motion, see
 // scenario.hpp) to a horizon with the same solver and step, and summarize
 // what will happen: the smallest clearance and when, the first WARNING and

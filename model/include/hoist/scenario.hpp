@@ -1,4 +1,4 @@
-// hoist/scenario.hpp -- winder motions for look-ahead forecasts (issue 17):
+// hoist/scenario.hpp -- winder motions for look-ahead forecasts:
 // what the winder will do from the current instant, as exact piecewise
 // polynomials.  Pure math: no allocation (fixed capacity), no I/O.
 //

@@ -99,7 +99,7 @@ console.log(`page shows after ${Date.now() - t0} ms:`, shown);
 // ~0.1 s on an idle machine; the bound allows for a loaded CI machine.
 check(shown.now_us - shown.utime < 2000e3, `displayed cage state is current (${((shown.now_us - shown.utime) / 1e3).toFixed(0)} ms old)`);
 
-// 8. HOIST_FORECAST (issue 17), from a synthetic publisher (the daemon's
+// 8. HOIST_FORECAST (look-ahead forecasts), from a synthetic publisher (the daemon's
 // forecast worker is built elsewhere): the forecast panel shows each
 // scenario's worst clearance and time to violation, draws both series, keeps
 // a hostile scenario name as text, and the lying message is dropped.

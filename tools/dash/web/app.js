@@ -3,17 +3,43 @@
 // shaft view, the trends (uPlot), the ISA-18.2 alarm list with operator
 // commands, the health panel, the load estimate (when the daemon's estimator
 // publishes HOIST_ESTIMATE) and the STALE / NO DATA state.
-"use strict";
+//
+// An ES module.  Both imports are put beside this file by the build
+// (tools/dash/CMakeLists.txt), nothing comes from elsewhere: the protocol
+// client is @foxglove/ws-protocol's FoxgloveClient (frame parsing, subscribe,
+// advertise, client message data), bundled by esbuild; the channel names and
+// the alarm level and event names are hoist_msgs.js, generated from msgs/*.lcm
+// by msgs/codec (the same tables as the daemon's).
+import { FoxgloveClient } from "./vendor/foxglove-client.js";
+import { CHANNELS, alarm_t } from "./hoist_msgs.js";
 
 (() => {
-  const SUBPROTOCOL = "foxglove.websocket.v1";
-  const SUFFIXES = ["HOIST_CAGE/history", "HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM_ACK", "HOIST_ALARM", "HOIST_HEALTH",
-                    "HOIST_FORECAST", "HOIST_TRIP_PLAN", "HOIST_WINDER", "HOIST_CAGE", "HOIST_ESTIMATE/decimated", "HOIST_ESTIMATE"];
-  const SUBSCRIBE = new Set(["HOIST_CAGE/history", "HOIST_CAGE/decimated", "HOIST_GUIDE_SHAPE", "HOIST_ALARM", "HOIST_HEALTH",
-                             "HOIST_FORECAST", "HOIST_TRIP_PLAN", "HOIST_ESTIMATE/decimated"]);
+  // Channel suffixes (what follows a shaft's prefix): the wire channels of
+  // msgs/*.lcm, and the ones hoist-dash derives from them (the decimated cage
+  // state and load estimate, the cage history).
+  const channelOf = (type) => {
+    const c = CHANNELS[type];
+    if (typeof c !== "string") throw new Error(`hoist_msgs.js names no channel for ${type}`);
+    return c;
+  };
+  const CH = {
+    cage: channelOf("hoist.cage_state_t"), shape: channelOf("hoist.guide_shape_t"), alarm: channelOf("hoist.alarm_t"),
+    ack: channelOf("hoist.alarm_ack_t"), health: channelOf("hoist.health_t"), forecast: channelOf("hoist.forecast_t"),
+    plan: channelOf("hoist.trip_plan_t"), estimate: channelOf("hoist.estimate_t"),
+  };
+  CH.history = `${CH.cage}/history`;
+  CH.cageDecimated = `${CH.cage}/decimated`;
+  CH.estimateDecimated = `${CH.estimate}/decimated`;
+  // Longest first: a topic belongs to the longest suffix it ends with.
+  const SUFFIXES = [...Object.values(CHANNELS), CH.history, CH.cageDecimated, CH.estimateDecimated]
+    .sort((a, b) => b.length - a.length);
+  const SUBSCRIBE = new Set([CH.history, CH.cageDecimated, CH.shape, CH.alarm, CH.health, CH.forecast, CH.plan,
+                             CH.estimateDecimated]);
   const STALE_AFTER_MS = 1500;     // STALE shown within 2 s of silence
   const KEEP_S = 300;              // longest trend window
-  const LEVELS = ["NONE", "WARNING", "CRITICAL"];
+  // alarm_t.level's name (NONE, WARNING, CRITICAL), the number for a value without one.
+  const levelName = (v) => alarm_t.LEVEL_NAMES[v - alarm_t.LEVEL_FIRST] ?? String(v);
+  const EVENT_RAISE = alarm_t.EVENT_FIRST + alarm_t.EVENT_NAMES.indexOf("RAISE");
 
   const $ = (sel, root = document) => root.querySelector(sel);
   const el = (tag, attrs = {}, ...kids) => {
@@ -40,8 +66,8 @@
   };
 
   const state = {
-    ws: null, readOnly: true, meta: {}, channels: new Map(), subs: new Map(), nextSub: 1,
-    shafts: new Map(), selected: null, ackChannels: new Map(), nextClientChan: 1,
+    ws: null, client: null, readOnly: true, meta: {}, channels: new Map(), subs: new Map(),
+    shafts: new Map(), selected: null, ackChannels: new Map(),
     windowS: 60, notices: new Map(), historyQueue: [], historyPending: false,
   };
 
@@ -50,9 +76,9 @@
     if (state.historyPending) return;
     while (state.historyQueue.length) {
       const h = state.historyQueue.shift();
-      if (!state.subs.has(h.id)) continue;  // withdrawn meanwhile
+      if (!state.channels.has(h.channelId)) continue;  // withdrawn meanwhile
+      if (!subscribe(h.shaft, h.suffix, h.channelId)) return;
       state.historyPending = true;
-      send({ op: "subscribe", subscriptions: [h] });
       // (a history dropped by the server, or a shaft withdrawn: go on after 3 s)
       clearTimeout(state.historyTimer);
       state.historyTimer = setTimeout(() => { state.historyPending = false; nextHistory(); }, 3000);
@@ -110,93 +136,91 @@
     c.dataset.state = st;
   }
 
+  // One FoxgloveClient per WebSocket; a closed one is replaced after 2 s.
   function connect() {
-    const ws = new WebSocket(`ws://${location.host}/`, [SUBPROTOCOL]);
-    ws.binaryType = "arraybuffer";
+    const ws = new WebSocket(`ws://${location.host}/`, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+    const client = new FoxgloveClient({ ws });
     state.ws = ws;
+    state.client = client;
     state.channels.clear(); state.subs.clear(); state.ackChannels.clear();
     state.historyQueue = []; state.historyPending = false;
     setConn("connecting…", "conn-wait", "connecting");
-    ws.onopen = () => setConn("connected", "conn-ok", "connected");
-    ws.onclose = () => {
+    client.on("open", () => setConn("connected", "conn-ok", "connected"));
+    client.on("close", () => {
       setConn("DISCONNECTED: retrying", "conn-bad", "disconnected");
       for (const s of state.shafts.values()) s.lastMsg = -1e12;
       setTimeout(connect, 2000);
-    };
-    ws.onmessage = (ev) => {
-      if (typeof ev.data === "string") onJson(JSON.parse(ev.data));
-      else onBinary(ev.data);
-    };
+    });
+    client.on("serverInfo", onServerInfo);
+    client.on("advertise", onAdvertise);
+    client.on("unadvertise", (ids) => onUnadvertise(ids || []));
+    client.on("status", (m) => {
+      if (typeof m.id === "string" && m.id) setNotice(m.id, m.message, m.level);
+      else toast(m.message, m.level >= 2);
+    });
+    client.on("removeStatus", (m) => {
+      for (const id of m.statusIds || []) state.notices.get(id)?.remove(), state.notices.delete(id);
+    });
+    client.on("message", onMessage);
+    // A frame the client cannot parse (or an opcode it does not know) is dropped.
+    client.on("error", (e) => console.warn("hoist-dash:", e));
   }
 
-  function send(obj) { if (state.ws && state.ws.readyState === 1) state.ws.send(JSON.stringify(obj)); }
+  // The client's calls send at once: only on the open socket of this page's client.
+  const isOpen = () => state.ws !== null && state.ws.readyState === WebSocket.OPEN;
 
-  function onJson(m) {
-    switch (m.op) {
-      case "serverInfo": {
-        state.readOnly = !(m.capabilities || []).includes("clientPublish");
-        document.body.classList.toggle("read-only", state.readOnly);
-        document.body.dataset.readOnly = String(state.readOnly);
-        $("#mode").textContent = state.readOnly ? "read-only: operator commands disabled" : "";
-        try { state.meta = JSON.parse((m.metadata || {}).shafts || "{}"); } catch { state.meta = {}; }
-        for (const s of state.shafts.values()) renderAlarms(s);
-        break;
+  // Subscribe one channel of a shaft; false when the socket is not open.
+  function subscribe(shaft, suffix, channelId) {
+    if (!isOpen()) return false;
+    const id = state.client.subscribe(channelId);
+    state.subs.set(id, { shaft, suffix, channelId });
+    return true;
+  }
+
+  function onServerInfo(m) {
+    state.readOnly = !(m.capabilities || []).includes("clientPublish");
+    document.body.classList.toggle("read-only", state.readOnly);
+    document.body.dataset.readOnly = String(state.readOnly);
+    $("#mode").textContent = state.readOnly ? "read-only: operator commands disabled" : "";
+    try { state.meta = JSON.parse((m.metadata || {}).shafts || "{}"); } catch { state.meta = {}; }
+    for (const s of state.shafts.values()) renderAlarms(s);
+  }
+
+  function onAdvertise(channels) {
+    for (const ch of channels || []) {
+      state.channels.set(ch.id, ch);
+      const [prefix, suffix] = splitTopic(ch.topic);
+      if (prefix === null) continue;
+      const shaft = getShaft(prefix);
+      if (SUBSCRIBE.has(suffix)) {
+        // Histories one shaft at a time (each up to ~0.5 MB): all at once
+        // would overflow the server's send queue with many shafts.
+        if (suffix === CH.history) state.historyQueue.push({ shaft, suffix, channelId: ch.id });
+        else subscribe(shaft, suffix, ch.id);
       }
-      case "advertise": {
-        const subs = [];
-        for (const ch of m.channels) {
-          state.channels.set(ch.id, ch);
-          const [prefix, suffix] = splitTopic(ch.topic);
-          if (prefix === null) continue;
-          const shaft = getShaft(prefix);
-          if (SUBSCRIBE.has(suffix)) {
-            const id = state.nextSub++;
-            state.subs.set(id, { shaft, suffix, channelId: ch.id });
-            // Histories one shaft at a time (each up to ~0.5 MB): all at once
-            // would overflow the server's send queue with many shafts.
-            if (suffix === "HOIST_CAGE/history") state.historyQueue.push({ id, channelId: ch.id });
-            else subs.push({ id, channelId: ch.id });
-          }
-          if (suffix === "HOIST_ALARM_ACK" && !state.readOnly) {
-            const cid = state.nextClientChan++;
-            state.ackChannels.set(prefix, cid);
-            send({ op: "advertise", channels: [{ id: cid, topic: ch.topic, encoding: "json", schemaName: "hoist.alarm_ack_t" }] });
-          }
-        }
-        if (subs.length) send({ op: "subscribe", subscriptions: subs });
-        nextHistory();
-        break;
+      if (suffix === CH.ack && !state.readOnly && isOpen()) {
+        state.ackChannels.set(prefix, state.client.advertise({ topic: ch.topic, encoding: "json", schemaName: "hoist.alarm_ack_t" }));
       }
-      case "unadvertise": onUnadvertise(m.channelIds || []); break;
-      case "status":
-        if (typeof m.id === "string" && m.id) setNotice(m.id, m.message, m.level);
-        else toast(m.message, m.level >= 2);
-        break;
-      case "removeStatus":
-        for (const id of m.statusIds || []) state.notices.get(id)?.remove(), state.notices.delete(id);
-        break;
-      default: break;
     }
+    nextHistory();
   }
 
   const decoder = new TextDecoder();
-  function onBinary(buf) {
-    const dv = new DataView(buf);
-    if (dv.byteLength < 13 || dv.getUint8(0) !== 1) return;
-    const sub = state.subs.get(dv.getUint32(1, true));
+  function onMessage({ subscriptionId, data }) {
+    const sub = state.subs.get(subscriptionId);
     if (!sub) return;
-    const msg = JSON.parse(decoder.decode(new Uint8Array(buf, 13)));
+    const msg = JSON.parse(decoder.decode(data));
     const s = sub.shaft;
     s.lastMsg = performance.now();
     switch (sub.suffix) {
-      case "HOIST_CAGE/history": onHistory(s, msg); clearTimeout(state.historyTimer); state.historyPending = false; nextHistory(); break;
-      case "HOIST_CAGE/decimated": onCage(s, msg); break;
-      case "HOIST_TRIP_PLAN": s.plan = msg; s.dirty = true; break;
-      case "HOIST_GUIDE_SHAPE": s.shape = msg; s.dirty = true; break;
-      case "HOIST_ALARM": onAlarm(s, msg); break;
-      case "HOIST_HEALTH": s.health = msg; renderHealth(s); break;
-      case "HOIST_FORECAST": s.forecast = msg; renderForecast(s); break;
-      case "HOIST_ESTIMATE/decimated": onEstimate(s, msg); break;
+      case CH.history: onHistory(s, msg); clearTimeout(state.historyTimer); state.historyPending = false; nextHistory(); break;
+      case CH.cageDecimated: onCage(s, msg); break;
+      case CH.plan: s.plan = msg; s.dirty = true; break;
+      case CH.shape: s.shape = msg; s.dirty = true; break;
+      case CH.alarm: onAlarm(s, msg); break;
+      case CH.health: s.health = msg; renderHealth(s); break;
+      case CH.forecast: s.forecast = msg; renderForecast(s); break;
+      case CH.estimateDecimated: onEstimate(s, msg); break;
     }
   }
 
@@ -370,7 +394,7 @@
   function cageVals(m, s) {
     const lam = m.lambdas || [NaN, NaN, NaN, NaN, NaN];
     const [w, c] = thresholds(s);
-    // The rope-force alarms' thresholds as the daemon publishes them (issue 17; absent from older daemons).
+    // The rope-force alarms' thresholds as the daemon publishes them (absent from older daemons).
     const kN = (x) => (typeof x === "number" && x > 0 ? x / 1e3 : NaN);
     const v = { y_c: m.y_c * 1e3, theta: m.theta * 1e3, l1: lam[1], l2: lam[2], l3: lam[3], l4: lam[4], l0: lam[0] / 1e3,
                 slk: kN(m.rope_slack_threshold), ovl: kN(m.rope_overload_threshold),
@@ -439,7 +463,7 @@
     set("theta", fix(m.theta * 1e3, 3));
     set("v", fix(m.v, 2));
     set("min_clearance", fix(m.min_clearance * 1e3, 1));
-    set("alarm_level", LEVELS[m.alarm_level] || String(m.alarm_level), "lvl" + m.alarm_level);
+    set("alarm_level", levelName(m.alarm_level), "lvl" + m.alarm_level);
     set("degraded", m.degraded ? "DEGRADED" : "no", m.degraded ? "lvl2" : "");
     s.tab.querySelector(".dot").style.background = ["#2fbf71", "#f0b429", "#ef4444"][m.alarm_level] || "#8a96a3";
   }
@@ -453,9 +477,10 @@
     const prev = s.alarms.get(key);
     a.serverIdentity = a.dash_activation_utime > 0;
     if (!a.serverIdentity) {
-      a.dash_activation_utime = a.event_type === 1 || !prev ? a.utime : prev.dash_activation_utime;
-      a.dash_activation_t = a.event_type === 1 || !prev ? a.t : prev.dash_activation_t;
-      a.dash_activation_known = a.event_type === 1 || Boolean(prev && prev.dash_activation_known);
+      const raised = a.event_type === EVENT_RAISE;
+      a.dash_activation_utime = raised || !prev ? a.utime : prev.dash_activation_utime;
+      a.dash_activation_t = raised || !prev ? a.t : prev.dash_activation_t;
+      a.dash_activation_known = raised || Boolean(prev && prev.dash_activation_known);
     }
     s.alarms.set(key, a);
     renderAlarms(s);
@@ -482,7 +507,7 @@
   function alarmOrder(a, b) {
     return (b.level - a.level) || (a.dash_activation_utime - b.dash_activation_utime) || (a.kind < b.kind ? -1 : a.kind > b.kind ? 1 : 0);
   }
-  const alarmName = (a) => `${a.kind} ${LEVELS[a.level] || a.level}`;
+  const alarmName = (a) => `${a.kind} ${levelName(a.level)}`;
   const activeSince = (a) => `${a.dash_activation_known === false ? "before " : ""}${clock(a.dash_activation_utime)}`;
 
   function renderAlarms(s) {
@@ -498,7 +523,7 @@
         "data-activation": String(a.dash_activation_utime),
       });
       const re = a.dash_reannounce_utime > 0 ? el("span", { class: "reann", "data-field": "reannounce" }, ` re-announced ${clock(a.dash_reannounce_utime)}`) : "";
-      tr.append(el("td", { class: "lv" }, LEVELS[a.level] || String(a.level)),
+      tr.append(el("td", { class: "lv" }, levelName(a.level)),
         el("td", { title: a.message }, a.kind),
         el("td", { class: "state" }, stateText(a)),
         el("td", { "data-field": "activation" }, `${activeSince(a)} (t=${fix(a.dash_activation_t, 1)} s)`, re),
@@ -531,12 +556,8 @@
     const cmd = { utime: 0, kind: ident.kind, level: ident.level, action, shelve_duration: action === 2 ? shelve : 0, user };
     // The server refuses the command if this alarm changed since the page drew it.
     if (ident.server) cmd.activation_utime = ident.activation;
-    const payload = new TextEncoder().encode(JSON.stringify(cmd));
-    const buf = new Uint8Array(5 + payload.length);
-    buf[0] = 1;
-    new DataView(buf.buffer).setUint32(1, cid, true);
-    buf.set(payload, 5);
-    state.ws.send(buf);
+    if (!isOpen()) { toast("Not connected: the command was not sent", true); return; }
+    state.client.sendMessage(cid, new TextEncoder().encode(JSON.stringify(cmd)));
   }
 
   // ---- load estimate (only when HOIST_ESTIMATE publishes) ----------------------------

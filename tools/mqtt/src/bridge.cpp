@@ -501,7 +501,7 @@ struct Bridge::Impl {
         if (st != hoist::msg::DecodeStatus::ok) return decodeError("alarm_t", st, channel);
         onAlarm(*s, m);
       } else if (ends(kChannelForecast)) {
-        // Issue 17: the look-ahead forecast, as JSON (nested scenarios), at
+        // The look-ahead forecast, as JSON (nested scenarios), at
         // the daemon's rate (~1 Hz); queued like health (low rate).
         Shaft* s = shaftFor(channel.substr(0, channel.size() - kChannelForecast.size()));
         if (!s) return void(++ignored_channels);

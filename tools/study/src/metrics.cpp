@@ -28,7 +28,7 @@ void checkSizes(const std::vector<double>& t, const std::vector<double>& y) {
 
 /// In-place iterative radix-2 FFT (size a power of two).
 ///
-/// Kept hand-written on purpose (issue 15 asked to justify it or replace it):
+/// Kept hand-written on purpose, rather than a library's FFT:
 ///   * Debian's kissfft (libkissfft-dev) is built for float only
 ///     (kiss_fft_scalar=float): single precision would move the detrended
 ///     spectral peaks that tests/study/study_metrics_test checks;

@@ -21,7 +21,7 @@
 //     slack_fraction x the static rope force) and ROPE_OVERLOAD (at or above
 //     overload_fraction x it) are CRITICAL, their deadband force_deadband x
 //     the static force (ShaftModel::staticRopeForce);
-//     PREDICTED_CLEARANCE and PREDICTED_SLACK (issue 17: a look-ahead
+//     PREDICTED_CLEARANCE and PREDICTED_SLACK (a look-ahead
 //     scenario crosses the CRITICAL clearance threshold / brings lambda_0
 //     below the slack threshold within the forecast horizon) are WARNINGs,
 //     never latched, raised at once (no on-delay: the forecast itself is the
@@ -81,7 +81,7 @@ struct AlarmConfig {
   double reannounce = 10.0;        ///< re-announce active alarms every ... [s]; 0 = never
   bool latch_critical = true;      ///< CRITICAL stays active until acknowledged
   double max_shelve = contract::kDefaultMaxShelve;  ///< longest shelve an operator may set [s]
-  /// Rope-force alarms (issue 17), as fractions of the static rope force at
+  /// Rope-force alarms, as fractions of the static rope force at
   /// the current length (ShaftModel::staticRopeForce, m g + Fa); see
   /// docs/service.md for the defaults' reasons.
   double slack_fraction = 0.5;     ///< ROPE_SLACK at lambda_0 <= fraction x static, in (0, 1)
@@ -252,7 +252,7 @@ class AlarmEngine {
   /// MODEL_FAULT events report `value` against `limit` (e.g. an implausible
   /// output and its bound; 1/0 for a non-finite state).
   void setModelFaultDetail(double value, double limit);
-  /// Look-ahead result (issue 17): `predicted` true while the latest
+  /// Look-ahead result: `predicted` true while the latest
   /// forecast has a scenario that crosses the threshold within the horizon;
   /// `seconds` when (after the forecast's start), `horizon` the horizon
   /// (reported as the event's value and threshold).

@@ -1,7 +1,7 @@
 // hoist/service/budget.hpp -- does a configuration fit its period?  The
 // daemon measures the cost of one tick of the ACTUAL configuration (model
 // size, substeps, envelope) at start-up, on a scratch TwinCore fed a
-// constant-speed trip, before it runs (issue 12, section 4).
+// constant-speed trip, before it runs: one too large is refused at start-up.
 #pragma once
 
 #include "hoist/service/config.hpp"

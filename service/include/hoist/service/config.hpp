@@ -50,7 +50,7 @@ struct ServiceConfig {
   int envelope_points = 401;    ///< depth samples for the guide-rope deflection alarm, [2, 20001]
   /// The deflection alarm's envelope may be a conservative bound at most
   /// this fraction of alarms.guide_rope_gap above the exact one (evaluated
-  /// exactly only when the bound would drift further: issue 13); 0 = exact
+  /// exactly only when the bound would drift further: cost per twin); 0 = exact
   /// every step, [0, 0.05].
   double envelope_tolerance = 0.01;
   int log_rate_limit = 5;       ///< log lines per second per rejection reason, [1, 1000]
@@ -77,7 +77,7 @@ struct ServiceConfig {
   void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
 };
 
-/// The [forecast] section: look-ahead forecasts (issue 17, docs/lookahead.md).
+/// The [forecast] section: look-ahead forecasts (docs/lookahead.md).
 /// Off by default: a forecast costs CPU in proportion to modes x horizon x
 /// rate (about 13 % of one core per shaft at n = 50 with the defaults below,
 /// far more at the converged n), which a deployment must budget for before

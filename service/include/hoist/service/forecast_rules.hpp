@@ -1,5 +1,5 @@
 // hoist/service/forecast_rules.hpp -- the daemon's rules around the model's
-// look-ahead engine (issue 17, docs/lookahead.md), pure (no I/O, no
+// look-ahead engine (docs/lookahead.md), pure (no I/O, no
 // allocation): which trip plans are accepted, what a forecast predicts
 // (PREDICTED_CLEARANCE / PREDICTED_SLACK), and the slack threshold.
 #pragma once

@@ -168,7 +168,7 @@ class TwinCore {
   std::int64_t catchupLimited() const { return catchups_; }
   /// Another publisher on the output channels (from the daemon).
   void setDuplicatePublisher(bool seen, double other_id);
-  /// The latest look-ahead forecast's verdicts (issue 17): PREDICTED_CLEARANCE
+  /// The latest look-ahead forecast's verdicts: PREDICTED_CLEARANCE
   /// and PREDICTED_SLACK (seconds to the crossing, horizon), at model time now.
   void setPredictions(bool clearance, double clearance_s, bool slack, double slack_s, double horizon,
                       bool from_estimate = false);

@@ -29,7 +29,7 @@
 // programs on the machine share the port, bound to INADDR_ANY:port, joined
 // to the group on INADDR_ANY; SO_RCVBUF from the URL's recv_buf_size, else
 // the caller's default (hoist-twind sizes it for 200 ms of its inputs: a
-// tick of many shafts must not overflow it, issue 13), asked for with
+// tick of many shafts must not overflow it), asked for with
 // SO_RCVBUFFORCE first (root / CAP_NET_ADMIN may exceed net.core.rmem_max),
 // then SO_RCVBUF (capped at rmem_max by the kernel); rcvbuf() is what the
 // kernel granted.  SO_RXQ_OVFL makes the kernel report, with every
