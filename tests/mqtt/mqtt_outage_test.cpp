@@ -520,3 +520,27 @@ TEST_F(MqttStoreAndForward, FleetCentreDownSixtySecondsConsumerSeesEveryAlarmAnd
   site.stop();
   centre.stop();
 }
+
+// An unusable [buffer] dir is a configuration error found at start-up: one
+// line naming the path, exit status 2 (never a bridge that runs without the
+// journal it was given).
+TEST_F(MqttStoreAndForward, UnusableJournalDirectoryExits2) {
+  dir_ = testDir("journal_dir_errors");
+  const auto not_a_dir = dir_ / "plain-file";
+  std::ofstream(not_a_dir.string()) << "x";
+  const auto symlinked = dir_ / "symlinked";
+  fs::create_directories(symlinked);
+  fs::create_symlink(not_a_dir, symlinked / "journal.bin");
+  for (const auto& bad : {not_a_dir.string(), (symlinked).string(), (dir_ / "no" / "such" / "dir").string()}) {
+    SCOPED_TRACE(bad);
+    const auto cfg = (dir_ / "bridge.toml").string();
+    std::ofstream(cfg) << "[broker]\nurl = \"mqtt://127.0.0.1:1\"\n[bridge]\nlcm_url = \"" << urlFor(8083)
+                       << "\"\nchannel_prefixes = [\"x/\"]\n[buffer]\ndir = \"" << bad << "\"\n";
+    const auto out = log("bad.log");
+    fs::remove(out);
+    EXPECT_EQ(runProcess({HOIST_MQTT, "--config", cfg}, out, 20s), 2) << readFile(out);
+    const std::string text = readFile(out);
+    EXPECT_NE(text.find(bad), std::string::npos) << text;
+    EXPECT_EQ(readFile(not_a_dir.string()), "x");  // the symlink's target untouched
+  }
+}
