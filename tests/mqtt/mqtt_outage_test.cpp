@@ -29,6 +29,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
@@ -37,6 +38,7 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/mqtt/journal.hpp"
 
 using namespace hoist::test;
 using json = nlohmann::json;
@@ -543,4 +545,57 @@ TEST_F(MqttStoreAndForward, UnusableJournalDirectoryExits2) {
     EXPECT_NE(text.find(bad), std::string::npos) << text;
     EXPECT_EQ(readFile(not_a_dir.string()), "x");  // the symlink's target untouched
   }
+}
+
+// A journal damaged while the bridge was down (a bad byte in its third
+// record): the bridge logs it, reports it in its health (journal.corrupt,
+// corrupt_bytes), replays the two good records and keeps running.
+TEST_F(MqttStoreAndForward, CorruptJournalIsReportedAndItsGoodPartReplayed) {
+  dir_ = testDir("journal_corrupt");
+  std::uint64_t good_end = 0;
+  {
+    hoist::mqtt::Journal j;
+    j.open((dir_ / "journal").string(), {});
+    for (int i = 1; i <= 3; ++i) {
+      hoist::mqtt::OutMsg m;
+      m.topic = "hoist/bad/cage";
+      m.payload = "{\"utime\":" + std::to_string(i) + "}";
+      m.qos = 1;
+      ASSERT_TRUE(j.append(m));
+      if (i == 2) good_end = j.fileBytes();
+    }
+  }
+  const auto path = (dir_ / "journal" / "journal.bin").string();
+  std::string bytes = readFile(path);
+  bytes[good_end + 14] ^= 0x01;  // the third record's sequence
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+
+  Broker broker(dir_, "broker", freePort());
+  ASSERT_NO_FATAL_FAILURE(broker.start());
+  Historian h(broker.port(), "historian-corrupt", "hoist/#", false);
+  ASSERT_TRUE(h.connected());
+  auto bridge = startBridge(bridgeConfig(dir_, broker.url(), urlFor(8084), "bad/"), "bridge-corrupt", "bridge.log");
+  std::optional<json> health;
+  ASSERT_TRUE(h.waitFor(
+      [&] {
+        for (const auto& m : h.messages())
+          if (m.topic == "hoist/_bridge/bridge-corrupt/health") {
+            const json j = json::parse(m.payload, nullptr, false);
+            if (j.is_object() && j.contains("journal")) health = j;
+          }
+        return health.has_value() && h.live("hoist/bad/cage").size() >= 2;
+      },
+      20s))
+      << readFile(log("bridge.log"));
+  EXPECT_EQ(utimes(h.live("hoist/bad/cage")), (std::vector<std::int64_t>{1, 2}));
+  EXPECT_EQ((*health)["journal"]["corrupt"], 1) << health->dump();
+  EXPECT_EQ((*health)["journal"]["corrupt_bytes"], bytes.size() - good_end) << health->dump();
+  EXPECT_EQ((*health)["journal"]["recovered"], 2) << health->dump();
+  const std::string text = readFile(log("bridge.log"));
+  EXPECT_NE(text.find("CRC mismatch"), std::string::npos) << text;
+  EXPECT_NE(text.find("byte " + std::to_string(good_end)), std::string::npos) << text;
+  EXPECT_TRUE(bridge->running()) << text;
+  bridge->signal(SIGTERM);
+  EXPECT_EQ(bridge->wait(15s), 0) << text;
+  broker.stop();
 }
