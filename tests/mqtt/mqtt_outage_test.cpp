@@ -1,7 +1,7 @@
 // Store-and-forward and the fleet path with real components: hoist-mqtt with
 // its journal ([buffer] dir) between LCM (published here at known rates on
-// loopback multicast, ports 8080-8082) and real mosquitto brokers started
-// here on free loopback ports.
+// loopback multicast, ports 8080-8084) and real mosquitto brokers started
+// here on loopback TCP ports 18640-18644.
 //
 //   Outage: the broker is stopped for 2 minutes (HOIST_OUTAGE_SECONDS to
 //     shorten it while developing) and restarted -- once as it is, once with
@@ -46,19 +46,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-int freePort() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  int port = -1;
-  if (::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) == 0)
-    port = ntohs(a.sin_port);
-  ::close(s);
-  return port;
-}
+/// The brokers' TCP ports: fixed, below the ephemeral range (a broker that
+/// restarts after minutes must find its port free; an ephemeral port may
+/// meanwhile be some client connection's source port).
+constexpr int kPortPlain = 18640, kPortRestart = 18641, kPortCentre = 18642, kPortSite = 18643, kPortCorrupt = 18644;
 
 bool tcpOpen(int port) {
   const int s = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -84,6 +75,7 @@ class Broker {
   Broker(fs::path dir, std::string name, int port, std::string extra = "")
       : dir_(std::move(dir)), name_(std::move(name)), port_(port), extra_(std::move(extra)) {}
   void start() {
+    ASSERT_FALSE(tcpOpen(port_)) << "port " << port_ << " is already in use (another broker?)";
     const auto data = dir_ / (name_ + "-data");
     fs::create_directories(data);
     // mosquitto started as root drops to its own user: the directory must be writable for it.
@@ -352,13 +344,13 @@ class MqttStoreAndForward : public ::testing::Test {
   /// The broker is stopped for `outage` s, then started again; with
   /// `restart_bridge`, the bridge is stopped (SIGTERM) and started again
   /// halfway through.
-  void outage(int lcm_port, const std::string& name, bool restart_bridge) {
+  void outage(int lcm_port, int broker_port, const std::string& name, bool restart_bridge) {
     dir_ = testDir(name);
     const std::string url = urlFor(lcm_port);
     std::string why;
     if (!loopbackMulticastWorks(url, why)) GTEST_FAIL() << kMulticastHelp << " (" << why << ")";
     const double outage_s = envSeconds("HOIST_OUTAGE_SECONDS", 120.0);
-    Broker broker(dir_, "broker", freePort());
+    Broker broker(dir_, "broker", broker_port);
     ASSERT_NO_FATAL_FAILURE(broker.start());
     Historian historian(broker.port(), "historian-" + name, "hoist/out/#", /*persistent=*/true);
     ASSERT_TRUE(historian.connected()) << readFile(broker.log());
@@ -433,11 +425,11 @@ class MqttStoreAndForward : public ::testing::Test {
 }  // namespace
 
 TEST_F(MqttStoreAndForward, OutageBrokerDownTwoMinutesEveryAlarmAndSampleOnceInOrder) {
-  outage(8080, "outage_plain", false);
+  outage(8080, kPortPlain, "outage_plain", false);
 }
 
 TEST_F(MqttStoreAndForward, OutageBrokerDownTwoMinutesBridgeRestartedEveryAlarmAndSampleOnceInOrder) {
-  outage(8081, "outage_restart", true);
+  outage(8081, kPortRestart, "outage_restart", true);
 }
 
 // The fleet path: hoist-mqtt -> site broker -> (mosquitto bridge, QoS 1,
@@ -449,7 +441,7 @@ TEST_F(MqttStoreAndForward, FleetCentreDownSixtySecondsConsumerSeesEveryAlarmAnd
   std::string why;
   if (!loopbackMulticastWorks(url, why)) GTEST_FAIL() << kMulticastHelp << " (" << why << ")";
   const double outage_s = envSeconds("HOIST_FLEET_OUTAGE_SECONDS", 60.0);
-  const int centre_port = freePort();
+  const int centre_port = kPortCentre;
   Broker centre(dir_, "centre", centre_port);
   ASSERT_NO_FATAL_FAILURE(centre.start());
   // The site's bridge to the centre, as docs/fleet.md gives it.
@@ -458,7 +450,7 @@ TEST_F(MqttStoreAndForward, FleetCentreDownSixtySecondsConsumerSeesEveryAlarmAnd
                                   "clientid site1-to-centre\nnotifications false\nrestart_timeout 1 2\n"
                                   "keepalive_interval 10\nbridge_protocol_version mqttv311\n"
                                   "start_type automatic\n";
-  Broker site(dir_, "site", freePort(), bridge_conf);
+  Broker site(dir_, "site", kPortSite, bridge_conf);
   ASSERT_NO_FATAL_FAILURE(site.start());
   Historian consumer(centre.port(), "centre-historian", "hoist/fleet/#", /*persistent=*/true);
   Historian local(site.port(), "site-historian", "hoist/fleet/#", /*persistent=*/false);
@@ -570,7 +562,7 @@ TEST_F(MqttStoreAndForward, CorruptJournalIsReportedAndItsGoodPartReplayed) {
   bytes[good_end + 14] ^= 0x01;  // the third record's sequence
   std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
 
-  Broker broker(dir_, "broker", freePort());
+  Broker broker(dir_, "broker", kPortCorrupt);
   ASSERT_NO_FATAL_FAILURE(broker.start());
   Historian h(broker.port(), "historian-corrupt", "hoist/#", false);
   ASSERT_TRUE(h.connected());
