@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -344,6 +345,40 @@ TEST_F(MqttJournal, LengthFieldsNeverReachTheAllocatorUnderAnAddressSpaceLimit) 
   EXPECT_EXIT(openBothUnderAddressSpaceLimit(dir_.string(), dir2), ::testing::ExitedWithCode(0), "");
 }
 #endif
+
+namespace {
+/// In a child limited to 8 KiB files (a full disk, as far as the journal can
+/// tell): appends fail, are counted and leave a journal whose records all
+/// read back; nothing is fatal.  Exit 0 if so.
+[[noreturn]] void appendPastAFileSizeLimit(const std::string& dir) {
+  std::signal(SIGXFSZ, SIG_IGN);  // write() then fails with EFBIG instead of killing the process
+  const rlimit rl{8192, 8192};
+  if (::setrlimit(RLIMIT_FSIZE, &rl) != 0) std::_Exit(3);
+  Journal j;
+  JournalLimits lim;
+  lim.max_bytes = 1 << 20;
+  j.open(dir, lim);
+  int stored = 0, refused = 0;
+  for (int i = 0; i < 40; ++i) (j.append(msg(i, MsgClass::Cage, 500)) ? stored : refused)++;
+  if (refused == 0 || stored == 0 || j.writeErrors() != static_cast<std::uint64_t>(refused)) std::_Exit(4);
+  if (j.lastError().find("journal.bin") == std::string::npos) std::_Exit(5);
+  j.close();
+  Journal k;
+  const auto rep = k.open(dir, lim);
+  if (!rep.problem.empty() || rep.recovered != static_cast<std::uint64_t>(stored)) std::_Exit(6);
+  int n = 0;
+  while (!k.empty()) {
+    auto m = k.peek();
+    if (!m || idOf(*m) != n++) std::_Exit(7);
+    k.pop();
+  }
+  std::_Exit(0);
+}
+}  // namespace
+
+TEST_F(MqttJournal, AFullDiskIsCountedAndLeavesAReadableJournal) {
+  EXPECT_EXIT(appendPastAFileSizeLimit(dir_.string()), ::testing::ExitedWithCode(0), "");
+}
 
 TEST_F(MqttJournal, RefusesWhatTheCheckedWriterRefuses) {
   // journal.bin a symbolic link: refused, the link's target untouched.
