@@ -197,11 +197,12 @@ void CheckedFile::printf(const char* fmt, ...) {
   bytes_ += static_cast<std::uint64_t>(n);
 }
 
-void CheckedFile::close() {
+void CheckedFile::close(bool durable) {
   if (f_ == nullptr) return;
   errno = 0;
   if (std::fflush(f_) != 0) fail("write failed", errno ? errno : EIO);
   if (std::ferror(f_)) fail("write failed", EIO);
+  if (durable && !tmp_.empty() && ::fsync(::fileno(f_)) != 0) fail("fsync failed", errno ? errno : EIO);
   std::FILE* f = std::exchange(f_, nullptr);
   errno = 0;
   if (std::fclose(f) != 0) fail("close failed", errno ? errno : EIO);
@@ -211,6 +212,15 @@ void CheckedFile::close() {
   if (std::string p = targetProblem(path_, err); !p.empty()) fail(p.c_str(), err);
   if (std::rename(tmp_.c_str(), path_.c_str()) != 0) fail("cannot rename the temporary file onto it", errno);
   tmp_.clear();
+  if (durable) {  // the rename itself must reach the disk
+    const int dfd = ::open(dirOf(path_).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd < 0 || ::fsync(dfd) != 0) {
+      const int e = errno;
+      if (dfd >= 0) ::close(dfd);
+      throw WriteError(path_, prefix(path_, label_) + ": fsync of its directory failed: " + std::strerror(e), e);
+    }
+    ::close(dfd);
+  }
 }
 
 void writeFileChecked(const std::string& path, std::string_view data, const std::string& label) {

@@ -70,6 +70,22 @@ TEST(CheckedFile, WritesAndReplacesARegularFileAtomically) {
   EXPECT_EQ(entries(d), std::vector<std::string>{"out.csv"});
 }
 
+// close(true) (hoist-mqtt's journal compactions): the same replacement, the
+// data and the rename fsynced; the null device stays a sink.
+TEST(CheckedFile, DurableCloseReplacesTheFileAndLeavesNoTemporary) {
+  const fs::path d = freshDir("durable");
+  const fs::path p = d / "journal.bin";
+  { std::ofstream(p) << "old"; }
+  CheckedFile f(p.string());
+  f.write("new");
+  f.close(/*durable=*/true);
+  EXPECT_EQ(slurp(p), "new");
+  EXPECT_EQ(entries(d), std::vector<std::string>{"journal.bin"});
+  CheckedFile null("/dev/null");
+  null.write("discarded");
+  EXPECT_NO_THROW(null.close(/*durable=*/true));
+}
+
 TEST(CheckedFile, AnAbandonedWriteLeavesNoFileBehind) {
   const fs::path d = freshDir("abandoned");
   {

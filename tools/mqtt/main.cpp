@@ -22,6 +22,7 @@
 #include "hoist/io/error.hpp"
 #include "hoist/mqtt/bridge.hpp"
 #include "hoist/mqtt/config.hpp"
+#include "hoist/mqtt/journal.hpp"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
@@ -102,6 +103,9 @@ int main(int argc, char** argv) {
   try {
     hoist::mqtt::Bridge bridge(cfg, password);
     rc = bridge.run(g_stop);
+  } catch (const hoist::mqtt::JournalError& e) {  // [buffer] dir unusable: a configuration error
+    std::cerr << "hoist-mqtt: " << e.what() << "\n";
+    rc = 2;
   } catch (const std::exception& e) {
     std::cerr << "hoist-mqtt: " << e.what() << "\n";
     rc = 1;

@@ -15,6 +15,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <spdlog/spdlog.h>
 #include <stdexcept>
 #include <string_view>
@@ -30,6 +31,7 @@
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/mqtt/command.hpp"
+#include "hoist/mqtt/journal.hpp"
 #include "hoist/mqtt/outbox.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/rt/log_rate_limiter.hpp"
@@ -151,6 +153,25 @@ struct Bridge::Impl {
 
   Outbox outbox;
 
+  // ---- store-and-forward ([buffer] dir; hoist/mqtt/journal.hpp) ---------------------
+  // While the broker is away (or the socket is congested, or too many
+  // messages await their acknowledgement) messages go to the journal, in
+  // order; on reconnection it is replayed before live data.  The messages
+  // handed to libmosquitto and not yet acknowledged (QoS 1) are kept here:
+  // libmosquitto resends them itself after a reconnection, and at shutdown
+  // the ones still unacknowledged go back to the front of the journal.
+  static constexpr std::size_t kMaxInflight = 256;
+  std::unique_ptr<Journal> journal;
+  JournalReport journal_report;
+  struct Inflight {
+    int mid;
+    OutMsg m;
+  };
+  std::deque<Inflight> inflight;
+  std::set<std::string> journaled_alarm_topics;  // alarm states waiting in the journal (no republish needed)
+  std::uint64_t journal_replayed = 0, journal_fallback = 0, journal_prepended = 0;
+  std::uint64_t journal_alarm_drops_seen = 0;
+
   // ---- counters ----------------------------------------------------------------
   Clock::time_point started = Clock::now();
   std::int64_t started_utime = hoist::bus::wallUtime();
@@ -244,7 +265,32 @@ struct Bridge::Impl {
     mosquitto_message_callback_set(mosq, [](struct mosquitto*, void* obj, const struct mosquitto_message* m) {
       static_cast<Impl*>(obj)->onMqttMessage(m);
     });
+    mosquitto_publish_callback_set(mosq, [](struct mosquitto*, void* obj, int mid) {
+      static_cast<Impl*>(obj)->onAcknowledged(mid);
+    });
     delay = cfg.reconnect_min;
+    if (!cfg.journal_dir.empty()) openJournal();
+  }
+
+  void openJournal() {
+    journal = std::make_unique<Journal>();
+    journal_report = journal->open(cfg.journal_dir, {cfg.journal_max_bytes, cfg.fsync_interval});
+    spdlog::info("store-and-forward journal {}: {}{} messages to replay ({} bytes), max_bytes {}, fsync every {} s",
+                 journal_report.path, journal_report.created ? "new; " : "", journal_report.recovered,
+                 journal_report.recovered_bytes, cfg.journal_max_bytes, cfg.fsync_interval);
+    if (!journal_report.problem.empty())
+      spdlog::error("store-and-forward journal {}: {}; {} bytes from there on skipped (the messages before it are "
+                    "replayed; see journal.corrupt_bytes in the bridge's health)",
+                    journal_report.path, journal_report.problem, journal_report.skipped_bytes);
+  }
+
+  /// A QoS 1 message was acknowledged by the broker (PUBACK).
+  void onAcknowledged(int mid) {
+    for (auto it = inflight.begin(); it != inflight.end(); ++it)
+      if (it->mid == mid) {
+        inflight.erase(it);
+        return;
+      }
   }
 
   ~Impl() {
@@ -598,20 +644,68 @@ struct Bridge::Impl {
 
   // ---- MQTT side: publishing -----------------------------------------------------
 
-  /// Publishes now if connected and nothing is waiting, else buffers (bounded).
+  /// Live data may go out now (connected; the Sparkplug mode adds: its
+  /// primary host is online).
+  bool liveReady() const { return conn == Conn::Connected; }
+
+  /// Publishes now if connected and nothing is waiting, else buffers
+  /// (bounded): in the journal with store-and-forward, else in memory.
   void publish(OutMsg m) {
+    if (journal) {
+      // Store-and-forward needs the broker's acknowledgement to know what
+      // arrived: JSON messages go at QoS 1 (Sparkplug keeps its own QoS).
+      if (!m.sparkplug && m.qos < 1) m.qos = 1;
+      if (liveReady() && journal->empty() && outbox.empty() && !mosquitto_want_write(mosq) &&
+          inflight.size() < kMaxInflight && sendOne(m, false))
+        return;
+      return store(std::move(m));
+    }
     if (conn == Conn::Connected && outbox.empty() && !mosquitto_want_write(mosq)) {
-      if (send(m)) return;
+      if (sendOne(m, false)) return;
     }
     outbox.push(std::move(m));
   }
 
-  /// true if handed to libmosquitto.
-  bool send(const OutMsg& m) {
-    const int rc = mosquitto_publish(mosq, nullptr, m.topic.c_str(), static_cast<int>(m.payload.size()),
+  /// Into the journal (or, if it cannot take it, the memory buffer: counted).
+  void store(OutMsg m) {
+    if (m.queued == Clock::time_point{}) m.queued = Clock::now();
+    if (journal->append(m)) {
+      if (m.cls == MsgClass::Alarm && m.retain) journaled_alarm_topics.insert(m.topic);
+      return;
+    }
+    if (journal_fallback++ == 0)
+      spdlog::error("store-and-forward journal: cannot store a message ({}); buffering in memory (counted: "
+                    "journal.fallback)",
+                    journal->lastError().empty() ? "larger than a record may be" : journal->lastError());
+    outbox.push(std::move(m));
+  }
+
+  /// Replays the journal, oldest first, as long as the connection takes it.
+  void flushJournal() {
+    while (journal && !journal->empty() && liveReady() && !mosquitto_want_write(mosq) &&
+           inflight.size() < kMaxInflight) {
+      auto m = journal->peek();
+      if (!m) {  // unreadable now: counted by the journal, skipped
+        journal->pop();
+        continue;
+      }
+      if (!sendOne(*m, /*historical=*/true)) return;
+      journal->pop();
+      ++journal_replayed;
+    }
+  }
+
+  /// The one send function: true if handed to libmosquitto.  `historical`:
+  /// a message replayed from the journal (JSON: sent as stored, its payload
+  /// carries its own utime).
+  bool sendOne(const OutMsg& m, bool historical) {
+    (void)historical;
+    int mid = 0;
+    const int rc = mosquitto_publish(mosq, &mid, m.topic.c_str(), static_cast<int>(m.payload.size()),
                                      m.payload.data(), m.qos, m.retain);
     if (rc == MOSQ_ERR_SUCCESS) {
       ++published;
+      if (journal && m.qos > 0 && m.topic != status_topic) inflight.push_back({mid, m});
       return true;
     }
     ++publish_errors;
@@ -637,12 +731,12 @@ struct Bridge::Impl {
           marked.payload.pop_back();
           marked.payload += fmt::format(",\"stale\":true,\"stale_age\":{:.3f}}}", seconds(now - m.queued));
         }
-        if (!send(marked)) return;
+        if (!sendOne(marked, false)) return;
         ++stale_marked;
         outbox.pop();
         continue;
       }
-      if (!send(m)) return;
+      if (!sendOne(m, false)) return;
       outbox.pop();
     }
   }
@@ -693,6 +787,30 @@ struct Bridge::Impl {
                 {"ignored_channels", ignored_channels}};
     j["mqtt"] = {{"published", published}, {"publish_errors", publish_errors}};
     j["stale_cage"] = {{"marked", stale_marked}, {"dropped", stale_dropped}};
+    if (journal)
+      j["journal"] = {{"path", journal->path()},
+                      {"queued", journal->size()},
+                      {"queued_alarms", journal->queuedAlarms()},
+                      {"file_bytes", journal->fileBytes()},
+                      {"max_bytes", cfg.journal_max_bytes},
+                      {"appended", journal->appended()},
+                      {"replayed", journal_replayed},
+                      {"inflight", inflight.size()},
+                      {"dropped_cage", journal->droppedCage()},
+                      {"dropped_health", journal->droppedHealth()},
+                      {"dropped_alarm", journal->droppedAlarm()},
+                      {"oversized", journal->oversized()},
+                      {"fallback", journal_fallback},
+                      {"recovered", journal_report.recovered},
+                      {"corrupt", journal_report.problem.empty() ? 0 : 1},
+                      {"corrupt_bytes", journal_report.skipped_bytes},
+                      {"corrupt_reason", journal_report.problem},
+                      {"read_errors", journal->readErrors()},
+                      {"write_errors", journal->writeErrors()},
+                      {"last_error", journal->lastError()},
+                      {"fsyncs", journal->fsyncs()},
+                      {"compactions", journal->compactions()},
+                      {"prepended_at_shutdown", journal_prepended}};
     j["buffer"] = {{"queued", outbox.size()},
                    {"queued_alarms", outbox.queuedAlarms()},
                    {"max_messages", cfg.max_messages},
@@ -793,9 +911,14 @@ struct Bridge::Impl {
     last_error = why;
     conn = Conn::Disconnected;
     for (auto& [p, s] : shafts) s.subscribed = false;
-    spdlog::warn("connection to the broker at {} lost: {}; reconnecting with backoff up to {} s, buffering at most "
-                 "{} messages and {} alarm transitions",
-                 brokerText(), why, cfg.reconnect_max, cfg.max_messages, cfg.max_alarm_events);
+    if (journal)
+      spdlog::warn("connection to the broker at {} lost: {}; reconnecting with backoff up to {} s, storing in the "
+                   "journal {} (at most {} bytes)",
+                   brokerText(), why, cfg.reconnect_max, journal->path(), cfg.journal_max_bytes);
+    else
+      spdlog::warn("connection to the broker at {} lost: {}; reconnecting with backoff up to {} s, buffering at most "
+                   "{} messages and {} alarm transitions",
+                   brokerText(), why, cfg.reconnect_max, cfg.max_messages, cfg.max_alarm_events);
     failing = true;  // further failed attempts are the same state
     delay = cfg.reconnect_min;
     next_attempt = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delay));
@@ -821,16 +944,25 @@ struct Bridge::Impl {
                  outbox.empty() ? std::string() : fmt::format("; sending {} buffered messages", outbox.size()));
     const std::string online =
         json{{"online", true}, {"client_id", client_id}, {"since_utime", connected_since_utime}}.dump();
-    send({status_topic, online, 1, true, MsgClass::Alarm});
+    sendOne({status_topic, online, 1, true, MsgClass::Alarm}, false);
     for (auto& [p, s] : shafts)
       if (s.bound) subscribeCommands(s);
+    if (journal && !journal->empty())
+      spdlog::info("replaying {} stored messages from the journal before live data", journal->size());
+    flushJournal();
     flushOutbox();
     // The broker may have restarted without its retained messages: republish
     // every alarm's current state (after the buffered transitions, so the
-    // retained message ends up being the current state).
+    // retained message ends up being the current state).  A state waiting in
+    // the journal is its kind's latest and is replayed retained: not sent
+    // twice (unless the journal had to drop alarm transitions).
+    const bool journal_lost_alarms = journal && journal->droppedAlarm() != journal_alarm_drops_seen;
+    if (journal) journal_alarm_drops_seen = journal->droppedAlarm();
     for (const auto& [p, s] : shafts)
       if (s.bound)
-        for (const auto& [kind, a] : s.alarms) publishAlarmState(s, kind, a);
+        for (const auto& [kind, a] : s.alarms)
+          if (journal_lost_alarms || !journaled_alarm_topics.count(s.t_alarm + kind)) publishAlarmState(s, kind, a);
+    journaled_alarm_topics.clear();
     publishBridgeHealth();
   }
 
@@ -1042,7 +1174,9 @@ struct Bridge::Impl {
           else if (conn == Conn::Connecting) failed(why);
         }
       }
+      flushJournal();
       flushOutbox();
+      if (journal) journal->sync();
 
       now = Clock::now();
       sweepDiscovery(now);
@@ -1069,11 +1203,27 @@ struct Bridge::Impl {
       const std::string offline = json{{"online", false}, {"client_id", client_id}, {"reason", "shutdown"}}.dump();
       mosquitto_publish(mosq, nullptr, status_topic.c_str(), static_cast<int>(offline.size()), offline.data(), 1, true);
       // Give the last messages a moment to leave, then disconnect cleanly (no LWT).
-      const auto end = Clock::now() + std::chrono::milliseconds(500);
-      while (Clock::now() < end && mosquitto_want_write(mosq) && mosquitto_loop(mosq, 10, 1) == MOSQ_ERR_SUCCESS) {
+      // With the journal, wait (a little longer) for the acknowledgements too.
+      const auto end = Clock::now() + std::chrono::milliseconds(journal ? 2000 : 500);
+      while (Clock::now() < end && (mosquitto_want_write(mosq) || (journal && !inflight.empty())) &&
+             mosquitto_loop(mosq, 10, 1) == MOSQ_ERR_SUCCESS) {
       }
       mosquitto_disconnect(mosq);
       mosquitto_loop(mosq, 10, 1);
+    }
+    if (journal) {
+      // What the broker has not acknowledged goes back to the journal's
+      // front (it is older than everything in it): sent again after a restart.
+      std::vector<OutMsg> unacked;
+      for (auto& f : inflight) unacked.push_back(std::move(f.m));
+      inflight.clear();
+      if (!unacked.empty()) {
+        if (journal->prepend(unacked)) journal_prepended += unacked.size();
+        else spdlog::error("store-and-forward journal: {} unacknowledged messages lost: {}", unacked.size(),
+                           journal->lastError());
+      }
+      spdlog::info("store-and-forward journal: {} messages kept for the next start", journal->size());
+      journal->close();
     }
     return 0;
   }

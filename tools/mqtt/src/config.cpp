@@ -151,6 +151,9 @@ void BridgeConfig::validate() const {
   range("buffer.stale_after", stale_after, 0.0, 3600.0, true);
   range("buffer.max_messages", max_messages, 1, 1000000);
   range("buffer.max_alarm_events", max_alarm_events, 1, 1000000);
+  if (journal_max_bytes < 65536 || journal_max_bytes > 1000000000000ull)
+    bad("buffer.max_bytes", std::to_string(journal_max_bytes) + " is outside 65536..1e12");
+  range("buffer.fsync_interval", fsync_interval, 0.0, 3600.0);
 }
 
 namespace {
@@ -277,7 +280,17 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   r.integer("buffer", "max_alarm_events", c.max_alarm_events);
   r.num("buffer", "stale_after", c.stale_after);
   r.boolean("buffer", "drop_stale", c.drop_stale);
+  r.str("buffer", "dir", c.journal_dir);
+  double max_bytes = static_cast<double>(c.journal_max_bytes);
+  r.num("buffer", "max_bytes", max_bytes);
+  r.num("buffer", "fsync_interval", c.fsync_interval);
   r.run(root);
+  if (max_bytes != static_cast<double>(c.journal_max_bytes)) {
+    const int line = r.lines.count("buffer.max_bytes") ? r.lines["buffer.max_bytes"] : 0;
+    if (!(max_bytes >= 65536.0 && max_bytes <= 1e12) || max_bytes != std::floor(max_bytes))
+      throw ConfigError(source, line, "buffer.max_bytes", "must be a whole number of bytes in 65536..1e12");
+    c.journal_max_bytes = static_cast<std::uint64_t>(max_bytes);
+  }
   applyCredentials(c);  // before the files are checked: a credential replaces an unreadable file
   try {
     c.validate();

@@ -74,8 +74,10 @@ class CheckedFile {
   /// Appends printf-formatted text (vfprintf, checked); throws WriteError.
   void printf(const char* fmt, ...) __attribute__((format(printf, 2, 3)));
   /// fflush + ferror + fclose, each checked, then the rename onto the
-  /// target; throws WriteError (and removes the temporary file).
-  void close();
+  /// target; throws WriteError (and removes the temporary file).  `durable`:
+  /// also fsync the data before the rename and the directory after it (a
+  /// file that must survive a power failure, e.g. hoist-mqtt's journal).
+  void close(bool durable = false);
   const std::string& path() const { return path_; }
   /// The temporary file being written ("" when none).
   const std::string& tempPath() const { return tmp_; }

@@ -21,8 +21,11 @@
 // reason.  No exception leaves a callback.  The broker being down at start or
 // going away is never fatal: the bridge retries with exponential backoff
 // ([broker] reconnect_min..reconnect_max), logs once per state change, buffers
-// a bounded number of messages (hoist/mqtt/outbox.hpp), and on every
-// (re)connection re-subscribes and republishes every alarm's current state.
+// a bounded number of messages (hoist/mqtt/outbox.hpp) -- or, with [buffer]
+// dir, stores them in an on-disk journal that survives a restart and is
+// replayed in order before live data (hoist/mqtt/journal.hpp; every message
+// then goes through one send function, sendOne(msg, historical)) -- and on
+// every (re)connection re-subscribes and republishes every alarm's current state.
 #pragma once
 
 #include <csignal>

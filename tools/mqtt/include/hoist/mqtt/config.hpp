@@ -6,7 +6,8 @@
 //   [bridge]  lcm_url, channel_prefixes, commands, cage_rate, health_period,
 //             max_shafts, discovery_timeout, max_command_bytes, command_rate, command_burst,
 //             max_command_age, alarm_sync_time
-//   [buffer]  max_messages, max_alarm_events, stale_after, drop_stale
+//   [buffer]  max_messages, max_alarm_events, stale_after, drop_stale,
+//             dir, max_bytes, fsync_interval (store-and-forward journal)
 //
 // Every key is optional.  Rejected with hoist::io::ConfigError
 // ("file:line: section.key: reason", exit status 2): TOML syntax errors,
@@ -16,6 +17,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -69,6 +71,13 @@ struct BridgeConfig {
   int max_alarm_events = 10000;  ///< alarm transitions buffered (never dropped for cage states)
   double stale_after = 1.0;      ///< a buffered cage state older than this when sent carries "stale": true [s]
   bool drop_stale = false;       ///< ... or is dropped (counted); alarm transitions are always sent
+  // Store-and-forward (hoist/mqtt/journal.hpp): with a directory, what the
+  // bridge cannot send goes to a bounded on-disk journal instead of the
+  // memory buffer above, survives a restart, and is replayed in order on
+  // reconnection; JSON messages then go out at QoS 1 (acknowledged).
+  std::string journal_dir;                         ///< [buffer] dir; "" = memory buffer only
+  std::uint64_t journal_max_bytes = 64ull << 20;   ///< [buffer] max_bytes: the journal file at most
+  double fsync_interval = 1.0;                     ///< [buffer] fsync_interval [s]; 0 = every append
 
   bool wantsTls() const;
   /// Throws std::invalid_argument("section.key: reason").
