@@ -5,8 +5,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <functional>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -14,6 +12,7 @@
 
 #include "hoist/io/config.hpp"
 #include "hoist/io/error.hpp"
+#include "hoist/io/toml_section.hpp"
 
 namespace hoist::mqtt {
 
@@ -155,139 +154,77 @@ void BridgeConfig::validate() const {
 
 namespace {
 
-int lineOf(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+using hoist::io::SectionReader;
 
-struct Reader {
-  const std::string& source;
-  std::map<std::string, std::map<std::string, std::function<void(const toml::node&, const std::string&)>>> keys;
-  std::map<std::string, int> lines;  // "section.key" -> line
-
-  [[noreturn]] void fail(const toml::node& n, const std::string& key, const std::string& why) const {
-    throw ConfigError(source, lineOf(n), key, why);
-  }
-  void str(const char* sec, const char* key, std::string& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto s = n.as_string();
-      if (!s) fail(n, k, "must be a string");
-      out = s->get();
-    };
-  }
-  void num(const char* sec, const char* key, double& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      if (auto i = n.as_integer()) out = static_cast<double>(i->get());
-      else if (auto f = n.as_floating_point()) out = f->get();
-      else fail(n, k, "must be a number");
-      if (!std::isfinite(out)) fail(n, k, "must be finite");
-    };
-  }
-  void integer(const char* sec, const char* key, int& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto i = n.as_integer();
-      if (!i) fail(n, k, "must be an integer");
-      if (i->get() < -1000000000 || i->get() > 1000000000) fail(n, k, "out of range");
-      out = static_cast<int>(i->get());
-    };
-  }
-  void boolean(const char* sec, const char* key, bool& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto b = n.as_boolean();
-      if (!b) fail(n, k, "must be true or false");
-      out = b->get();
-    };
-  }
-  void strings(const char* sec, const char* key, std::vector<std::string>& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto a = n.as_array();
-      if (!a) fail(n, k, "must be an array of strings, e.g. [\"north/\", \"south/\"]");
-      out.clear();
-      for (const auto& e : *a) {
-        auto s = e.as_string();
-        if (!s) fail(e, k, "must be an array of strings");
-        out.push_back(s->get());
-      }
-    };
-  }
-
-  void run(const toml::table& root) {
-    std::vector<std::string> sections;
-    for (const auto& s : keys) sections.push_back(s.first);
-    for (const auto& [k, node] : root) {
-      const std::string sec(k.str());
-      auto it = keys.find(sec);
-      if (it == keys.end()) {
-        const std::string m = hoist::io::closestMatch(sec, sections);
-        std::string msg = node.is_table() ? "unknown section" : "key outside a section";
-        if (!m.empty()) msg += " (did you mean '" + m + "'?)";
-        msg += "; known sections: broker, tls, bridge, buffer";
-        fail(node, sec, msg);
-      }
-      const auto* tbl = node.as_table();
-      if (!tbl) fail(node, sec, "must be a table [" + sec + "]");
-      std::vector<std::string> names;
-      for (const auto& kv : it->second) names.push_back(kv.first);
-      for (const auto& [kk, value] : *tbl) {
-        const std::string key(kk.str());
-        const std::string full = sec + "." + key;
-        auto h = it->second.find(key);
-        if (h == it->second.end()) {
-          const std::string m = hoist::io::closestMatch(key, names);
-          std::string known;
-          for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-          fail(value, full, "unknown key" + (m.empty() ? std::string() : " (did you mean '" + m + "'?)") +
-                                "; known: " + known);
-        }
-        h->second(value, full);
-        lines[full] = lineOf(value);
-      }
-    }
-  }
-};
+/// The sections hoist-mqtt takes, in the order they are listed in errors.
+const std::vector<std::string>& sectionNames() {
+  static const std::vector<std::string> names{"broker", "tls", "bridge", "buffer"};
+  return names;
+}
 
 void apply(const toml::table& root, const std::string& source, BridgeConfig& c) {
-  Reader r{source, {}, {}};
-  r.str("broker", "url", c.url);
-  r.str("broker", "client_id", c.client_id);
-  r.integer("broker", "keepalive", c.keepalive);
-  r.str("broker", "username", c.username);
-  r.str("broker", "password", c.password);
-  r.str("broker", "password_file", c.password_file);
-  r.str("broker", "password_env", c.password_env);
-  r.num("broker", "reconnect_min", c.reconnect_min);
-  r.num("broker", "reconnect_max", c.reconnect_max);
-  r.num("broker", "connect_timeout", c.connect_timeout);
-  r.str("tls", "ca_file", c.ca_file);
-  r.str("tls", "ca_path", c.ca_path);
-  r.str("tls", "cert_file", c.cert_file);
-  r.str("tls", "key_file", c.key_file);
-  r.boolean("tls", "insecure", c.tls_insecure);
-  r.str("tls", "version", c.tls_version);
-  r.str("bridge", "lcm_url", c.lcm_url);
-  r.strings("bridge", "channel_prefixes", c.channel_prefixes);
-  r.boolean("bridge", "commands", c.commands);
-  r.num("bridge", "cage_rate", c.cage_rate);
-  r.num("bridge", "health_period", c.health_period);
-  r.integer("bridge", "max_shafts", c.max_shafts);
-  r.num("bridge", "discovery_timeout", c.discovery_timeout);
-  r.integer("bridge", "max_command_bytes", c.max_command_bytes);
-  r.num("bridge", "command_rate", c.command_rate);
-  r.integer("bridge", "command_burst", c.command_burst);
-  r.num("bridge", "max_command_age", c.max_command_age);
-  r.num("bridge", "alarm_sync_time", c.alarm_sync_time);
-  r.integer("buffer", "max_messages", c.max_messages);
-  r.integer("buffer", "max_alarm_events", c.max_alarm_events);
-  r.num("buffer", "stale_after", c.stale_after);
-  r.boolean("buffer", "drop_stale", c.drop_stale);
-  r.run(root);
+  // Top level: only known sections (keys outside a section are refused too).
+  for (const auto& [k, node] : root) {
+    const std::string sec(k.str());
+    bool known = false;
+    for (const auto& n : sectionNames()) known = known || n == sec;
+    if (known) continue;
+    std::string msg = node.is_table() ? "unknown section" : "key outside a section";
+    msg += hoist::io::didYouMean(sec, sectionNames()) + "; known sections: ";
+    for (std::size_t i = 0; i < sectionNames().size(); ++i) msg += (i ? ", " : "") + sectionNames()[i];
+    throw ConfigError(source, hoist::io::lineOf(node), sec, msg);
+  }
+  auto str = [](std::string& out) { return [&out](const toml::node&, const std::string& v) { out = v; }; };
+  SectionReader broker(root, "broker", source), tls(root, "tls", source), bridge(root, "bridge", source),
+      buffer(root, "buffer", source);
+  broker.string("url", str(c.url));
+  broker.string("client_id", str(c.client_id));
+  broker.integer("keepalive", c.keepalive);
+  broker.string("username", str(c.username));
+  broker.string("password", str(c.password));
+  broker.string("password_file", str(c.password_file));
+  broker.string("password_env", str(c.password_env));
+  broker.number("reconnect_min", c.reconnect_min);
+  broker.number("reconnect_max", c.reconnect_max);
+  broker.number("connect_timeout", c.connect_timeout);
+  tls.string("ca_file", str(c.ca_file));
+  tls.string("ca_path", str(c.ca_path));
+  tls.string("cert_file", str(c.cert_file));
+  tls.string("key_file", str(c.key_file));
+  tls.boolean("insecure", c.tls_insecure);
+  tls.string("version", str(c.tls_version));
+  bridge.string("lcm_url", str(c.lcm_url));
+  bridge.on("channel_prefixes", [&bridge, &c](const toml::node& n) {
+    const auto* a = n.as_array();
+    if (!a) bridge.fail(n, "channel_prefixes", "must be an array of strings, e.g. [\"north/\", \"south/\"]");
+    c.channel_prefixes.clear();
+    for (const auto& e : *a) {
+      const auto* s = e.as_string();
+      if (!s) bridge.fail(e, "channel_prefixes", "must be an array of strings");
+      c.channel_prefixes.push_back(s->get());
+    }
+  });
+  bridge.boolean("commands", c.commands);
+  bridge.number("cage_rate", c.cage_rate);
+  bridge.number("health_period", c.health_period);
+  bridge.integer("max_shafts", c.max_shafts);
+  bridge.number("discovery_timeout", c.discovery_timeout);
+  bridge.integer("max_command_bytes", c.max_command_bytes);
+  bridge.number("command_rate", c.command_rate);
+  bridge.integer("command_burst", c.command_burst);
+  bridge.number("max_command_age", c.max_command_age);
+  bridge.number("alarm_sync_time", c.alarm_sync_time);
+  buffer.integer("max_messages", c.max_messages);
+  buffer.integer("max_alarm_events", c.max_alarm_events);
+  buffer.number("stale_after", c.stale_after);
+  buffer.boolean("drop_stale", c.drop_stale);
+  for (SectionReader* r : {&broker, &tls, &bridge, &buffer}) r->run();
+  const std::vector<const SectionReader*> readers{&broker, &tls, &bridge, &buffer};
   applyCredentials(c);  // before the files are checked: a credential replaces an unreadable file
   try {
     c.validate();
   } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    const auto colon = what.find(": ");
-    const std::string key = colon == std::string::npos ? std::string() : what.substr(0, colon);
-    auto it = r.lines.find(key);
-    throw ConfigError(source, it == r.lines.end() ? 0 : it->second, key,
-                      colon == std::string::npos ? what : what.substr(colon + 2));
+    hoist::io::rethrowWithLine(e.what(), source, readers, false);
   }
 }
 
