@@ -13,6 +13,8 @@
 #include "hoist/io/config.hpp"
 #include "hoist/io/error.hpp"
 #include "hoist/io/toml_section.hpp"
+#include "hoist/mqtt/command.hpp"
+#include "hoist/mqtt/sparkplug_metrics.hpp"
 
 namespace hoist::mqtt {
 
@@ -150,6 +152,51 @@ void BridgeConfig::validate() const {
   range("buffer.stale_after", stale_after, 0.0, 3600.0, true);
   range("buffer.max_messages", max_messages, 1, 1000000);
   range("buffer.max_alarm_events", max_alarm_events, 1, 1000000);
+  if (sparkplug) {
+    if (sp_group_id.empty()) bad("sparkplug.group_id", "Sparkplug mode needs a group id (or --sparkplug GROUP/EDGE)");
+    if (sp_edge_node_id.empty())
+      bad("sparkplug.edge_node_id", "Sparkplug mode needs an edge node id (or --sparkplug GROUP/EDGE)");
+  }
+  for (const auto& [key, id] : {std::pair<const char*, const std::string*>{"sparkplug.group_id", &sp_group_id},
+                                {"sparkplug.edge_node_id", &sp_edge_node_id},
+                                {"sparkplug.primary_host_id", &sp_primary_host_id}})
+    if (!id->empty())
+      if (const std::string why = checkSparkplugId(*id); !why.empty()) bad(key, "'" + printable(*id) + "': " + why);
+  range("sparkplug.deadband", sp_deadband, 0.0, 1e12);
+  for (const auto& [name, db] : sp_deadbands) {
+    const sparkplug::MetricDef* d = sparkplug::findDeviceMetric(name);
+    if (!d) {
+      bad("sparkplug.deadbands", "'" + printable(name) + "' is not a device metric" +
+                                     hoist::io::didYouMean(name, sparkplug::deviceMetricNames()));
+    }
+    if (!sparkplug::isNumeric(d->type))
+      bad("sparkplug.deadbands", "'" + name + "' is not numeric (a deadband applies to numbers only)");
+    if (!std::isfinite(db) || db < 0.0)
+      bad("sparkplug.deadbands", "'" + name + "' must be a finite number >= 0");
+  }
+}
+
+std::string checkSparkplugId(const std::string& id) {
+  if (id.empty()) return "must not be empty";
+  if (id.size() > 64) return "at most 64 characters";
+  for (char c : id)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == ' '))
+      return "may contain only letters, digits, space and _ - . (Sparkplug forbids / + # in ids)";
+  return {};
+}
+
+void applySparkplugOption(const std::string& group_edge, BridgeConfig& cfg) {
+  const auto slash = group_edge.find('/');
+  if (slash == std::string::npos || group_edge.find('/', slash + 1) != std::string::npos)
+    throw std::invalid_argument("--sparkplug: expected GROUP/EDGE (one '/'), got '" + printable(group_edge) + "'");
+  const std::string g = group_edge.substr(0, slash), e = group_edge.substr(slash + 1);
+  if (const std::string why = checkSparkplugId(g); !why.empty())
+    throw std::invalid_argument("--sparkplug: group '" + printable(g) + "': " + why);
+  if (const std::string why = checkSparkplugId(e); !why.empty())
+    throw std::invalid_argument("--sparkplug: edge node '" + printable(e) + "': " + why);
+  cfg.sparkplug = true;
+  cfg.sp_group_id = g;
+  cfg.sp_edge_node_id = e;
 }
 
 namespace {
@@ -158,7 +205,7 @@ using hoist::io::SectionReader;
 
 /// The sections hoist-mqtt takes, in the order they are listed in errors.
 const std::vector<std::string>& sectionNames() {
-  static const std::vector<std::string> names{"broker", "tls", "bridge", "buffer"};
+  static const std::vector<std::string> names{"broker", "tls", "bridge", "buffer", "sparkplug"};
   return names;
 }
 
@@ -176,7 +223,7 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   }
   auto str = [](std::string& out) { return [&out](const toml::node&, const std::string& v) { out = v; }; };
   SectionReader broker(root, "broker", source), tls(root, "tls", source), bridge(root, "bridge", source),
-      buffer(root, "buffer", source);
+      buffer(root, "buffer", source), sp(root, "sparkplug", source);
   broker.string("url", str(c.url));
   broker.string("client_id", str(c.client_id));
   broker.integer("keepalive", c.keepalive);
@@ -218,8 +265,24 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   buffer.integer("max_alarm_events", c.max_alarm_events);
   buffer.number("stale_after", c.stale_after);
   buffer.boolean("drop_stale", c.drop_stale);
-  for (SectionReader* r : {&broker, &tls, &bridge, &buffer}) r->run();
-  const std::vector<const SectionReader*> readers{&broker, &tls, &bridge, &buffer};
+  sp.boolean("enabled", c.sparkplug);
+  sp.string("group_id", str(c.sp_group_id));
+  sp.string("edge_node_id", str(c.sp_edge_node_id));
+  sp.string("primary_host_id", str(c.sp_primary_host_id));
+  sp.number("deadband", c.sp_deadband);
+  sp.on("deadbands", [&sp, &c](const toml::node& n) {
+    const auto* t = n.as_table();
+    if (!t) sp.fail(n, "deadbands", "must be a table [sparkplug.deadbands] of \"metric name\" = deadband");
+    for (const auto& [k, v] : *t) {
+      double d = 0.0;
+      if (const auto* i = v.as_integer()) d = static_cast<double>(i->get());
+      else if (const auto* f = v.as_floating_point()) d = f->get();
+      else sp.fail(v, "deadbands." + std::string(k.str()), std::string("must be a number, got ") + hoist::io::typeName(v));
+      c.sp_deadbands[std::string(k.str())] = d;
+    }
+  });
+  for (SectionReader* r : {&broker, &tls, &bridge, &buffer, &sp}) r->run();
+  const std::vector<const SectionReader*> readers{&broker, &tls, &bridge, &buffer, &sp};
   applyCredentials(c);  // before the files are checked: a credential replaces an unreadable file
   try {
     c.validate();

@@ -26,6 +26,10 @@ struct OutMsg {
   bool retain = false;
   MsgClass cls = MsgClass::Cage;
   std::chrono::steady_clock::time_point queued{};  ///< set by Outbox::push (age at sending: stale cage states)
+  /// The payload is an encoded Sparkplug B Payload whose seq (and the
+  /// metrics' is_historical) are set when it is actually sent
+  /// (hoist::mqtt::sparkplug::stamp, in the bridge's one send path).
+  bool sparkplug = false;
 };
 
 class Outbox {
