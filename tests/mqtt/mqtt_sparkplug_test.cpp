@@ -463,3 +463,51 @@ TEST_F(MqttSparkplug, NoCommandsRefusesAndCountsWrites) {
   acks.pump(300ms);
   EXPECT_EQ(acks.count("north/HOIST_ALARM_ACK"), 0u);
 }
+
+TEST_F(MqttSparkplug, PrimaryHostGatesBirthsAndStoredDataIsHistorical) {
+  ASSERT_NO_FATAL_FAILURE(start(18623, 8063, "primary_host_id = \"scada\"\n"));
+  lcm::LCM pub(lcm_url_);
+  auto cageDdata = [&](std::int64_t seq, bool historical) {
+    json alias;  // of Cage/Seq, from the DBIRTH
+    for (const auto& b : ofType("DBIRTH"))
+      for (const auto& x : b["metrics"])
+        if (x["name"] == "Cage/Seq") alias = x["alias"];
+    return waitMsg(
+        [&](const json& m) {
+          if (m.value("type", "") != "DDATA") return false;
+          for (const auto& x : m["metrics"])
+            if (x["alias"] == alias && x["value"] == seq) return x.value("historical", false) == historical;
+          return false;
+        },
+        5s);
+  };
+  // No primary host yet: connected, but nothing is published; data is stored.
+  const auto c1 = cage(1);
+  std::this_thread::sleep_for(500ms);
+  ASSERT_EQ(pub.publish("north/HOIST_CAGE", &c1), 0);
+  std::this_thread::sleep_for(700ms);
+  EXPECT_TRUE(ofType("NBIRTH").empty()) << tail(host_log_);
+  const std::int64_t t0 = 1'800'000'000'000;
+  command("state scada true " + std::to_string(t0));
+  ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 5s)) << tail(host_log_);
+  EXPECT_TRUE(cageDdata(c1.seq, true)) << "stored before the births: sent after them, is_historical";
+  // The host goes offline: the session ends (NDEATH), the bridge reconnects and stores.
+  command("state scada false " + std::to_string(t0 + 1));
+  ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "NDEATH"; }, 5s)) << tail(host_log_);
+  const auto c2 = cage(2);
+  std::this_thread::sleep_for(300ms);
+  ASSERT_EQ(pub.publish("north/HOIST_CAGE", &c2), 0);
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(ofType("NBIRTH").size(), 1u);
+  command("state scada true " + std::to_string(t0 + 2));
+  ASSERT_TRUE(waitMsg([&](const json&) { return ofType("NBIRTH").size() >= 2; }, 10s)) << tail(host_log_);
+  EXPECT_TRUE(cageDdata(c2.seq, true));
+  // Live again.
+  const auto c3 = cage(3);
+  ASSERT_EQ(pub.publish("north/HOIST_CAGE", &c3), 0);
+  EXPECT_TRUE(cageDdata(c3.seq, false));
+  const auto births = ofType("NBIRTH");
+  EXPECT_EQ(births[1]["metrics"][0]["value"], births[0]["metrics"][0]["value"].get<int>() + 1) << "bdSeq + 1 per CONNECT";
+  const json r = report();
+  EXPECT_EQ(r["errors"], json::array()) << r.dump(1);
+}

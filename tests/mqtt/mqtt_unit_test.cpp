@@ -194,7 +194,7 @@ TEST(MqttOutbox, DropsOldestCageStatesFirstNeverAlarms) {
   EXPECT_EQ(f.queuedAlarms(), 1u);
   EXPECT_EQ(f.front().payload, "A");
   // Past their own (large) bound alarm transitions are dropped oldest first, and counted.
-  for (int i = 0; i < 7; ++i) f.push({"a", "B" + std::to_string(i), 1, true, MsgClass::Alarm});
+  for (int i = 0; i < 7; ++i) f.push({"a", std::string("B") + std::to_string(i), 1, true, MsgClass::Alarm});
   EXPECT_EQ(f.queuedAlarms(), 5u);
   EXPECT_EQ(f.droppedAlarm(), 3u);
 }

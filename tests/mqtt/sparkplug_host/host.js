@@ -11,7 +11,7 @@
 //                 birth or changed across births, NDEATH bdSeq != NBIRTH bdSeq, ...
 //   REPORT {...}  on the command "report": counts and the errors so far
 // Commands, one per line appended to COMMAND_FILE:
-//   dcmd DEVICE JSON_METRICS | ncmd JSON_METRICS | raw TOPIC HEX
+//   dcmd DEVICE JSON_METRICS | ncmd JSON_METRICS | raw TOPIC HEX | state HOST true|false TIMESTAMP
 //   flood DEVICE N RATE JSON_METRICS | report | quit
 'use strict';
 const fs = require('fs');
@@ -134,6 +134,9 @@ function run(line) {
   const tail = (n) => rest.slice(n).join(' ');
   if (cmd === 'dcmd') send(`spBv1.0/${group}/DCMD/${edge}/${rest[0]}`, JSON.parse(tail(1)));
   else if (cmd === 'ncmd') send(`spBv1.0/${group}/NCMD/${edge}`, JSON.parse(tail(0)));
+  else if (cmd === 'state')  // a primary host's STATE (Sparkplug 3.0), retained
+    client.publish(`spBv1.0/STATE/${rest[0]}`, JSON.stringify({ online: rest[1] === 'true', timestamp: +rest[2] }),
+                   { qos: 1, retain: true });
   else if (cmd === 'raw') client.publish(rest[0], Buffer.from(rest[1] || '', 'hex'), { qos: 1 });
   else if (cmd === 'flood') {
     const n = +rest[1], rate = +rest[2], metrics = JSON.parse(tail(3));

@@ -200,6 +200,17 @@ struct Bridge::Impl {
     status_topic = "hoist/_bridge/" + client_id + "/status";
     bridge_health_topic = "hoist/_bridge/" + client_id + "/health";
 
+    if (cfg.sparkplug) {
+      if (!sparkplug::available()) throw std::runtime_error(sparkplugMissing());
+      sparkplug::NodeOptions o;
+      o.group = cfg.sp_group_id;
+      o.edge = cfg.sp_edge_node_id;
+      o.primary_host = cfg.sp_primary_host_id;
+      o.version = std::string("hoist-mqtt ") + hoist::kVersionString;
+      o.deadband = cfg.sp_deadband;
+      o.deadbands = cfg.sp_deadbands;
+      sp = std::make_unique<sparkplug::Node>(o);
+    }
     discover = cfg.channel_prefixes.empty();
     for (const auto& p : cfg.channel_prefixes) addShaft(p, true);
     std::string why;
@@ -227,19 +238,7 @@ struct Bridge::Impl {
     mosq = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
     if (!mosq) throw std::runtime_error("mosquitto_new failed: " + std::string(std::strerror(errno)));
     mosquitto_int_option(mosq, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V311);
-    if (cfg.sparkplug) {
-      if (!sparkplug::available()) throw std::runtime_error(sparkplugMissing());
-      sparkplug::NodeOptions o;
-      o.group = cfg.sp_group_id;
-      o.edge = cfg.sp_edge_node_id;
-      o.primary_host = cfg.sp_primary_host_id;
-      o.version = std::string("hoist-mqtt ") + hoist::kVersionString;
-      o.deadband = cfg.sp_deadband;
-      o.deadbands = cfg.sp_deadbands;
-      sp = std::make_unique<sparkplug::Node>(o);
-      for (auto& [p, s] : shafts)
-        if (s.bound) sp->device(s.name);
-    } else {
+    if (!sp) {  // Sparkplug: the will (NDEATH) is set before each connection
       const std::string will =
           json{{"online", false}, {"client_id", client_id}, {"reason", "connection lost (last will)"}}.dump();
       check(mosquitto_will_set(mosq, status_topic.c_str(), static_cast<int>(will.size()), will.data(), 1, true),
@@ -415,6 +414,7 @@ struct Bridge::Impl {
     if (it == shafts.end()) return;
     if (it->second.bound) {
       if (sp && sp_session) sendOne(sp->deviceDeath(it->second.name, nowMs()), false);
+      if (sp) sp->retireDevice(it->second.name);
       bound.erase(it->second.name);
       cmd_topics.erase(it->second.t_cmd);
       if (conn == Conn::Connected && it->second.subscribed)
@@ -655,6 +655,12 @@ struct Bridge::Impl {
   }
 
   // ---- Sparkplug B mode ------------------------------------------------------------
+
+  /// Where a shaft's commands arrive (for the log).
+  std::string cmdTopic(const Shaft& s) const {
+    return sp ? sparkplug::deviceTopic(cfg.sp_group_id, "DCMD", cfg.sp_edge_node_id, sparkplug::deviceId(s.name))
+              : s.t_cmd;
+  }
 
   static std::uint64_t nowMs() { return static_cast<std::uint64_t>(hoist::bus::wallUtime() / 1000); }
 
@@ -1151,7 +1157,7 @@ struct Bridge::Impl {
     ++cmd_rejected;
     ++cmd_by_reason[static_cast<int>(why)];
     if (may_log)
-      spdlog::warn("rejected command on {} ({} bytes): {}: {}", s.t_cmd, payloadlen, toString(why), detail);
+      spdlog::warn("rejected command on {} ({} bytes): {}: {}", cmdTopic(s), payloadlen, toString(why), detail);
     answer(s, "refused", toString(why), detail, ack);
   }
 
@@ -1228,7 +1234,7 @@ struct Bridge::Impl {
                                               r.ack.kind.empty() || r.ack.kind == "*" ? std::string("of any kind")
                                                                                       : printable(r.ack.kind, 32),
                                               int(r.ack.level), s.name);
-          spdlog::info("acknowledge on {} from '{}' matches no alarm: {}", s.t_cmd, printable(r.ack.user), why);
+          spdlog::info("acknowledge on {} from '{}' matches no alarm: {}", cmdTopic(s), printable(r.ack.user), why);
           return answer(s, "refused", toString(CommandReject::NoMatchingAlarm), why, cmd);
         }
         note = "no matching alarm known yet (the bridge has not yet heard the daemon re-announce its alarms); "
@@ -1237,14 +1243,14 @@ struct Bridge::Impl {
       const std::string channel = hoist::bus::channel(s.prefix, kChannelAlarmAck);
       if (lcm.publish(channel, &r.ack) != 0) {
         ++cmd_lcm_failures;
-        if (may_log) spdlog::error("command on {}: LCM publish on {} failed", s.t_cmd, channel);
+        if (may_log) spdlog::error("command on {}: LCM publish on {} failed", cmdTopic(s), channel);
         return answer(s, "refused", "lcm_publish_failed", "LCM publish on " + channel + " failed", cmd);
       }
       ++cmd_forwarded;
       ++s.commands;
       answer(s, "accepted", "forwarded", note.empty() ? "forwarded to " + channel : note, cmd);
       if (may_log)
-        spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", s.t_cmd, printable(r.ack.user),
+        spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", cmdTopic(s), printable(r.ack.user),
                      int(r.ack.action), r.ack.kind.empty() ? "*" : printable(r.ack.kind, 32), int(r.ack.level),
                      r.ack.action == hoist::alarm_ack_t::ACTION_SHELVE ? fmt::format(" for {} s", r.ack.shelve_duration)
                                                                        : std::string(),
@@ -1263,7 +1269,9 @@ struct Bridge::Impl {
     next_attempt = Clock::now();
     spdlog::info("hoist-mqtt: LCM {}; broker {}; cage states at {} Hz; commands {}; shafts: {}",
                  hoist::bus::describeLcmUrl(lcm_url), brokerText(), cfg.cage_rate,
-                 cfg.commands ? "accepted on hoist/<shaft>/cmd/ack" : "disabled (--no-commands)",
+                 !cfg.commands ? "disabled (--no-commands)"
+                 : sp          ? "accepted as DCMD writes of Alarms/<KIND>/{Ack,Shelve,Unshelve}"
+                               : "accepted on hoist/<shaft>/cmd/ack",
                  discover ? "discovered from their *HOIST_{HEALTH,CAGE,ALARM} channels" : std::to_string(shafts.size()) + " configured");
     const int lcm_fd = rx ? rx->fd() : lcm.getFileno();
     while (!stop) {

@@ -48,13 +48,17 @@ std::vector<OutMsg> Node::births(const NodeCounters& c, std::uint64_t now_ms) {
   out.push_back(make(nodeTopic(opt_.group, "NBIRTH", opt_.edge), nodeBirth(bd_seq_ < 0 ? 0 : bd_seq_, opt_.version, c, now_ms),
                      MsgClass::Alarm));
   last_counters_ = c;
-  for (auto& d : devices_) out.push_back(deviceBirth(d.shaft, now_ms));
+  for (auto& d : devices_)
+    if (d.active) out.push_back(deviceBirth(d.shaft, now_ms));
   return out;
 }
 
 DeviceMetrics& Node::device(const std::string& shaft_name) {
   for (auto& d : devices_)
-    if (d.shaft == shaft_name) return d.metrics;
+    if (d.shaft == shaft_name) {
+      d.active = true;
+      return d.metrics;
+    }
   const std::uint64_t base = kAliasBlock * (devices_.size() + 1);
   devices_.push_back(Dev{shaft_name, deviceId(shaft_name), DeviceMetrics(base, opt_.deadband, opt_.deadbands)});
   return devices_.back().metrics;
@@ -62,13 +66,18 @@ DeviceMetrics& Node::device(const std::string& shaft_name) {
 
 bool Node::hasDevice(const std::string& shaft_name) const {
   for (const auto& d : devices_)
-    if (d.shaft == shaft_name) return true;
+    if (d.shaft == shaft_name && d.active) return true;
   return false;
+}
+
+void Node::retireDevice(const std::string& shaft_name) {
+  for (auto& d : devices_)
+    if (d.shaft == shaft_name) d.active = false;
 }
 
 std::string Node::shaftOf(const std::string& device_id) const {
   for (const auto& d : devices_)
-    if (d.id == device_id) return d.shaft;
+    if (d.id == device_id && d.active) return d.shaft;
   return {};
 }
 
@@ -100,7 +109,7 @@ std::optional<OutMsg> Node::nodeData(const NodeCounters& c, std::uint64_t now_ms
 void Node::deviceCommands(const std::string& device_id, const Payload& p, std::vector<Command>& out) const {
   const Dev* dev = nullptr;
   for (const auto& d : devices_)
-    if (d.id == device_id) dev = &d;
+    if (d.id == device_id && d.active) dev = &d;
   if (p.metrics.empty()) {
     Command c;
     c.device = device_id;

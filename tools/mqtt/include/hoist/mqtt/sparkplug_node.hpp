@@ -72,6 +72,9 @@ class Node {
   /// The device of a shaft name (created with its alias block on first use).
   DeviceMetrics& device(const std::string& shaft_name);
   bool hasDevice(const std::string& shaft_name) const;
+  /// The shaft is no longer bridged: no DBIRTH for it until device() again
+  /// (its aliases stay reserved for it).
+  void retireDevice(const std::string& shaft_name);
   OutMsg deviceBirth(const std::string& shaft_name, std::uint64_t now_ms);
   OutMsg deviceDeath(const std::string& shaft_name, std::uint64_t now_ms);
   /// DDATA of the metrics of `src` that changed (nullopt: nothing changed).
@@ -102,6 +105,7 @@ class Node {
   struct Dev {
     std::string shaft, id;
     DeviceMetrics metrics;
+    bool active = true;
   };
   std::deque<Dev> devices_;  // in creation order (alias blocks 1000, 2000, ...)
 };
