@@ -376,7 +376,7 @@ TEST(MqttConfig, SparkplugKeys) {
   for (const char* bad : {"Mine", "a/b/c", "/e", "g/", "g+/e"}) EXPECT_THROW(applySparkplugOption(bad, o), std::invalid_argument) << bad;
 }
 
-TEST(MqttSparkplug, PayloadRoundTripAndStamp) {
+TEST(MqttSparkplugCore, PayloadRoundTripAndStamp) {
   if (!sp::available()) GTEST_SKIP() << "built without nanopb";
   sp::DeviceMetrics d(1000, 0.0, {});
   hoist::cage_state_t c{};
@@ -420,7 +420,7 @@ TEST(MqttSparkplug, PayloadRoundTripAndStamp) {
   EXPECT_EQ(sp::stamp(junk, 1, true), junk);
 }
 
-TEST(MqttSparkplug, ReportByExceptionWithDeadband) {
+TEST(MqttSparkplugCore, ReportByExceptionWithDeadband) {
   sp::DeviceMetrics d(2000, 0.0, {{"Cage/Length", 0.5}});
   hoist::cage_state_t c{};
   c.l = 100.0;
@@ -450,7 +450,7 @@ TEST(MqttSparkplug, ReportByExceptionWithDeadband) {
   EXPECT_TRUE(p.metrics[0].value.b);
 }
 
-TEST(MqttSparkplug, NodeClassifiesCommands) {
+TEST(MqttSparkplugCore, NodeClassifiesCommands) {
   if (!sp::available()) GTEST_SKIP() << "built without nanopb";
   sp::Node n({"G", "E", "", "v", 0.0, {}});
   n.device("north");
@@ -510,7 +510,7 @@ TEST(MqttSparkplug, NodeClassifiesCommands) {
   EXPECT_EQ(out[0].reject, CommandReject::BadPayload);
 }
 
-TEST(MqttSparkplug, PrimaryHostState) {
+TEST(MqttSparkplugCore, PrimaryHostState) {
   sp::Node n({"G", "E", "scada", "v", 0.0, {}});
   std::vector<sp::Command> out;
   auto state = [&](const std::string& j) { return n.onMessage("spBv1.0/STATE/scada", j.data(), j.size(), 1024, true, out); };
