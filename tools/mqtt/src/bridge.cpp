@@ -735,6 +735,7 @@ struct Bridge::Impl {
                    cfg.sp_primary_host_id);
       endSparkplugSession();
       lost("the primary host went offline");
+      cb_disconnected = false;  // our own disconnect: not a failure of the next attempt
       next_attempt = Clock::now();
       return;
     }
