@@ -9,7 +9,13 @@
 # the retained alarm states a late SCADA client would get.  Everything it
 # started is stopped at the end (or on Ctrl-C), and the script returns.
 #
-#   scripts/demo-mqtt.sh [--no-setup] [--speed X] [--quick] [--broker-port N] [--port N]
+# With --sparkplug the bridge speaks Sparkplug B instead (edge node Edge1 of
+# group Mine, the shaft as device "default"): the subscriber shows
+# spBv1.0/# (topic, size and the start of the protobuf in hex: NBIRTH,
+# DBIRTH, DDATA), and the acknowledge is a DCMD write to
+# Alarms/CAGE_POS_Y/Ack.
+#
+#   scripts/demo-mqtt.sh [--no-setup] [--speed X] [--quick] [--broker-port N] [--port N] [--sparkplug]
 #
 #   --no-setup       skip scripts/setup.sh (the build must exist)
 #   --speed X        replay speed (default 3: the 60-s trip in 20 s)
@@ -17,9 +23,10 @@
 #   --broker-port N  the private broker's port on 127.0.0.1 (default: a free one);
 #                    exit 2 if N is taken
 #   --port N         UDP port of the private LCM URL (default 7691)
+#   --sparkplug      Sparkplug B mode (hoist-mqtt --sparkplug Mine/Edge1)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-setup=1 speed=3 bport="" port=7691 pause=1.5
+setup=1 speed=3 bport="" port=7691 pause=1.5 sparkplug=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --no-setup) setup=0; shift ;;
@@ -27,7 +34,8 @@ while [[ $# -gt 0 ]]; do
     --quick) speed=30; pause=0.5; shift ;;
     --broker-port) bport="$2"; shift 2 ;;
     --port) port="$2"; shift 2 ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --sparkplug) sparkplug=1; shift ;;
+    -h|--help) sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo-mqtt.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -84,8 +92,32 @@ echo "== started a private mosquitto on 127.0.0.1:$bport (log: $logdir/mosquitto
 echo "== LCM $url; logs in $logdir"
 "$bin/hoist-twind" --config "$here/service/config/demo.toml" --clock input --lcm-url "$url" 2> "$logdir/hoist-twind.log" &
 pids+=($!)
-"$bin/hoist-mqtt" --broker "$broker" --lcm-url "$url" --cage-rate 1 --client-id hoist-mqtt-demo 2> "$logdir/hoist-mqtt.log" &
+spargs=()
+[[ $sparkplug -eq 1 ]] && spargs=(--sparkplug Mine/Edge1)
+"$bin/hoist-mqtt" --broker "$broker" --lcm-url "$url" --cage-rate 1 --client-id hoist-mqtt-demo "${spargs[@]}" \
+  2> "$logdir/hoist-mqtt.log" &
 pids+=($!)
+if [[ $sparkplug -eq 1 ]]; then
+  echo "== mosquitto_sub -t 'spBv1.0/#' -F '%t (%l bytes) %x'  (Sparkplug B: protobuf, shown as hex, cut to 160 characters)"
+  mosquitto_sub -h 127.0.0.1 -p "$bport" -t 'spBv1.0/#' -F '%t (%l bytes) %x' > >(cut -c1-160) &
+  pids+=($!)
+  sleep "$pause"
+  echo "== replay: the paper's trip at speed $speed"
+  "$bin/hoist-replay" --lcm-url "$url" --profile paper --speed "$speed" -q
+  # A Sparkplug payload with one metric: name "Alarms/CAGE_POS_Y/Ack",
+  # datatype Boolean (11), boolean_value true (protobuf written out by hand).
+  name="Alarms/CAGE_POS_Y/Ack"
+  dcmd="$logdir/dcmd.bin"
+  hex() { printf "\\x$(printf %02x "$1")"; }
+  { printf '\x12'; hex $(( ${#name} + 6 )); printf '\x0a'; hex "${#name}"; printf '%s' "$name"; printf '\x20\x0b\x70\x01'; } > "$dcmd"
+  echo "== an operator acknowledges CAGE_POS_Y from a Sparkplug host: DCMD spBv1.0/Mine/DCMD/Edge1/default, Alarms/CAGE_POS_Y/Ack = true"
+  mosquitto_pub -h 127.0.0.1 -p "$bport" -q 1 -t spBv1.0/Mine/DCMD/Edge1/default -f "$dcmd"
+  sleep "$pause"
+  cleanup
+  echo "== bridge log:"
+  cat "$logdir/hoist-mqtt.log"
+  exit 0
+fi
 echo "== mosquitto_sub -v -t 'hoist/#'  (cage states at 1 Hz for the demo; payloads cut to 160 characters)"
 # The subscriber's own pid is kept (not a pipeline's last element), so it is
 # stopped at the end; the cut behind it ends at its EOF.  (A pipeline in the

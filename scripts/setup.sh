@@ -37,6 +37,9 @@ required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev
 dashboard=(nodejs npm chromium fonts-dejavu-core)
 # MQTT bridge (hoist-mqtt): the client library, and the broker, clients and openssl (TLS test) its tests and demo use.
 required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
+# Its Sparkplug B mode: nanopb's generator (runs at build time; pulls protoc
+# and python3-protobuf) and its library.  Without them: no Sparkplug mode.
+required+=(nanopb libnanopb-dev)
 # Java bindings let lcm-spy decode the hoist channels (jchart2d draws its
 # plots; xvfb lets the test open its window headless); clang gives the
 # fuzzers; dpkg-dev gives dpkg-shlibdeps for the .deb (cpack -G DEB);
@@ -95,6 +98,19 @@ if [[ -f "$dash/package-lock.json" ]]; then
     say "npm ci in tools/dash (uPlot, @foxglove/ws-protocol, esbuild, puppeteer-core, ws)"
     (cd "$dash" && npm ci --no-audit --no-fund --loglevel=error) ||
       { say "npm ci failed in $dash"; exit 1; }
+  fi
+fi
+
+# ---- 1c. npm packages of the Sparkplug host of hoist-mqtt's tests -----------
+# (sparkplug-payload, mqtt; exact versions from package-lock.json)
+sphost="$here/tests/mqtt/sparkplug_host"
+if [[ -f "$sphost/package-lock.json" ]] && command -v npm >/dev/null 2>&1; then
+  if [[ -f "$sphost/node_modules/.package-lock.json" && "$sphost/node_modules/.package-lock.json" -nt "$sphost/package-lock.json" ]]; then
+    say "npm packages (tests/mqtt/sparkplug_host): up to date"
+  else
+    say "npm ci in tests/mqtt/sparkplug_host (sparkplug-payload, mqtt)"
+    (cd "$sphost" && npm ci --no-audit --no-fund --loglevel=error) ||
+      say "WARNING: npm ci failed in $sphost: the Sparkplug host tests will be skipped"
   fi
 fi
 

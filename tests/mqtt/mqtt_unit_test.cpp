@@ -194,7 +194,7 @@ TEST(MqttOutbox, DropsOldestCageStatesFirstNeverAlarms) {
   EXPECT_EQ(f.queuedAlarms(), 1u);
   EXPECT_EQ(f.front().payload, "A");
   // Past their own (large) bound alarm transitions are dropped oldest first, and counted.
-  for (int i = 0; i < 7; ++i) f.push({"a", "B" + std::to_string(i), 1, true, MsgClass::Alarm});
+  for (int i = 0; i < 7; ++i) f.push({"a", std::string("B") + std::to_string(i), 1, true, MsgClass::Alarm});
   EXPECT_EQ(f.queuedAlarms(), 5u);
   EXPECT_EQ(f.droppedAlarm(), 3u);
 }
@@ -332,4 +332,195 @@ TEST(MqttConfig, SystemdCredentialsReplaceTheFiles) {
   EXPECT_EQ(resolvePassword(c, "x"), "s3cret");
   ::unsetenv("CREDENTIALS_DIRECTORY");
   std::filesystem::remove_all(dir);
+}
+
+// ---- Sparkplug B mode ----------------------------------------------------------
+
+#include "hoist/mqtt/sparkplug.hpp"
+#include "hoist/mqtt/sparkplug_node.hpp"
+
+namespace sp = hoist::mqtt::sparkplug;
+
+TEST(MqttConfig, SparkplugKeys) {
+  BridgeConfig c;
+  applyBridgeToml("[sparkplug]\nenabled = true\ngroup_id = \"Mine A\"\nedge_node_id = \"edge-1\"\n"
+                  "primary_host_id = \"scada\"\ndeadband = 0.01\n[sparkplug.deadbands]\n\"Cage/Length\" = 0.5\n",
+                  "bridge.toml", c);
+  EXPECT_TRUE(c.sparkplug);
+  EXPECT_EQ(c.sp_group_id, "Mine A");
+  EXPECT_EQ(c.sp_edge_node_id, "edge-1");
+  EXPECT_EQ(c.sp_primary_host_id, "scada");
+  EXPECT_DOUBLE_EQ(c.sp_deadband, 0.01);
+  EXPECT_DOUBLE_EQ(c.sp_deadbands.at("Cage/Length"), 0.5);
+  const std::pair<const char*, const char*> cases[] = {
+      {"[sparkplug]\nenabled = true\nedge_node_id = \"e\"\n", "bridge.toml: sparkplug.group_id: Sparkplug mode needs a group id"},
+      {"[sparkplug]\nenabled = true\ngroup_id = \"g\"\n", "sparkplug.edge_node_id: Sparkplug mode needs an edge node id"},
+      {"[sparkplug]\ngroup_id = \"a/b\"\n", "bridge.toml:2: sparkplug.group_id: 'a/b': may contain only"},
+      {"[sparkplug]\nprimary_host_id = \"h#\"\n", "sparkplug.primary_host_id"},
+      {"[sparkplug]\ndeadband = -1\n", "bridge.toml:2: sparkplug.deadband: must be in [0"},
+      {"[sparkplug.deadbands]\n\"Cage/Lenght\" = 1\n", "sparkplug.deadbands: 'Cage/Lenght' is not a device metric (did you mean 'Cage/Length'?)"},
+      {"[sparkplug.deadbands]\n\"Cage/Degraded\" = 1\n", "is not numeric"},
+      {"[sparkplug.deadbands]\n\"Cage/Length\" = \"x\"\n", "sparkplug.deadbands.Cage/Length: must be a number"},
+      {"[sparkplug]\nenable = true\n", "sparkplug.enable: unknown key (did you mean 'enabled'?)"},
+      {"[sparkplg]\n", "unknown section (did you mean 'sparkplug'?)"},
+  };
+  for (const auto& [toml, expect] : cases) {
+    const std::string msg = configError(toml);
+    EXPECT_NE(msg.find(expect), std::string::npos) << toml << "\nmessage: " << msg;
+  }
+  BridgeConfig o;
+  applySparkplugOption("Mine/Edge1", o);
+  EXPECT_TRUE(o.sparkplug);
+  EXPECT_EQ(o.sp_group_id, "Mine");
+  EXPECT_EQ(o.sp_edge_node_id, "Edge1");
+  for (const char* bad : {"Mine", "a/b/c", "/e", "g/", "g+/e"}) EXPECT_THROW(applySparkplugOption(bad, o), std::invalid_argument) << bad;
+}
+
+TEST(MqttSparkplugCore, PayloadRoundTripAndStamp) {
+  if (!sp::available()) GTEST_SKIP() << "built without nanopb";
+  sp::DeviceMetrics d(1000, 0.0, {});
+  hoist::cage_state_t c{};
+  c.utime = 1'700'000'000'123'000;
+  c.seq = 42;
+  c.l = 123.25;
+  c.alarm_level = -1;  // a negative Int32 survives the uint32 field
+  c.degraded = true;
+  d.onCage(c);
+  const sp::Payload birth = d.birth(5);
+  const std::string bytes = sp::encode(birth);
+  std::string why;
+  auto back = sp::decode(bytes.data(), bytes.size(), 1 << 20, why);
+  ASSERT_TRUE(back) << why;
+  ASSERT_EQ(back->metrics.size(), sp::deviceMetrics().size());
+  std::map<std::string, sp::Metric> by;
+  for (const auto& m : back->metrics) by[m.name] = m;
+  EXPECT_EQ(by["Cage/Length"].value.d, 123.25);
+  EXPECT_EQ(by["Cage/Length"].units, "m");
+  EXPECT_EQ(by["Cage/Length"].timestamp_ms, 1'700'000'000'123u);
+  EXPECT_EQ(by["Cage/Seq"].value.i, 42);
+  EXPECT_EQ(by["Cage/Alarm Level"].value.i, -1);
+  EXPECT_TRUE(by["Cage/Degraded"].value.b);
+  EXPECT_TRUE(by["Estimate/Load Force"].value.is_null);
+  EXPECT_EQ(by["Cage/Length"].alias, d.aliasOf(2));
+  EXPECT_FALSE(back->has_seq && back->seq != 0);
+  // stamp(): seq and is_historical set, the rest unchanged.
+  const std::string st = sp::stamp(bytes, 200, true);
+  auto s2 = sp::decode(st.data(), st.size(), 1 << 20, why);
+  ASSERT_TRUE(s2);
+  EXPECT_TRUE(s2->has_seq);
+  EXPECT_EQ(s2->seq, 200u);
+  for (const auto& m : s2->metrics) EXPECT_TRUE(m.is_historical) << m.name;
+  EXPECT_EQ(s2->metrics.size(), back->metrics.size());
+  // Bad bytes: refused with a reason, never thrown.
+  const std::string junk = "\xff\xff\xff\xff\xff";
+  EXPECT_FALSE(sp::decode(junk.data(), junk.size(), 1024, why));
+  EXPECT_NE(why.find("not a Sparkplug B payload"), std::string::npos);
+  EXPECT_FALSE(sp::decode(bytes.data(), bytes.size(), 100, why));
+  EXPECT_EQ(why.rfind("oversized", 0), 0u);
+  EXPECT_EQ(sp::stamp(junk, 1, true), junk);
+}
+
+TEST(MqttSparkplugCore, ReportByExceptionWithDeadband) {
+  sp::DeviceMetrics d(2000, 0.0, {{"Cage/Length", 0.5}});
+  hoist::cage_state_t c{};
+  c.l = 100.0;
+  c.v = 1.0;
+  d.onCage(c);
+  d.birth(1);
+  EXPECT_TRUE(d.changes(sp::Source::Cage, 2).metrics.empty()) << "nothing changed since the birth";
+  c.l = 100.4;  // within the deadband
+  c.v = 1.5;    // no deadband: any change
+  d.onCage(c);
+  auto p = d.changes(sp::Source::Cage, 3);
+  ASSERT_EQ(p.metrics.size(), 1u);
+  EXPECT_EQ(p.metrics[0].alias, d.aliasOf(3));  // Cage/Velocity, by alias only
+  EXPECT_TRUE(p.metrics[0].name.empty());
+  c.l = 100.6;  // 0.6 from the last reported 100.0
+  d.onCage(c);
+  p = d.changes(sp::Source::Cage, 4);
+  ASSERT_EQ(p.metrics.size(), 1u);
+  EXPECT_EQ(p.metrics[0].value.d, 100.6);
+  EXPECT_TRUE(d.changes(sp::Source::Health, 5).metrics.empty());
+  EXPECT_TRUE(d.setAlarm("CAGE_POS_Y", 1, true, false, false, 7));
+  EXPECT_FALSE(d.setAlarm("NOT_A_KIND", 1, true, false, false, 7));
+  EXPECT_EQ(d.changes(sp::Source::Alarm, 6).metrics.size(), 4u);  // null (born before any alarm) -> values
+  EXPECT_TRUE(d.setAlarm("CAGE_POS_Y", 1, true, true, false, 8));  // acknowledged
+  p = d.changes(sp::Source::Alarm, 7);
+  ASSERT_EQ(p.metrics.size(), 1u);
+  EXPECT_TRUE(p.metrics[0].value.b);
+}
+
+TEST(MqttSparkplugCore, NodeClassifiesCommands) {
+  if (!sp::available()) GTEST_SKIP() << "built without nanopb";
+  sp::Node n({"G", "E", "", "v", 0.0, {}});
+  n.device("north");
+  const auto will1 = n.nextWill();
+  EXPECT_EQ(will1.topic, "spBv1.0/G/NDEATH/E");
+  EXPECT_EQ(n.bdSeq(), 0);
+  n.nextWill();
+  EXPECT_EQ(n.bdSeq(), 1);
+  const auto births = n.births({}, 1);
+  ASSERT_EQ(births.size(), 2u);
+  EXPECT_EQ(births[0].topic, "spBv1.0/G/NBIRTH/E");
+  EXPECT_EQ(births[1].topic, "spBv1.0/G/DBIRTH/E/north");
+  auto cmd = [&](const std::string& topic, std::vector<sp::Metric> ms) {
+    sp::Payload p;
+    p.metrics = std::move(ms);
+    const std::string b = sp::encode(p);
+    std::vector<sp::Command> out;
+    n.onMessage(topic, b.data(), b.size(), 1024, false, out);
+    return out;
+  };
+  auto metric = [](const std::string& name, sp::DataType t, bool b, double d = 0) {
+    sp::Metric m;
+    m.name = name;
+    m.has_type = true;
+    m.type = t;
+    m.value.is_null = false;
+    m.value.b = b;
+    m.value.d = d;
+    return m;
+  };
+  auto r = cmd("spBv1.0/G/DCMD/E/north", {metric("Alarms/CAGE_POS_Y/Ack", sp::DataType::Boolean, true)});
+  ASSERT_EQ(r.size(), 1u);
+  ASSERT_EQ(r[0].what, sp::Command::What::Alarm);
+  // The JSON command the checker of hoist/<shaft>/cmd/ack accepts.
+  const CommandResult ok = parseAckCommand(r[0].json.data(), r[0].json.size(), 1024, 1234567);
+  EXPECT_EQ(ok.reject, CommandReject::None) << ok.detail;
+  EXPECT_EQ(ok.ack.kind, "CAGE_POS_Y");
+  EXPECT_EQ(ok.ack.action, +hoist::alarm_ack_t::ACTION_ACK);
+  r = cmd("spBv1.0/G/DCMD/E/north", {metric("Alarms/CAGE_POS_Y/Shelve", sp::DataType::Double, false, 60.0)});
+  ASSERT_EQ(r[0].what, sp::Command::What::Alarm);
+  EXPECT_EQ(parseAckCommand(r[0].json.data(), r[0].json.size(), 1024, 1).ack.shelve_duration, 60.0);
+  r = cmd("spBv1.0/G/DCMD/E/north", {metric("Cage/Length", sp::DataType::Double, false, 1.0)});
+  EXPECT_EQ(r[0].reject, CommandReject::ReadOnly);
+  r = cmd("spBv1.0/G/DCMD/E/south", {metric("Alarms/CAGE_POS_Y/Ack", sp::DataType::Boolean, true)});
+  EXPECT_EQ(r[0].reject, CommandReject::UnknownMetric);
+  r = cmd("spBv1.0/G/DCMD/E/north", {metric("Alarms/CAGE_POS_Y/Ack", sp::DataType::String, true)});
+  EXPECT_EQ(r[0].reject, CommandReject::BadValue);
+  r = cmd("spBv1.0/G/NCMD/E", {metric("Node Control/Rebirth", sp::DataType::Boolean, true)});
+  EXPECT_EQ(r[0].what, sp::Command::What::Rebirth);
+  r = cmd("spBv1.0/G/NCMD/E", {metric("Node Control/Rebirth", sp::DataType::Boolean, false)});
+  EXPECT_EQ(r[0].reject, CommandReject::BadValue);
+  std::vector<sp::Command> out;
+  EXPECT_EQ(n.onMessage("spBv1.0/Other/NCMD/E", "x", 1, 1024, false, out), sp::Node::Inbound::NotOurs);
+  const std::string junk = "\x0a";
+  n.onMessage("spBv1.0/G/NCMD/E", junk.data(), junk.size(), 1024, false, out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].reject, CommandReject::BadPayload);
+}
+
+TEST(MqttSparkplugCore, PrimaryHostState) {
+  sp::Node n({"G", "E", "scada", "v", 0.0, {}});
+  std::vector<sp::Command> out;
+  auto state = [&](const std::string& j) { return n.onMessage("spBv1.0/STATE/scada", j.data(), j.size(), 1024, true, out); };
+  using In = sp::Node::Inbound;
+  EXPECT_EQ(state(R"({"online": true, "timestamp": 1000})"), In::HostOnline);
+  EXPECT_TRUE(n.hostOnline());
+  EXPECT_EQ(state(R"({"online": false, "timestamp": 999})"), In::StateIgnored) << "older than the online STATE";
+  EXPECT_TRUE(n.hostOnline());
+  EXPECT_EQ(state(R"({"online": false, "timestamp": 1001})"), In::HostOffline);
+  EXPECT_EQ(state("not json"), In::StateIgnored);
+  EXPECT_EQ(state(R"({"online": "yes", "timestamp": 1})"), In::StateIgnored);
+  EXPECT_EQ(n.subscriptions().back(), "spBv1.0/STATE/scada");
 }

@@ -3,7 +3,7 @@
 //
 //   hoist-mqtt --broker mqtt://HOST:PORT [--config FILE] [--no-commands]
 //              [--channel-prefix P]... [--cage-rate HZ] [--client-id ID]
-//              [--lcm-url URL] [-q]
+//              [--lcm-url URL] [--sparkplug GROUP/EDGE] [-q]
 //
 // Exit status: 0 after SIGINT/SIGTERM, 1 if LCM cannot be opened, 2 bad
 // options or configuration.  A broker that is down or goes away is never
@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
                "hoist-mqtt"};
   app.set_version_flag("--version", std::string("hoist-mqtt ") + hoist::kVersionString);
   app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  std::string config_path, broker, client_id, lcm_url;
+  std::string config_path, broker, client_id, lcm_url, sparkplug;
   std::vector<std::string> prefixes;
   bool no_commands = false, quiet = false;
   double cage_rate = 0.0;
@@ -52,6 +52,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-3, 1000.0));
   app.add_option("--client-id", client_id, "MQTT client id (default hoist-mqtt-<hostname>)");
   app.add_option("--lcm-url", lcm_url, "LCM URL; default: $LCM_DEFAULT_URL, else [bridge] lcm_url, else LCM's default");
+  app.add_option("--sparkplug", sparkplug,
+                 "Sparkplug B mode as edge node EDGE of group GROUP (spBv1.0/GROUP/...; each shaft is a device) "
+                 "instead of the JSON topics; or [sparkplug] in the configuration (docs/mqtt.md)");
   app.add_flag("-q,--quiet", quiet, "log warnings and errors only");
   try {
     app.parse(argc, argv);
@@ -74,6 +77,14 @@ int main(int argc, char** argv) {
     if (no_commands) cfg.commands = false;
     if (cage_rate > 0.0) cfg.cage_rate = cage_rate;
     if (!lcm_url.empty()) cfg.lcm_url = lcm_url;
+    if (!sparkplug.empty()) {
+      try {
+        hoist::mqtt::applySparkplugOption(sparkplug, cfg);
+      } catch (const std::invalid_argument& e) {
+        std::cerr << "hoist-mqtt: " << e.what() << "\n";
+        return 2;
+      }
+    }
     // systemd credentials (LoadCredential=, hoist-mqtt@.service): a non-empty
     // mqtt-password / mqtt-tls-key in $CREDENTIALS_DIRECTORY replaces
     // [broker] password_file / [tls] key_file, so those files can stay

@@ -33,6 +33,9 @@
 #include "hoist/mqtt/command.hpp"
 #include "hoist/mqtt/journal.hpp"
 #include "hoist/mqtt/outbox.hpp"
+#include "hoist/mqtt/sparkplug.hpp"
+#include "hoist/mqtt/sparkplug_node.hpp"
+#include "hoist/version.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/rt/log_rate_limiter.hpp"
 
@@ -118,6 +121,7 @@ struct Bridge::Impl {
     int streak = 0;                // health messages of streak_instance, gaps <= discovery_timeout
     bool refused = false;          // confirmed-quality but no slot (table full) or its name is taken
     bool cage_new = false;
+    bool alarms_settled = false;   // Sparkplug: alarm kinds never heard of are known inactive
     hoist::cage_state_t cage{};
     bool estimate_new = false;  // like the cage: the latest estimate at [bridge] cage_rate
     hoist::estimate_t estimate{};
@@ -171,6 +175,12 @@ struct Bridge::Impl {
   std::set<std::string> journaled_alarm_topics;  // alarm states waiting in the journal (no republish needed)
   std::uint64_t journal_replayed = 0, journal_fallback = 0, journal_prepended = 0;
   std::uint64_t journal_alarm_drops_seen = 0;
+  // ---- Sparkplug B mode ([sparkplug] enabled; hoist/mqtt/sparkplug_node.hpp) ----
+  // The JSON topics are not used then (the bridge's own health topic stays).
+  std::unique_ptr<sparkplug::Node> sp;
+  bool sp_session = false;          // births sent on this connection: live data may go out
+  Clock::time_point sp_births_at{};  // messages queued before it are history (is_historical)
+  std::uint64_t sp_births = 0, sp_rebirths = 0, sp_host_offline = 0;
 
   // ---- counters ----------------------------------------------------------------
   Clock::time_point started = Clock::now();
@@ -210,6 +220,17 @@ struct Bridge::Impl {
     status_topic = "hoist/_bridge/" + client_id + "/status";
     bridge_health_topic = "hoist/_bridge/" + client_id + "/health";
 
+    if (cfg.sparkplug) {
+      if (!sparkplug::available()) throw std::runtime_error(sparkplugMissing());
+      sparkplug::NodeOptions o;
+      o.group = cfg.sp_group_id;
+      o.edge = cfg.sp_edge_node_id;
+      o.primary_host = cfg.sp_primary_host_id;
+      o.version = std::string("hoist-mqtt ") + hoist::kVersionString;
+      o.deadband = cfg.sp_deadband;
+      o.deadbands = cfg.sp_deadbands;
+      sp = std::make_unique<sparkplug::Node>(o);
+    }
     discover = cfg.channel_prefixes.empty();
     for (const auto& p : cfg.channel_prefixes) addShaft(p, true);
     std::string why;
@@ -237,8 +258,12 @@ struct Bridge::Impl {
     mosq = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
     if (!mosq) throw std::runtime_error("mosquitto_new failed: " + std::string(std::strerror(errno)));
     mosquitto_int_option(mosq, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V311);
-    const std::string will = json{{"online", false}, {"client_id", client_id}, {"reason", "connection lost (last will)"}}.dump();
-    check(mosquitto_will_set(mosq, status_topic.c_str(), static_cast<int>(will.size()), will.data(), 1, true), "will");
+    if (!sp) {  // Sparkplug: the will (NDEATH) is set before each connection
+      const std::string will =
+          json{{"online", false}, {"client_id", client_id}, {"reason", "connection lost (last will)"}}.dump();
+      check(mosquitto_will_set(mosq, status_topic.c_str(), static_cast<int>(will.size()), will.data(), 1, true),
+            "will");
+    }
     if (!cfg.username.empty())
       check(mosquitto_username_pw_set(mosq, cfg.username.c_str(), password.empty() ? nullptr : password.c_str()),
             "username/password");
@@ -297,6 +322,11 @@ struct Bridge::Impl {
     if (mosq) mosquitto_destroy(mosq);
   }
 
+  static std::string sparkplugMissing() {
+    return "[sparkplug] enabled, but this hoist-mqtt was built without nanopb (apt-get install nanopb "
+           "libnanopb-dev, then rebuild)";
+  }
+
   void check(int rc, const char* what) {
     if (rc != MOSQ_ERR_SUCCESS)
       throw std::runtime_error(std::string("libmosquitto refused ") + what + ": " + mosquitto_strerror(rc));
@@ -341,11 +371,23 @@ struct Bridge::Impl {
     bound[s.name] = s.prefix;
     cmd_topics[s.t_cmd] = s.prefix;
     const std::string base = "hoist/" + s.name + "/";
-    spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST,ESTIMATE}} -> "
-                 "{}{{cage,health,alarm/<KIND>,forecast,estimate}}{}{}",
-                 s.name, s.prefix, base,
-                 cfg.commands ? ", " + s.t_cmd + " -> " + hoist::bus::channel(s.prefix, kChannelAlarmAck) : "",
-                 s.configured ? "" : fmt::format(" (discovered: daemon instance {})", s.streak_instance));
+    if (sp)
+      spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST,ESTIMATE}} -> Sparkplug device "
+                   "spBv1.0/{}/{{DBIRTH,DDATA,DCMD}}/{}/{}{}",
+                   s.name, s.prefix, cfg.sp_group_id, cfg.sp_edge_node_id, sparkplug::deviceId(s.name),
+                   s.configured ? "" : fmt::format(" (discovered: daemon instance {})", s.streak_instance));
+    else  // the JSON topics
+      spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST,ESTIMATE}} -> "
+                   "{}{{cage,health,alarm/<KIND>,forecast,estimate}}{}{}",
+                   s.name, s.prefix, base,
+                   cfg.commands ? ", " + s.t_cmd + " -> " + hoist::bus::channel(s.prefix, kChannelAlarmAck) : "",
+                   s.configured ? "" : fmt::format(" (discovered: daemon instance {})", s.streak_instance));
+    if (sp) {
+      sparkplug::DeviceMetrics& d = sp->device(s.name);
+      for (const auto& [kind, a] : s.alarms) setAlarmMetrics(d, kind, a);
+      if (sp_session) sendOne(sp->deviceBirth(s.name, nowMs()), false);  // a new device after the NBIRTH
+      return;
+    }
     if (conn == Conn::Connected) subscribeCommands(s);
     for (const auto& [kind, a] : s.alarms) publishAlarmState(s, kind, a);
   }
@@ -416,6 +458,8 @@ struct Bridge::Impl {
     auto it = shafts.find(prefix);
     if (it == shafts.end()) return;
     if (it->second.bound) {
+      if (sp && sp_session) sendOne(sp->deviceDeath(it->second.name, nowMs()), false);
+      if (sp) sp->retireDevice(it->second.name);
       bound.erase(it->second.name);
       cmd_topics.erase(it->second.t_cmd);
       if (conn == Conn::Connected && it->second.subscribed)
@@ -495,6 +539,10 @@ struct Bridge::Impl {
     if (!s.bound) return tryConfirm(s, now);
     if (s.instance_id != 0 && m.instance_id != s.instance_id) daemonRestarted(s, m);
     s.instance_id = m.instance_id;
+    if (sp) {
+      sp->device(s.name).onHealth(m);
+      return sparkplugData(s, sparkplug::Source::Health, MsgClass::Health);
+    }
     publish({s.t_health, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
   }
 
@@ -555,7 +603,12 @@ struct Bridge::Impl {
         const auto st = hoist::msg::checkedDecode(rb->data, rb->data_size, m);
         if (st != hoist::msg::DecodeStatus::ok) return decodeError("forecast_t", st, channel);
         ++s->forecasts_in;
-        if (s->bound) publish({s->t_forecast, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
+        if (s->bound && sp) {
+          sp->device(s->name).onForecast(m);
+          sparkplugData(*s, sparkplug::Source::Forecast, MsgClass::Health);
+        } else if (s->bound) {
+          publish({s->t_forecast, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
+        }
       } else if (ends(kChannelEstimate)) {
         // The load estimate, at the cage rate; sent like the cage
         // state (the latest one at [bridge] cage_rate, QoS 0, not retained).
@@ -639,14 +692,165 @@ struct Bridge::Impl {
   }
 
   void publishAlarmState(const Shaft& s, const std::string& kind, const AlarmState& a) {
+    if (sp) {
+      setAlarmMetrics(sp->device(s.name), kind, a);
+      return sparkplugData(s, sparkplug::Source::Alarm, MsgClass::Alarm);
+    }
     publish({s.t_alarm + kind, alarmStateJson(s, kind, a).dump(), 1, true, MsgClass::Alarm});
+  }
+
+  // ---- Sparkplug B mode ------------------------------------------------------------
+
+  /// Where a shaft's commands arrive (for the log).
+  std::string cmdTopic(const Shaft& s) const {
+    return sp ? sparkplug::deviceTopic(cfg.sp_group_id, "DCMD", cfg.sp_edge_node_id, sparkplug::deviceId(s.name))
+              : s.t_cmd;
+  }
+
+  static std::uint64_t nowMs() { return static_cast<std::uint64_t>(hoist::bus::wallUtime() / 1000); }
+
+  /// The kind's state as the JSON mode's alarm topic gives it: level = the
+  /// highest active, unshelved level; acked = active and nothing unacknowledged.
+  void setAlarmMetrics(sparkplug::DeviceMetrics& d, const std::string& kind, const AlarmState& a) {
+    int level = 0;
+    bool unacked = false, shelved = false;
+    for (int lv = 1; lv <= 2; ++lv) {
+      const auto& e = a.by_level[lv];
+      if (!e) continue;
+      if (e->active && !e->shelved) level = lv;
+      unacked = unacked || (e->active && !e->acked && !e->shelved);
+      shelved = shelved || e->shelved;
+    }
+    d.setAlarm(kind, level, level > 0, level > 0 && !unacked, shelved, a.last.utime);
+  }
+
+  /// DDATA with the shaft's metrics of `src` that changed (report by exception).
+  void sparkplugData(const Shaft& s, sparkplug::Source src, MsgClass cls) {
+    if (auto m = sp->deviceData(s.name, src, cls, nowMs())) publish(std::move(*m));
+  }
+
+  /// Alarm kinds without any event since the shaft was bridged are inactive
+  /// once the daemon has had [bridge] alarm_sync_time to re-announce (null until then).
+  void settleAlarms(Clock::time_point now) {
+    for (auto& [p, s] : shafts)
+      if (s.bound && !s.alarms_settled && seconds(now - s.bound_since) >= cfg.alarm_sync_time) {
+        s.alarms_settled = true;
+        sp->device(s.name).alarmsSettled(hoist::bus::wallUtime());
+        sparkplugData(s, sparkplug::Source::Alarm, MsgClass::Alarm);
+      }
+  }
+
+  sparkplug::NodeCounters nodeCounters() const {
+    std::uint64_t dec = 0;
+    for (const auto& [k, n] : decode_errors) dec += n;
+    return {static_cast<std::int64_t>(cmd_received), static_cast<std::int64_t>(cmd_forwarded),
+            static_cast<std::int64_t>(cmd_rejected), static_cast<std::int64_t>(dec)};
+  }
+
+  /// NBIRTH (seq 0) and every DBIRTH, then what was buffered (as history).
+  void sparkplugBirths() {
+    sp->resetSeq();
+    sp_births_at = Clock::now();
+    for (const auto& m : sp->births(nodeCounters(), nowMs())) sendOne(m, false);
+    sp_session = true;
+    ++sp_births;
+    spdlog::info("Sparkplug: NBIRTH and {} DBIRTH on spBv1.0/{} as edge node '{}' (bdSeq {}){}", bound.size(),
+                 cfg.sp_group_id, cfg.sp_edge_node_id, sp->bdSeq(),
+                 outbox.empty() ? std::string() : fmt::format("; then {} buffered messages", outbox.size()));
+  }
+
+  void onSparkplugMessage(const struct mosquitto_message* m) {
+    std::vector<sparkplug::Command> cmds;
+    const auto in = sp->onMessage(m->topic, m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
+                                  static_cast<std::size_t>(cfg.max_command_bytes), m->retain, cmds);
+    using In = sparkplug::Node::Inbound;
+    if (in == In::HostOnline) {
+      if (!sp_session) {
+        spdlog::info("Sparkplug: primary host '{}' is online", cfg.sp_primary_host_id);
+        sparkplugBirths();
+        flushJournal();  // history first (the journal, then the memory buffer), then live data
+        flushOutbox();
+      }
+      return;
+    }
+    if (in == In::HostOffline) {
+      ++sp_host_offline;
+      if (!sp_session) return;
+      // Sparkplug 3.0: end the session (NDEATH, disconnect) and start over; meanwhile, store.
+      spdlog::warn("Sparkplug: primary host '{}' went offline: NDEATH, reconnecting and storing until it is back",
+                   cfg.sp_primary_host_id);
+      endSparkplugSession();
+      lost("the primary host went offline");
+      cb_disconnected = false;  // our own disconnect: not a failure of the next attempt
+      next_attempt = Clock::now();
+      return;
+    }
+    if (in != In::Commands) return;
+    const auto now = Clock::now();
+    for (const auto& c : cmds) {
+      ++cmd_received;
+      std::int64_t suppressed = 0;
+      const bool may_log = log_limit.allow(kCmdLog, sinceStart(now), suppressed);
+      if (c.what == sparkplug::Command::What::Rebirth) {
+        ++sp_rebirths;
+        ++cmd_forwarded;
+        if (may_log) spdlog::info("Sparkplug: rebirth requested (NCMD)");
+        if (sp_session) sparkplugBirths();
+        continue;
+      }
+      const std::string shaft = sp->shaftOf(c.device);
+      auto b = bound.find(shaft);
+      Shaft* s = b == bound.end() ? nullptr : &shafts.at(b->second);
+      if (c.what == sparkplug::Command::What::Refused) {
+        refuseSp(s, c.reject, c.detail, m->topic, may_log);
+        continue;
+      }
+      if (!s) {
+        refuseSp(nullptr, CommandReject::UnknownMetric, "no shaft '" + printable(c.device) + "'", m->topic, may_log);
+        continue;
+      }
+      if (!cfg.commands) {
+        refuseSp(s, CommandReject::Disabled, "alarm commands are off (--no-commands)", m->topic, may_log);
+        continue;
+      }
+      // The same checker as hoist/<shaft>/cmd/ack.
+      CommandResult r = parseAckCommand(c.json.data(), c.json.size(), static_cast<std::size_t>(cfg.max_command_bytes),
+                                        hoist::bus::wallUtime(), cfg.max_command_age);
+      if (r.reject != CommandReject::None) {
+        refuseSp(s, r.reject, r.detail, m->topic, may_log);
+        continue;
+      }
+      executeCommand(*s, r, m->payloadlen, may_log, now);
+    }
+  }
+
+  void refuseSp(Shaft* s, CommandReject why, const std::string& detail, const char* topic, bool may_log) {
+    if (s) return refuse(*s, why, detail, 0, may_log);
+    ++cmd_rejected;
+    ++cmd_by_reason[static_cast<int>(why)];
+    if (may_log) spdlog::warn("rejected command on {}: {}: {}", topic, toString(why), detail);
+  }
+
+  /// NDEATH before an intended disconnect (MQTT 3.1.1: the broker does not send the will then).
+  void endSparkplugSession() {
+    if (conn == Conn::Connected) {
+      const OutMsg d = sp->death();
+      mosquitto_publish(mosq, nullptr, d.topic.c_str(), static_cast<int>(d.payload.size()), d.payload.data(), d.qos,
+                        d.retain);
+      const auto end = Clock::now() + std::chrono::milliseconds(300);
+      while (Clock::now() < end && mosquitto_want_write(mosq) && mosquitto_loop(mosq, 10, 1) == MOSQ_ERR_SUCCESS) {
+      }
+      mosquitto_disconnect(mosq);
+    }
+    sp_session = false;
   }
 
   // ---- MQTT side: publishing -----------------------------------------------------
 
-  /// Live data may go out now (connected; the Sparkplug mode adds: its
-  /// primary host is online).
-  bool liveReady() const { return conn == Conn::Connected; }
+  /// Live data may go out now: connected and, in Sparkplug mode, the births
+  /// are out (with a primary host: once its STATE said online).
+  bool liveReady() const { return conn == Conn::Connected && (!sp || sp_session); }
+  bool sessionReady() const { return liveReady(); }
 
   /// Publishes now if connected and nothing is waiting, else buffers
   /// (bounded): in the journal with store-and-forward, else in memory.
@@ -660,7 +864,7 @@ struct Bridge::Impl {
         return;
       return store(std::move(m));
     }
-    if (conn == Conn::Connected && outbox.empty() && !mosquitto_want_write(mosq)) {
+    if (liveReady() && outbox.empty() && !mosquitto_want_write(mosq)) {
       if (sendOne(m, false)) return;
     }
     outbox.push(std::move(m));
@@ -698,11 +902,16 @@ struct Bridge::Impl {
   /// The one send function: true if handed to libmosquitto.  `historical`:
   /// a message replayed from the journal (JSON: sent as stored, its payload
   /// carries its own utime).
+  ///
+  /// A Sparkplug message gets the node's next seq (and, if `historical`,
+  /// is_historical on every metric) now, when it is sent.
   bool sendOne(const OutMsg& m, bool historical) {
-    (void)historical;
+    std::string stamped;
+    if (m.sparkplug) stamped = sparkplug::stamp(m.payload, sp ? sp->nextSeq() : 0, historical);
+    const std::string& payload = m.sparkplug ? stamped : m.payload;
     int mid = 0;
-    const int rc = mosquitto_publish(mosq, &mid, m.topic.c_str(), static_cast<int>(m.payload.size()),
-                                     m.payload.data(), m.qos, m.retain);
+    const int rc = mosquitto_publish(mosq, &mid, m.topic.c_str(), static_cast<int>(payload.size()),
+                                     payload.data(), m.qos, m.retain);
     if (rc == MOSQ_ERR_SUCCESS) {
       ++published;
       if (journal && m.qos > 0 && m.topic != status_topic) inflight.push_back({mid, m});
@@ -718,8 +927,13 @@ struct Bridge::Impl {
   /// transitions and the rest are sent as they are.
   void flushOutbox() {
     const auto now = Clock::now();
-    while (conn == Conn::Connected && !outbox.empty() && !mosquitto_want_write(mosq)) {
+    while (sessionReady() && !outbox.empty() && !mosquitto_want_write(mosq)) {
       const OutMsg& m = outbox.front();
+      if (m.sparkplug) {  // queued before this session's births: history
+        if (!sendOne(m, m.queued < sp_births_at)) return;
+        outbox.pop();
+        continue;
+      }
       if (m.cls == MsgClass::Cage && seconds(now - m.queued) > cfg.stale_after) {
         if (cfg.drop_stale) {
           ++stale_dropped;
@@ -746,12 +960,22 @@ struct Bridge::Impl {
       if (!s.cage_new || !s.bound) continue;
       s.cage_new = false;
       ++s.cage_out;
+      if (sp) {
+        sp->device(s.name).onCage(s.cage);
+        sparkplugData(s, sparkplug::Source::Cage, MsgClass::Cage);
+        continue;
+      }
       publish({s.t_cage, hoist::msg::toJson(s.cage).dump(), 0, false, MsgClass::Cage});
     }
     for (auto& [p, s] : shafts) {
       if (!s.estimate_new || !s.bound) continue;
       s.estimate_new = false;
       ++s.estimates_out;
+      if (sp) {
+        sp->device(s.name).onEstimate(s.estimate);
+        sparkplugData(s, sparkplug::Source::Estimate, MsgClass::Cage);
+        continue;
+      }
       publish({s.t_estimate, hoist::msg::toJson(s.estimate).dump(), 0, false, MsgClass::Cage});
     }
   }
@@ -786,6 +1010,16 @@ struct Bridge::Impl {
                 {"alarm_rejected", alarm_rejected},
                 {"ignored_channels", ignored_channels}};
     j["mqtt"] = {{"published", published}, {"publish_errors", publish_errors}};
+    if (sp)
+      j["sparkplug"] = {{"group_id", cfg.sp_group_id},
+                        {"edge_node_id", cfg.sp_edge_node_id},
+                        {"primary_host_id", cfg.sp_primary_host_id},
+                        {"host_online", sp->waitsForHost() ? sp->hostOnline() : true},
+                        {"session", sp_session},
+                        {"bdseq", sp->bdSeq()},
+                        {"births", sp_births},
+                        {"rebirths", sp_rebirths},
+                        {"host_offline", sp_host_offline}};
     j["stale_cage"] = {{"marked", stale_marked}, {"dropped", stale_dropped}};
     if (journal)
       j["journal"] = {{"path", journal->path()},
@@ -880,6 +1114,12 @@ struct Bridge::Impl {
     if (!failing && connects == 0 && connect_failures == 0)
       spdlog::info("connecting to the broker at {} as '{}'{}", brokerText(), client_id,
                    cfg.wantsTls() ? " (TLS)" : "");
+    if (sp) {  // NDEATH with the next bdSeq is this connection's will
+      const OutMsg will = sp->nextWill();
+      check(mosquitto_will_set(mosq, will.topic.c_str(), static_cast<int>(will.payload.size()), will.payload.data(),
+                               will.qos, will.retain),
+            "will (NDEATH)");
+    }
     errno = 0;
     const int rc = mosquitto_connect_async(mosq, broker.host.c_str(), broker.port, cfg.keepalive);
     if (rc == MOSQ_ERR_SUCCESS) {
@@ -910,6 +1150,7 @@ struct Bridge::Impl {
     ++disconnects;
     last_error = why;
     conn = Conn::Disconnected;
+    sp_session = false;
     for (auto& [p, s] : shafts) s.subscribed = false;
     if (journal)
       spdlog::warn("connection to the broker at {} lost: {}; reconnecting with backoff up to {} s, storing in the "
@@ -942,6 +1183,21 @@ struct Bridge::Impl {
     connected_since_utime = hoist::bus::wallUtime();
     spdlog::info("connected to the broker at {} as '{}'{}", brokerText(), client_id,
                  outbox.empty() ? std::string() : fmt::format("; sending {} buffered messages", outbox.size()));
+    if (sp) {
+      for (const auto& t : sp->subscriptions())
+        if (const int rc = mosquitto_subscribe(mosq, nullptr, t.c_str(), 1); rc != MOSQ_ERR_SUCCESS)
+          spdlog::warn("cannot subscribe to {}: {}", t, mosquitto_strerror(rc));
+      if (sp->waitsForHost())
+        spdlog::info("Sparkplug: waiting for the primary host '{}' (spBv1.0/STATE/{} online) before the births; "
+                     "storing until then",
+                     cfg.sp_primary_host_id, cfg.sp_primary_host_id);
+      else
+        sparkplugBirths();
+      flushJournal();
+      flushOutbox();
+      publishBridgeHealth();
+      return;
+    }
     const std::string online =
         json{{"online", true}, {"client_id", client_id}, {"since_utime", connected_since_utime}}.dump();
     sendOne({status_topic, online, 1, true, MsgClass::Alarm}, false);
@@ -1008,6 +1264,7 @@ struct Bridge::Impl {
   /// The command's answer on hoist/<shaft>/cmd/result (QoS 1, not retained).
   void answer(Shaft& s, const char* result, const char* reason, const std::string& detail,
               const hoist::alarm_ack_t* ack) {
+    if (sp) return;  // Sparkplug has no answer topic: counted (bridge health, NDATA Bridge/Commands ...)
     if (!result_budget.take(Clock::now(), 20.0, 50.0)) return void(++results_dropped);
     json j = json::object();
     j["utime"] = hoist::bus::wallUtime();
@@ -1032,7 +1289,7 @@ struct Bridge::Impl {
     ++cmd_rejected;
     ++cmd_by_reason[static_cast<int>(why)];
     if (may_log)
-      spdlog::warn("rejected command on {} ({} bytes): {}: {}", s.t_cmd, payloadlen, toString(why), detail);
+      spdlog::warn("rejected command on {} ({} bytes): {}: {}", cmdTopic(s), payloadlen, toString(why), detail);
     answer(s, "refused", toString(why), detail, ack);
   }
 
@@ -1051,6 +1308,7 @@ struct Bridge::Impl {
   void onMqttMessage(const struct mosquitto_message* m) {
     try {
       if (!m || !m->topic) return;
+      if (sp) return onSparkplugMessage(m);
       auto it = cmd_topics.find(m->topic);
       if (it == cmd_topics.end() || !cfg.commands) return;
       Shaft& s = shafts.at(it->second);
@@ -1073,18 +1331,28 @@ struct Bridge::Impl {
                                         static_cast<std::size_t>(cfg.max_command_bytes), hoist::bus::wallUtime(),
                                         cfg.max_command_age);
       if (r.reject != CommandReject::None) return refuse(s, r.reject, r.detail, m->payloadlen, may_log);
+      executeCommand(s, r, m->payloadlen, may_log, now);
+    } catch (const std::exception& e) {
+      spdlog::error("error handling an MQTT message: {}", e.what());
+    }
+  }
+
+  /// A command that passed the checker (parseAckCommand): shaft conflicts,
+  /// rate limit, a matching alarm, then HOIST_ALARM_ACK on LCM.  Both modes.
+  void executeCommand(Shaft& s, const CommandResult& r, int payloadlen, bool may_log, Clock::time_point now) {
+    {
       const hoist::alarm_ack_t* cmd = &r.ack;
       for (const auto& rp : rivals(s))
         if (const Shaft& o = shafts.at(rp); o.refused && !silent(o, now))
           return refuse(s, CommandReject::AmbiguousShaft,
                         fmt::format("shaft '{}' is claimed by LCM prefixes '{}' and '{}'", s.name, printable(s.prefix),
                                     printable(rp)),
-                        m->payloadlen, may_log, cmd);
+                        payloadlen, may_log, cmd);
       if (!rateAllows(s, r.ack.user, now))
         return refuse(s, CommandReject::RateLimited,
                       fmt::format("user '{}' over {} commands/s (burst {}) on shaft '{}'", printable(r.ack.user),
                                   cfg.command_rate, cfg.command_burst, s.name),
-                      m->payloadlen, may_log, cmd);
+                      payloadlen, may_log, cmd);
       // An acknowledge for no alarm: answered (the daemon would do nothing).
       // Until the daemon has re-announced its active alarms since the shaft
       // was bridged, the bridge's view may be incomplete: forwarded then.
@@ -1098,7 +1366,7 @@ struct Bridge::Impl {
                                               r.ack.kind.empty() || r.ack.kind == "*" ? std::string("of any kind")
                                                                                       : printable(r.ack.kind, 32),
                                               int(r.ack.level), s.name);
-          spdlog::info("acknowledge on {} from '{}' matches no alarm: {}", s.t_cmd, printable(r.ack.user), why);
+          spdlog::info("acknowledge on {} from '{}' matches no alarm: {}", cmdTopic(s), printable(r.ack.user), why);
           return answer(s, "refused", toString(CommandReject::NoMatchingAlarm), why, cmd);
         }
         note = "no matching alarm known yet (the bridge has not yet heard the daemon re-announce its alarms); "
@@ -1107,20 +1375,18 @@ struct Bridge::Impl {
       const std::string channel = hoist::bus::channel(s.prefix, kChannelAlarmAck);
       if (lcm.publish(channel, &r.ack) != 0) {
         ++cmd_lcm_failures;
-        if (may_log) spdlog::error("command on {}: LCM publish on {} failed", s.t_cmd, channel);
+        if (may_log) spdlog::error("command on {}: LCM publish on {} failed", cmdTopic(s), channel);
         return answer(s, "refused", "lcm_publish_failed", "LCM publish on " + channel + " failed", cmd);
       }
       ++cmd_forwarded;
       ++s.commands;
       answer(s, "accepted", "forwarded", note.empty() ? "forwarded to " + channel : note, cmd);
       if (may_log)
-        spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", s.t_cmd, printable(r.ack.user),
+        spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", cmdTopic(s), printable(r.ack.user),
                      int(r.ack.action), r.ack.kind.empty() ? "*" : printable(r.ack.kind, 32), int(r.ack.level),
                      r.ack.action == hoist::alarm_ack_t::ACTION_SHELVE ? fmt::format(" for {} s", r.ack.shelve_duration)
                                                                        : std::string(),
                      channel);
-    } catch (const std::exception& e) {
-      spdlog::error("error handling an MQTT message: {}", e.what());
     }
   }
 
@@ -1135,7 +1401,9 @@ struct Bridge::Impl {
     next_attempt = Clock::now();
     spdlog::info("hoist-mqtt: LCM {}; broker {}; cage states at {} Hz; commands {}; shafts: {}",
                  hoist::bus::describeLcmUrl(lcm_url), brokerText(), cfg.cage_rate,
-                 cfg.commands ? "accepted on hoist/<shaft>/cmd/ack" : "disabled (--no-commands)",
+                 !cfg.commands ? "disabled (--no-commands)"
+                 : sp          ? "accepted as DCMD writes of Alarms/<KIND>/{Ack,Shelve,Unshelve}"
+                               : "accepted on hoist/<shaft>/cmd/ack",
                  discover ? "discovered from their *HOIST_{HEALTH,CAGE,ALARM} channels" : std::to_string(shafts.size()) + " configured");
     const int lcm_fd = rx ? rx->fd() : lcm.getFileno();
     while (!stop) {
@@ -1192,6 +1460,9 @@ struct Bridge::Impl {
         if (next_cage < now) next_cage = now + cage_period;
       }
       if (now >= next_health) {
+        if (sp && sp_session)
+          if (auto m = sp->nodeData(nodeCounters(), nowMs())) publish(std::move(*m));
+        if (sp) settleAlarms(now);
         publishBridgeHealth();
         next_health += health_period;
         if (next_health < now) next_health = now + health_period;
@@ -1199,7 +1470,10 @@ struct Bridge::Impl {
     }
 
     spdlog::info("hoist-mqtt: stopping");
-    if (conn == Conn::Connected) {
+    if (sp) {
+      endSparkplugSession();
+      mosquitto_loop(mosq, 10, 1);
+    } else if (conn == Conn::Connected) {
       const std::string offline = json{{"online", false}, {"client_id", client_id}, {"reason", "shutdown"}}.dump();
       mosquitto_publish(mosq, nullptr, status_topic.c_str(), static_cast<int>(offline.size()), offline.data(), 1, true);
       // Give the last messages a moment to leave, then disconnect cleanly (no LWT).

@@ -31,6 +31,11 @@ const char* toString(CommandReject r) {
     case CommandReject::RateLimited: return "rate_limited";
     case CommandReject::NoMatchingAlarm: return "no_matching_alarm";
     case CommandReject::AmbiguousShaft: return "ambiguous_shaft";
+    case CommandReject::BadPayload: return "bad_payload";
+    case CommandReject::UnknownMetric: return "unknown_metric";
+    case CommandReject::ReadOnly: return "read_only";
+    case CommandReject::BadValue: return "bad_value";
+    case CommandReject::Disabled: return "disabled";
   }
   return "?";
 }

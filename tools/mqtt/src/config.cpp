@@ -5,8 +5,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <functional>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -14,6 +12,9 @@
 
 #include "hoist/io/config.hpp"
 #include "hoist/io/error.hpp"
+#include "hoist/io/toml_section.hpp"
+#include "hoist/mqtt/command.hpp"
+#include "hoist/mqtt/sparkplug_metrics.hpp"
 
 namespace hoist::mqtt {
 
@@ -154,153 +155,152 @@ void BridgeConfig::validate() const {
   if (journal_max_bytes < 65536 || journal_max_bytes > 1000000000000ull)
     bad("buffer.max_bytes", std::to_string(journal_max_bytes) + " is outside 65536..1e12");
   range("buffer.fsync_interval", fsync_interval, 0.0, 3600.0);
+  if (sparkplug) {
+    if (sp_group_id.empty()) bad("sparkplug.group_id", "Sparkplug mode needs a group id (or --sparkplug GROUP/EDGE)");
+    if (sp_edge_node_id.empty())
+      bad("sparkplug.edge_node_id", "Sparkplug mode needs an edge node id (or --sparkplug GROUP/EDGE)");
+  }
+  for (const auto& [key, id] : {std::pair<const char*, const std::string*>{"sparkplug.group_id", &sp_group_id},
+                                {"sparkplug.edge_node_id", &sp_edge_node_id},
+                                {"sparkplug.primary_host_id", &sp_primary_host_id}})
+    if (!id->empty())
+      if (const std::string why = checkSparkplugId(*id); !why.empty()) bad(key, "'" + printable(*id) + "': " + why);
+  range("sparkplug.deadband", sp_deadband, 0.0, 1e12);
+  for (const auto& [name, db] : sp_deadbands) {
+    const sparkplug::MetricDef* d = sparkplug::findDeviceMetric(name);
+    if (!d) {
+      bad("sparkplug.deadbands", "'" + printable(name) + "' is not a device metric" +
+                                     hoist::io::didYouMean(name, sparkplug::deviceMetricNames()));
+    }
+    if (!sparkplug::isNumeric(d->type))
+      bad("sparkplug.deadbands", "'" + name + "' is not numeric (a deadband applies to numbers only)");
+    if (!std::isfinite(db) || db < 0.0)
+      bad("sparkplug.deadbands", "'" + name + "' must be a finite number >= 0");
+  }
+}
+
+std::string checkSparkplugId(const std::string& id) {
+  if (id.empty()) return "must not be empty";
+  if (id.size() > 64) return "at most 64 characters";
+  for (char c : id)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' || c == ' '))
+      return "may contain only letters, digits, space and _ - . (Sparkplug forbids / + # in ids)";
+  return {};
+}
+
+void applySparkplugOption(const std::string& group_edge, BridgeConfig& cfg) {
+  const auto slash = group_edge.find('/');
+  if (slash == std::string::npos || group_edge.find('/', slash + 1) != std::string::npos)
+    throw std::invalid_argument("--sparkplug: expected GROUP/EDGE (one '/'), got '" + printable(group_edge) + "'");
+  const std::string g = group_edge.substr(0, slash), e = group_edge.substr(slash + 1);
+  if (const std::string why = checkSparkplugId(g); !why.empty())
+    throw std::invalid_argument("--sparkplug: group '" + printable(g) + "': " + why);
+  if (const std::string why = checkSparkplugId(e); !why.empty())
+    throw std::invalid_argument("--sparkplug: edge node '" + printable(e) + "': " + why);
+  cfg.sparkplug = true;
+  cfg.sp_group_id = g;
+  cfg.sp_edge_node_id = e;
 }
 
 namespace {
 
-int lineOf(const toml::node& n) { return static_cast<int>(n.source().begin.line); }
+using hoist::io::SectionReader;
 
-struct Reader {
-  const std::string& source;
-  std::map<std::string, std::map<std::string, std::function<void(const toml::node&, const std::string&)>>> keys;
-  std::map<std::string, int> lines;  // "section.key" -> line
-
-  [[noreturn]] void fail(const toml::node& n, const std::string& key, const std::string& why) const {
-    throw ConfigError(source, lineOf(n), key, why);
-  }
-  void str(const char* sec, const char* key, std::string& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto s = n.as_string();
-      if (!s) fail(n, k, "must be a string");
-      out = s->get();
-    };
-  }
-  void num(const char* sec, const char* key, double& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      if (auto i = n.as_integer()) out = static_cast<double>(i->get());
-      else if (auto f = n.as_floating_point()) out = f->get();
-      else fail(n, k, "must be a number");
-      if (!std::isfinite(out)) fail(n, k, "must be finite");
-    };
-  }
-  void integer(const char* sec, const char* key, int& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto i = n.as_integer();
-      if (!i) fail(n, k, "must be an integer");
-      if (i->get() < -1000000000 || i->get() > 1000000000) fail(n, k, "out of range");
-      out = static_cast<int>(i->get());
-    };
-  }
-  void boolean(const char* sec, const char* key, bool& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto b = n.as_boolean();
-      if (!b) fail(n, k, "must be true or false");
-      out = b->get();
-    };
-  }
-  void strings(const char* sec, const char* key, std::vector<std::string>& out) {
-    keys[sec][key] = [this, &out](const toml::node& n, const std::string& k) {
-      auto a = n.as_array();
-      if (!a) fail(n, k, "must be an array of strings, e.g. [\"north/\", \"south/\"]");
-      out.clear();
-      for (const auto& e : *a) {
-        auto s = e.as_string();
-        if (!s) fail(e, k, "must be an array of strings");
-        out.push_back(s->get());
-      }
-    };
-  }
-
-  void run(const toml::table& root) {
-    std::vector<std::string> sections;
-    for (const auto& s : keys) sections.push_back(s.first);
-    for (const auto& [k, node] : root) {
-      const std::string sec(k.str());
-      auto it = keys.find(sec);
-      if (it == keys.end()) {
-        const std::string m = hoist::io::closestMatch(sec, sections);
-        std::string msg = node.is_table() ? "unknown section" : "key outside a section";
-        if (!m.empty()) msg += " (did you mean '" + m + "'?)";
-        msg += "; known sections: broker, tls, bridge, buffer";
-        fail(node, sec, msg);
-      }
-      const auto* tbl = node.as_table();
-      if (!tbl) fail(node, sec, "must be a table [" + sec + "]");
-      std::vector<std::string> names;
-      for (const auto& kv : it->second) names.push_back(kv.first);
-      for (const auto& [kk, value] : *tbl) {
-        const std::string key(kk.str());
-        const std::string full = sec + "." + key;
-        auto h = it->second.find(key);
-        if (h == it->second.end()) {
-          const std::string m = hoist::io::closestMatch(key, names);
-          std::string known;
-          for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-          fail(value, full, "unknown key" + (m.empty() ? std::string() : " (did you mean '" + m + "'?)") +
-                                "; known: " + known);
-        }
-        h->second(value, full);
-        lines[full] = lineOf(value);
-      }
-    }
-  }
-};
+/// The sections hoist-mqtt takes, in the order they are listed in errors.
+const std::vector<std::string>& sectionNames() {
+  static const std::vector<std::string> names{"broker", "tls", "bridge", "buffer", "sparkplug"};
+  return names;
+}
 
 void apply(const toml::table& root, const std::string& source, BridgeConfig& c) {
-  Reader r{source, {}, {}};
-  r.str("broker", "url", c.url);
-  r.str("broker", "client_id", c.client_id);
-  r.integer("broker", "keepalive", c.keepalive);
-  r.str("broker", "username", c.username);
-  r.str("broker", "password", c.password);
-  r.str("broker", "password_file", c.password_file);
-  r.str("broker", "password_env", c.password_env);
-  r.num("broker", "reconnect_min", c.reconnect_min);
-  r.num("broker", "reconnect_max", c.reconnect_max);
-  r.num("broker", "connect_timeout", c.connect_timeout);
-  r.str("tls", "ca_file", c.ca_file);
-  r.str("tls", "ca_path", c.ca_path);
-  r.str("tls", "cert_file", c.cert_file);
-  r.str("tls", "key_file", c.key_file);
-  r.boolean("tls", "insecure", c.tls_insecure);
-  r.str("tls", "version", c.tls_version);
-  r.str("bridge", "lcm_url", c.lcm_url);
-  r.strings("bridge", "channel_prefixes", c.channel_prefixes);
-  r.boolean("bridge", "commands", c.commands);
-  r.num("bridge", "cage_rate", c.cage_rate);
-  r.num("bridge", "health_period", c.health_period);
-  r.integer("bridge", "max_shafts", c.max_shafts);
-  r.num("bridge", "discovery_timeout", c.discovery_timeout);
-  r.integer("bridge", "max_command_bytes", c.max_command_bytes);
-  r.num("bridge", "command_rate", c.command_rate);
-  r.integer("bridge", "command_burst", c.command_burst);
-  r.num("bridge", "max_command_age", c.max_command_age);
-  r.num("bridge", "alarm_sync_time", c.alarm_sync_time);
-  r.integer("buffer", "max_messages", c.max_messages);
-  r.integer("buffer", "max_alarm_events", c.max_alarm_events);
-  r.num("buffer", "stale_after", c.stale_after);
-  r.boolean("buffer", "drop_stale", c.drop_stale);
-  r.str("buffer", "dir", c.journal_dir);
-  double max_bytes = static_cast<double>(c.journal_max_bytes);
-  r.num("buffer", "max_bytes", max_bytes);
-  r.num("buffer", "fsync_interval", c.fsync_interval);
-  r.run(root);
-  if (max_bytes != static_cast<double>(c.journal_max_bytes)) {
-    const int line = r.lines.count("buffer.max_bytes") ? r.lines["buffer.max_bytes"] : 0;
-    if (!(max_bytes >= 65536.0 && max_bytes <= 1e12) || max_bytes != std::floor(max_bytes))
-      throw ConfigError(source, line, "buffer.max_bytes", "must be a whole number of bytes in 65536..1e12");
-    c.journal_max_bytes = static_cast<std::uint64_t>(max_bytes);
+  // Top level: only known sections (keys outside a section are refused too).
+  for (const auto& [k, node] : root) {
+    const std::string sec(k.str());
+    bool known = false;
+    for (const auto& n : sectionNames()) known = known || n == sec;
+    if (known) continue;
+    std::string msg = node.is_table() ? "unknown section" : "key outside a section";
+    msg += hoist::io::didYouMean(sec, sectionNames()) + "; known sections: ";
+    for (std::size_t i = 0; i < sectionNames().size(); ++i) msg += (i ? ", " : "") + sectionNames()[i];
+    throw ConfigError(source, hoist::io::lineOf(node), sec, msg);
   }
+  auto str = [](std::string& out) { return [&out](const toml::node&, const std::string& v) { out = v; }; };
+  SectionReader broker(root, "broker", source), tls(root, "tls", source), bridge(root, "bridge", source),
+      buffer(root, "buffer", source), sp(root, "sparkplug", source);
+  broker.string("url", str(c.url));
+  broker.string("client_id", str(c.client_id));
+  broker.integer("keepalive", c.keepalive);
+  broker.string("username", str(c.username));
+  broker.string("password", str(c.password));
+  broker.string("password_file", str(c.password_file));
+  broker.string("password_env", str(c.password_env));
+  broker.number("reconnect_min", c.reconnect_min);
+  broker.number("reconnect_max", c.reconnect_max);
+  broker.number("connect_timeout", c.connect_timeout);
+  tls.string("ca_file", str(c.ca_file));
+  tls.string("ca_path", str(c.ca_path));
+  tls.string("cert_file", str(c.cert_file));
+  tls.string("key_file", str(c.key_file));
+  tls.boolean("insecure", c.tls_insecure);
+  tls.string("version", str(c.tls_version));
+  bridge.string("lcm_url", str(c.lcm_url));
+  bridge.on("channel_prefixes", [&bridge, &c](const toml::node& n) {
+    const auto* a = n.as_array();
+    if (!a) bridge.fail(n, "channel_prefixes", "must be an array of strings, e.g. [\"north/\", \"south/\"]");
+    c.channel_prefixes.clear();
+    for (const auto& e : *a) {
+      const auto* s = e.as_string();
+      if (!s) bridge.fail(e, "channel_prefixes", "must be an array of strings");
+      c.channel_prefixes.push_back(s->get());
+    }
+  });
+  bridge.boolean("commands", c.commands);
+  bridge.number("cage_rate", c.cage_rate);
+  bridge.number("health_period", c.health_period);
+  bridge.integer("max_shafts", c.max_shafts);
+  bridge.number("discovery_timeout", c.discovery_timeout);
+  bridge.integer("max_command_bytes", c.max_command_bytes);
+  bridge.number("command_rate", c.command_rate);
+  bridge.integer("command_burst", c.command_burst);
+  bridge.number("max_command_age", c.max_command_age);
+  bridge.number("alarm_sync_time", c.alarm_sync_time);
+  buffer.integer("max_messages", c.max_messages);
+  buffer.integer("max_alarm_events", c.max_alarm_events);
+  buffer.number("stale_after", c.stale_after);
+  buffer.boolean("drop_stale", c.drop_stale);
+  buffer.string("dir", str(c.journal_dir));
+  buffer.on("max_bytes", [&buffer, &c](const toml::node& n) {
+    double v = -1.0;
+    if (const auto* i = n.as_integer()) v = static_cast<double>(i->get());
+    else if (const auto* f = n.as_floating_point()) v = f->get();
+    if (!(v >= 65536.0 && v <= 1e12) || v != std::floor(v))
+      buffer.fail(n, "max_bytes", "must be a whole number of bytes in 65536..1e12");
+    c.journal_max_bytes = static_cast<std::uint64_t>(v);
+  });
+  buffer.number("fsync_interval", c.fsync_interval);
+  sp.boolean("enabled", c.sparkplug);
+  sp.string("group_id", str(c.sp_group_id));
+  sp.string("edge_node_id", str(c.sp_edge_node_id));
+  sp.string("primary_host_id", str(c.sp_primary_host_id));
+  sp.number("deadband", c.sp_deadband);
+  sp.on("deadbands", [&sp, &c](const toml::node& n) {
+    const auto* t = n.as_table();
+    if (!t) sp.fail(n, "deadbands", "must be a table [sparkplug.deadbands] of \"metric name\" = deadband");
+    for (const auto& [k, v] : *t) {
+      double d = 0.0;
+      if (const auto* i = v.as_integer()) d = static_cast<double>(i->get());
+      else if (const auto* f = v.as_floating_point()) d = f->get();
+      else sp.fail(v, "deadbands." + std::string(k.str()), std::string("must be a number, got ") + hoist::io::typeName(v));
+      c.sp_deadbands[std::string(k.str())] = d;
+    }
+  });
+  for (SectionReader* r : {&broker, &tls, &bridge, &buffer, &sp}) r->run();
+  const std::vector<const SectionReader*> readers{&broker, &tls, &bridge, &buffer, &sp};
   applyCredentials(c);  // before the files are checked: a credential replaces an unreadable file
   try {
     c.validate();
   } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    const auto colon = what.find(": ");
-    const std::string key = colon == std::string::npos ? std::string() : what.substr(0, colon);
-    auto it = r.lines.find(key);
-    throw ConfigError(source, it == r.lines.end() ? 0 : it->second, key,
-                      colon == std::string::npos ? what : what.substr(colon + 2));
+    hoist::io::rethrowWithLine(e.what(), source, readers, false);
   }
 }
 

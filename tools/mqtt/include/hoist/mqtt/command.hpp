@@ -45,8 +45,14 @@ enum class CommandReject : std::uint8_t {
   RateLimited,    ///< over the per-user, per-shaft rate ([bridge] command_rate, command_burst)
   NoMatchingAlarm,  ///< an acknowledge that matches no unacknowledged alarm the bridge knows of
   AmbiguousShaft,   ///< two live prefixes claim the shaft's name (discovery): refused until one stops
+  // Sparkplug B mode (DCMD/NCMD; hoist/mqtt/sparkplug_node.hpp):
+  BadPayload,       ///< not a Sparkplug B payload (malformed protobuf, too many metrics, strings too long)
+  UnknownMetric,    ///< a name or alias that is not a metric of the device (or node), or an unknown device
+  ReadOnly,         ///< a write to a metric that is not writable
+  BadValue,         ///< the value's type or range does not fit the metric
+  Disabled,         ///< alarm commands are off (--no-commands, [bridge] commands = false)
 };
-inline constexpr int kCommandRejects = 16;
+inline constexpr int kCommandRejects = 21;
 const char* toString(CommandReject r);  ///< "ok", "oversized", "not_json", ...
 
 struct CommandResult {

@@ -8,6 +8,8 @@
 //             max_command_age, alarm_sync_time
 //   [buffer]  max_messages, max_alarm_events, stale_after, drop_stale,
 //             dir, max_bytes, fsync_interval (store-and-forward journal)
+//   [sparkplug] enabled, group_id, edge_node_id, primary_host_id, deadband,
+//             [sparkplug.deadbands] "<metric name>" = deadband
 //
 // Every key is optional.  Rejected with hoist::io::ConfigError
 // ("file:line: section.key: reason", exit status 2): TOML syntax errors,
@@ -18,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -79,10 +82,24 @@ struct BridgeConfig {
   std::uint64_t journal_max_bytes = 64ull << 20;   ///< [buffer] max_bytes: the journal file at most
   double fsync_interval = 1.0;                     ///< [buffer] fsync_interval [s]; 0 = every append
 
+  // [sparkplug] (Sparkplug B mode instead of the JSON topics; docs/mqtt.md)
+  bool sparkplug = false;              ///< enabled
+  std::string sp_group_id;             ///< Sparkplug group id (required when enabled)
+  std::string sp_edge_node_id;         ///< edge node id (required when enabled)
+  std::string sp_primary_host_id;      ///< "" = no primary host; else wait for its STATE online before births
+  double sp_deadband = 0.0;            ///< default deadband of every numeric device metric (in its units)
+  std::map<std::string, double> sp_deadbands;  ///< per metric name (hoist/mqtt/sparkplug_metrics.hpp)
+
   bool wantsTls() const;
   /// Throws std::invalid_argument("section.key: reason").
   void validate() const;
 };
+
+/// Applies `--sparkplug GROUP/EDGE`: enables Sparkplug mode with those ids.
+/// Throws std::invalid_argument("--sparkplug: reason") if not GROUP/EDGE.
+void applySparkplugOption(const std::string& group_edge, BridgeConfig& cfg);
+/// "" if `id` is usable as a Sparkplug group, edge node or host id, else why.
+std::string checkSparkplugId(const std::string& id);
 
 /// Reads and validates a configuration file.  Throws hoist::io::ConfigError.
 BridgeConfig loadBridgeConfig(const std::string& path);
