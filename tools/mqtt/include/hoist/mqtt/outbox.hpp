@@ -25,7 +25,6 @@ struct OutMsg {
   int qos = 0;
   bool retain = false;
   MsgClass cls = MsgClass::Cage;
-  bool sparkplug = false;  ///< payload is a Sparkplug Payload whose seq/is_historical are stamped at send time
   std::chrono::steady_clock::time_point queued{};  ///< set by Outbox::push (age at sending: stale cage states)
   /// The payload is an encoded Sparkplug B Payload whose seq (and the
   /// metrics' is_historical) are set when it is actually sent
