@@ -135,7 +135,7 @@ TickBudget measureTickBudget(const TwinConfig& cfg, int max_ticks, double max_se
     }
     b.ticks = k + 1;
     b.moved_m = std::fabs(kin.l - c.shaft.l0);
-    if (b.moved_m > room) break;  // a slow rate: the trip would leave the shaft before the time is up
+    if (b.moved_m > room && counted >= 3) break;  // a slow rate: the trip would leave the shaft before the time is up
     if (counted >= 3 && (shape_div == 0 || shapes > 0) &&
         std::chrono::duration<double>(Clock::now() - start).count() > max_seconds)
       break;
