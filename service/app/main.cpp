@@ -202,10 +202,12 @@ int main(int argc, char** argv) {
   opt.lcm_url_out = opt.shafts[0].service.lcm_url_out;
   // Can this configuration run?  Measure a tick of each shaft on a scratch
   // model; refuse (exit 2) when the loop cannot keep up, unless --force.
-  std::string budget_line;
+  std::string budget_line, budget_parts;
   bool budget_warn = false;
   {
     double use = 0.0;
+    std::string too_slow;  // shafts whose slowest tick (one with the exact envelope) exceeds the period
+    bool tight = false;    // ... or takes more than half of it
     for (std::size_t i = 0; i < opt.shafts.size(); ++i) {
       TickBudget b;
       try {
@@ -215,7 +217,14 @@ int main(int argc, char** argv) {
         return 2;
       }
       use += b.use;
-      char line[256];
+      char line[320];
+      if (b.worst_us > 0.5 * b.period_us && b.worst_us <= b.period_us) tight = true;
+      if (b.worst_us > b.period_us) {
+        std::snprintf(line, sizeof line, "%s%sa tick that needs the exact guide-rope envelope takes %.0f us, more than "
+                      "the period of %.0f us", too_slow.empty() ? "" : "; ",
+                      opt.labels[i].empty() ? "" : (opt.labels[i] + ": ").c_str(), b.worst_us, b.period_us);
+        too_slow += line;
+      }
       std::snprintf(line, sizeof line, "%s%s%.1f us per tick of %.0f us (%.1f %%, n = %d, %d substeps of max_step)",
                     budget_line.empty() ? "" : "; ", opt.labels[i].empty() ? "" : (opt.labels[i] + ": ").c_str(),
                     b.tick_us, b.period_us, 100.0 * b.use, opt.shafts[i].shaft.n,
@@ -223,19 +232,29 @@ int main(int argc, char** argv) {
                         ? static_cast<int>(std::ceil(1.0 / opt.shafts[i].service.rate / opt.shafts[i].service.max_step - 1e-9))
                         : 1);
       budget_line += line;
+      budget_parts += (budget_parts.empty() ? "" : "; ") +
+                      (opt.labels[i].empty() ? std::string() : opt.labels[i] + ": ") +
+                      describeBudget(b, opt.shafts[i]);
     }
     char total[96];
     std::snprintf(total, sizeof total, " -> budget use %.1f %% of one core", 100.0 * use);
     budget_line = "measured start-up budget: " + budget_line + total;
-    if (use > 1.0 && !force) {
+    if (!too_slow.empty()) budget_line += "; " + too_slow;
+    const bool over = use > 1.0 || !too_slow.empty();
+    if (over && !force) {
       std::cerr << "hoist-twind: configuration cannot run in real time: " << budget_line
-                << ".  Lower [model] modes or [service] rate, raise [service] max_step, or host fewer shafts; "
-                   "--force runs anyway (deadline misses, degraded outputs).\n";
+                << ".  A whole tick with the cage moving, largest part first: " << budget_parts
+                << ".  Lower the keys of the largest parts ([model] modes, [service] rate, envelope_points, "
+                   "shape_rate, shape_points, cage_rate), raise [service] max_step or envelope_tolerance, or host "
+                   "fewer shafts; --force runs anyway (deadline misses, degraded outputs).\n";
       return 2;
     }
-    if (use > 1.0) budget_line += " -- OVER BUDGET, running because of --force";
-    else if (use > 0.5) budget_line += " -- more than half the period: little margin for jitter";
-    budget_warn = use > 0.5;
+    if (over) budget_line += " -- OVER BUDGET, running because of --force";
+    else if (use > 0.5 || tight)
+      budget_line += use > 0.5 ? " -- more than half the period: little margin for jitter"
+                               : " -- a tick that needs the exact guide-rope envelope takes more than half the period";
+    if (over || use > 0.5 || tight) budget_line += " (" + budget_parts + ")";
+    budget_warn = over || use > 0.5 || tight;
   }
   opt.duration = duration;
   opt.hooks.inject_fault_at = inject_fault_at;

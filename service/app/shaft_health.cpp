@@ -125,6 +125,9 @@ void ShaftHealth::logFinal() const {
   if (st.command_decode_rejects > 0)
     log.info("{}  rejected alarm commands (command_decode): {}", tag, st.command_decode_rejects);
   if (st.handler_exceptions > 0) log.info("{}  exceptions caught in LCM handlers: {}", tag, st.handler_exceptions);
+  if (st.reannounce_requests > 0)
+    log.info("{}  alarm re-announce requests: {} ({} honoured, {} merged into a pending one)", tag,
+             st.reannounce_requests, st.reannounces, st.reannounce_merged);
   if (ctx_.cfg.forecast.enabled) {
     log.info("{}forecasts: {} done (compute p50/p99/max {:.1f}/{:.1f}/{:.1f} ms), {} dropped (worker late), {} "
              "skipped (degraded), {} failed; trip plans accepted {}, no longer fitting the motion {}",

@@ -182,6 +182,11 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
     logJunk(fmt::format("ignored alarm command from '{}' (kind '{}'): {}", user, printable(ack.kind), why));
     return;
   }
+  if (cmd->action == AlarmAction::Reannounce) {
+    // Changes no state: outside the command budget, rate-limited on its own.
+    requestReannounce(cmd->kind, cmd->level, user);
+    return;
+  }
   const int budget = ctx_.cfg.service.max_commands_per_tick;
   if (++commands_this_tick_ > budget) {
     ++st.commands_dropped;
@@ -222,6 +227,35 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   cause.requested_shelve = 0.0;
 }
 
+void ShaftInputs::requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user) {
+  ShaftStats& st = ctx_.stats;
+  ++st.reannounce_requests;
+  if (reannounce_pending_) {
+    ++st.reannounce_merged;
+    if (kind != reannounce_kind_) reannounce_kind_.reset();  // two different requests: everything
+    if (level != reannounce_level_) reannounce_level_ = AlarmLevel::None;
+    return;
+  }
+  reannounce_pending_ = true;
+  reannounce_kind_ = kind;
+  reannounce_level_ = level;
+  std::int64_t suppressed = 0;
+  if (log_limit_.allow(kLogReannounce, ctx_.wallNow(), suppressed))
+    ctx_.log.info("{}'{}' asks for every alarm's current state: re-announced (at most once per {} s) [{} similar "
+                  "suppressed]", ctx_.tag, user, kReannounceInterval, suppressed);
+  serviceReannounce();
+}
+
+void ShaftInputs::serviceReannounce() {
+  const double wall = ctx_.wallNow();
+  if (reannounce_wall_ >= 0.0 && wall - reannounce_wall_ < kReannounceInterval) return;
+  reannounce_pending_ = false;
+  reannounce_wall_ = wall;
+  ++ctx_.stats.reannounces;
+  ctx_.core.command(AlarmAction::Reannounce, reannounce_kind_, reannounce_level_, 0.0);
+  out_.publishAlarmEvents();
+}
+
 // ---- HOIST_TRIP_PLAN -------------------------------------------------------------
 
 void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
@@ -235,9 +269,17 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
   }
   const trip_plan_t& m = plan_in_;
   const double t = ctx_.core.modelTime();
-  if (forecast_->hasPlan(t) && m.seq <= forecast_->planSeq()) {
-    std::snprintf(text_, sizeof text_, "seq %lld is not newer than the plan in force (seq %lld)",
-                  static_cast<long long>(m.seq), static_cast<long long>(forecast_->planSeq()));
+  const double timeout = ctx_.cfg.forecast.plan_timeout;
+  // The sequence rule is per sender (hoist/service/plan_senders.hpp): another
+  // sender's seq, however large, never makes this sender's plans old.
+  std::int64_t last_seq = 0;
+  double last_t = 0.0;
+  if (plan_senders_.isOld(m.sender_id, m.seq, t, timeout, last_seq, last_t)) {
+    std::snprintf(text_, sizeof text_, "seq %lld from sender %lld is not newer than that sender's last accepted "
+                  "plan (seq %lld, %.1f s ago; any seq is accepted again once it is forecast.plan_timeout = %g s "
+                  "old)",
+                  static_cast<long long>(m.seq), static_cast<long long>(m.sender_id),
+                  static_cast<long long>(last_seq), std::fabs(t - last_t), timeout);
     rejectPlan(PlanReject::OldSeq, text_);
     return;
   }
@@ -265,9 +307,19 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   ++ctx_.stats.plans_accepted;
-  if (forecast_->acceptPlan(p, m.seq, t))
-    ctx_.log.info("{}trip plan accepted (seq {}): target {} m, vmax {} m/s, amax {} m/s^2, jerk {} m/s^3", ctx_.tag,
-                  m.seq, m.target_length, m.vmax, m.amax, m.jerk);
+  plan_senders_.accept(m.sender_id, m.seq, t, timeout);
+  forecast_->hasPlan(t);  // expire (and log) the plan in force first
+  const bool other_sender = plan_sender_ != m.sender_id;
+  plan_sender_ = m.sender_id;
+  if (forecast_->acceptPlan(p, m.seq, t) || other_sender) {
+    // The first plan, or a plan from another sender than the last one's
+    // (two controllers, or a forged sender): logged, rate-limited.
+    std::int64_t suppressed = 0;
+    if (log_limit_.allow(kLogPlan, ctx_.wallNow(), suppressed))
+      ctx_.log.info("{}trip plan accepted (seq {} from sender {}): target {} m, vmax {} m/s, amax {} m/s^2, jerk {} "
+                    "m/s^3 [{} similar suppressed]",
+                    ctx_.tag, m.seq, m.sender_id, m.target_length, m.vmax, m.amax, m.jerk, suppressed);
+  }
 }
 
 // ---- our own HOIST_HEALTH from another instance ------------------------------------

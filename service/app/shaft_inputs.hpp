@@ -17,11 +17,13 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
 
 #include "hoist/bus/udpm_receiver.hpp"
 #include "hoist/cage_imu_t.hpp"
+#include "hoist/service/plan_senders.hpp"
 #include "hoist/rope_load_t.hpp"
 #include "hoist/trip_plan_t.hpp"
 #include "hoist/winder_t.hpp"
@@ -51,7 +53,13 @@ class ShaftInputs {
   void beginTick() {
     commands_this_tick_ = 0;
     decodes_this_tick_ = 0;
+    if (reannounce_pending_) serviceReannounce();
   }
+  /// Re-announce requests (alarm_ack_t ACTION_REANNOUNCE) are honoured at
+  /// most once per this many seconds of wall time; one arriving sooner is
+  /// merged into a pending one, honoured when the interval is over (so a
+  /// client that asked is never left without an answer).
+  static constexpr double kReannounceInterval = 1.0;
   /// Command datagrams decoded per tick at most: this many per second...
   static constexpr double kDecodesPerSecond = 200000.0;
   /// ... but at least this many per tick.
@@ -87,6 +95,10 @@ class ShaftInputs {
   void logReject(RejectReason r, const char* detail);
   void rejectPlan(PlanReject r, const char* detail);
   void logJunk(const std::string& what);
+  /// A valid re-announce request: honour it now, or merge it into the pending one.
+  void requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user);
+  /// Honour the pending re-announce request if the interval allows.
+  void serviceReannounce();
   void add(bus::InputRouter* router, Route& r);
 
   ShaftContext& ctx_;               ///< the shaft's shared state
@@ -99,11 +111,16 @@ class ShaftInputs {
   static constexpr int kLogHandlerException = kRejectReasons + 1; ///< exceptions caught in handlers
   static constexpr int kLogPlan = kRejectReasons + 2;             ///< rejected trip plans
   static constexpr int kLogSensor = kRejectReasons + 3;           ///< rejected sensor samples
-  static constexpr int kLogKeys = kRejectReasons + 4;             ///< number of keys
+  static constexpr int kLogReannounce = kRejectReasons + 4;       ///< honoured re-announce requests
+  static constexpr int kLogKeys = kRejectReasons + 5;             ///< number of keys
   LogRateLimiter<kLogKeys> log_limit_{5};  ///< rate limit of this room's warning lines
   int commands_this_tick_ = 0;      ///< valid commands applied or dropped this tick
   int decodes_this_tick_ = 0;       ///< command datagrams decoded (or dropped undecoded) this tick
   int decode_budget_ = kMinDecodesPerTick;  ///< command datagrams decoded per tick at most
+  bool reannounce_pending_ = false; ///< a re-announce request waits for its interval
+  std::optional<AlarmKind> reannounce_kind_;  ///< what it asks for (merged requests: everything)
+  AlarmLevel reannounce_level_ = AlarmLevel::None;
+  double reannounce_wall_ = -1.0;   ///< wall time of the last honoured one (< 0: none yet)
   std::int64_t other_id_ = 0;       ///< another publisher's instance id
   double other_seen_wall_ = -1.0;   ///< when it was last seen (< 0: not seen)
   hoist::winder_t winder_in_;       ///< decode scratch of HOIST_WINDER
@@ -111,6 +128,8 @@ class ShaftInputs {
   hoist::cage_imu_t imu_in_;        ///< decode scratch of HOIST_CAGE_IMU (flat)
   hoist::rope_load_t rope_in_;      ///< decode scratch of HOIST_ROPE_LOAD (flat)
   MotionProfile plan_scratch_;      ///< checkPlan's workspace
+  PlanSenders plan_senders_;        ///< the trip-plan sequence rule, per sender
+  std::int64_t plan_sender_ = 0;    ///< sender of the last accepted plan
   char text_[256];                  ///< the text of a rejection being logged
 };
 

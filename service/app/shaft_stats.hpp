@@ -37,6 +37,9 @@ struct ShaftStats {
   std::int64_t commands_dropped = 0;        ///< valid commands beyond max_commands_per_tick, plus decode-bound drops
   std::int64_t commands_invalid = 0;        ///< undecodable or invalid commands
   std::int64_t commands_applied = 0;        ///< effective commands (audited)
+  std::int64_t reannounce_requests = 0;     ///< valid re-announce requests (alarm_ack_t ACTION_REANNOUNCE)
+  std::int64_t reannounces = 0;             ///< ... honoured (at most one a second)
+  std::int64_t reannounce_merged = 0;       ///< ... merged into a pending one (arrived within the interval)
   std::int64_t plans_accepted = 0;          ///< trip plans accepted
   std::int64_t sensor_accepted = 0;         ///< cage IMU and rope-load samples handed to the estimator
   std::int64_t sensor_rejected = 0;         ///< ... refused (undecodable, implausible, old seq)

@@ -55,13 +55,13 @@ void BinaryAlarm::configure(AlarmKind kind, AlarmLevel level, const AlarmSetting
   kind_ = kind;
   level_ = level;
   s_ = s;
-  cond_ = active_ = acked_ = shelved_ = announced_ = pending_valid_ = false;
+  cond_ = active_ = acked_ = shelved_ = announced_ = pending_valid_ = touched_ = false;
   pending_since_ = shelved_until_ = last_announce_ = value_ = 0.0;
   // A low alarm's "no value yet" must read as clear (poll() feeds value_ back).
   if (s.low) value_ = std::numeric_limits<double>::max();
 }
 
-void BinaryAlarm::emit(AlarmEventType type, double now, AlarmEvents& out) {
+AlarmEvent BinaryAlarm::event(AlarmEventType type, double now) const {
   AlarmEvent e;
   e.kind = kind_;
   e.level = level_;
@@ -74,7 +74,12 @@ void BinaryAlarm::emit(AlarmEventType type, double now, AlarmEvents& out) {
   e.shelved = shelved_;
   e.latched = latched();
   e.shelved_for = shelved_ ? std::max(0.0, shelved_until_ - now) : 0.0;
-  out.push(e);
+  return e;
+}
+
+void BinaryAlarm::emit(AlarmEventType type, double now, AlarmEvents& out) {
+  out.push(event(type, now));
+  touched_ = true;
   if (type == AlarmEventType::Raise || type == AlarmEventType::Clear ||
       type == AlarmEventType::Reannounce) {
     announced_ = active_;
@@ -406,6 +411,14 @@ int AlarmEngine::shelve(double now, std::optional<AlarmKind> kind, AlarmLevel le
 int AlarmEngine::unshelve(double now, std::optional<AlarmKind> kind, AlarmLevel level,
                           AlarmEvents& out) {
   return forMatching(kind, level, [&](BinaryAlarm& a) { return a.unshelve(now, out); });
+}
+
+int AlarmEngine::reannounce(double now, std::optional<AlarmKind> kind, AlarmLevel level, AlarmEvents& out) {
+  return forMatching(kind, level, [&](BinaryAlarm& a) {
+    if (!a.hasState()) return false;
+    a.reportState(now, out);
+    return true;
+  });
 }
 
 AlarmLevel AlarmEngine::highestActive() const {

@@ -207,7 +207,7 @@ std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*
     case CommandError::None: return c;
     case CommandError::UnknownKind: why = "unknown alarm kind"; break;
     case CommandError::BadLevel: why = "bad level (0 both, 1 warning, 2 critical)"; break;
-    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve)"; break;
+    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce)"; break;
     case CommandError::BadShelveDuration: why = "shelve_duration must be a finite number > 0 s"; break;
   }
   return std::nullopt;

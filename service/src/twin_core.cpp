@@ -537,6 +537,7 @@ int TwinCore::command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLe
     case AlarmAction::Ack: n = alarms_.acknowledge(t_, kind, level, events_); break;
     case AlarmAction::Shelve: n = alarms_.shelve(t_, kind, level, shelve_duration, events_); break;
     case AlarmAction::Unshelve: n = alarms_.unshelve(t_, kind, level, events_); break;
+    case AlarmAction::Reannounce: n = alarms_.reannounce(t_, kind, level, events_); break;
   }
   out_.alarm_level = alarms_.highestActive();
   out_.degraded = degradedNow();

@@ -520,6 +520,75 @@ TEST_F(HubClockTest, ActivationKeptAcrossReannouncesAndStaleCommandsRefused) {
   EXPECT_EQ(pub.size(), 1u);
 }
 
+// hoist-dash asks each shaft's daemon for its alarms' current states
+// (alarm_ack_t ACTION_REANNOUNCE) once its LCM receive path is open: when a
+// daemon's health first arrives (a fixed prefix), when a discovered shaft is
+// confirmed, and for a new daemon instance -- never into the void, never for
+// an unconfirmed (possibly forged) prefix.  The daemon's answer (a
+// REANNOUNCE of an alarm raised before the dashboard started) is in the
+// alarm list at once, as its state, its activation marked as from before.
+TEST_F(HubClockTest, AlarmStatesAreRequestedAtStartAndForEachDiscoveredShaft) {
+  auto requests = [&](const std::string& channel) {
+    int n = 0;
+    for (const auto& p : pub) {
+      if (p.channel != channel) continue;
+      alarm_ack_t m{};
+      EXPECT_GE(m.decode(p.bytes.data(), 0, static_cast<int>(p.bytes.size())), 0);
+      EXPECT_EQ(m.action, +alarm_ack_t::ACTION_REANNOUNCE);
+      EXPECT_EQ(m.kind, "*");
+      EXPECT_EQ(m.level, 0);
+      ++n;
+    }
+    return n;
+  };
+  {
+    Hub fixed = makeTimed({"a/", "b/"});
+    health(fixed, "a/", 7);
+    EXPECT_TRUE(pub.empty()) << "not before the receive path is open";
+    fixed.requestAlarmStates();
+    EXPECT_TRUE(pub.empty()) << "no request before a daemon is heard";
+    health(fixed, "a/", 7);
+    health(fixed, "a/", 7);
+    EXPECT_EQ(requests("a/HOIST_ALARM_ACK"), 1) << "once per daemon instance";
+    health(fixed, "a/", 8);  // the daemon restarted
+    EXPECT_EQ(requests("a/HOIST_ALARM_ACK"), 2);
+    EXPECT_EQ(requests("b/HOIST_ALARM_ACK"), 0);
+    health(fixed, "b/", 9);
+    EXPECT_EQ(requests("b/HOIST_ALARM_ACK"), 1);
+    EXPECT_EQ(pub.size(), 3u);
+  }
+  pub.clear();
+  Hub hub = makeTimed();
+  hub.requestAlarmStates();
+  for (int i = 0; i < 3; ++i) {
+    health(hub, "north/", 7);
+    health(hub, "forged/", 66);  // one datagram each, at most (never confirmed)
+    EXPECT_EQ(requests("north/HOIST_ALARM_ACK"), i == 2 ? 1 : 0) << "asked when confirmed (third health)";
+    advance(1.0);
+    if (i == 0) health(hub, "forged/", 67);
+  }
+  EXPECT_EQ(requests("forged/HOIST_ALARM_ACK"), 0);
+  // The daemon's answer: CAGE_POS_Y raised before the dashboard started.
+  RecClient c;
+  hub.addClient(c);
+  alarm_t a{};
+  a.utime = 5000;
+  a.kind = "CAGE_POS_Y";
+  a.level = 1;
+  a.event_type = alarm_t::EVENT_REANNOUNCE;
+  a.active = true;
+  const auto b = encode(a);
+  hub.onLcm("north/HOIST_ALARM", b.data(), b.size());
+  hub.onClientText(c, Json{{"op", "subscribe"},
+                           {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "north/HOIST_ALARM")}}}}}.dump());
+  ASSERT_EQ(c.data.size(), 1u);
+  const Json got = Json::parse(c.data[0].substr(13));
+  EXPECT_TRUE(got["active"].get<bool>());
+  EXPECT_EQ(got["event_type"], +alarm_t::EVENT_REANNOUNCE);
+  EXPECT_FALSE(got["dash_activation_known"].get<bool>()) << "raised before the dashboard heard it";
+  EXPECT_EQ(hub.counter("alarm_state_requests"), 1u);
+}
+
 TEST_F(HubClockTest, HistoryIsSentOnSubscribeAndBounded) {
   Hub hub = makeTimed({""});
   for (int i = 0; i < 400 * 25; ++i) {  // 400 s at 25 Hz, one cage state per flush

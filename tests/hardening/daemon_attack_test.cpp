@@ -242,6 +242,23 @@ TEST_F(DaemonAttack, ConfigsThatCannotRunAreRefusedAndForcedOnesStayResponsive) 
   EXPECT_NE(log.find("the loop fell behind"), std::string::npos) << log;
 }
 
+TEST_F(DaemonAttack, TheBudgetCheckMeasuresTheWholeTickWithTheCageMoving) {
+  // modes 400 at 1 kHz with 20001 envelope points and the shape published
+  // every tick passed a check that measured the model step at rest (47 %),
+  // then missed most ticks once the cage moved.  The whole tick -- step,
+  // envelope, shape publication -- with the cage moving does not fit: exit 2,
+  // naming the keys.
+  start(8003, "budget_whole_tick");
+  const auto cfg = writeConfig("whole.toml", "[model]\nmodes = 400\n[service]\nrate = 1000\nenvelope_points = 20001\n"
+                                             "shape_rate = 1000\n");
+  EXPECT_EQ(runProcess({HOIST_TWIND, "--config", cfg, "--lcm-url", url_}, (dir_ / "whole.log").string(), 60s), 2);
+  const std::string text = readFile((dir_ / "whole.log").string());
+  EXPECT_NE(text.find("cannot run in real time"), std::string::npos) << text;
+  EXPECT_NE(text.find("cage moving"), std::string::npos) << text;
+  for (const char* key : {"envelope_points = 20001", "shape_rate = 1000", "modes = 400", "--force"})
+    EXPECT_NE(text.find(key), std::string::npos) << key << " not named in: " << text;
+}
+
 TEST_F(DaemonAttack, EffectiveCommandsAreAuditedWithTheirUser) {
   // Commands: five invalid commands, then a '*' shelve from "mallory":
   // the shelve is in HOIST_ALARM (user field) and the log, whatever the

@@ -347,6 +347,7 @@ TEST(Log2Csv, ForecastOneRowPerScenarioAndTheSeries) {
   plan.vmax = 5.0;
   plan.amax = 1.0;
   plan.jerk = 0.5;
+  plan.sender_id = 42;
   hoist::cage_state_t cage{};
   cage.rope_slack_threshold = 4424.0;
   cage.rope_overload_threshold = 13272.0;
@@ -380,7 +381,7 @@ TEST(Log2Csv, ForecastOneRowPerScenarioAndTheSeries) {
   EXPECT_NE(series.find("1700000000000000,4,1,\"con,\"\"tinue\"\"\",1,2,0.050000000000000003,8000,9001\n"),
             std::string::npos)
       << series;
-  EXPECT_NE(slurp(d / "out" / "HOIST_TRIP_PLAN.csv").find("5,9,300,5,1,0.5\n"), std::string::npos);
+  EXPECT_NE(slurp(d / "out" / "HOIST_TRIP_PLAN.csv").find("5,9,300,5,1,0.5,42\n"), std::string::npos);
   const std::string c = slurp(d / "out" / "HOIST_CAGE.csv");
   EXPECT_NE(c.find(",alarm_level,degraded,rope_slack_threshold,rope_overload_threshold\n"), std::string::npos) << c;
   EXPECT_NE(c.find(",0,0,4424,13272\n"), std::string::npos) << c;

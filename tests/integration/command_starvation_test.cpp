@@ -17,6 +17,7 @@
 
 #include "daemon.hpp"
 #include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
 
 using namespace hoist;
 using namespace hoist::svc;
@@ -161,3 +162,80 @@ INSTANTIATE_TEST_SUITE_P(JunkRates, CommandStarvation,
                          [](const ::testing::TestParamInfo<StarvationCase>& info) {
                            return "Junk" + std::to_string(info.param.junk_per_s) + "PerSecond";
                          });
+
+// A client that starts late asks for the alarms' current states
+// (alarm_ack_t ACTION_REANNOUNCE): the daemon re-announces every alarm that
+// has a state at once, without waiting for the periodic re-announce (an hour
+// here); a burst of requests is honoured once at once and once more a second
+// later (merged), never more often; the request changes no state.  Port 8002.
+TEST(ReannounceRequest, HonouredAtOnceThenAtMostOnceASecondAndChangesNothing) {
+  const std::string url = "udpm://239.255.76.67:8002?ttl=0";
+  {
+    lcm::LCM probe(url);
+    if (!probe.good()) GTEST_FAIL() << "UDP multicast on loopback is off: run scripts/setup.sh";
+  }
+  std::ostringstream logs;
+  auto logger = std::make_shared<spdlog::logger>("reannounce", std::make_shared<spdlog::sinks::ostream_sink_mt>(logs));
+  DaemonOptions opt;
+  TwinConfig cfg;
+  cfg.shaft.n = 6;
+  cfg.service.rate = 100.0;
+  cfg.service.stale_timeout = 0.2;  // no winder: INPUT_STALE raises at once
+  cfg.alarms.reannounce = 3600.0;
+  opt.shafts = {cfg};
+  opt.lcm_url = url;
+  Daemon d(std::move(opt), logger);
+  struct Seen {
+    std::vector<std::pair<hoist::alarm_t, std::chrono::steady_clock::time_point>> events;
+    void on(const lcm::ReceiveBuffer* rb, const std::string&, const hoist::alarm_t* m) {
+      events.emplace_back(*m, std::chrono::steady_clock::now());
+    }
+    int count(std::int8_t type) const {
+      int n = 0;
+      for (const auto& [e, t] : events) n += e.event_type == type;
+      return n;
+    }
+  } seen;
+  lcm::LCM listen(url);
+  listen.subscribe("HOIST_ALARM", &Seen::on, &seen);
+  ASSERT_TRUE(d.start());
+  auto loopFor = [&](std::chrono::duration<double> span) {
+    const auto until = std::chrono::steady_clock::now() + span;
+    while (std::chrono::steady_clock::now() < until) {
+      d.poll();
+      listen.handleTimeout(0);
+      std::this_thread::sleep_for(100us);
+    }
+  };
+  const auto raise_deadline = std::chrono::steady_clock::now() + 5s;
+  while (seen.count(hoist::alarm_t::EVENT_RAISE) == 0 && std::chrono::steady_clock::now() < raise_deadline)
+    loopFor(0.05s);
+  ASSERT_EQ(seen.count(hoist::alarm_t::EVENT_RAISE), 1) << logs.str();
+  loopFor(0.2s);
+  const std::size_t before = seen.events.size();
+  lcm::LCM client(url);
+  hoist::alarm_ack_t req = command(hoist::alarm_ack_t::ACTION_REANNOUNCE, "*");
+  req.user = "hoist-mqtt-test";
+  const auto t_sent = std::chrono::steady_clock::now();
+  for (int i = 0; i < 5; ++i) client.publish("HOIST_ALARM_ACK", &req);
+  loopFor(2.5s);
+  std::vector<std::chrono::steady_clock::time_point> answers;
+  for (std::size_t i = before; i < seen.events.size(); ++i) {
+    const hoist::alarm_t& e = seen.events[i].first;
+    ASSERT_EQ(e.event_type, +hoist::alarm_t::EVENT_REANNOUNCE) << "only re-announces follow the requests";
+    EXPECT_EQ(e.kind, "INPUT_STALE") << "alarms without a state are not announced";
+    EXPECT_TRUE(e.active);
+    EXPECT_FALSE(e.acked);
+    answers.push_back(seen.events[i].second);
+  }
+  ASSERT_EQ(answers.size(), 2u) << "five requests: honoured at once, then once (merged) a second later\n" << logs.str();
+  // (Receive times: the second answer is honoured a full second after the
+  // first; the margin is for a loaded machine delaying the first delivery.)
+  EXPECT_LT(std::chrono::duration<double>(answers[0] - t_sent).count(), 0.9) << "the first is answered at once";
+  EXPECT_GE(std::chrono::duration<double>(answers[1] - answers[0]).count(), 0.8) << "at most one a second";
+  const ShaftRunStats st = d.shaft(0).runStats();
+  EXPECT_EQ(st.commands_applied, 0) << "a re-announce changes nothing (no AUDIT)";
+  d.requestStop("test over");
+  d.finish();
+  EXPECT_NE(logs.str().find("alarm re-announce requests: 5 (2 honoured, 3 merged"), std::string::npos) << logs.str();
+}

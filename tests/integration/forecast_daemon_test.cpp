@@ -127,8 +127,9 @@ class Rig {
     pub_->publish(prefix + "HOIST_WINDER", &m);
   }
   void publishPlan(const std::string& prefix, std::int64_t seq, double target, double vmax, double amax,
-                   double jerk) {
+                   double jerk, std::int64_t sender = 0) {
     trip_plan_t p{};
+    p.sender_id = sender;
     p.utime = 1;
     p.seq = seq;
     p.target_length = target;
@@ -536,6 +537,60 @@ TEST(ForecastPlans, ImplausiblePlansAreRefusedAndAMaxSeqPlanExpires) {
                                              f.plan_seq == std::numeric_limits<std::int64_t>::max())
       << f.plan_seq;
   EXPECT_EQ(fc.back().plan_seq, 5);
+}
+
+// Plans carry their sender's identity and the sequence rule is per sender: a
+// forged plan from another sender with seq = INT64_MAX is in force only until
+// the genuine sender's next plan (never locks it out); the genuine sender's
+// own old seq is refused while its plan is in force, and its sequence reset
+// is accepted once its last plan expired.  Port 8000.
+TEST(ForecastPlans, AForgedMaxSeqFromAnotherSenderDoesNotLockOutTheGenuineOne) {
+  TwinConfig c = demoShaft(6, ClockMode::Input);
+  c.forecast.rate = 1.0;
+  c.forecast.horizon = 1.0;
+  c.forecast.plan_timeout = 2.0;
+  Rig rig(8000, {c});
+  REQUIRE_MULTICAST(rig);
+  ASSERT_TRUE(rig.start({"HOIST_CAGE", "HOIST_HEALTH", "HOIST_FORECAST"})) << rig.logs();
+  const HoistProfile trip = HoistProfile::trapezoid();
+  long k = 0;
+  auto feedTo = [&](long last) {
+    for (; k <= last; ++k) {
+      rig.publishWinder("", kUtime0 + 10000 * k, k, trip.at(0.01 * static_cast<double>(k)));
+      const std::size_t want = static_cast<std::size_t>(k + 1);
+      ASSERT_TRUE(rig.pumpUntil([&] { return rig.listener().count("HOIST_CAGE") >= want; })) << rig.logs();
+    }
+  };
+  constexpr std::int64_t kGenuine = 0x5eed1234, kForger = 666;
+  const std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+  feedTo(1000);                                                   // cruising down at 5 m/s
+  rig.publishPlan("", 7, 300.0, 5.0, 1.0, 1.0, kGenuine);         // accepted
+  feedTo(1050);
+  rig.publishPlan("", kMax, 300.0, 5.0, 1.0, 1.0, kForger);       // forged, plausible: accepted
+  feedTo(1100);
+  rig.publishPlan("", 8, 300.0, 5.0, 1.0, 1.0, kGenuine);         // not locked out
+  rig.publishPlan("", 7, 300.0, 5.0, 1.0, 1.0, kGenuine);         // its own old seq: refused
+  feedTo(1250);                                                   // forecasts at 12 s follow seq 8
+  const std::size_t f12 = rig.listener().count("HOIST_FORECAST");
+  feedTo(1420);                                                   // the genuine plan expired at 13 s
+  rig.publishPlan("", 1, 300.0, 5.0, 1.0, 1.0, kGenuine);         // a sequence reset: accepted
+  feedTo(1520);                                                   // the forecast at 15 s follows it
+  const std::size_t h0 = rig.listener().count("HOIST_HEALTH");
+  ASSERT_TRUE(rig.pumpUntil([&] { return rig.listener().count("HOIST_HEALTH") >= h0 + 2; }));
+  const auto health = rig.listener().decoded<health_t>("HOIST_HEALTH");
+  ASSERT_FALSE(health.empty());
+  const health_t& h = health.back();
+  EXPECT_EQ(h.plans_accepted, 4);
+  EXPECT_EQ(reasonCount(h, "plan_old_seq"), 1);
+  EXPECT_EQ(h.plans_rejected, 1);
+  const auto fc = rig.listener().decoded<forecast_t>("HOIST_FORECAST");
+  ASSERT_GE(fc.size(), f12);
+  ASSERT_GT(f12, 0u);
+  EXPECT_EQ(fc[f12 - 1].plan_seq, 8) << "the forecast at 12 s follows the genuine seq 8, not the forged INT64_MAX";
+  EXPECT_EQ(fc.back().plan_seq, 1) << "the last forecast follows the genuine sender's sequence reset";
+  const std::string logs = rig.logs();
+  EXPECT_NE(logs.find("seq 7 from sender " + std::to_string(kGenuine) + " is not newer"), std::string::npos) << logs;
+  EXPECT_NE(logs.find("from sender " + std::to_string(kForger)), std::string::npos) << logs;
 }
 
 // ---- several shafts ------------------------------------------------------------

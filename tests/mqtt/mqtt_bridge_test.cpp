@@ -721,9 +721,18 @@ TEST_F(MqttBridge, DiscoveryIsNotPoisoned) {
   EXPECT_GE((*bh)["discovery"]["aged_out"].get<int>(), 71);
   // A command for north goes to the real daemon's channel.
   lcm.pump(200ms);
+  // (Besides the commands, the bridge asked the real daemon, once, for its
+  // alarm states: alarm_ack_t ACTION_REANNOUNCE.  The forged prefixes were asked nothing.)
+  auto commandsOn = [&](const std::string& ch, bool requests = false) {
+    std::size_t n = 0;
+    for (const auto& a : lcm.decoded<hoist::alarm_ack_t>(ch))
+      n += (a.action == hoist::alarm_ack_t::ACTION_REANNOUNCE) == requests;
+    return n;
+  };
   c.publish("hoist/north/cmd/ack", R"({"kind":"*","level":0,"action":3,"user":"op"})");
-  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("north/HOIST_ALARM_ACK") == 1; }, 5s)) << readFile(log("bridge.log"));
+  ASSERT_TRUE(lcm.waitFor([&] { return commandsOn("north/HOIST_ALARM_ACK") == 1; }, 5s)) << readFile(log("bridge.log"));
   EXPECT_EQ(lcm.count("north_HOIST_ALARM_ACK"), 0u);
+  EXPECT_EQ(commandsOn("north/HOIST_ALARM_ACK", true), 1u);
 
   // Another prefix claims "north" at the health rate: both reported, commands refused while it lasts.
   auto claim = [&](const std::vector<std::string>& prefixes, std::chrono::milliseconds d) {
@@ -1047,3 +1056,94 @@ TEST_F(MqttBridge, EstimateAtTheCageRateNotRetained) {
   bridge.signal(SIGTERM);
   EXPECT_EQ(bridge.wait(5s), 0);
 }
+
+// An alarm raised before the bridge starts is published on MQTT right after
+// the bridge hears the daemon -- as its current state (active, WARNING), never
+// first as a CLEAR -- without waiting for the periodic re-announce (an hour
+// here): the bridge asks the daemon to re-announce (alarm_ack_t
+// ACTION_REANNOUNCE).  A configured shaft and a discovered one.  LCM port 8001.
+TEST_F(MqttBridge, AnAlarmRaisedBeforeTheBridgeStartsAppearsAtOnce) {
+  dir_ = testDir("mqtt_alarm_at_start");
+  const std::string url = urlFor(8001);
+  Broker broker(dir_, freePort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  lcm.subscribe("north/HOIST_(HEALTH|ALARM|ALARM_ACK)");
+  std::string twin = readFile(daemonConfig(dir_, "north/"));
+  const auto pos = twin.find("reannounce = ");
+  ASSERT_NE(pos, std::string::npos);
+  twin.replace(pos, twin.find('\n', pos) - pos, "reannounce = 3600.0");
+  std::ofstream((dir_ / "twin_quiet.toml").string()) << twin;
+  auto twind = startDaemonAndWait(lcm, {HOIST_TWIND, "--config", (dir_ / "twin_quiet.toml").string(), "--lcm-url", url},
+                                  log("twind.log"), "north/HOIST_HEALTH");
+  Process replay({HOIST_REPLAY, "--profile", "rest:t_end=60", "--lcm-url", url, "--channel-prefix", "north/"},
+                 log("replay.log"));
+  // CAGE_POS_Y WARNING (demo.toml's 16 mm gap) is raised before any bridge runs.
+  ASSERT_TRUE(lcm.waitFor([&] {
+    for (const auto& a : lcm.decoded<hoist::alarm_t>("north/HOIST_ALARM"))
+      if (a.kind == "CAGE_POS_Y" && a.event_type == hoist::alarm_t::EVENT_RAISE) return true;
+    return false;
+  }, 15s)) << readFile(log("twind.log"));
+  lcm.pump(500ms);
+
+  auto firstState = [&](const std::string& topic) -> std::optional<json> {
+    for (const auto& m : c.on(topic)) return json::parse(m.payload, nullptr, false);
+    return std::nullopt;
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.5\n";
+  Process configured({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--channel-prefix",
+                      "north/", "--client-id", "bridge-s"},
+                     log("bridge.log"));
+  std::optional<json> alarm;
+  lcm.waitFor([&] {
+    alarm = c.waitJson("hoist/north/alarm/CAGE_POS_Y", [](const json& j, bool) { return isWarningActive(j); }, 0ms);
+    return alarm.has_value();
+  }, 10s);
+  ASSERT_TRUE(alarm) << readFile(log("bridge.log")) << readFile(log("twind.log"));
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(took, 8.0) << "not the periodic re-announce (3600 s)";
+  EXPECT_EQ((*alarm)["last_event"], "REANNOUNCE");
+  EXPECT_TRUE((*alarm)["unacked"].get<bool>());
+  const auto first = firstState("hoist/north/alarm/CAGE_POS_Y");
+  ASSERT_TRUE(first);
+  EXPECT_TRUE((*first)["active"].get<bool>()) << "the first state published is the alarm's state, not a CLEAR: "
+                                              << first->dump();
+  // Alarms that never had a state are not invented.
+  EXPECT_TRUE(c.on("hoist/north/alarm/GUIDE_ROPE").empty());
+  configured.signal(SIGTERM);
+  EXPECT_EQ(configured.wait(5s), 0);
+
+  // A discovering bridge (no --channel-prefix) asks when it confirms the shaft.
+  Client c2(broker.port(), "c2");
+  ASSERT_TRUE(c2.connected());
+  c2.subscribe("hoist/+/alarm/#");
+  lcm.pump(300ms);
+  const std::size_t retained_seen = c2.on("hoist/north/alarm/CAGE_POS_Y").size();  // the first bridge's retained state
+  const auto t1 = std::chrono::steady_clock::now();
+  Process discovering({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id",
+                       "bridge-d2"},
+                      log("bridge2.log"));
+  ASSERT_TRUE(lcm.waitFor([&] { return c2.on("hoist/north/alarm/CAGE_POS_Y").size() > retained_seen; }, 15s))
+      << readFile(log("bridge2.log"));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count(), 10.0);
+  const json fresh = json::parse(c2.on("hoist/north/alarm/CAGE_POS_Y")[retained_seen].payload);
+  EXPECT_TRUE(isWarningActive(fresh)) << fresh.dump();
+  auto requests = [&] {
+    std::size_t n = 0;
+    for (const auto& a : lcm.decoded<hoist::alarm_ack_t>("north/HOIST_ALARM_ACK"))
+      n += a.action == hoist::alarm_ack_t::ACTION_REANNOUNCE;
+    return n;
+  };
+  lcm.waitFor([&] { return requests() >= 2; }, 3s);
+  lcm.pump(500ms);
+  EXPECT_EQ(requests(), 2u) << "one request per bridge";
+  discovering.signal(SIGTERM);
+  EXPECT_EQ(discovering.wait(5s), 0);
+  stopDaemonCleanly(*twind, log("twind.log"));
+}
+

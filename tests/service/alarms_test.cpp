@@ -472,3 +472,56 @@ TEST(AlarmEngine, SlotTableGivesEachAlarmItsKindLevelAndSettings) {
   EXPECT_FALSE(pred.latch);
   EXPECT_DOUBLE_EQ(eng.find(AlarmKind::InputStale, AlarmLevel::Warning)->settings().off_delay, 0.0);
 }
+
+// A re-announce request (alarm_ack_t ACTION_REANNOUNCE): one EVENT_REANNOUNCE
+// per alarm that has a state to tell -- active, shelved, or raised and
+// cleared since the start -- and none for alarms never touched; nothing
+// changes (the periodic re-announce keeps its schedule, a later raise is
+// still a RAISE).
+TEST(AlarmEngine, ReannounceRequestReportsEveryAlarmWithAStateAndChangesNothing) {
+  AlarmConfig cfg;
+  cfg.reannounce = 100.0;
+  AlarmEngine eng(cfg);
+  AlarmEvents ev;
+  EXPECT_EQ(eng.reannounce(0.0, std::nullopt, AlarmLevel::None, ev), 0) << "nothing has a state yet";
+  EXPECT_TRUE(ev.empty());
+  eng.setInputStale(1.0, true, ev);                                            // active WARNING
+  eng.shelve(1.0, AlarmKind::GuideRope, AlarmLevel::Critical, 600.0, ev);      // shelved, inactive
+  eng.setDuplicatePublisher(1.0, true, 7.0, ev);
+  eng.setDuplicatePublisher(2.0, false, 0.0, ev);                              // raised and cleared
+  ev.clear();
+  EXPECT_EQ(eng.reannounce(3.0, std::nullopt, AlarmLevel::None, ev), 3);
+  ASSERT_EQ(ev.size(), 3u);
+  for (const AlarmEvent& e : ev) {
+    EXPECT_EQ(e.type, AlarmEventType::Reannounce);
+    EXPECT_DOUBLE_EQ(e.t, 3.0);
+    if (e.kind == AlarmKind::InputStale) {
+      EXPECT_TRUE(e.active);
+      EXPECT_FALSE(e.acked);
+    } else if (e.kind == AlarmKind::GuideRope) {
+      EXPECT_EQ(e.level, AlarmLevel::Critical);
+      EXPECT_TRUE(e.shelved);
+      EXPECT_FALSE(e.active);
+      EXPECT_NEAR(e.shelved_for, 598.0, 1e-9);
+    } else {
+      EXPECT_EQ(e.kind, AlarmKind::DuplicatePublisher);
+      EXPECT_FALSE(e.active);
+    }
+  }
+  // Filtered by kind; the states did not change.
+  ev.clear();
+  EXPECT_EQ(eng.reannounce(3.5, AlarmKind::InputStale, AlarmLevel::None, ev), 1);
+  EXPECT_EQ(eng.activeCount(), 1);
+  EXPECT_EQ(eng.unackedCount(), 1);
+  EXPECT_EQ(eng.shelvedCount(), 1);
+  // The periodic re-announce still runs from the RAISE at 1 s (not from the requests).
+  ev.clear();
+  eng.poll(100.5, ev);
+  EXPECT_EQ(count(ev, AlarmEventType::Reannounce), 0);
+  eng.poll(101.0, ev);
+  EXPECT_EQ(count(ev, AlarmEventType::Reannounce), 1);
+  // A clear after the request is still announced as a CLEAR.
+  ev.clear();
+  eng.setInputStale(102.0, false, ev);
+  EXPECT_EQ(count(ev, AlarmEventType::Clear), 1);
+}

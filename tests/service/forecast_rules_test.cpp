@@ -14,6 +14,7 @@
 #include "hoist/service/forecast_rules.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
 #include "hoist/service/messages.hpp"
+#include "hoist/service/plan_senders.hpp"
 
 using namespace hoist;
 using namespace hoist::svc;
@@ -189,4 +190,31 @@ TEST(PredictedAlarms, RaiseAtOnceClearAfterOffDelayNameScenarioAndSeconds) {
   EXPECT_EQ(eng.acknowledge(20.5, AlarmKind::PredictedSlack, AlarmLevel::None, ev), 1);
   EXPECT_EQ(parseAlarmKind("PREDICTED_CLEARANCE"), AlarmKind::PredictedClearance);
   EXPECT_EQ(parseAlarmKind("PREDICTED_SLACK"), AlarmKind::PredictedSlack);
+}
+
+// The trip-plan sequence rule is per sender (hoist/service/plan_senders.hpp):
+// a forged INT64_MAX from one sender never makes another's plans old; a
+// sender's own old seq is refused until its last plan expired, then a
+// sequence reset is accepted; a full table forgets the sender heard longest ago.
+TEST(PlanSenders, SequenceIsPerSenderAndResetsAfterExpiry) {
+  PlanSenders s;
+  const double timeout = 10.0;
+  std::int64_t last = 0;
+  double last_t = 0.0;
+  EXPECT_FALSE(s.isOld(1, 5, 0.0, timeout, last, last_t));
+  s.accept(1, 5, 0.0, timeout);
+  s.accept(666, std::numeric_limits<std::int64_t>::max(), 0.5, timeout);  // forged sender
+  EXPECT_FALSE(s.isOld(1, 6, 1.0, timeout, last, last_t)) << "another sender's seq does not lock sender 1 out";
+  EXPECT_TRUE(s.isOld(1, 5, 1.0, timeout, last, last_t));
+  EXPECT_EQ(last, 5);
+  EXPECT_DOUBLE_EQ(last_t, 0.0);
+  EXPECT_TRUE(s.isOld(666, 1, 1.0, timeout, last, last_t));
+  s.accept(1, 6, 1.0, timeout);
+  EXPECT_TRUE(s.isOld(1, 0, 10.9, timeout, last, last_t)) << "a reset before expiry is old";
+  EXPECT_FALSE(s.isOld(1, 0, 11.1, timeout, last, last_t)) << "a reset after expiry is accepted";
+  EXPECT_FALSE(s.isOld(1, 0, -9.1, timeout, last, last_t)) << "model time restarted (a new winder stream)";
+  // More senders than the table holds: the one accepted longest ago is forgotten.
+  for (std::int64_t id = 100; id < 100 + PlanSenders::kSenders; ++id) s.accept(id, 1, 2.0, timeout);
+  EXPECT_FALSE(s.isOld(1, 6, 2.0, timeout, last, last_t)) << "sender 1 was forgotten";
+  EXPECT_TRUE(s.isOld(100 + PlanSenders::kSenders - 1, 1, 2.0, timeout, last, last_t));
 }

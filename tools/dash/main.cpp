@@ -227,6 +227,7 @@ int main(int argc, char** argv) {
       lcm.subscribe(".*HOIST_.*", &LcmPump::onMessage, &pump);
     }
   }
+  hub.requestAlarmStates();  // alarms raised before this start: their states now
 
   net::io_context io;
   hoist::dash::Server::Limits lim;

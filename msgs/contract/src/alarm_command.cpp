@@ -11,6 +11,7 @@ const char* toString(AlarmAction a) {
     case AlarmAction::Ack: return "ACK";
     case AlarmAction::Shelve: return "SHELVE";
     case AlarmAction::Unshelve: return "UNSHELVE";
+    case AlarmAction::Reannounce: return "REANNOUNCE";
   }
   return "?";
 }
@@ -39,6 +40,7 @@ CommandError validateAlarmCommand(std::string_view kind, int level, int action, 
     case static_cast<int>(AlarmAction::Ack): c.action = AlarmAction::Ack; break;
     case static_cast<int>(AlarmAction::Shelve): c.action = AlarmAction::Shelve; break;
     case static_cast<int>(AlarmAction::Unshelve): c.action = AlarmAction::Unshelve; break;
+    case static_cast<int>(AlarmAction::Reannounce): c.action = AlarmAction::Reannounce; break;
     default: return CommandError::BadAction;
   }
   if (c.action == AlarmAction::Shelve && !(std::isfinite(shelve_duration) && shelve_duration > 0.0))

@@ -158,6 +158,39 @@ Hub::Hub(Options opt, Publisher publish, Clock clock)
   for (const auto& p : opt_.prefixes) addPrefix(p);
 }
 
+void Hub::requestAlarmStates() { request_states_ = true; }
+
+void Hub::maybeRequestAlarmStates(const std::string& prefix, const Json& health) {
+  // Once per daemon instance of a shaft: its first health (a fixed prefix)
+  // or its confirmation (a discovered one).  Into the void never (no daemon
+  // yet), and a one-shot forged prefix costs no request.
+  if (!request_states_) return;
+  const std::int64_t instance = health.value("instance_id", std::int64_t{0});
+  if (instance == 0) return;
+  if (const auto d = disc_.find(prefix); d != disc_.end() && !d->second.confirmed) return;
+  auto [it, fresh] = states_asked_.emplace(prefix, instance);
+  if (!fresh && it->second == instance) return;
+  it->second = instance;
+  requestAlarmStates(prefix);
+}
+
+void Hub::requestAlarmStates(const std::string& prefix) {
+  // alarm_ack_t ACTION_REANNOUNCE changes nothing in the daemon (which
+  // honours one a second): its answer is every alarm's current state, so an
+  // alarm raised before this dashboard started, or before the shaft was
+  // discovered, is in the alarm list at once.  Sent also with --read-only.
+  alarm_ack_t m{};
+  m.utime = static_cast<std::int64_t>(clock_() / 1000);
+  m.kind = "*";
+  m.action = alarm_ack_t::ACTION_REANNOUNCE;
+  m.user = "hoist-dash";
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
+  if (m.encode(buf.data(), 0, static_cast<int>(buf.size())) >= 0 && publish_(prefix + std::string(bus::kChannelAlarmAck), buf))
+    count("alarm_state_requests");
+  else
+    count("alarm_state_requests_failed");
+}
+
 std::uint64_t Hub::counter(const std::string& what) const {
   const auto it = counters_.find(what);
   return it == counters_.end() ? 0 : it->second;
@@ -347,6 +380,7 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
   if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
+  if (suffix == "HOIST_HEALTH" && channelFor(channel) != nullptr) maybeRequestAlarmStates(prefix, j);
   if (suffix == "HOIST_ALARM" && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
@@ -693,6 +727,7 @@ void Hub::removePrefix(const std::string& prefix) {
   if (pit == prefix_list_.end()) return;
   prefix_list_.erase(pit);
   disc_.erase(prefix);
+  states_asked_.erase(prefix);
   decimators_.erase(prefix);
   estimate_decimators_.erase(prefix);
   history_.erase(prefix);

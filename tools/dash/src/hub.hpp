@@ -106,6 +106,12 @@ class Hub {
   /// Flush the decimated channels (call at the display rate, ~25 Hz); also
   /// ages out discovered prefixes and updates the discovery status.
   void flushDecimated();
+  /// From now on, ask each shaft's daemon to re-announce its alarms' current
+  /// states (alarm_ack_t ACTION_REANNOUNCE; it changes nothing) when its
+  /// health first arrives -- at start, for a shaft discovered later, for a
+  /// new daemon instance -- so that alarms raised before are listed at once.
+  /// Call once the LCM receive path is open (main.cpp).
+  void requestAlarmStates();
   /// Ages out silent candidate prefixes; updates the discovery status.
   void maintainDiscovery();
   /// The shaft name of a channel prefix: the prefix without one trailing
@@ -156,6 +162,8 @@ class Hub {
   void addHistory(const std::string& prefix, const Json& decimated);
   std::string historyOf(const std::string& prefix) const;
   void addPrefix(const std::string& prefix);
+  void requestAlarmStates(const std::string& prefix);
+  void maybeRequestAlarmStates(const std::string& prefix, const Json& health);
   void removePrefix(const std::string& prefix);
   void onDiscoveryHealth(const std::string& prefix, const Json& health);
   void noteHealth(Evidence& e, std::int64_t instance, std::uint64_t now) const;
@@ -175,6 +183,8 @@ class Hub {
   void handleClientMessage(Client& c, std::uint32_t chan, std::string_view payload);
 
   Options opt_;
+  bool request_states_ = false;  // requestAlarmStates() was called
+  std::map<std::string, std::int64_t> states_asked_;  // prefix -> daemon instance asked (bounded by the prefixes)
   Publisher publish_;
   Clock clock_;
   std::set<Client*> clients_;

@@ -119,6 +119,7 @@ struct Bridge::Impl {
     Clock::time_point first_seen{}, last_seen{}, streak_start{}, last_refused_log{};
     std::int64_t streak_instance = 0;
     int streak = 0;                // health messages of streak_instance, gaps <= discovery_timeout
+    std::int64_t states_asked = 0;  // daemon instance asked for its alarm states (requestAlarmStates)
     bool refused = false;          // confirmed-quality but no slot (table full) or its name is taken
     bool cage_new = false;
     bool alarms_settled = false;   // Sparkplug: alarm kinds never heard of are known inactive
@@ -390,6 +391,27 @@ struct Bridge::Impl {
     }
     if (conn == Conn::Connected) subscribeCommands(s);
     for (const auto& [kind, a] : s.alarms) publishAlarmState(s, kind, a);
+    // Discovered: bound on its daemon's health, which it has heard.
+    if (!s.configured) requestAlarmStates(s, s.streak_instance);
+  }
+
+  /// Asks the shaft's daemon (instance `instance`, whose health was heard) to
+  /// re-announce every alarm's current state now (alarm_ack_t
+  /// ACTION_REANNOUNCE; it changes nothing, and the daemon honours one a
+  /// second), once per daemon instance: an alarm raised before this bridge
+  /// started, or before the shaft was discovered, is published at once as its
+  /// state, not first as a CLEAR.  Sent also with --no-commands (it commands
+  /// nothing); never into the void (no daemon heard yet).
+  void requestAlarmStates(Shaft& s, std::int64_t instance) {
+    if (instance == 0 || instance == s.states_asked) return;
+    s.states_asked = instance;
+    hoist::alarm_ack_t m{};
+    m.utime = hoist::bus::wallUtime();
+    m.kind = "*";
+    m.action = hoist::alarm_ack_t::ACTION_REANNOUNCE;
+    m.user = client_id;
+    const std::string channel = hoist::bus::channel(s.prefix, kChannelAlarmAck);
+    if (lcm.publish(channel, &m) != 0) spdlog::warn("shaft '{}': cannot ask for its alarm states on {}", s.name, channel);
   }
 
   std::size_t slotsUsed() const {
@@ -537,6 +559,7 @@ struct Bridge::Impl {
     ++s.health_in;
     s.last_health = now;
     if (!s.bound) return tryConfirm(s, now);
+    requestAlarmStates(s, m.instance_id);
     if (s.instance_id != 0 && m.instance_id != s.instance_id) daemonRestarted(s, m);
     s.instance_id = m.instance_id;
     if (sp) {

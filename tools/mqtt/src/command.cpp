@@ -138,7 +138,7 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
         return r;
       case hoist::contract::CommandError::BadAction:
         r.reject = CommandReject::BadAction;
-        r.detail = "action " + std::to_string(int(r.ack.action)) + " (1 ack, 2 shelve, 3 unshelve)";
+        r.detail = "action " + std::to_string(int(r.ack.action)) + " (1 ack, 2 shelve, 3 unshelve, 4 re-announce)";
         return r;
       case hoist::contract::CommandError::BadShelveDuration:
         r.reject = CommandReject::BadShelveDuration;

@@ -174,6 +174,13 @@ class BinaryAlarm {
   /// Shelve for `duration` seconds (> 0).  Re-shelving extends/shortens.
   bool shelve(double now, double duration, AlarmEvents& out);
   bool unshelve(double now, AlarmEvents& out);
+  /// Whether the alarm has a state to tell a client: it emitted an event
+  /// since it was configured (raised, cleared, acknowledged, shelved, ...).
+  bool hasState() const { return touched_; }
+  /// Append an EVENT_REANNOUNCE of the current state, active or not; no
+  /// state changes (an operator's re-announce request, alarm_ack_t
+  /// ACTION_REANNOUNCE).
+  void reportState(double now, AlarmEvents& out) const { out.push(event(AlarmEventType::Reannounce, now)); }
 
   AlarmKind kind() const { return kind_; }
   AlarmLevel level() const { return level_; }
@@ -186,6 +193,7 @@ class BinaryAlarm {
   double value() const { return value_; }
 
  private:
+  AlarmEvent event(AlarmEventType type, double now) const;
   void emit(AlarmEventType type, double now, AlarmEvents& out);
   void announce(double now, AlarmEvents& out);  // publish active_ if it differs from announced_
   void expireShelve(double now, AlarmEvents& out);
@@ -197,6 +205,7 @@ class BinaryAlarm {
   double pending_since_ = -1.0;  // < 0: raw state agrees with cond_
   bool pending_valid_ = false;
   bool active_ = false, acked_ = false, shelved_ = false, announced_ = false;
+  bool touched_ = false;  // emitted an event since configure()
   double shelved_until_ = 0.0;
   double last_announce_ = 0.0;
   double value_ = 0.0;
@@ -272,6 +281,10 @@ class AlarmEngine {
   int shelve(double now, std::optional<AlarmKind> kind, AlarmLevel level, double duration,
              AlarmEvents& out);
   int unshelve(double now, std::optional<AlarmKind> kind, AlarmLevel level, AlarmEvents& out);
+  /// Re-announce request: an EVENT_REANNOUNCE of the current state of every
+  /// matching alarm that has one (BinaryAlarm::hasState), shelved or not,
+  /// active or not; nothing changes.  Returns the number of events.
+  int reannounce(double now, std::optional<AlarmKind> kind, AlarmLevel level, AlarmEvents& out);
 
   AlarmLevel highestActive() const;  ///< over unshelved active alarms
   int activeCount() const;

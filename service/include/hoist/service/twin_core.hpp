@@ -144,7 +144,8 @@ class TwinCore {
   /// Staleness, shelve expiry and re-announcement; call at least a few times
   /// per second (the daemon calls it every tick).
   void housekeeping(double wall_now);
-  /// Operator command; returns the number of alarms affected.
+  /// Operator command; returns the number of alarms affected (Reannounce:
+  /// the number of alarms whose state was re-announced; the daemon rate-limits it).
   int command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLevel level,
               double shelve_duration);
 

@@ -12,14 +12,17 @@
 
 namespace hoist::contract {
 
-/// Operator command; values match alarm_ack_t.ACTION_*.
-enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3 };
+/// Operator command; values match alarm_ack_t.ACTION_*.  Reannounce changes
+/// no state: it asks the daemon to announce the current state of every
+/// alarm that has one (a client that just started learns of alarms raised
+/// before it); the daemon honours at most one a second per shaft.
+enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3, Reannounce = 4 };
 
 /// Why a command was refused.
 enum class CommandError { None, UnknownKind, BadLevel, BadAction, BadShelveDuration };
 inline constexpr int kCommandErrors = 5;
 
-const char* toString(AlarmAction a);   ///< "ACK", "SHELVE", "UNSHELVE"
+const char* toString(AlarmAction a);   ///< "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE"
 const char* toString(CommandError e);  ///< "ok", "unknown_kind", "bad_level", "bad_action", "bad_shelve_duration"
 
 /// A validated command.  kind empty = every kind; level None = both levels.
@@ -32,7 +35,7 @@ struct AlarmCommand {
 
 /// Validates the fields of an alarm_ack_t: `kind` an alarm kind name
 /// (parseAlarmKind), "" or "*" (all kinds); `level` 0 (both), 1 (WARNING) or
-/// 2 (CRITICAL); `action` alarm_ack_t.ACTION_ACK/SHELVE/UNSHELVE; for SHELVE a
+/// 2 (CRITICAL); `action` alarm_ack_t.ACTION_ACK/SHELVE/UNSHELVE/REANNOUNCE; for SHELVE a
 /// finite `shelve_duration` > 0 (the daemon bounds it by [alarms].max_shelve).
 /// Fills `out` and returns CommandError::None when valid.
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
