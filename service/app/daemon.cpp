@@ -262,6 +262,10 @@ void Daemon::startSchedules() {
     const ServiceConfig& s = shafts_[i]->config().service;
     shafts_[i]->start(start_, static_cast<double>(i) / static_cast<double>(n) / s.health_rate);
   }
+  // Every shaft announced itself (one HOIST_HEALTH each, milliseconds for
+  // hundreds of shafts): the schedule starts after that burst, not under it.
+  start_ = Clock::now();
+  for (auto& sp : shafts_) sp->rebase(start_);
   for (auto& g : groups_) {
     g->k = 1;
     g->last_start = start_;

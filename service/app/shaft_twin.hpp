@@ -102,6 +102,9 @@ class ShaftTwin {
   /// first HOIST_HEALTH at once, the next ones `health_phase` s earlier than
   /// a full period later (the shafts of one daemon spread them out).
   void start(Clock::time_point start, double health_phase);
+  /// Wall times are measured from `start` from now on (the daemon's schedule
+  /// starts after the shafts announced themselves).
+  void rebase(Clock::time_point start) { ctx_.start = start; }
   /// The daemon's loop-time split and miss record (miss_record.hpp), and
   /// this shaft's publication phase: with shape_rate (cage_rate) below the
   /// step rate, HOIST_GUIDE_SHAPE (HOIST_CAGE) goes out on the ticks k with
