@@ -37,8 +37,11 @@ def worst_miss_text(r):
     sp = w.get("split_us", {})
     parts = [f"{lbl} {fmt_us(sp[k])}" for k, lbl in MISS_PHASES if sp.get(k, 0) >= 1.0]
     kept = f"{m.get('kept', '?')} kept" + (f", {m['dropped']} dropped" if m.get("dropped") else "")
+    cpu = w.get("cpu_us", -1)
+    cpu_txt = f"; loop thread CPU {fmt_us(cpu)}" if cpu is not None and cpu >= 0 else ""
     return (f"worst: tick {w.get('tick', '?')} at t = {w.get('model_t', 0):.2f} s, {fmt_us(w.get('late_us', float('nan')))} "
-            f"late, {w.get('shafts_late', '?')}/{w.get('shafts', '?')} shafts; " + ", ".join(parts) + f" ({kept})")
+            f"late, {w.get('shafts_late', '?')}/{w.get('shafts', '?')} shafts; " + ", ".join(parts) + cpu_txt +
+            f" ({kept})")
 
 
 def bare_cell(b):
@@ -147,11 +150,13 @@ def main():
                "daemon's CPU during the same run (`hoist-wakeup-latency`, same rate, SCHED_FIFO 90, no work): the "
                "ticks the machine itself woke up more than a period late, and its worst wake-up lateness.  A "
                "platform stall of more than a period makes every hosted shaft miss that tick (N misses per stall).  "
-               "\"worst miss\": the daemon's miss record (`misses` in its run report): the latest tick, how late, how "
+               "\"worst miss\": the daemon's miss record (`misses` in its run report): the tick that began latest in the run, how late, how "
                "many shafts began more than a period late, and where the loop's time went from the schedule's previous "
                "tick to it (receive, model step, envelope, publish, forecast hand-over, deferred starts, health, the rest "
                "of the tick, and timer: neither worked nor idle before the deadline, i.e. the wake-up, the kernel or a "
-               "stall of the machine); phases under 1 µs are left out.")
+               "stall of the machine), and the loop thread's CPU time over the same interval (the phases are steady-clock "
+               "spans: a thread preempted inside one counts the wait there, and its CPU time is then well below their "
+               "sum); phases under 1 µs are left out.")
     out.append("")
     # Summary: per setting and daemon, the largest count that keeps up.
     out.append("## Twins per core")

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <limits>
 #include <map>
 #include <systemd/sd-daemon.h>
@@ -25,6 +26,17 @@ using std::chrono::duration_cast;
 
 using rt::nanos;
 using rt::processCpuNanos;
+
+namespace {
+
+/// CPU time of the calling thread [ns] (0 if unavailable).
+std::int64_t threadCpuNanos() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+}  // namespace
 
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
@@ -270,6 +282,7 @@ void Daemon::startSchedules() {
     g->k = 1;
     g->last_start = start_;
     g->split_at = split_;
+    g->cpu_at = threadCpuNanos();
     armTimer(*g);
   }
   armMissLog();
@@ -405,9 +418,11 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   // The outputs queued by the shafts go out at the same points.
   // A tick that skipped deadlines is a miss: its record takes the split of
   // the loop's time since this schedule's previous tick (miss_record.hpp).
-  MissRecord* miss = skipped > 0 ? &beginMiss(g, now, deadline, skipped) : nullptr;
+  const std::int64_t cpu_now = threadCpuNanos();  // one clock_gettime per tick (not per shaft)
+  MissRecord* miss = skipped > 0 ? &beginMiss(g, now, deadline, skipped, cpu_now) : nullptr;
   g.split_at = split_;
   g.last_start = now;
+  g.cpu_at = cpu_now;
   const std::int64_t work0 = split_.sum();
   const double period_us = duration<double, std::micro>(g.period).count();
   // Deferred starts: at most the group's budget in this tick.
@@ -438,7 +453,7 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
 // ---- the miss record (miss_record.hpp) -------------------------------------------
 
 MissRecord& Daemon::beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
-                              std::int64_t skipped) {
+                              std::int64_t skipped, std::int64_t cpu_now) {
   MissRecord& r = misses_->begin();
   r.utime = bus::wallUtime();
   r.wall = duration<double>(now - start_).count();
@@ -461,6 +476,7 @@ MissRecord& Daemon::beginMiss(const RateGroup& g, Clock::time_point now, Clock::
   const double to_deadline_us = duration<double, std::micro>(deadline - g.last_start).count();
   r.idle_us = std::max(0.0, to_deadline_us - work_us);
   r.timer_us = std::max(0.0, r.window_us - work_us - r.idle_us);
+  r.cpu_us = g.cpu_at > 0 && cpu_now > 0 ? 1e-3 * static_cast<double>(cpu_now - g.cpu_at) : -1.0;
   return r;
 }
 
@@ -502,10 +518,12 @@ void Daemon::onMissLog(const boost::system::error_code& ec) {
       log_.warn("deadline misses: {} in the last second ({} since start); the worst: tick {} of the {} Hz schedule "
                 "(t = {:.2f} s) {:.2f} ms late, {} deadline(s) skipped, {} of {} shafts more than a period late; "
                 "since the previous tick [ms]: receive {:.2f}, step {:.2f}, envelope {:.2f}, publish {:.2f}, "
-                "forecast {:.2f}, start {:.2f}, health {:.2f}, other {:.2f}, timer {:.2f}, idle {:.2f}",
+                "forecast {:.2f}, start {:.2f}, health {:.2f}, other {:.2f}, timer {:.2f}, idle {:.2f}; "
+                "the loop thread's CPU time {:.2f}",
                 total - misses_logged_, total, w->tick, w->rate, w->model_t, 1e-3 * w->late_us, w->skipped,
                 w->shafts_late, w->shafts, ms(x.receive), ms(x.step), ms(x.envelope), ms(x.publish),
-                ms(x.forecast), ms(x.start), ms(x.health), ms(x.other), 1e-3 * w->timer_us, 1e-3 * w->idle_us);
+                ms(x.forecast), ms(x.start), ms(x.health), ms(x.other), 1e-3 * w->timer_us, 1e-3 * w->idle_us,
+                1e-3 * w->cpu_us);
     }
     misses_logged_ = total;
   }

@@ -115,6 +115,7 @@ class Daemon {
     // previous tick began.
     LoopSplit split_at{};
     Clock::time_point last_start{};
+    std::int64_t cpu_at = 0;  ///< the loop thread's CPU time then [ns]
   };
 
   // start(), step by step
@@ -140,7 +141,7 @@ class Daemon {
   /// A tick that skipped deadlines: a record of when, which and the split
   /// of the loop's time since the schedule's previous tick.
   MissRecord& beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
-                        std::int64_t skipped);
+                        std::int64_t skipped, std::int64_t cpu_now);
   /// Shaft j of the group ran its step in the late tick.
   static void noteMissShaft(MissRecord& r, const RateGroup& g, std::size_t j, double period_us);
   /// Once a second, outside the ticks: one log line for the misses since the

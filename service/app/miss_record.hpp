@@ -61,6 +61,11 @@ struct MissRecord {
   /// Time neither worked nor idle before the deadline: the timer's wake-up,
   /// the kernel, Asio, and any stall of the machine itself [us].
   double timer_us = 0.0;
+  /// The loop thread's CPU time in that interval [us].  The phases are
+  /// steady-clock spans: a thread preempted inside one (another process on
+  /// its CPU, a stall of the machine) counts the wait in that phase, and the
+  /// work then exceeds this CPU time by as much.
+  double cpu_us = 0.0;
 };
 
 /// The latest kCapacity miss records (a ring; older ones are dropped and

@@ -86,6 +86,7 @@ nlohmann::ordered_json missJson(const MissRecord& r, const RunFacts& f) {
           {"worst_shaft", label(r.worst_shaft)},
           {"worst_late_us", r.worst_late_us},
           {"window_us", r.window_us},
+          {"cpu_us", r.cpu_us},
           {"split_us", splitJson(r)}};
 }
 
@@ -98,8 +99,9 @@ nlohmann::ordered_json missesJson(const RunFacts& f) {
   o["note"] =
       "one record per tick that started more than a period late (each shaft of its schedule missed `skipped` "
       "deadlines); split_us: the loop's time from the schedule's previous tick start to this one, by phase "
-      "(timer: neither worked nor idle before the deadline: wake-up, kernel, a stall of the machine); the ring "
-      "keeps the latest " + std::to_string(MissLog::kCapacity) + " records";
+      "(timer: neither worked nor idle before the deadline: wake-up, kernel, a stall of the machine); the phases "
+      "are steady-clock spans, so a preemption inside one counts there: cpu_us, the loop thread's CPU time in the "
+      "same interval, shows it (work well above cpu_us: the thread was not running); the ring keeps the latest " + std::to_string(MissLog::kCapacity) + " records";
   o["recorded"] = m.total();
   o["kept"] = m.kept();
   o["dropped"] = m.dropped();

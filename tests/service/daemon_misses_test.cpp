@@ -237,6 +237,10 @@ TEST(DaemonMisses, ASlowTickIsRecordedWithItsSplitInHealthAndReport) {
   for (std::int64_t other : {w.receive, w.envelope, w.publish, w.forecast, w.start, w.health, w.other})
     EXPECT_LT(other, w.step) << "the step dominates the split";
   EXPECT_LE(1e-3 * static_cast<double>(w.sum()), slow->window_us + 1.0) << "the work fits the interval";
+  // The busy-wait ran on the loop thread: its CPU time in the interval is
+  // positive and no more than the interval (one thread).
+  EXPECT_GT(slow->cpu_us, 0.0);
+  EXPECT_LE(slow->cpu_us, slow->window_us * 1.05 + 1000.0);
 
   // In HOIST_HEALTH of the shaft that took part (all four did).
   const auto health = listener.decoded<health_t>("m0/HOIST_HEALTH");
