@@ -212,7 +212,8 @@ json.dump(r, open(p, "w"), separators=(",", ":"))
 PY
       cpu=$(python3 -c "print(f'{100.0 * ((${st1[0]} + ${st1[1]}) - (${st0[0]} + ${st0[1]})) / $clk / ($t1 - $t0):.0f}')")
       steal=$(python3 -c "print(f'{($steal1 - $steal0) / $clk:.2f}')")
-      echo "[multishaft] $tag: timing test exit $verdict, daemon CPU $cpu %, steal $steal s" >&2
+      echo "[multishaft] $tag: timing test exit $verdict, daemon CPU $cpu %, steal $steal s;" \
+        "$(python3 "$here/bench/multishaft_report.py" --row-summary "$raw/$tag.json")" >&2
       rm -rf "$cfgdir"
       rows+=("$name" "$modes:$corr" "$N" "$raw/$tag.json" "$raw/$tag.timing.md" "$cpu/$steal")
     done

@@ -21,6 +21,29 @@ PHASES = [("model_step", "model step"), ("envelope", "envelope"), ("publish", "L
           ("receive", "LCM receive"), ("tick_other", "rest of the tick"), ("timer_and_rest", "timer, kernel, rest")]
 
 
+MISS_PHASES = [("receive", "receive"), ("step", "step"), ("envelope", "envelope"), ("publish", "publish"),
+               ("forecast", "forecast"), ("start", "start"), ("health", "health"), ("other", "other"),
+               ("timer", "timer")]
+
+
+def worst_miss_text(r):
+    """The worst recorded miss of a run report and the split of the loop's time
+    before it (the daemon's miss record), in one short cell; "" when the
+    report has no miss record or no miss."""
+    m = (r or {}).get("misses")
+    if not m or not m.get("worst"):
+        return ""
+    w = m["worst"]
+    sp = w.get("split_us", {})
+    parts = [f"{lbl} {fmt_us(sp[k])}" for k, lbl in MISS_PHASES if sp.get(k, 0) >= 1.0]
+    kept = f"{m.get('kept', '?')} kept" + (f", {m['dropped']} dropped" if m.get("dropped") else "")
+    cpu = w.get("cpu_us", -1)
+    cpu_txt = f"; loop thread CPU {fmt_us(cpu)}" if cpu is not None and cpu >= 0 else ""
+    return (f"worst: tick {w.get('tick', '?')} at t = {w.get('model_t', 0):.2f} s, {fmt_us(w.get('late_us', float('nan')))} "
+            f"late, {w.get('shafts_late', '?')}/{w.get('shafts', '?')} shafts; " + ", ".join(parts) + cpu_txt +
+            f" ({kept})")
+
+
 def bare_cell(b):
     if not b:
         return "—"
@@ -35,8 +58,22 @@ def main():
     ap.add_argument("--same-url", default="0")
     ap.add_argument("--feeder-rt", default="0")
     ap.add_argument("--out-dir", default=".")
-    ap.add_argument("items", nargs="+")
+    ap.add_argument("--row-summary", metavar="JSON",
+                    help="print one line for the run report JSON (misses and the worst miss's split) and exit")
+    ap.add_argument("items", nargs="*")
     a = ap.parse_args()
+    if a.row_summary:
+        try:
+            with open(a.row_summary) as f:
+                r = json.load(f)
+        except (OSError, ValueError) as e:
+            print(f"no run report ({e})")
+            return
+        misses = sum(s["deadline_misses"] for s in r.get("shafts", []))
+        print(f"deadline misses {misses}" + (f"; {worst_miss_text(r)}" if worst_miss_text(r) else ""))
+        return
+    if not a.items:
+        sys.exit("multishaft_report.py: no runs given")
     if len(a.items) % 6:
         sys.exit("multishaft_report.py: arguments come in sextuples NAME SETTING N JSON MD CPU/STEAL")
     rows = []
@@ -76,7 +113,7 @@ def main():
                + "  Lateness is measured at the start of each shaft's own step, so it includes the work of the "
                "shafts stepped before it in the same tick.")
     out.append("")
-    out.append("| setting | twins | daemon | deadline misses | worst lateness p99 / max | step p50 / p99 | CPU used "
+    out.append("| setting | twins | daemon | deadline misses (worst miss: split of the loop's time before it) | worst lateness p99 / max | step p50 / p99 | CPU used "
                "| steal | inputs lost (seq. gaps) | of which rejected | kernel drops | bare machine: misses / max late "
                "| timing test |")
     out.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -96,7 +133,9 @@ def main():
         lmax = max(s["late_us"]["max"] for s in sh)
         sp50 = sorted(s["step_us"]["p50"] for s in sh)[len(sh) // 2]
         sp99 = max(s["step_us"]["p99"] for s in sh)
-        out.append(f"| {setting} | {x['n']} | {x['name']} | **{x['misses']}** | {fmt_us(lp99)} / {fmt_us(lmax)} | "
+        wm = worst_miss_text(r)
+        out.append(f"| {setting} | {x['n']} | {x['name']} | **{x['misses']}**{' (' + wm + ')' if wm else ''} | "
+                   f"{fmt_us(lp99)} / {fmt_us(lmax)} | "
                    f"{fmt_us(sp50)} / {fmt_us(sp99)} | {x['cpu']:.0f} % | {x['steal'] or '?'} s | **{x['gaps']}** | {rejected} | "
                    f"{'—' if drops is None else drops} | {bare_cell(x['bare'])} | {verdict(x['md'])} "
                    f"([report]({os.path.relpath(x['md'], a.out_dir)})) |")
@@ -110,7 +149,14 @@ def main():
                "(SO_RXQ_OVFL; — where the daemon does not report it); \"bare machine\": a watcher thread on the "
                "daemon's CPU during the same run (`hoist-wakeup-latency`, same rate, SCHED_FIFO 90, no work): the "
                "ticks the machine itself woke up more than a period late, and its worst wake-up lateness.  A "
-               "platform stall of more than a period makes every hosted shaft miss that tick (N misses per stall).")
+               "platform stall of more than a period makes every hosted shaft miss that tick (N misses per stall).  "
+               "\"worst miss\": the daemon's miss record (`misses` in its run report): the tick that began latest in the run, how late, how "
+               "many shafts began more than a period late, and where the loop's time went from the schedule's previous "
+               "tick to it (receive, model step, envelope, publish, forecast hand-over, deferred starts, health, the rest "
+               "of the tick, and timer: neither worked nor idle before the deadline, i.e. the wake-up, the kernel or a "
+               "stall of the machine), and the loop thread's CPU time over the same interval (the phases are steady-clock "
+               "spans: a thread preempted inside one counts the wait there, and its CPU time is then well below their "
+               "sum); phases under 1 µs are left out.")
     out.append("")
     # Summary: per setting and daemon, the largest count that keeps up.
     out.append("## Twins per core")

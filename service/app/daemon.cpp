@@ -5,6 +5,8 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <ctime>
+#include <limits>
 #include <map>
 #include <systemd/sd-daemon.h>
 #include <thread>
@@ -25,6 +27,17 @@ using std::chrono::duration_cast;
 using rt::nanos;
 using rt::processCpuNanos;
 
+namespace {
+
+/// CPU time of the calling thread [ns] (0 if unavailable).
+std::int64_t threadCpuNanos() {
+  timespec ts{};
+  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+}  // namespace
+
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
       out_(std::move(log)),
@@ -43,12 +56,19 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
   if (!opt_.lcm_url_out.empty() && opt_.lcm_url_out != opt_.lcm_url)
     lcm_out_ = std::make_unique<lcm::LCM>(opt_.lcm_url_out);
   opt_.labels.resize(opt_.shafts.size());
+  misses_ = std::make_unique<MissLog>();
+  miss_log_timer_ = std::make_unique<asio::steady_timer>(io_);
   // One ShaftTwin per configuration, one schedule (timer) per distinct rate.
   std::map<double, RateGroup*> by_rate;
   for (std::size_t i = 0; i < opt_.shafts.size(); ++i) {
-    shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, opt_.hooks,
+    TestHooks hooks = opt_.hooks;
+    if (i > 0) hooks.slow_tick_at = -1.0;  // the slow tick is the first shaft's only
+    shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, hooks,
                                                   instance_id_, lcm_out_.get()));
+    // Shaft i publishes its shapes at phase i of the shape divider.
+    shafts_.back()->attachLoop(&split_, misses_.get(), static_cast<int>(i));
     const double rate = opt_.shafts[i].service.rate;
+    const int budget = opt_.shafts[i].service.max_starts_per_tick;
     RateGroup*& g = by_rate[rate];
     if (!g) {
       groups_.push_back(std::make_unique<RateGroup>());
@@ -56,8 +76,13 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
       g->rate = rate;
       g->period = duration_cast<Clock::duration>(duration<double>(1.0 / rate));
       g->timer = std::make_unique<asio::steady_timer>(io_);
+      g->index = static_cast<int>(groups_.size() - 1);
+      g->start_budget = budget > 0 ? budget : std::numeric_limits<int>::max();
+    } else if (budget > 0) {
+      g->start_budget = std::min(g->start_budget, budget);
     }
     g->shafts.push_back(shafts_.back().get());
+    g->ids.push_back(static_cast<int>(i));
   }
   for (auto& g : groups_) g->shafts.shrink_to_fit();
   // Look-ahead forecasts: one pool for the process; the forecasting shafts
@@ -249,10 +274,18 @@ void Daemon::startSchedules() {
     const ServiceConfig& s = shafts_[i]->config().service;
     shafts_[i]->start(start_, static_cast<double>(i) / static_cast<double>(n) / s.health_rate);
   }
+  // Every shaft announced itself (one HOIST_HEALTH each, milliseconds for
+  // hundreds of shafts): the schedule starts after that burst, not under it.
+  start_ = Clock::now();
+  for (auto& sp : shafts_) sp->rebase(start_);
   for (auto& g : groups_) {
     g->k = 1;
+    g->last_start = start_;
+    g->split_at = split_;
+    g->cpu_at = threadCpuNanos();
     armTimer(*g);
   }
+  armMissLog();
 }
 
 void Daemon::logStarted() {
@@ -309,8 +342,10 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
   if (receiver_) {
     drainInput();
   } else {
+    const auto t0 = Clock::now();
     for (int i = 0; i < 256; ++i)
       if (lcm_.handleTimeout(0) <= 0) break;
+    split_.receive += nanos(Clock::now() - t0);
   }
   if (!stopping_) armLcm();
 }
@@ -335,14 +370,18 @@ void Daemon::flushOutputs() {
   if (!sender_ || sender_->queued() == 0) return;
   const auto t0 = Clock::now();
   sender_->flush();
-  ns_flush_ += nanos(Clock::now() - t0);
+  const std::int64_t ns = nanos(Clock::now() - t0);
+  ns_flush_ += ns;
+  split_.publish += ns;
 }
 
 void Daemon::drainInput() {
   const auto t0 = Clock::now();
   receiver_->drain(256);
   ignored_ = receiver_->ignored() + receiver_->malformed();
-  ns_receive_ += nanos(Clock::now() - t0);
+  const std::int64_t ns = nanos(Clock::now() - t0);
+  ns_receive_ += ns;
+  split_.receive += ns;
 }
 
 // ---- timers ------------------------------------------------------------------
@@ -377,23 +416,118 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   // of the next period arrive (no input may be lost).  An empty
   // socket costs one recvmsg.
   // The outputs queued by the shafts go out at the same points.
+  // A tick that skipped deadlines is a miss: its record takes the split of
+  // the loop's time since this schedule's previous tick (miss_record.hpp).
+  const std::int64_t cpu_now = threadCpuNanos();  // one clock_gettime per tick (not per shaft)
+  MissRecord* miss = skipped > 0 ? &beginMiss(g, now, deadline, skipped, cpu_now) : nullptr;
+  g.split_at = split_;
+  g.last_start = now;
+  g.cpu_at = cpu_now;
+  const std::int64_t work0 = split_.sum();
+  const double period_us = duration<double, std::micro>(g.period).count();
+  // Deferred starts: at most the group's budget in this tick.
+  int starts_left = g.start_budget;
   const auto ns_rx0 = ns_receive_, ns_fl0 = ns_flush_;
   std::size_t i = 0;
   for (ShaftTwin* s : g.shafts) {
-    s->tick(k, deadline, skipped);
+    s->tick(k, deadline, skipped, starts_left);
+    if (miss) [[unlikely]] noteMissShaft(*miss, g, i, period_us);
     if (++i % kDrainEvery == 0) {
       flushOutputs();
       if (receiver_) drainInput();
     }
   }
   flushOutputs();
-  ns_ticks_ += nanos(Clock::now() - now) - (ns_receive_ - ns_rx0) - (ns_flush_ - ns_fl0);
+  const std::int64_t tick_ns = nanos(Clock::now() - now);
+  split_.other += std::max<std::int64_t>(0, tick_ns - (split_.sum() - work0));
+  ns_ticks_ += tick_ns - (ns_receive_ - ns_rx0) - (ns_flush_ - ns_fl0);
+  if (miss) misses_->commit();
   if (opt_.duration > 0.0 && duration<double>(Clock::now() - start_).count() >= opt_.duration) {
     stop("--duration elapsed");
     return;
   }
   g.k = k + 1;
   armTimer(g);
+}
+
+// ---- the miss record (miss_record.hpp) -------------------------------------------
+
+MissRecord& Daemon::beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
+                              std::int64_t skipped, std::int64_t cpu_now) {
+  MissRecord& r = misses_->begin();
+  r.utime = bus::wallUtime();
+  r.wall = duration<double>(now - start_).count();
+  r.model_t = static_cast<double>(g.k) / g.rate;
+  r.group = g.index;
+  r.rate = g.rate;
+  r.tick = g.k;
+  r.skipped = skipped;
+  r.late_us = duration<double, std::micro>(now - deadline).count();
+  r.shafts = static_cast<int>(g.shafts.size());
+  const LoopSplit& a = g.split_at;
+  const LoopSplit& b = split_;
+  r.work = LoopSplit{b.receive - a.receive, b.step - a.step,     b.envelope - a.envelope, b.publish - a.publish,
+                     b.forecast - a.forecast, b.start - a.start, b.health - a.health,     b.other - a.other};
+  r.window_us = duration<double, std::micro>(now - g.last_start).count();
+  const double work_us = 1e-3 * static_cast<double>(r.work.sum());
+  // The loop works first (the previous tick, inputs) and then idles until
+  // the deadline; what is left of the interval is the timer's: its wake-up,
+  // the kernel, a stall of the machine.
+  const double to_deadline_us = duration<double, std::micro>(deadline - g.last_start).count();
+  r.idle_us = std::max(0.0, to_deadline_us - work_us);
+  r.timer_us = std::max(0.0, r.window_us - work_us - r.idle_us);
+  r.cpu_us = g.cpu_at > 0 && cpu_now > 0 ? 1e-3 * static_cast<double>(cpu_now - g.cpu_at) : -1.0;
+  return r;
+}
+
+void Daemon::noteMissShaft(MissRecord& r, const RateGroup& g, std::size_t j, double period_us) {
+  const ShaftTwin& s = *g.shafts[j];
+  const double late = s.lastLateUs();
+  const int id = g.ids[j];
+  if (late > period_us) ++r.shafts_late;
+  if (r.first_shaft < 0) {
+    r.first_shaft = id;
+    r.first_late_us = late;
+  }
+  if (r.worst_shaft < 0 || late > r.worst_late_us) {
+    r.worst_shaft = id;
+    r.worst_late_us = late;
+  }
+  g.shafts[j]->noteMiss(r.seq, late);
+}
+
+void Daemon::armMissLog() {
+  miss_log_timer_->expires_after(std::chrono::seconds(1));
+  miss_log_timer_->async_wait([this](const boost::system::error_code& ec) { onMissLog(ec); });
+}
+
+void Daemon::onMissLog(const boost::system::error_code& ec) {
+  if (ec || stopping_) return;
+  const std::int64_t total = misses_->total();
+  if (total > misses_logged_) {
+    // The worst of the new ones that the ring still keeps.
+    const std::int64_t oldest = total - static_cast<std::int64_t>(misses_->kept());
+    const MissRecord* w = nullptr;
+    for (std::int64_t q = std::max(misses_logged_, oldest); q < total; ++q) {
+      const MissRecord& r = misses_->at(static_cast<std::size_t>(q - oldest));
+      if (!w || r.late_us > w->late_us) w = &r;
+    }
+    if (w) {
+      const LoopSplit& x = w->work;
+      auto ms = [](std::int64_t ns) { return 1e-6 * static_cast<double>(ns); };
+      log_.warn("deadline misses: {} in the last second ({} since start); the worst: tick {} of the {} Hz schedule "
+                "(t = {:.2f} s) {:.2f} ms late, {} deadline(s) skipped, {} of {} shafts more than a period late; "
+                "since the previous tick [ms]: receive {:.2f}, step {:.2f}, envelope {:.2f}, publish {:.2f}, "
+                "forecast {:.2f}, start {:.2f}, health {:.2f}, other {:.2f}, timer {:.2f}, idle {:.2f}; "
+                "the loop thread's CPU time {:.2f}",
+                total - misses_logged_, total, w->tick, w->rate, w->model_t, 1e-3 * w->late_us, w->skipped,
+                w->shafts_late, w->shafts, ms(x.receive), ms(x.step), ms(x.envelope), ms(x.publish),
+                ms(x.forecast), ms(x.start), ms(x.health), ms(x.other), 1e-3 * w->timer_us, 1e-3 * w->idle_us,
+                1e-3 * w->cpu_us);
+    }
+    misses_logged_ = total;
+  }
+  armMissLog();
 }
 
 void Daemon::armSignals() {
@@ -428,6 +562,7 @@ void Daemon::stop(const char* why) {
   }
   stopping_ = true;
   for (auto& g : groups_) g->timer->cancel();
+  miss_log_timer_->cancel();
   signals_.cancel();
   if (lcm_fd_.is_open()) {
     lcm_fd_.cancel();
@@ -500,6 +635,7 @@ bool Daemon::writeReport() const {
   f.ns_receive = ns_receive_;
   f.ns_flush = ns_flush_;
   f.cpu_ns = processCpuNanos() - cpu0_;
+  f.misses = misses_.get();
   for (const auto& sp : shafts_) f.shafts.push_back(sp.get());
   return writeRunReport(opt_.report_path, f, *out_);
 }

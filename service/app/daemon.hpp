@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "forecast_pool.hpp"
+#include "miss_record.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
@@ -93,6 +94,10 @@ class Daemon {
   /// Ticks handled so far (all schedules); the systemd watchdog follows it.
   std::uint64_t loopProgress() const { return progress_.load(std::memory_order_relaxed); }
   std::int64_t instanceId() const { return instance_id_; }
+  /// The miss record (miss_record.hpp): every deadline miss of the loop.
+  const MissLog& misses() const { return *misses_; }
+  /// The loop-time split so far (cumulative).
+  const LoopSplit& loopSplit() const { return split_; }
 
  private:
   struct RateGroup {
@@ -100,7 +105,17 @@ class Daemon {
     Clock::duration period{};
     std::int64_t k = 1;  ///< index of the next deadline
     std::vector<ShaftTwin*> shafts;
+    std::vector<int> ids;  ///< the daemon's index of each shaft (shafts_[ids[j]] == shafts[j])
     std::unique_ptr<boost::asio::steady_timer> timer;
+    int index = 0;         ///< in groups_
+    /// Deferred starts per tick: the smallest [service] max_starts_per_tick
+    /// of the group (0 there = no budget).
+    int start_budget = 0;
+    // The miss record: the loop's split and the time when this schedule's
+    // previous tick began.
+    LoopSplit split_at{};
+    Clock::time_point last_start{};
+    std::int64_t cpu_at = 0;  ///< the loop thread's CPU time then [ns]
   };
 
   // start(), step by step
@@ -122,6 +137,17 @@ class Daemon {
   void onOutReadable(const boost::system::error_code& ec);
   void armTimer(RateGroup& g);
   void onTick(RateGroup& g, const boost::system::error_code& ec);
+  // The miss record (miss_record.hpp), kept apart from the loop itself:
+  /// A tick that skipped deadlines: a record of when, which and the split
+  /// of the loop's time since the schedule's previous tick.
+  MissRecord& beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
+                        std::int64_t skipped, std::int64_t cpu_now);
+  /// Shaft j of the group ran its step in the late tick.
+  static void noteMissShaft(MissRecord& r, const RateGroup& g, std::size_t j, double period_us);
+  /// Once a second, outside the ticks: one log line for the misses since the
+  /// previous line (their number and the worst one's split).
+  void armMissLog();
+  void onMissLog(const boost::system::error_code& ec);
   void stop(const char* why);
   void armSignals();
   bool writeReport() const;
@@ -153,6 +179,10 @@ class Daemon {
   boost::asio::signal_set signals_;
   std::vector<std::unique_ptr<ShaftTwin>> shafts_;
   std::vector<std::unique_ptr<RateGroup>> groups_;
+  LoopSplit split_;                        ///< the loop's time by phase, cumulative (miss_record.hpp)
+  std::unique_ptr<MissLog> misses_;        ///< every deadline miss (preallocated ring)
+  std::int64_t misses_logged_ = 0;         ///< misses_->total() at the last miss-log line
+  std::unique_ptr<boost::asio::steady_timer> miss_log_timer_;  ///< the miss-log second
   /// The one forecast pool of the process (issue 17): serves every shaft with
   /// [forecast] enabled and --clock wall.  Declared after shafts_ so that it
   /// stops (joins its workers) before the jobs it serves are destroyed.

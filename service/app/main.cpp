@@ -108,6 +108,11 @@ int main(int argc, char** argv) {
   app.add_option("--test-fail-publish-every", fail_publish_every)->group("")->check(CLI::NonNegativeNumber);
   double stall_at = -1.0;  // the loop thread hangs at this time: the systemd watchdog test
   app.add_option("--test-stall-at", stall_at)->group("")->check(CLI::NonNegativeNumber);
+  // One slow tick on purpose (the miss record's test): at this wall time the
+  // first shaft's step busy-waits this many milliseconds.
+  double slow_tick_at = -1.0, slow_tick_ms = 0.0;
+  app.add_option("--test-slow-tick-at", slow_tick_at)->group("")->check(CLI::NonNegativeNumber);
+  app.add_option("--test-slow-tick-ms", slow_tick_ms)->group("")->check(CLI::Range(0.0, 10000.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -260,6 +265,8 @@ int main(int argc, char** argv) {
   opt.hooks.inject_fault_at = inject_fault_at;
   opt.hooks.fail_publish_every = fail_publish_every;
   opt.test_stall_at = stall_at;
+  opt.hooks.slow_tick_at = slow_tick_at;
+  opt.hooks.slow_tick_ms = slow_tick_ms;
   opt.realtime.mlockall = mlock;
   opt.realtime.fifo_priority = rt_priority;
   opt.report_path = report;

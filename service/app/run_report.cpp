@@ -57,6 +57,60 @@ nlohmann::ordered_json costSplit(const RunFacts& f) {
           {"envelope_bounded", bounded}};
 }
 
+nlohmann::ordered_json splitJson(const MissRecord& r) {
+  auto us = [](std::int64_t ns) { return 1e-3 * static_cast<double>(ns); };
+  const LoopSplit& x = r.work;
+  return {{"receive", us(x.receive)}, {"step", us(x.step)},     {"envelope", us(x.envelope)},
+          {"publish", us(x.publish)}, {"forecast", us(x.forecast)}, {"start", us(x.start)},
+          {"health", us(x.health)},   {"other", us(x.other)},     {"timer", r.timer_us},
+          {"idle", r.idle_us}};
+}
+
+nlohmann::ordered_json missJson(const MissRecord& r, const RunFacts& f) {
+  auto label = [&](int id) -> std::string {
+    if (id < 0 || static_cast<std::size_t>(id) >= f.shafts.size()) return "";
+    return f.shafts[static_cast<std::size_t>(id)]->runStats().label;
+  };
+  return {{"seq", r.seq},
+          {"utime", r.utime},
+          {"wall_s", r.wall},
+          {"model_t", r.model_t},
+          {"schedule_hz", r.rate},
+          {"tick", r.tick},
+          {"skipped", r.skipped},
+          {"late_us", r.late_us},
+          {"shafts", r.shafts},
+          {"shafts_late", r.shafts_late},
+          {"first_shaft", label(r.first_shaft)},
+          {"first_late_us", r.first_late_us},
+          {"worst_shaft", label(r.worst_shaft)},
+          {"worst_late_us", r.worst_late_us},
+          {"window_us", r.window_us},
+          {"cpu_us", r.cpu_us},
+          {"split_us", splitJson(r)}};
+}
+
+/// Every kept miss record, oldest first, and how many were dropped.
+nlohmann::ordered_json missesJson(const RunFacts& f) {
+  const MissLog& m = *f.misses;
+  nlohmann::ordered_json records = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < m.kept(); ++i) records.push_back(missJson(m.at(i), f));
+  nlohmann::ordered_json o;
+  o["note"] =
+      "one record per tick that started more than a period late (each shaft of its schedule missed `skipped` "
+      "deadlines); split_us: the loop's time from the schedule's previous tick start to this one, by phase "
+      "(timer: neither worked nor idle before the deadline: wake-up, kernel, a stall of the machine); the phases "
+      "are steady-clock spans, so a preemption inside one counts there: cpu_us, the loop thread's CPU time in the "
+      "same interval, shows it (work well above cpu_us: the thread was not running); the ring keeps the latest " + std::to_string(MissLog::kCapacity) + " records";
+  o["recorded"] = m.total();
+  o["kept"] = m.kept();
+  o["dropped"] = m.dropped();
+  const MissRecord* w = m.worst();
+  o["worst"] = w ? missJson(*w, f) : nlohmann::ordered_json();
+  o["records"] = std::move(records);
+  return o;
+}
+
 nlohmann::ordered_json shaftJson(const ShaftTwin& sp) {
   const ShaftRunStats s = sp.runStats();
   const TwinConfig& c = sp.config();
@@ -76,6 +130,7 @@ nlohmann::ordered_json shaftJson(const ShaftTwin& sp) {
   o["model_faults"] = s.model_faults;
   o["publish_failures"] = s.publish_failures;
   o["nonfinite_withheld"] = s.nonfinite_blocked;
+  o["starts_deferred"] = s.starts_deferred;
   o["step_us"] = histogramJson(*s.step);
   o["late_us"] = histogramJson(*s.late);
   return o;
@@ -110,6 +165,7 @@ bool writeRunReport(const std::string& path, const RunFacts& f, spdlog::logger& 
                          {"malformed", f.receiver->malformed()}};
   if (f.sender) j["output_socket"] = {{"datagrams", f.sender->sent()}, {"system_calls", f.sender->systemCalls()}};
   j["cost_split_us_per_twin_tick"] = costSplit(f);
+  if (f.misses) j["misses"] = missesJson(f);
   j["histogram_note"] =
       "times in microseconds; " + std::to_string(LatencyHistogram::kPerDecade) +
       " logarithmic bins per decade from 0.1 us, so quantiles are bin centres (about 1.2 % resolution); "

@@ -27,6 +27,7 @@ struct RunFacts {
   std::int64_t ns_flush = 0;              ///< steady-clock ns in the sender's flushes
   std::int64_t cpu_ns = 0;                ///< process CPU time since the loop started [ns]
   std::vector<const ShaftTwin*> shafts;   ///< the hosted shafts
+  const MissLog* misses = nullptr;        ///< the miss record (nullptr: none)
 };
 
 /// Writes the report to `path` (PATH.tmp, then renamed); errors go to

@@ -13,6 +13,7 @@
 #include "hoist/rt/rt_log.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/twin_core.hpp"
+#include "miss_record.hpp"
 #include "shaft_stats.hpp"
 
 namespace hoist::svc {
@@ -26,6 +27,11 @@ inline constexpr std::size_t kUserMax = 64;
 struct TestHooks {
   double inject_fault_at = -1.0;  ///< wall time [s] at which the model state is treated as non-finite once
   int fail_publish_every = 0;     ///< every N-th LCM publish is treated as failed (0 = never)
+  /// Wall time [s] at which one tick of the first shaft busy-waits for
+  /// slow_tick_ms inside its model step (a deadline miss on purpose: the
+  /// miss record's test); < 0 = never.
+  double slow_tick_at = -1.0;
+  double slow_tick_ms = 0.0;
 };
 
 /// Who or what caused the alarm events about to be published, for their
@@ -71,6 +77,11 @@ struct ShaftContext {
   /// time passing for this shaft's staleness and health windows (the inputs
   /// wait in the socket meanwhile; they are not late).
   Clock::duration sync_pause{};
+  /// The daemon's loop-time split (miss_record.hpp): the rooms add their
+  /// phases' time to it (nullptr: not hosted by a Daemon).
+  LoopSplit* split = nullptr;
+  /// The daemon's miss record, for HOIST_HEALTH (nullptr: none).
+  const MissLog* misses = nullptr;
 
   /// Wall time of `t` [s] on this shaft's clock.
   double wallAt(Clock::time_point t) const {

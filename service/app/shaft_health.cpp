@@ -2,6 +2,7 @@
 #include "shaft_health.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cstdio>
 #include <fcntl.h>
 #include <unistd.h>
@@ -80,6 +81,47 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   m.commands_invalid = st.commands_invalid;
   m.catchup_limited = core.catchupLimited();
   m.datagrams_ignored = ignored_counter_ ? *ignored_counter_ : 0;
+  fillStartsAndMisses(m);
+}
+
+void ShaftHealth::fillStartsAndMisses(hoist::health_t& m) const {
+  static_assert(ShaftStats::kMissesNoted == hoist::health_t::MAX_MISSES, "one noted miss per health_t slot");
+  const TwinCore& core = ctx_.core;
+  const ShaftStats& st = ctx_.stats;
+  m.starting = core.startPending();
+  m.starts_deferred = core.startsDeferred();
+  const MissLog* log = ctx_.misses;
+  m.misses_recorded = log ? log->total() : 0;
+  // This shaft's latest misses whose records the ring still keeps, oldest first.
+  int n = 0;
+  if (log) {
+    const std::int64_t noted = st.misses_noted;
+    const std::int64_t from = std::max<std::int64_t>(0, noted - ShaftStats::kMissesNoted);
+    const std::int64_t oldest_kept = log->total() - static_cast<std::int64_t>(log->kept());
+    for (std::int64_t j = from; j < noted; ++j) {
+      const auto slot = static_cast<std::size_t>(j % ShaftStats::kMissesNoted);
+      const std::int64_t seq = st.miss_seq[slot];
+      if (seq < oldest_kept || seq >= log->total()) continue;
+      const MissRecord& r = log->at(static_cast<std::size_t>(seq - oldest_kept));
+      const auto i = static_cast<std::size_t>(n++);
+      m.miss_utime[i] = r.utime;
+      m.miss_t[i] = core.publishedTime(r.model_t);
+      m.miss_tick[i] = r.tick;
+      m.miss_skipped[i] = static_cast<int32_t>(std::min<std::int64_t>(r.skipped, INT32_MAX));
+      m.miss_late_us[i] = st.miss_late_us[slot];
+      m.miss_shafts_late[i] = r.shafts_late;
+      m.miss_receive_us[i] = 1e-3 * static_cast<double>(r.work.receive);
+      m.miss_step_us[i] = 1e-3 * static_cast<double>(r.work.step);
+      m.miss_envelope_us[i] = 1e-3 * static_cast<double>(r.work.envelope);
+      m.miss_publish_us[i] = 1e-3 * static_cast<double>(r.work.publish);
+      m.miss_forecast_us[i] = 1e-3 * static_cast<double>(r.work.forecast);
+      m.miss_start_us[i] = 1e-3 * static_cast<double>(r.work.start);
+      m.miss_health_us[i] = 1e-3 * static_cast<double>(r.work.health);
+      m.miss_other_us[i] = 1e-3 * static_cast<double>(r.work.other);
+      m.miss_timer_us[i] = r.timer_us;
+    }
+  }
+  m.n_misses = n;
 }
 
 void ShaftHealth::endWindow(const hoist::health_t& m, double wall, bool final_report) {
@@ -189,6 +231,8 @@ ShaftRunStats ShaftHealth::runStats() const {
   s.commands_dropped = st.commands_dropped;
   s.commands_invalid = st.commands_invalid;
   s.forecast = &st.forecast_total;
+  s.starts_deferred = core.startsDeferred();
+  s.ns_start = st.ns_start;
   return s;
 }
 

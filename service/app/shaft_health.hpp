@@ -45,6 +45,8 @@ struct ShaftRunStats {
   // publishing (encode + sendmsg of every output); the whole tick() call.
   std::int64_t ns_model = 0, ns_envelope = 0, ns_publish = 0, ns_tick = 0;
   std::int64_t envelope_exact = 0, envelope_bounded = 0;  ///< envelope evaluations
+  std::int64_t starts_deferred = 0;    ///< starts that waited for the start budget
+  std::int64_t ns_start = 0;           ///< steady-clock ns in deferred starts (in ns_model too)
 };
 
 class ShaftHealth {
@@ -72,6 +74,9 @@ class ShaftHealth {
 
  private:
   std::int64_t rssKb() const;
+  /// HOIST_HEALTH's starting / miss-record fields (the latest misses this
+  /// shaft took part in, from the daemon's miss record).
+  void fillStartsAndMisses(hoist::health_t& m) const;
 
   ShaftContext& ctx_;                           ///< the shaft's shared state
   double last_wall_ = 0.0;                      ///< wall time of the last report [s]

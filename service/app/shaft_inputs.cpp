@@ -131,8 +131,9 @@ void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
     logReject(res.reason, text_);
   }
   if (res.reinitialized)
-    ctx_.log.info("{}new winder stream (seq {}): model re-initialized at l = {} m", ctx_.tag, s.seq,
-                  core.output().kin.l);
+    ctx_.log.info("{}new winder stream (seq {}): model re-initialized at l = {} m{}", ctx_.tag, s.seq,
+                  s.has_length ? s.length : core.output().kin.l,
+                  core.startPending() ? " (at the next tick within the start budget)" : "");
   if (res.republish) out_.publishCage(s.utime);  // the held state, flagged degraded
   if (res.stepped) {
     ctx_.stats.step_hist.add(duration<double, std::micro>(t1 - t0).count());

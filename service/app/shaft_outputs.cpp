@@ -72,7 +72,24 @@ ShaftOutputs::ShaftOutputs(ShaftContext& ctx, lcm::LCM& out) : ctx_(ctx), out_(o
   cage_buf_.resize(static_cast<std::size_t>(cage_msg_.getEncodedSize()) + 64);
   shape_buf_.resize(static_cast<std::size_t>(shape_msg_.getEncodedSize()) + 64);
   alarm_buf_.resize(static_cast<std::size_t>(alarm_msg_.getEncodedSize()) + 64 + sizeof text_);
+  // The miss record's arrays, sized once at their bound (n_misses says how
+  // many are in use); the buffer fits them all.
+  {
+    hoist::health_t& h = health_msg_;
+    const auto m = static_cast<std::size_t>(hoist::health_t::MAX_MISSES);
+    h.n_misses = hoist::health_t::MAX_MISSES;
+    h.miss_utime.assign(m, 0);
+    h.miss_t.assign(m, 0.0);
+    h.miss_tick.assign(m, 0);
+    h.miss_skipped.assign(m, 0);
+    h.miss_late_us.assign(m, 0.0);
+    h.miss_shafts_late.assign(m, 0);
+    for (auto* v : {&h.miss_receive_us, &h.miss_step_us, &h.miss_envelope_us, &h.miss_publish_us,
+                    &h.miss_forecast_us, &h.miss_start_us, &h.miss_health_us, &h.miss_other_us, &h.miss_timer_us})
+      v->assign(m, 0.0);
+  }
   health_buf_.resize(static_cast<std::size_t>(health_msg_.getEncodedSize()) + 256);
+  health_msg_.n_misses = 0;
   text_[0] = '\0';
 }
 
@@ -123,11 +140,11 @@ bool ShaftOutputs::encodeAndPublish(const std::string& channel, const Msg& msg, 
 }
 
 void ShaftOutputs::publishTick(std::int64_t k, std::int64_t utime) {
-  if (k % cage_div_ == 0) {
+  if ((k + cage_phase_) % cage_div_ == 0) {
     publishCage(utime, true);
     publishEstimate(utime, true);
   }
-  if (ctx_.cfg.service.shape_rate > 0.0 && k % shape_div_ == 0) publishShape(utime, true);
+  if (ctx_.cfg.service.shape_rate > 0.0 && (k + shape_phase_) % shape_div_ == 0) publishShape(utime, true);
 }
 
 void ShaftOutputs::publishStep(std::int64_t utime) {

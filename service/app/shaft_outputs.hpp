@@ -36,6 +36,14 @@ class ShaftOutputs {
   /// The daemon's own udpm publisher (udpm_sender.hpp), used instead of
   /// LCM's publish when set (udpm output URLs).
   void setSender(UdpmSender* s) { sender_ = s; }
+  /// --clock wall: publish HOIST_CAGE / HOIST_GUIDE_SHAPE on the ticks k
+  /// with (k + phase) a multiple of their divider (the daemon staggers its
+  /// shafts: shaft i has phase i, so their shapes spread over the divider's
+  /// ticks instead of all going out on one).
+  void setPhase(int phase) {
+    cage_phase_ = phase % cage_div_;
+    shape_phase_ = phase % shape_div_;
+  }
   /// The LCM instance that publishes (the input one unless lcm_url_out is set).
   const lcm::LCM& lcm() const { return out_; }
 
@@ -71,6 +79,8 @@ class ShaftOutputs {
   UdpmSender* sender_ = nullptr; ///< the daemon's own publisher, or nullptr
   int cage_div_ = 1;             ///< --clock wall: HOIST_CAGE every cage_div_ ticks
   int shape_div_ = 1;            ///< --clock wall: HOIST_GUIDE_SHAPE every shape_div_ ticks
+  int cage_phase_ = 0;           ///< --clock wall: HOIST_CAGE on ticks with (k + cage_phase_) % cage_div_ == 0
+  int shape_phase_ = 0;          ///< ... HOIST_GUIDE_SHAPE likewise with shape_div_
   double last_shape_t_ = -1e300; ///< --clock input: model time of the last shape message
   static constexpr int kLogPublish = 0;  ///< log limiter key: publish failures, withheld messages
   LogRateLimiter<1> log_limit_{5};       ///< rate limit of this room's error lines

@@ -30,6 +30,25 @@ struct ShaftStats {
   LatencyHistogram step_total;       ///< model step time [us], whole run (windows merged at each health report)
   LatencyHistogram late_total;       ///< tick lateness [us], whole run
 
+  // ---- starts and misses (ShaftTwin, the Daemon's miss record) ----
+  double last_late_us = 0.0;         ///< this tick's lateness [us] (the miss record reads it)
+  std::int64_t starts = 0;           ///< deferred starts completed in a tick (within the start budget)
+  std::int64_t start_tick = -1;      ///< `ticks` at the latest deferred start (-1: none yet)
+  double start_wall = -1.0;          ///< its wall time [s] (-1: none yet)
+  std::int64_t ns_start = 0;         ///< steady-clock ns in deferred starts (also in ns_model)
+  /// The latest misses this shaft took part in: the miss record's seq and
+  /// this shaft's lateness in that tick, a ring of kMissesNoted.
+  static constexpr int kMissesNoted = 8;
+  std::array<std::int64_t, kMissesNoted> miss_seq{};
+  std::array<double, kMissesNoted> miss_late_us{};
+  std::int64_t misses_noted = 0;
+  void noteMiss(std::int64_t seq, double late_us) {
+    const auto j = static_cast<std::size_t>(misses_noted % kMissesNoted);
+    miss_seq[j] = seq;
+    miss_late_us[j] = late_us;
+    ++misses_noted;
+  }
+
   // ---- inputs (ShaftInputs) ----
   std::int64_t command_decode_rejects = 0;  ///< undecodable alarm commands
   std::int64_t handler_exceptions = 0;      ///< exceptions caught in an input handler

@@ -20,6 +20,40 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
       inputs_(ctx_, lcm, outputs_, forecast_.get()),
       health_(ctx_) {
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
+  // Wall clock: the first input's (and a new stream's) static solve waits
+  // for the daemon's per-tick start budget ([service] max_starts_per_tick).
+  ctx_.core.deferStarts(ctx_.cfg.service.clock == ClockMode::Wall && ctx_.cfg.service.max_starts_per_tick > 0);
+}
+
+void ShaftTwin::attachLoop(LoopSplit* split, const MissLog* misses, int phase) {
+  ctx_.split = split;
+  ctx_.misses = misses;
+  outputs_.setPhase(phase);
+}
+
+void ShaftTwin::startWithinBudget(double t, double wall, int& starts_left) {
+  if (starts_left <= 0) return;  // waits for a later tick: "starting"
+  --starts_left;
+  ShaftStats& st = ctx_.stats;
+  const auto s0 = Clock::now();
+  ctx_.core.completeStart(t - 1.0 / ctx_.cfg.service.rate, wall);
+  const std::int64_t ns = nanos(Clock::now() - s0);
+  st.ns_model += ns;
+  st.ns_start += ns;
+  if (ctx_.split) ctx_.split->start += ns;
+  ++st.starts;
+  st.start_tick = st.ticks;
+  st.start_wall = wall;
+}
+
+void ShaftTwin::slowTickHook(double wall) {
+  if (slow_tick_done_ || ctx_.hooks.slow_tick_at < 0.0 || wall < ctx_.hooks.slow_tick_at) return;
+  slow_tick_done_ = true;
+  // Busy (not asleep): the time is the loop's, as a slow model step's would be.
+  const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                        duration<double, std::milli>(ctx_.hooks.slow_tick_ms));
+  while (Clock::now() < until) {
+  }
 }
 
 void ShaftTwin::subscribe(InputRouter* router) {
@@ -46,11 +80,13 @@ void ShaftTwin::publishHealth(bool final_report) {
   health_.endWindow(m, wall, final_report);
 }
 
-void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped) {
+void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, int& starts_left) {
   ShaftStats& st = ctx_.stats;
   TwinCore& core = ctx_.core;
+  LoopSplit* split = ctx_.split;
   const auto now = Clock::now();
-  st.late_hist.add(std::max(0.0, duration<double, std::micro>(now - deadline).count()));
+  st.last_late_us = std::max(0.0, duration<double, std::micro>(now - deadline).count());
+  st.late_hist.add(st.last_late_us);
   ++st.ticks;
   st.deadline_misses += skipped;
   inputs_.beginTick();
@@ -63,11 +99,19 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
 
   if (core.clock() == ClockMode::Wall) {
     const double t = static_cast<double>(k) / ctx_.cfg.service.rate;
+    if (core.startPending()) startWithinBudget(t, wall, starts_left);
     const auto t0 = Clock::now();
+    const std::int64_t env0 = core.envelopeNanos();
+    if (ctx_.hooks.slow_tick_at >= 0.0) [[unlikely]] slowTickHook(wall);
     const TickResult r = core.tick(t, wall);
     core.housekeeping(wall);
     const auto t1 = Clock::now();
     st.ns_model += nanos(t1 - t0);
+    if (split) {
+      const std::int64_t env = core.envelopeNanos() - env0;
+      split->envelope += env;
+      split->step += nanos(t1 - t0) - env;
+    }
     if (r.stepped) st.step_hist.add(duration<double, std::micro>(t1 - t0).count());
     if (r.catchup_limited) {
       std::int64_t suppressed = 0;
@@ -77,13 +121,24 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
                       ctx_.tag, ctx_.cfg.service.max_catchup_periods, suppressed);
     }
     // Results of earlier snapshots (the worker posts them when done).
-    if (forecast_) forecast_->pollResult();
-    if (r.stepped && core.hasInput()) {
+    if (forecast_) {
+      const auto f0 = Clock::now();
+      forecast_->pollResult();
+      if (split) split->forecast += nanos(Clock::now() - f0);
+    }
+    // No HOIST_CAGE before the trip started (no input yet, or the start
+    // still waits for the start budget).
+    if (r.stepped && core.hasOutput()) {
       const auto p0 = Clock::now();
       const std::int64_t utime = bus::wallUtime();
       outputs_.publishTick(k, utime);
-      st.ns_publish += nanos(Clock::now() - p0);
-      if (forecast_) forecast_->afterStep(utime);
+      const auto p1 = Clock::now();
+      st.ns_publish += nanos(p1 - p0);
+      if (split) split->publish += nanos(p1 - p0);
+      if (forecast_) {
+        forecast_->afterStep(utime);
+        if (split) split->forecast += nanos(Clock::now() - p1);
+      }
     }
   } else {
     core.housekeeping(wall);
@@ -94,7 +149,9 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   if (health_.due(wall)) {
     const auto p0 = Clock::now();
     publishHealth();
-    st.ns_publish += nanos(Clock::now() - p0);
+    const std::int64_t ns = nanos(Clock::now() - p0);
+    st.ns_publish += ns;
+    if (split) split->health += ns;
   }
   st.ns_tick += nanos(Clock::now() - now);
 }

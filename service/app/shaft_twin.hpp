@@ -102,11 +102,31 @@ class ShaftTwin {
   /// first HOIST_HEALTH at once, the next ones `health_phase` s earlier than
   /// a full period later (the shafts of one daemon spread them out).
   void start(Clock::time_point start, double health_phase);
+  /// Wall times are measured from `start` from now on (the daemon's schedule
+  /// starts after the shafts announced themselves).
+  void rebase(Clock::time_point start) { ctx_.start = start; }
+  /// The daemon's loop-time split and miss record (miss_record.hpp), and
+  /// this shaft's publication phase: with shape_rate (cage_rate) below the
+  /// step rate, HOIST_GUIDE_SHAPE (HOIST_CAGE) goes out on the ticks k with
+  /// (k + phase) a multiple of the divider, so that the shafts of one
+  /// daemon do not all publish their shapes on the same tick.
+  void attachLoop(LoopSplit* split, const MissLog* misses, int phase);
   /// One period of the schedule: deadline index k (model time k / rate with
   /// --clock wall), the deadline this tick was scheduled for (lateness is
   /// measured from it), and how many deadlines the schedule skipped just
-  /// before k (missed ticks).
-  void tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped);
+  /// before k (missed ticks).  `starts_left`: the tick's remaining start
+  /// budget; a pending start (TwinCore::startPending) takes one, or waits.
+  void tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, int& starts_left);
+  /// The twin's start waits for the start budget (HOIST_HEALTH.starting).
+  bool starting() const { return ctx_.core.startPending(); }
+  /// This shaft took part in miss record `seq`, `late_us` late.
+  void noteMiss(std::int64_t seq, double late_us) { ctx_.stats.noteMiss(seq, late_us); }
+  /// The latest tick's lateness [us].
+  double lastLateUs() const { return ctx_.stats.last_late_us; }
+  /// Ticks run, and the tick count / wall time of the latest deferred start (-1: none).
+  std::int64_t ticks() const { return ctx_.stats.ticks; }
+  std::int64_t startTick() const { return ctx_.stats.start_tick; }
+  double startWall() const { return ctx_.stats.start_wall; }
   void publishHealth(bool final_report = false);
   /// The final health line and per-reason rejection counts, in the log.
   void logFinal() const { health_.logFinal(); }
@@ -128,6 +148,10 @@ class ShaftTwin {
   static constexpr int kLogCatchup = 0;          ///< log limiter key: limited catch-up
   LogRateLimiter<1> log_limit_{5};               ///< rate limit of the tick's warning lines
   bool fault_injected_ = false;                  ///< TestHooks::inject_fault_at has fired
+  bool slow_tick_done_ = false;                  ///< TestHooks::slow_tick_at has fired
+  /// A pending start within the tick's budget (model time t of the tick).
+  void startWithinBudget(double t, double wall, int& starts_left);
+  void slowTickHook(double wall);                ///< TestHooks::slow_tick_at
 };
 
 }  // namespace hoist::svc

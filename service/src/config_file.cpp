@@ -60,6 +60,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   sr.number("plausible_factor", s.plausible_factor);
   sr.integer("max_catchup_periods", s.max_catchup_periods);
   sr.integer("max_commands_per_tick", s.max_commands_per_tick);
+  sr.integer("max_starts_per_tick", s.max_starts_per_tick);
   sr.run();
   try {
     s.validate();
@@ -153,7 +154,7 @@ std::string toToml(const TwinConfig& c) {
      << "\"\naccel_tolerance = " << Num{s.accel_tolerance} << "\nvelocity_tolerance = " << Num{s.velocity_tolerance}
      << "\nconsistency_window = " << Num{s.consistency_window} << "\nplausible_factor = " << Num{s.plausible_factor}
      << "\nmax_catchup_periods = " << s.max_catchup_periods << "\nmax_commands_per_tick = " << s.max_commands_per_tick
-     << "\n\n";
+     << "\nmax_starts_per_tick = " << s.max_starts_per_tick << "\n\n";
   const AlarmConfig& a = c.alarms;
   os << "[alarms]\ngap_pos_y = " << Num{a.gap_pos_y} << "\ngap_neg_y = " << Num{a.gap_neg_y}
      << "\nguide_rope_gap = " << Num{a.guide_rope_gap} << "\nwarning_fraction = " << Num{a.warning_fraction}

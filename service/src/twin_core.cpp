@@ -135,13 +135,24 @@ class WallClock final : public ClockPolicy {
     c.acceptSample(s, wall_now);
     if (s.has_length || !c.domain_outside_) c.setDomain(false, s.has_length ? s.length : c.kin_.l);
     else c.setDomain(false, c.kin_.l);
-    if (first_input) {
+    if (c.start_pending_) {
+      // A deferred start waits: carry an encoder-less length forward with
+      // this sample (the ticks would have integrated it likewise).
+      if (!s.has_length) {
+        const double dt = std::max(0.0, wall_now - c.pend_t_);
+        c.pend_k_ = c.integrate(c.pend_k_, s.v, s.a, dt);
+        c.pend_t_ = std::max(c.pend_t_, wall_now);
+      }
+    } else if (first_input) {
       // The twin idled at rest at l0 until now.  Start the trip here: the
       // model is re-initialized at this input's kinematics (consistent with
       // a winder already moving), and the published time counts from this
       // instant (trip time, comparable with hoist-sim for the same profile).
       const Kinematics k{s.has_length ? s.length : c.kin_.l, s.v, s.a};
-      if (c.lengthOk(k.l)) {
+      if (c.lengthOk(k.l) && c.defer_starts_) {
+        res.reinitialized = s.has_length && std::fabs(s.length - c.kin_.l) > c.cfg_.service.max_length_jump;
+        c.deferStart(wall_now, k, true);
+      } else if (c.lengthOk(k.l)) {
         const auto resets = c.resets_;
         res.reinitialized = s.has_length && std::fabs(s.length - c.kin_.l) > c.cfg_.service.max_length_jump;
         // The trip starts when the input arrived (the daemon's wall clock
@@ -152,7 +163,8 @@ class WallClock final : public ClockPolicy {
         c.resets_ = resets;
       }
     } else if (new_stream && s.has_length && std::fabs(s.length - c.kin_.l) > c.cfg_.service.max_length_jump) {
-      c.initializeAt(c.t_, Kinematics{s.length, s.v, s.a});
+      if (c.defer_starts_) c.deferStart(wall_now, Kinematics{s.length, s.v, s.a}, false);
+      else c.initializeAt(c.t_, Kinematics{s.length, s.v, s.a});
       res.reinitialized = true;
     }
     c.out_.degraded = c.degradedNow();
@@ -162,7 +174,7 @@ class WallClock final : public ClockPolicy {
 
   TickResult tick(TwinCore& c, double t, double wall_now) override {
     TickResult res;
-    if (!c.started_ || !(t > c.t_)) return res;
+    if (!c.started_ || c.start_pending_ || !(t > c.t_)) return res;
     const double dt = t - c.t_;
     Kinematics k;
     if (!c.have_input_ || c.stale_) {
@@ -516,6 +528,44 @@ InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
 }
 
 TickResult TwinCore::tick(double t, double wall_now) { return clock_->tick(*this, t, wall_now); }
+
+void TwinCore::deferStart(double wall_now, const Kinematics& k, bool first) {
+  start_pending_ = true;
+  if (first && !pending_first_) pend_trip_t_ = std::max(t_, wall_now);
+  pending_first_ = pending_first_ || first;
+  pend_t_ = wall_now;
+  pend_k_ = k;
+  ++starts_deferred_;
+}
+
+void TwinCore::completeStart(double t_prev, double wall_now) {
+  if (!start_pending_) return;
+  start_pending_ = false;
+  // At the previous tick's model time, so that the coming tick steps one
+  // ordinary period (no catch-up across the ticks the start waited), but
+  // never before the input that asked for it nor before the model's time.
+  const double t0 = std::max({t_, pend_t_, t_prev});
+  Kinematics k;
+  if (last_.has_length) {
+    const double tau = std::clamp(t0 - last_input_wall_, 0.0, staleTimeout());
+    k = Kinematics{last_.length + last_.v * tau, last_.v, last_.a};
+  } else {
+    k = integrate(pend_k_, last_.v, last_.a, std::max(0.0, t0 - pend_t_));
+  }
+  (void)wall_now;
+  if (!lengthOk(k.l)) {
+    // The winder left the valid range meanwhile: the tick holds and raises
+    // MODEL_DOMAIN as for any input (the start is not retried).
+    pending_first_ = false;
+    return;
+  }
+  const bool first = pending_first_;
+  pending_first_ = false;
+  const auto resets = resets_;
+  if (first) t_pub_offset_ = pend_trip_t_;
+  initializeAt(t0, k);
+  if (first) resets_ = resets;
+}
 
 void TwinCore::housekeeping(double wall_now) {
   if (start_wall_ < 0.0) start_wall_ = wall_now;

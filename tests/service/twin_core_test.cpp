@@ -516,3 +516,90 @@ TEST(TwinCoreAlarms, ThePaperTripRaisesNoRopeForceAlarm) {
   EXPECT_GT(r.lambda0_min, 0.75 * F);
   EXPECT_LT(r.lambda0_max, 1.25 * F);
 }
+
+// Deferred starts (the daemon's start budget, [service] max_starts_per_tick):
+// the first input only marks the start pending; meanwhile the twin does not
+// step, has no output to publish and is not flagged degraded for the wait; a
+// start completed on the next tick gives bit for bit the twin that started in
+// the input handler; one that waited several ticks steps one ordinary period
+// (no catch-up) and counts its published time from the first input.
+TEST(TwinCoreDeferredStart, PendingUntilCompletedThenSameAsAnImmediateStart) {
+  const TwinConfig cfg = smallConfig();
+  const double P = 1.0 / cfg.service.rate;
+  const HoistProfile prof = HoistProfile::trapezoid();
+  TwinCore now_core(cfg, ClockMode::Wall), later(cfg, ClockMode::Wall);
+  later.deferStarts(true);
+  for (int k = 1; k <= 3; ++k) {  // idle ticks before the winder speaks
+    now_core.tick(k * P, k * P);
+    later.tick(k * P, k * P);
+  }
+  const double steps_idle = static_cast<double>(later.steps());
+  // The first input between ticks 3 and 4 (moving already: 2 s into the trip).
+  WinderSample s = sampleAt(prof, 200, P, true);
+  const double w_in = 3.3 * P;
+  ASSERT_TRUE(now_core.onInput(s, w_in).accepted);
+  ASSERT_TRUE(later.onInput(s, w_in).accepted);
+  EXPECT_FALSE(now_core.startPending());
+  EXPECT_TRUE(later.startPending());
+  EXPECT_TRUE(later.hasInput());
+  EXPECT_FALSE(later.hasOutput()) << "no trip state to publish while the start waits";
+  EXPECT_TRUE(now_core.hasOutput());
+  EXPECT_FALSE(later.degraded()) << "waiting for the start budget is not degraded output";
+  EXPECT_EQ(later.startsDeferred(), 1);
+  // Tick 4: the budget lets it start; then both step alike, bit for bit.
+  later.completeStart(3 * P, 4 * P);
+  EXPECT_FALSE(later.startPending());
+  EXPECT_TRUE(later.hasOutput());
+  for (int k = 4; k <= 12; ++k) {
+    s = sampleAt(prof, 200 + k - 3, P, true);
+    const TickResult a = now_core.tick(k * P, k * P);
+    const TickResult b = later.tick(k * P, k * P);
+    EXPECT_EQ(a.stepped, b.stepped);
+    ASSERT_TRUE(now_core.onInput(s, (k + 0.3) * P).accepted);
+    ASSERT_TRUE(later.onInput(s, (k + 0.3) * P).accepted);
+  }
+  const CageOutput& x = now_core.output();
+  const CageOutput& y = later.output();
+  EXPECT_TRUE(sameBits(x.t, y.t));
+  EXPECT_TRUE(sameBits(x.kin.l, y.kin.l));
+  EXPECT_TRUE(sameBits(x.y_c, y.y_c));
+  EXPECT_TRUE(sameBits(x.theta, y.theta));
+  EXPECT_TRUE(sameBits(x.lambda[0], y.lambda[0]));
+  EXPECT_EQ(now_core.modelResets(), later.modelResets()) << "the first start is not a reset";
+  EXPECT_GT(static_cast<double>(later.steps()), steps_idle);
+}
+
+TEST(TwinCoreDeferredStart, AStartThatWaitedStepsOnePeriodAndKeepsTheTripTime) {
+  const TwinConfig cfg = smallConfig();
+  const double P = 1.0 / cfg.service.rate;
+  TwinCore core(cfg, ClockMode::Wall);
+  core.deferStarts(true);
+  core.tick(P, P);
+  WinderSample s;
+  s.utime = kT0;
+  s.seq = 0;
+  s.v = 2.0;  // descending at 2 m/s, no encoder: the length is integrated
+  s.a = 0.0;
+  const double l0 = core.output().kin.l;
+  ASSERT_TRUE(core.onInput(s, 1.5 * P).accepted);
+  // It waits 10 ticks: no steps meanwhile, the inputs keep coming.
+  const auto steps0 = core.steps();
+  for (int k = 2; k <= 11; ++k) {
+    EXPECT_FALSE(core.tick(k * P, k * P).stepped);
+    EXPECT_TRUE(core.startPending());
+    s.seq = k;
+    s.utime = kT0 + std::llround((k + 0.5 - 1.5) * P * 1e6);
+    ASSERT_TRUE(core.onInput(s, (k + 0.5) * P).accepted);
+  }
+  EXPECT_EQ(core.steps(), steps0);
+  core.completeStart(11 * P, 12 * P);
+  const TickResult r = core.tick(12 * P, 12 * P);
+  EXPECT_TRUE(r.stepped);
+  EXPECT_FALSE(r.catchup_limited) << "the start waited; the step after it is an ordinary period";
+  EXPECT_FALSE(core.degraded());
+  // The length moved on with the winder while the start waited (2 m/s from
+  // the first input at 1.5 P to the model time 12 P).
+  EXPECT_NEAR(core.output().kin.l, l0 + 2.0 * (12 - 1.5) * P, 1e-9);
+  // Published time counts from the first input (the trip's start).
+  EXPECT_NEAR(core.publishedTime(core.modelTime()), (12 - 1.5) * P, 1e-12);
+}

@@ -73,6 +73,15 @@ struct ServiceConfig {
   /// Valid operator commands applied per tick; more are dropped and counted
   /// (undecodable and invalid ones never count against it), [1, 1000].
   int max_commands_per_tick = 4;
+  /// --clock wall: twin starts (the static solve of a first input or of a
+  /// new stream whose length jumped, tens of microseconds each) done per tick
+  /// of the daemon's schedule; the others wait, reporting "starting"
+  /// (HOIST_HEALTH.starting), for the next ticks.  Hundreds of twins whose
+  /// first inputs arrive in the same period then start over a few ticks
+  /// instead of breaking one deadline.  The daemon uses the smallest value
+  /// among the shafts of a schedule; 0 = no budget (start at once, in the
+  /// input handler), [0, 100000].
+  int max_starts_per_tick = 8;
 
   void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
 };

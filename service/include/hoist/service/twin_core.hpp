@@ -140,7 +140,30 @@ class TwinCore {
   /// path (alarm, re-initialization, degraded outputs) end to end.
   void injectFault() { inject_fault_ = true; }
   /// Wall clock: step the model to model time t (> current).  Input clock: no-op.
+  /// While a deferred start is pending (see deferStarts) it does not step.
   TickResult tick(double t, double wall_now);
+
+  // ---- deferred starts (wall clock; the daemon's start budget) ---------------
+  /// With --clock wall, the first input (and a new stream whose encoder
+  /// length jumped) re-initializes the model: a static solve, tens of
+  /// microseconds at the converged n.  Hundreds of twins that see their
+  /// first input in the same period would do hundreds of them in one tick.
+  /// With deferStarts(true) onInput() only accepts the sample and marks the
+  /// start pending; the daemon calls completeStart() from a tick within its
+  /// per-tick start budget ([service] max_starts_per_tick).  Meanwhile the
+  /// twin is "starting": tick() does not step it, it has no trip state to
+  /// publish (hasOutput() is false), its outputs are not flagged degraded
+  /// for it.  Off by default (TwinCore used directly starts at once).
+  void deferStarts(bool on) { defer_starts_ = on; }
+  /// A start (or re-initialization) waits for completeStart().
+  bool startPending() const { return start_pending_; }
+  /// The pending start now, at the model time of the previous tick `t_prev`
+  /// (so that the next tick(t) steps one ordinary period) but never before
+  /// the input that asked for it; the kinematics are the stream's latest,
+  /// carried forward to that time.  No-op without a pending start.
+  void completeStart(double t_prev, double wall_now);
+  /// Starts (first inputs and new streams) deferred since construction.
+  std::int64_t startsDeferred() const { return starts_deferred_; }
   /// Staleness, shelve expiry and re-announcement; call at least a few times
   /// per second (the daemon calls it every tick).
   void housekeeping(double wall_now);
@@ -201,6 +224,9 @@ class TwinCore {
   /// Any input accepted since start (the wall-clock twin publishes cage
   /// output only from its first input on: before that it has no trip).
   bool hasInput() const { return have_input_; }
+  /// The twin has a trip state to publish: an input accepted and no start
+  /// pending (the wall-clock daemon publishes HOIST_CAGE only then).
+  bool hasOutput() const { return have_input_ && !start_pending_; }
   /// The staleness timeout in force [s]: stale_timeout, or with --clock wall
   /// stale_periods input periods (clamped to [stale_min, stale_timeout]) once
   /// the current stream's period is known.
@@ -297,6 +323,15 @@ class TwinCore {
   double rope_force_ = 0.0;
   void estimatorStep(const CageResponse& r);  // predict, apply the pending samples, finish
   double catchup_until_ = -1.0;   // degraded through this model time after a limited catch-up
+  // deferred starts (deferStarts)
+  bool defer_starts_ = false;     // first inputs / new streams wait for completeStart()
+  bool start_pending_ = false;    // a start waits
+  bool pending_first_ = false;    // ... and it is the first start (the trip starts; not counted as a reset)
+  double pend_t_ = 0.0;           // wall time of the input that asked for it [s]
+  double pend_trip_t_ = 0.0;      // the first start: when the trip started (published time counts from it) [s]
+  Kinematics pend_k_;             // kinematics at pend_t_, carried forward by later inputs without an encoder
+  std::int64_t starts_deferred_ = 0;
+  void deferStart(double wall_now, const Kinematics& k, bool first);
   bool domain_outside_ = false;
   const char* fault_what_ = "";
   double fault_value_ = 0.0, fault_limit_ = 0.0;
