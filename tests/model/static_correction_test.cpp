@@ -13,6 +13,7 @@
 
 #include "exact_static.hpp"
 #include "hoist/fast_solver.hpp"
+#include "hoist/guide_rope_envelope.hpp"
 #include "hoist/paper_solver.hpp"
 #include "hoist/simulator.hpp"
 #include "hoist/solver.hpp"
