@@ -109,11 +109,6 @@ class FastSolver final : public Solver {
   /// Longitudinal state: hoisting-rope modal coordinates q0 and rates.
   const VectorXd& hoistingRopeCoordinates() const { return y_; }
   const VectorXd& hoistingRopeRates() const { return yd_; }
-  /// The longitudinal step matrix E built in one pass from the constant
-  /// matrices (default), or, false, the previous form (Ek built, applied, scaled
-  /// and added to): kept to benchmark the two side by side and to test that
-  /// they agree.
-  void setFusedLongitudinal(bool on) { fused_ = on; }
   /// Static correction active, and the sleeves' residual flexibility R(l) at
   /// the current position (zero without the correction) [m/N].
   bool staticCorrection() const { return corr_; }
@@ -135,7 +130,7 @@ class FastSolver final : public Solver {
   void fillResidualFlexibility(double l);            // R_ at l (after fillConstraintRows)
   // KKT solve  S qdd - G^T lam = r,  G qdd + c R lam = d  (c = 0: rigid sleeves).
   void solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d, double c);
-  void longitudinalOperators(const Kinematics& k);  // Ek_ and F0_ at k
+  void longitudinalOperators(const Kinematics& k);  // Ek_ and F0_ at k (initialize(); step() builds E fused)
   void longitudinalLoads(const Kinematics& k);      // F0_ at k
   void updateResponse(double t, const Kinematics& k);
 
@@ -176,7 +171,6 @@ class FastSolver final : public Solver {
   VectorXd k2_, Pd_, w_, res_, dy_;  // k_i^2, diagonal of P, P^-1 u, residual, update
   int last_iters_ = 0;
   long fallbacks_ = 0;
-  bool fused_ = true;
   Forcing forcing_ = Forcing::Full;
   double lambda0_ = 0.0;
 
