@@ -51,8 +51,9 @@ endforeach()
 list(REMOVE_DUPLICATES _tool_names)
 
 # Include directories a service/ or io/ file may legitimately reach.
+file(GLOB _service_incs LIST_DIRECTORIES true "${ROOT}/service/*/include")  # one per library of service/
 set(_allowed_dirs "${ROOT}/model/include" "${ROOT}/io/include" "${ROOT}/msgs/include"
-                  "${ROOT}/service/include" "${ROOT}/service/app")
+                  "${ROOT}/service/include" ${_service_incs} "${ROOT}/service/app")
 
 function(_includes file out)
   file(STRINGS "${file}" _lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]")
@@ -101,8 +102,8 @@ set(_svc_names "")
 foreach(h IN LISTS _svc_headers)
   get_filename_component(_name "${h}" NAME)
   list(APPEND _svc_names "${_name}")
-  if(h MATCHES "^include/(.+)$")                # service/include/hoist/service/...
-    list(APPEND _svc_names "${CMAKE_MATCH_1}")
+  if(h MATCHES "^([^/]+/)?include/(.+)$")       # service/<lib>/include/hoist/service/...
+    list(APPEND _svc_names "${CMAKE_MATCH_2}")
   endif()
   if(h MATCHES "^[^/]+/(.+)$")                  # relative to service/<x>/
     list(APPEND _svc_names "${CMAKE_MATCH_1}")
