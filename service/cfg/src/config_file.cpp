@@ -24,42 +24,124 @@ using hoist::io::SectionReader;
   hoist::io::rethrowWithLine(e.what(), source, {&r}, true);
 }
 
+/// One key of a [service], [alarms] or [forecast] section and the member it
+/// sets: the one list of the keys, in file order, that both the reader
+/// (parseServiceSections) and the writer (toToml) go through -- as
+/// hoist::kParamFields is for the shaft's sections.  Exactly one member
+/// pointer is set; a key with a value of its own syntax (the clock) has a
+/// reader and writer of its own.
+template <class S>
+struct Key {
+  const char* name;
+  double S::*real = nullptr;
+  int S::*integer = nullptr;
+  bool S::*boolean = nullptr;
+  std::string S::*text = nullptr;
+  ClockMode S::*clock = nullptr;
+};
+template <class S>
+constexpr Key<S> real(const char* n, double S::*m) { return {n, m, nullptr, nullptr, nullptr, nullptr}; }
+template <class S>
+constexpr Key<S> integer(const char* n, int S::*m) { return {n, nullptr, m, nullptr, nullptr, nullptr}; }
+template <class S>
+constexpr Key<S> boolean(const char* n, bool S::*m) { return {n, nullptr, nullptr, m, nullptr, nullptr}; }
+template <class S>
+constexpr Key<S> text(const char* n, std::string S::*m) { return {n, nullptr, nullptr, nullptr, m, nullptr}; }
+
+using SC = ServiceConfig;
+const Key<SC> kServiceKeys[] = {
+    real("rate", &SC::rate),
+    real("cage_rate", &SC::cage_rate),
+    real("shape_rate", &SC::shape_rate),
+    real("health_rate", &SC::health_rate),
+    text("channel_prefix", &SC::channel_prefix),
+    text("lcm_url", &SC::lcm_url),
+    Key<SC>{"clock", nullptr, nullptr, nullptr, nullptr, &SC::clock},
+    real("max_speed", &SC::max_speed),
+    real("max_accel", &SC::max_accel),
+    real("max_length_jump", &SC::max_length_jump),
+    real("max_time_step", &SC::max_time_step),
+    real("stale_timeout", &SC::stale_timeout),
+    real("stale_periods", &SC::stale_periods),
+    real("stale_min", &SC::stale_min),
+    real("max_step", &SC::max_step),
+    integer("shape_points", &SC::shape_points),
+    integer("envelope_points", &SC::envelope_points),
+    real("envelope_tolerance", &SC::envelope_tolerance),
+    integer("log_rate_limit", &SC::log_rate_limit),
+    real("fault_hold", &SC::fault_hold),
+    text("lcm_url_out", &SC::lcm_url_out),
+    real("accel_tolerance", &SC::accel_tolerance),
+    real("velocity_tolerance", &SC::velocity_tolerance),
+    real("consistency_window", &SC::consistency_window),
+    real("plausible_factor", &SC::plausible_factor),
+    integer("max_catchup_periods", &SC::max_catchup_periods),
+    integer("max_commands_per_tick", &SC::max_commands_per_tick),
+};
+
+using AC = AlarmConfig;
+const Key<AC> kAlarmKeys[] = {
+    real("gap_pos_y", &AC::gap_pos_y),
+    real("gap_neg_y", &AC::gap_neg_y),
+    real("guide_rope_gap", &AC::guide_rope_gap),
+    real("warning_fraction", &AC::warning_fraction),
+    real("critical_fraction", &AC::critical_fraction),
+    real("deadband", &AC::deadband),
+    real("on_delay", &AC::on_delay),
+    real("off_delay", &AC::off_delay),
+    real("reannounce", &AC::reannounce),
+    boolean("latch_critical", &AC::latch_critical),
+    real("max_shelve", &AC::max_shelve),
+    real("slack_fraction", &AC::slack_fraction),
+    real("overload_fraction", &AC::overload_fraction),
+    real("force_deadband", &AC::force_deadband),
+};
+
+using FC = ForecastConfig;
+const Key<FC> kForecastKeys[] = {
+    boolean("enabled", &FC::enabled),
+    real("rate", &FC::rate),
+    real("horizon", &FC::horizon),
+    real("estop_decel", &FC::estop_decel),
+    real("estop_jerk", &FC::estop_jerk),
+    real("vmax", &FC::vmax),
+    real("amax", &FC::amax),
+    real("jerk", &FC::jerk),
+    real("plan_timeout", &FC::plan_timeout),
+    integer("workers", &FC::workers),
+    integer("series_points", &FC::series_points),
+};
+
+/// Registers every key of `keys` on `r`, setting the members of `out`.
+template <class S, std::size_t N>
+void readKeys(SectionReader& r, const Key<S> (&keys)[N], S& out) {
+  for (const Key<S>& k : keys) {
+    if (k.real) {
+      r.number(k.name, out.*k.real);
+    } else if (k.integer) {
+      r.integer(k.name, out.*k.integer);
+    } else if (k.boolean) {
+      r.boolean(k.name, out.*k.boolean);
+    } else if (k.text) {
+      std::string S::*m = k.text;
+      r.string(k.name, [&out, m](const toml::node&, const std::string& v) { out.*m = v; });
+    } else if (k.clock) {
+      ClockMode S::*m = k.clock;
+      r.string(k.name, [&out, &r, m](const toml::node& n, const std::string& v) {
+        if (v == "wall") out.*m = ClockMode::Wall;
+        else if (v == "input") out.*m = ClockMode::Input;
+        else r.fail(n, "clock", "must be \"wall\" or \"input\", got \"" + v + "\"");
+      });
+    }
+  }
+}
+
 }  // namespace
 
 void parseServiceSections(const toml::table& tbl, const std::string& source, TwinConfig& cfg) {
   ServiceConfig& s = cfg.service;
   SectionReader sr(tbl, "service", source);
-  sr.number("rate", s.rate);
-  sr.number("cage_rate", s.cage_rate);
-  sr.number("shape_rate", s.shape_rate);
-  sr.number("health_rate", s.health_rate);
-  sr.string("channel_prefix", [&](const toml::node&, const std::string& v) { s.channel_prefix = v; });
-  sr.string("lcm_url", [&](const toml::node&, const std::string& v) { s.lcm_url = v; });
-  sr.string("clock", [&](const toml::node& n, const std::string& v) {
-    if (v == "wall") s.clock = ClockMode::Wall;
-    else if (v == "input") s.clock = ClockMode::Input;
-    else sr.fail(n, "clock", "must be \"wall\" or \"input\", got \"" + v + "\"");
-  });
-  sr.number("max_speed", s.max_speed);
-  sr.number("max_accel", s.max_accel);
-  sr.number("max_length_jump", s.max_length_jump);
-  sr.number("max_time_step", s.max_time_step);
-  sr.number("stale_timeout", s.stale_timeout);
-  sr.number("stale_periods", s.stale_periods);
-  sr.number("stale_min", s.stale_min);
-  sr.number("max_step", s.max_step);
-  sr.integer("shape_points", s.shape_points);
-  sr.integer("envelope_points", s.envelope_points);
-  sr.number("envelope_tolerance", s.envelope_tolerance);
-  sr.integer("log_rate_limit", s.log_rate_limit);
-  sr.number("fault_hold", s.fault_hold);
-  sr.string("lcm_url_out", [&](const toml::node&, const std::string& v) { s.lcm_url_out = v; });
-  sr.number("accel_tolerance", s.accel_tolerance);
-  sr.number("velocity_tolerance", s.velocity_tolerance);
-  sr.number("consistency_window", s.consistency_window);
-  sr.number("plausible_factor", s.plausible_factor);
-  sr.integer("max_catchup_periods", s.max_catchup_periods);
-  sr.integer("max_commands_per_tick", s.max_commands_per_tick);
+  readKeys(sr, kServiceKeys, s);
   sr.run();
   try {
     s.validate();
@@ -69,20 +151,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
 
   AlarmConfig& a = cfg.alarms;
   SectionReader ar(tbl, "alarms", source);
-  ar.number("gap_pos_y", a.gap_pos_y);
-  ar.number("gap_neg_y", a.gap_neg_y);
-  ar.number("guide_rope_gap", a.guide_rope_gap);
-  ar.number("warning_fraction", a.warning_fraction);
-  ar.number("critical_fraction", a.critical_fraction);
-  ar.number("deadband", a.deadband);
-  ar.number("on_delay", a.on_delay);
-  ar.number("off_delay", a.off_delay);
-  ar.number("reannounce", a.reannounce);
-  ar.boolean("latch_critical", a.latch_critical);
-  ar.number("max_shelve", a.max_shelve);
-  ar.number("slack_fraction", a.slack_fraction);
-  ar.number("overload_fraction", a.overload_fraction);
-  ar.number("force_deadband", a.force_deadband);
+  readKeys(ar, kAlarmKeys, a);
   ar.run();
   try {
     a.validate();
@@ -92,17 +161,7 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
 
   ForecastConfig& f = cfg.forecast;
   SectionReader fr(tbl, "forecast", source);
-  fr.boolean("enabled", f.enabled);
-  fr.number("rate", f.rate);
-  fr.number("horizon", f.horizon);
-  fr.number("estop_decel", f.estop_decel);
-  fr.number("estop_jerk", f.estop_jerk);
-  fr.number("vmax", f.vmax);
-  fr.number("amax", f.amax);
-  fr.number("jerk", f.jerk);
-  fr.number("plan_timeout", f.plan_timeout);
-  fr.integer("workers", f.workers);
-  fr.integer("series_points", f.series_points);
+  readKeys(fr, kForecastKeys, f);
   fr.run();
   try {
     f.validate(s.rate);
@@ -136,39 +195,31 @@ std::ostream& operator<<(std::ostream& os, Num n) {
 }
 }  // namespace
 
+namespace {
+/// "[name]\n" and one "key = value" line per key of `keys`, in table order.
+template <class S, std::size_t N>
+void writeKeys(std::ostream& os, const char* name, const Key<S> (&keys)[N], const S& in) {
+  os << "[" << name << "]\n";
+  for (const Key<S>& k : keys) {
+    os << k.name << " = ";
+    if (k.real) os << Num{in.*k.real};
+    else if (k.integer) os << in.*k.integer;
+    else if (k.boolean) os << (in.*k.boolean ? "true" : "false");
+    else if (k.text) os << "\"" << in.*k.text << "\"";
+    else if (k.clock) os << "\"" << toString(in.*k.clock) << "\"";
+    os << "\n";
+  }
+}
+}  // namespace
+
 std::string toToml(const TwinConfig& c) {
   std::ostringstream os;
   os << "# hoist-twind effective configuration\n" << hoist::io::toToml(c.shaft) << "\n";
-  const ServiceConfig& s = c.service;
-  os << "[service]\nrate = " << Num{s.rate} << "\ncage_rate = " << Num{s.cage_rate}
-     << "\nshape_rate = " << Num{s.shape_rate} << "\nhealth_rate = " << Num{s.health_rate}
-     << "\nchannel_prefix = \"" << s.channel_prefix << "\"\nlcm_url = \"" << s.lcm_url
-     << "\"\nclock = \"" << toString(s.clock) << "\"\nmax_speed = " << Num{s.max_speed}
-     << "\nmax_accel = " << Num{s.max_accel} << "\nmax_length_jump = " << Num{s.max_length_jump}
-     << "\nmax_time_step = " << Num{s.max_time_step} << "\nstale_timeout = " << Num{s.stale_timeout}
-     << "\nstale_periods = " << Num{s.stale_periods} << "\nstale_min = " << Num{s.stale_min}
-     << "\nmax_step = " << Num{s.max_step} << "\nshape_points = " << s.shape_points
-     << "\nenvelope_points = " << s.envelope_points << "\nenvelope_tolerance = " << Num{s.envelope_tolerance} << "\nlog_rate_limit = " << s.log_rate_limit
-     << "\nfault_hold = " << Num{s.fault_hold} << "\nlcm_url_out = \"" << s.lcm_url_out
-     << "\"\naccel_tolerance = " << Num{s.accel_tolerance} << "\nvelocity_tolerance = " << Num{s.velocity_tolerance}
-     << "\nconsistency_window = " << Num{s.consistency_window} << "\nplausible_factor = " << Num{s.plausible_factor}
-     << "\nmax_catchup_periods = " << s.max_catchup_periods << "\nmax_commands_per_tick = " << s.max_commands_per_tick
-     << "\n\n";
-  const AlarmConfig& a = c.alarms;
-  os << "[alarms]\ngap_pos_y = " << Num{a.gap_pos_y} << "\ngap_neg_y = " << Num{a.gap_neg_y}
-     << "\nguide_rope_gap = " << Num{a.guide_rope_gap} << "\nwarning_fraction = " << Num{a.warning_fraction}
-     << "\ncritical_fraction = " << Num{a.critical_fraction} << "\ndeadband = " << Num{a.deadband}
-     << "\non_delay = " << Num{a.on_delay} << "\noff_delay = " << Num{a.off_delay}
-     << "\nreannounce = " << Num{a.reannounce} << "\nlatch_critical = "
-     << (a.latch_critical ? "true" : "false") << "\nmax_shelve = " << Num{a.max_shelve}
-     << "\nslack_fraction = " << Num{a.slack_fraction} << "\noverload_fraction = " << Num{a.overload_fraction}
-     << "\nforce_deadband = " << Num{a.force_deadband} << "\n";
-  const ForecastConfig& f = c.forecast;
-  os << "\n[forecast]\nenabled = " << (f.enabled ? "true" : "false") << "\nrate = " << Num{f.rate}
-     << "\nhorizon = " << Num{f.horizon} << "\nestop_decel = " << Num{f.estop_decel}
-     << "\nestop_jerk = " << Num{f.estop_jerk} << "\nvmax = " << Num{f.vmax} << "\namax = " << Num{f.amax}
-     << "\njerk = " << Num{f.jerk} << "\nplan_timeout = " << Num{f.plan_timeout}
-     << "\nworkers = " << f.workers << "\nseries_points = " << f.series_points << "\n";
+  writeKeys(os, "service", kServiceKeys, c.service);
+  os << "\n";
+  writeKeys(os, "alarms", kAlarmKeys, c.alarms);
+  os << "\n";
+  writeKeys(os, "forecast", kForecastKeys, c.forecast);
   os << "\n" << hoist::io::toToml(hoist::io::EstimatorConfig{c.estimator.enabled, c.estimator.settings});
   return os.str();
 }
