@@ -29,10 +29,10 @@ FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model, Forcing forcing)
   Kd_.head(n) = model_->guideModalStiffness(1);
   Kd_.segment(n, n) = model_->guideModalStiffness(2);
   Kd_.tail(2).setZero();
-  fa_ = p.Fa;
-  moment_ = p.Fa * p.b;
-  F_(N - 1) = moment_;  // moment of the eccentric load; F(y_c) = 0 (Eq. 17)
-  x_ = xd_ = xdd_ = xa_ = Sd_ = xhat_ = vhat_ = r_ = VectorXd::Zero(N);
+  s_.Fa = p.Fa;
+  s_.moment = p.Fa * p.b;
+  F_(N - 1) = s_.moment;  // moment of the eccentric load; F(y_c) = 0 (Eq. 17)
+  s_.x = s_.xd = s_.xdd = s_.xa = Sd_ = xhat_ = vhat_ = r_ = VectorXd::Zero(N);
   tmp_ = VectorXd::Zero(N);
   sa_ = sb_ = VectorXd::Zero(n);
   Gt_ = Glt_ = Gllt_ = Y_ = Eigen::Matrix<double, Eigen::Dynamic, 4>::Zero(N, 4);
@@ -42,14 +42,14 @@ FastSolver::FastSolver(std::shared_ptr<const ShaftModel> model, Forcing forcing)
   Gt_(N - 1, 1) = p.h;
   Gt_(N - 1, 2) = -p.h;
   Gt_(N - 1, 3) = -p.h;
-  lam_.setZero();
+  s_.lam.setZero();
   corr_ = p.static_correction;
   kinv_ = Kd_.head(2 * n).cwiseInverse();
   zs_ = VectorXd::Zero(2 * n);
-  R_.setZero();
+  s_.R.setZero();
 
   u_ = model_->hoistingRope().U1;
-  y_ = yd_ = ydd_ = ya_ = yhat_ = yvhat_ = r0_ = F0_ = VectorXd::Zero(n);
+  s_.y = s_.yd = s_.ydd = s_.ya = yhat_ = yvhat_ = r0_ = F0_ = VectorXd::Zero(n);
   k2_ = model_->hoistingRope().k.array().square();
   Pd_ = w_ = res_ = dy_ = VectorXd::Zero(n);
   S0_ = Ek_ = MatrixXd::Zero(n, n);
@@ -112,16 +112,16 @@ void FastSolver::fillResidualFlexibility(double l) {
   // Wave impedance of the rope at each sleeve (both directions): 2 sqrt(T rho2).
   const double Ta1 = model_->guideTension(1, a), Tb1 = model_->guideTension(1, b);
   const double Ta2 = model_->guideTension(2, a), Tb2 = model_->guideTension(2, b);
-  Zd_ << 2.0 * std::sqrt(Ta1 * p.rho2), 2.0 * std::sqrt(Ta2 * p.rho2), 2.0 * std::sqrt(Tb2 * p.rho2),
+  s_.Zd << 2.0 * std::sqrt(Ta1 * p.rho2), 2.0 * std::sqrt(Ta2 * p.rho2), 2.0 * std::sqrt(Tb2 * p.rho2),
       2.0 * std::sqrt(Tb1 * p.rho2);
-  Zd_ *= zscale_;
-  R_.setZero();
-  R_(0, 0) = G1(0) - g1.cwiseProduct(k1).dot(g1);
-  R_(0, 3) = R_(3, 0) = G1(1) - g1.cwiseProduct(k1).dot(g4);
-  R_(3, 3) = G1(2) - g4.cwiseProduct(k1).dot(g4);
-  R_(1, 1) = G2(0) - g2.cwiseProduct(k2).dot(g2);
-  R_(1, 2) = R_(2, 1) = G2(1) - g2.cwiseProduct(k2).dot(g3);
-  R_(2, 2) = G2(2) - g3.cwiseProduct(k2).dot(g3);
+  s_.Zd *= zscale_;
+  s_.R.setZero();
+  s_.R(0, 0) = G1(0) - g1.cwiseProduct(k1).dot(g1);
+  s_.R(0, 3) = s_.R(3, 0) = G1(1) - g1.cwiseProduct(k1).dot(g4);
+  s_.R(3, 3) = G1(2) - g4.cwiseProduct(k1).dot(g4);
+  s_.R(1, 1) = G2(0) - g2.cwiseProduct(k2).dot(g2);
+  s_.R(1, 2) = s_.R(2, 1) = G2(1) - g2.cwiseProduct(k2).dot(g3);
+  s_.R(2, 2) = G2(2) - g3.cwiseProduct(k2).dot(g3);
 }
 
 void FastSolver::setResidualDampingScale(double s) {
@@ -161,13 +161,13 @@ void FastSolver::solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen
   Y_ = Gt_.array().colwise() / Sd.array();
   Eigen::Matrix4d W;
   W.noalias() = Gt_.transpose() * Y_;
-  if (c != 0.0) W += c * Rc_;
+  if (c != 0.0) W += c * s_.Rc;
   tmp_ = r.array() / Sd.array();
   Eigen::Vector4d rhs = d;
   rhs.noalias() -= Gt_.transpose() * tmp_;
-  lam_ = W.partialPivLu().solve(rhs);
-  xdd_ = tmp_;
-  xdd_.noalias() += Y_ * lam_;
+  s_.lam = W.partialPivLu().solve(rhs);
+  s_.xdd = tmp_;
+  s_.xdd.noalias() += Y_ * s_.lam;
 }
 
 void FastSolver::longitudinalOperators(const Kinematics& k) {
@@ -183,27 +183,27 @@ void FastSolver::longitudinalLoads(const Kinematics& k) {
   const auto& H = model_->hoistingRope();
   // F0 + u * F(x_c): hoisting-rope load plus the cage load carried through x_c = u.q0
   if (forcing_ == Forcing::LoadOnly) {
-    F0_ = fa_ * u_;
+    F0_ = s_.Fa * u_;
     return;
   }
-  const double Fxc = fa_ + p.m * (p.g - k.a);
+  const double Fxc = s_.Fa + p.m * (p.g - k.a);
   F0_ = (-p.rho1 * k.l * k.a) * H.intU - (p.m * p.g) * H.U1 + Fxc * u_;
 }
 
 void FastSolver::updateResponse(double t, const Kinematics& k) {
   const ShaftParams& p = model_->params();
-  resp_.t = t;
-  resp_.kin = k;
-  resp_.x_c = u_.dot(y_);
-  resp_.y_c = x_(N_ - 2);
-  resp_.theta = x_(N_ - 1);
-  const double xcdd = u_.dot(ydd_);
-  lambda0_ = forcing_ == Forcing::LoadOnly ? fa_ - p.m * xcdd : fa_ + p.m * (p.g - k.a) - p.m * xcdd;
-  resp_.lambda[0] = lambda0_;
-  for (int i = 0; i < 4; ++i) resp_.lambda[i + 1] = lam_(i);
-  resp_.x_c_ddot = xcdd;
-  resp_.y_c_ddot = xdd_(N_ - 2);
-  resp_.theta_dot = xd_(N_ - 1);
+  s_.response.t = t;
+  s_.response.kin = k;
+  s_.response.x_c = u_.dot(s_.y);
+  s_.response.y_c = s_.x(N_ - 2);
+  s_.response.theta = s_.x(N_ - 1);
+  const double xcdd = u_.dot(s_.ydd);
+  s_.lambda0 = forcing_ == Forcing::LoadOnly ? s_.Fa - p.m * xcdd : s_.Fa + p.m * (p.g - k.a) - p.m * xcdd;
+  s_.response.lambda[0] = s_.lambda0;
+  for (int i = 0; i < 4; ++i) s_.response.lambda[i + 1] = s_.lam(i);
+  s_.response.x_c_ddot = xcdd;
+  s_.response.y_c_ddot = s_.xdd(N_ - 2);
+  s_.response.theta_dot = s_.xd(N_ - 1);
 }
 
 // When the winder already moves at t = 0 (v != 0), zero velocities violate the
@@ -219,10 +219,10 @@ void FastSolver::updateResponse(double t, const Kinematics& k) {
 // mass-weighted least-norm velocity is used instead.
 void FastSolver::consistentInitialVelocity(double v) {
   // Allocation-free: D_ and MG_ are preallocated; every 4 x 4 object is fixed-size.
-  xd_.setZero();
+  s_.xd.setZero();
   if (v == 0.0) return;
   const int n = n_;
-  const Eigen::Vector4d rhs = -v * (Glt_.transpose() * x_);
+  const Eigen::Vector4d rhs = -v * (Glt_.transpose() * s_.x);
   if (rhs.cwiseAbs().maxCoeff() == 0.0) return;
   if (n >= 2) {
     const Eigen::Matrix4d B = Gt_.transpose() * D_;
@@ -230,14 +230,14 @@ void FastSolver::consistentInitialVelocity(double v) {
     const auto& sv = svd.singularValues();
     if (sv(3) > 1e-8 * sv(0)) {
       const Eigen::Vector4d c = B.partialPivLu().solve(rhs);
-      xd_.noalias() = D_ * c;
+      s_.xd.noalias() = D_ * c;
       return;
     }
   }
   MG_ = Md_.cwiseInverse().asDiagonal() * Gt_;
   const Eigen::Matrix4d S = Gt_.transpose() * MG_;
   const Eigen::Vector4d c = S.ldlt().solve(rhs);
-  xd_.noalias() = MG_ * c;
+  s_.xd.noalias() = MG_ * c;
 }
 
 void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) {
@@ -246,17 +246,17 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
     throw std::domain_error("initial rope length " + std::to_string(k0.l) + " m outside (0, L - 2h = " +
                             std::to_string(p.maxRopeLength()) + ")");
   const int N = N_;
-  t_ = t0;
-  kin_ = k0;
+  s_.t = t0;
+  s_.kin = k0;
   h_cached_ = -1.0;
-  fallbacks_ = 0;
-  last_iters_ = 0;
+  s_.fallbacks = 0;
+  s_.last_iters = 0;
   fillConstraintRows(k0.l);
   fillResidualFlexibility(k0.l);
 
   // ---- lateral ------------------------------------------------------------
-  xd_.setZero();
-  lam_.setZero();
+  s_.xd.setZero();
+  s_.lam.setZero();
   if (init == InitialState::Static) {
     // K x - G^T lam = F,  G x + R lam = 0  (R = 0 without the static correction)
     MatrixXd& A = initA_;
@@ -264,45 +264,45 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
     A.topLeftCorner(N, N).diagonal() = Kd_;
     A.topRightCorner(N, 4) = -Gt_;
     A.bottomLeftCorner(4, N) = Gt_.transpose();
-    A.bottomRightCorner(4, 4) = R_;
+    A.bottomRightCorner(4, 4) = s_.R;
     initRhs_.setZero();
     initRhs_.head(N) = F_;
     initLu_.compute(A);
     initSol_ = initLu_.solve(initRhs_);
-    x_ = initSol_.head(N);
-    lam_ = initSol_.tail(4);
+    s_.x = initSol_.head(N);
+    s_.lam = initSol_.tail(4);
   } else {
-    x_.setZero();
+    s_.x.setZero();
   }
-  delta_.noalias() = -(Gt_.transpose() * x_);
-  lamS_ = lam_;
+  s_.delta.noalias() = -(Gt_.transpose() * s_.x);
+  s_.lamS = s_.lam;
   fillConstraintRowDerivatives(k0.l);
   consistentInitialVelocity(k0.v);
-  r_ = F_ - Cd_.cwiseProduct(xd_) - Kd_.cwiseProduct(x_);
+  r_ = F_ - Cd_.cwiseProduct(s_.xd) - Kd_.cwiseProduct(s_.x);
   if (corr_) {
     // Compliant sleeves: lam is fixed by the positions (G x + R lam = 0: the
     // static solution's lam, or 0 at rest), the accelerations follow from it.
-    tmp_.noalias() = Gt_ * lam_;
-    xdd_ = (r_ + tmp_).cwiseQuotient(Md_);
+    tmp_.noalias() = Gt_ * s_.lam;
+    s_.xdd = (r_ + tmp_).cwiseQuotient(Md_);
   } else {
     // Consistent accelerations: G qdd = -2 Gdot qd - Gddot q, Gdot = v G_l, Gddot = a G_l + v^2 G_ll.
-    Eigen::Vector4d d = -2.0 * k0.v * (Glt_.transpose() * xd_) -
-                        (k0.a * (Glt_.transpose() * x_) + k0.v * k0.v * (Gllt_.transpose() * x_));
+    Eigen::Vector4d d = -2.0 * k0.v * (Glt_.transpose() * s_.xd) -
+                        (k0.a * (Glt_.transpose() * s_.x) + k0.v * k0.v * (Gllt_.transpose() * s_.x));
     solveLateral(Md_, r_, d, 0.0);
   }
-  xa_ = xdd_;
+  s_.xa = s_.xdd;
 
   // ---- longitudinal ---------------------------------------------------------
-  yd_.setZero();
+  s_.yd.setZero();
   const auto& H = model_->hoistingRope();
   if (init == InitialState::Static) {
     longitudinalOperators({k0.l, 0.0, 0.0});
     initK_ = Ek_;
     initK_.diagonal() += (p.EA / k0.l) * k2_;
     initLuN_.compute(initK_);
-    y_ = initLuN_.solve(F0_);
+    s_.y = initLuN_.solve(F0_);
   } else {
-    y_.setZero();
+    s_.y.setZero();
   }
   longitudinalOperators(k0);
   // M ydd = F0 - C yd - K y with M = rho1 l I + m u u^T,
@@ -314,18 +314,18 @@ void FastSolver::initialize(double t0, const Kinematics& k0, InitialState init) 
   initK_ = Ek_;
   initK_.diagonal() += (p.EA / k0.l) * k2_;
   initRhsN_ = F0_;
-  initRhsN_.noalias() -= initC_ * yd_;
-  initRhsN_.noalias() -= initK_ * y_;
+  initRhsN_.noalias() -= initC_ * s_.yd;
+  initRhsN_.noalias() -= initK_ * s_.y;
   initLuN_.compute(initM_);
-  ydd_ = initLuN_.solve(initRhsN_);
-  ya_ = ydd_;
+  s_.ydd = initLuN_.solve(initRhsN_);
+  s_.ya = s_.ydd;
 
   updateResponse(t0, k0);
 }
 
 void FastSolver::step(double t1, const Kinematics& k1) {
   const ShaftParams& p = model_->params();
-  const double h = t1 - t_;
+  const double h = t1 - s_.t;
   if (!(h > 0.0) || !std::isfinite(h)) throw std::invalid_argument("step: t1 must be after the current time");
   if (!(k1.l > 0.0 && k1.l < p.maxRopeLength()) || !std::isfinite(k1.v) || !std::isfinite(k1.a))
     throw std::domain_error("step: rope length outside (0, L - 2h) or non-finite kinematics");
@@ -337,14 +337,14 @@ void FastSolver::step(double t1, const Kinematics& k1) {
     Sd_ = Md_ + hg * Cd_ + hb * Kd_;
     h_cached_ = h;
   }
-  tmp_ = (g.alpha_f * xdd_ - g.alpha_m * xa_) / (1.0 - g.alpha_m);  // abar
-  xhat_ = x_ + h * xd_ + (h * h * (0.5 - g.beta)) * xa_ + (h * h * g.beta) * tmp_;
-  vhat_ = xd_ + (h * (1.0 - g.gamma)) * xa_ + (h * g.gamma) * tmp_;
-  xa_ = tmp_;  // holds abar until the new accelerations are known
+  tmp_ = (g.alpha_f * s_.xdd - g.alpha_m * s_.xa) / (1.0 - g.alpha_m);  // abar
+  xhat_ = s_.x + h * s_.xd + (h * h * (0.5 - g.beta)) * s_.xa + (h * h * g.beta) * tmp_;
+  vhat_ = s_.xd + (h * (1.0 - g.gamma)) * s_.xa + (h * g.gamma) * tmp_;
+  s_.xa = tmp_;  // holds abar until the new accelerations are known
   r_ = F_ - Cd_.cwiseProduct(vhat_) - Kd_.cwiseProduct(xhat_);
   fillConstraintRows(k1.l);
   fillResidualFlexibility(k1.l);
-  // Position level at t_{n+1}: G (xhat + hb qdd) + R lam = 0.
+  // Position level at s_.t{n+1}: G (xhat + hb qdd) + R lam = 0.
   Eigen::Vector4d d;
   d.noalias() = Gt_.transpose() * xhat_;
   d *= -1.0 / hb;
@@ -354,52 +354,48 @@ void FastSolver::step(double t1, const Kinematics& k1) {
     //   A R^-1 ... :  (I + R Z/h)^-1 R lam = delta - (I + R Z/h)^-1 (R Z/h) delta_n.
     // With delta = -G (xhat + hb qdd):  G qdd + Rc lam / hb = d - e / hb,
     // Rc = (I + R Z/h)^-1 R = (R^-1 + Z/h)^-1 (symmetric positive definite).
-    Eigen::Matrix4d A = R_ * (Zd_ / h).asDiagonal();
-    const Eigen::Vector4d rz = A * delta_;
+    Eigen::Matrix4d A = s_.R * (s_.Zd / h).asDiagonal();
+    const Eigen::Vector4d rz = A * s_.delta;
     A.diagonal().array() += 1.0;
     const Eigen::PartialPivLU<Eigen::Matrix4d> lu(A);
-    Rc_ = lu.solve(R_);
+    s_.Rc = lu.solve(s_.R);
     d -= lu.solve(rz) / hb;
   }
   solveLateral(Sd_, r_, d, corr_ ? 1.0 / hb : 0.0);
-  xa_ += g.ca * xdd_;
-  x_ = xhat_ + hb * xdd_;
+  s_.xa += g.ca * s_.xdd;
+  s_.x = xhat_ + hb * s_.xdd;
   if (corr_) {
     Eigen::Vector4d dn;
-    dn.noalias() = -(Gt_.transpose() * x_);
-    lamS_ = lam_ - Zd_.cwiseProduct(dn - delta_) / h;  // spring part: R lamS = delta
-    delta_ = dn;
+    dn.noalias() = -(Gt_.transpose() * s_.x);
+    s_.lamS = s_.lam - s_.Zd.cwiseProduct(dn - s_.delta) / h;  // spring part: R lamS = delta
+    s_.delta = dn;
   }
-  xd_ = vhat_ + hg * xdd_;
+  s_.xd = vhat_ + hg * s_.xdd;
 
   // ---- longitudinal -----------------------------------------------------------
   const auto& H = model_->hoistingRope();
-  if (fused_) longitudinalLoads(k1);
-  else longitudinalOperators(k1);
-  r0_ = (g.alpha_f * ydd_ - g.alpha_m * ya_) / (1.0 - g.alpha_m);  // abar (r0_ reused below)
-  yhat_ = y_ + h * yd_ + (h * h * (0.5 - g.beta)) * ya_ + (h * h * g.beta) * r0_;
-  yvhat_ = yd_ + (h * (1.0 - g.gamma)) * ya_ + (h * g.gamma) * r0_;
-  ya_ = r0_;  // holds abar until the new accelerations are known
+  longitudinalLoads(k1);
+  r0_ = (g.alpha_f * s_.ydd - g.alpha_m * s_.ya) / (1.0 - g.alpha_m);  // abar (r0_ reused below)
+  yhat_ = s_.y + h * s_.yd + (h * h * (0.5 - g.beta)) * s_.ya + (h * h * g.beta) * r0_;
+  yvhat_ = s_.yd + (h * (1.0 - g.gamma)) * s_.ya + (h * g.gamma) * r0_;
+  s_.ya = r0_;  // holds abar until the new accelerations are known
   const double cdiag = p.rho1 * k1.v + p.u1 * k1.l;
   const double kscale = p.EA / k1.l;
   // r0 = F0 - C vhat - K yhat
   r0_ = F0_ - cdiag * yvhat_ - kscale * k2_.cwiseProduct(yhat_);
   // S = M + hg C + hb K = P + E,  P = diag(Pd) + m u u^T,  E = hg rho1 v A_gyro + hb Ek.
   const double c4 = p.rho1 * k1.v;
-  if (fused_) {
+  {
     // E is linear in four scalars of (l, v, a, h): one pass over the four
     // constant matrices builds it (Ek itself is never formed), and
     //   Ek yhat + c4 A_gyro vhat = E yhat / hb + c4 A_gyro (vhat - (hg/hb) yhat).
+    // (The previous form -- Ek built, applied, scaled and added to -- is kept
+    // for the benchmark and the test that both agree: bench/longitudinal_reference.hpp.)
     const double c1 = p.rho1 * k1.a, c2 = -p.u1 * k1.v, c3 = -p.rho1 * k1.v * k1.v / k1.l;
     Ek_ = (hb * c1) * H.A_acc + (hb * c2) * H.A_vel + (hb * c3) * H.A_cent + (hg * c4) * H.A_gyro;  // E
     r0_.noalias() -= (1.0 / hb) * (Ek_ * yhat_);
     dy_ = yvhat_ - (hg / hb) * yhat_;  // workspace (dy_ is overwritten by the sweeps)
     r0_.noalias() -= c4 * (H.A_gyro * dy_);
-  } else {
-    r0_.noalias() -= c4 * (H.A_gyro * yvhat_);
-    r0_.noalias() -= Ek_ * yhat_;
-    Ek_ *= hb;
-    Ek_.noalias() += (hg * c4) * H.A_gyro;  // Ek_ now holds E
   }
   Pd_ = (p.rho1 * k1.l + hg * cdiag) + (hb * kscale) * k2_.array();
   w_ = u_.cwiseQuotient(Pd_);
@@ -408,31 +404,31 @@ void FastSolver::step(double t1, const Kinematics& k1) {
     out = rhs.cwiseQuotient(Pd_);
     out -= (sm * u_.dot(out)) * w_;
   };
-  applyPinv(r0_, ydd_);
+  applyPinv(r0_, s_.ydd);
   bool converged = false;
   int it = 0;
   for (; it < kMaxSweeps && !converged; ++it) {
-    res_ = r0_ - Pd_.cwiseProduct(ydd_) - (p.m * u_.dot(ydd_)) * u_;
-    res_.noalias() -= Ek_ * ydd_;
+    res_ = r0_ - Pd_.cwiseProduct(s_.ydd) - (p.m * u_.dot(s_.ydd)) * u_;
+    res_.noalias() -= Ek_ * s_.ydd;
     applyPinv(res_, dy_);
-    ydd_ += dy_;
-    converged = dy_.cwiseAbs().maxCoeff() <= 1e-14 * ydd_.cwiseAbs().maxCoeff() + 1e-300;
+    s_.ydd += dy_;
+    converged = dy_.cwiseAbs().maxCoeff() <= 1e-14 * s_.ydd.cwiseAbs().maxCoeff() + 1e-300;
   }
-  last_iters_ = it;
+  s_.last_iters = it;
   if (!converged) {
-    ++fallbacks_;
+    ++s_.fallbacks;
     S0_ = Ek_;
     S0_.noalias() += p.m * (u_ * u_.transpose());
     S0_.diagonal() += Pd_;
     lu_.compute(S0_);
-    ydd_.noalias() = lu_.solve(r0_);
+    s_.ydd.noalias() = lu_.solve(r0_);
   }
-  ya_ += g.ca * ydd_;
-  y_ = yhat_ + hb * ydd_;
-  yd_ = yvhat_ + hg * ydd_;
+  s_.ya += g.ca * s_.ydd;
+  s_.y = yhat_ + hb * s_.ydd;
+  s_.yd = yvhat_ + hg * s_.ydd;
 
-  t_ = t1;
-  kin_ = k1;
+  s_.t = t1;
+  s_.kin = k1;
   updateResponse(t1, k1);
 }
 
@@ -444,28 +440,7 @@ FastSolverState::FastSolverState(int n) {
 }
 
 void FastSolver::saveState(FastSolverState& s) const {
-  s.t = t_;
-  s.kin = kin_;
-  s.x = x_;
-  s.xd = xd_;
-  s.xdd = xdd_;
-  s.xa = xa_;
-  s.lam = lam_;
-  s.R = R_;
-  s.Rc = Rc_;
-  s.Zd = Zd_;
-  s.delta = delta_;
-  s.lamS = lamS_;
-  s.y = y_;
-  s.yd = yd_;
-  s.ydd = ydd_;
-  s.ya = ya_;
-  s.lambda0 = lambda0_;
-  s.Fa = fa_;
-  s.moment = moment_;
-  s.last_iters = last_iters_;
-  s.fallbacks = fallbacks_;
-  s.response = resp_;
+  s = s_;  // same n: Eigen assigns into the existing buffers (no allocation)
   s.valid = true;
 }
 
@@ -473,39 +448,20 @@ void FastSolver::restoreState(const FastSolverState& s) {
   if (!s.valid) throw std::invalid_argument("FastSolver::restoreState: the state was never saved");
   if (s.modes() != n_ || s.x.size() != N_)
     throw std::invalid_argument("FastSolver::restoreState: state saved with another number of modes");
-  t_ = s.t;
-  kin_ = s.kin;
-  x_ = s.x;
-  xd_ = s.xd;
-  xdd_ = s.xdd;
-  xa_ = s.xa;
-  lam_ = s.lam;
-  R_ = s.R;
-  Rc_ = s.Rc;
-  Zd_ = s.Zd;
-  delta_ = s.delta;
-  lamS_ = s.lamS;
-  y_ = s.y;
-  yd_ = s.yd;
-  ydd_ = s.ydd;
-  ya_ = s.ya;
-  lambda0_ = s.lambda0;
-  setLoad(s.Fa, s.moment);
-  last_iters_ = s.last_iters;
-  fallbacks_ = s.fallbacks;
-  resp_ = s.response;
+  s_ = s;
+  F_(N_ - 1) = s_.moment;  // the load the state was integrated under (setLoad)
   // Sd_ depends on the step size only: recomputing it gives the same bits.
   // Gt_ (the sleeve rows at l) is read between steps by the shapes and the
   // envelope (the static correction's residual term), so rebuild it at the
   // restored l; Y_ and Ek_ are rebuilt by every step before use.
   h_cached_ = -1.0;
-  fillConstraintRows(kin_.l);
+  fillConstraintRows(s_.kin.l);
 }
 
 void FastSolver::setLoad(double Fa, double moment) {
-  fa_ = Fa;
-  moment_ = moment;
-  F_(N_ - 1) = moment_;
+  s_.Fa = Fa;
+  s_.moment = moment;
+  F_(N_ - 1) = moment;
 }
 
 bool addLoadResponse(FastSolverState& s, const FastSolverState& unit, double dFa, double dM) {
@@ -552,14 +508,14 @@ void FastSolver::guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const {
   if (corr_) {
     // tmp: modal coordinates shifted by the modal part of the sleeve loads
     VectorXd& z = zs_;  // preallocated workspace (keeps GuideRopeEnvelope::evaluate allocation-free)
-    z = x_.head(2 * n_);
-    for (int k = 0; k < 4; ++k) z -= lamS_(k) * kinv_.cwiseProduct(Gt_.col(k).head(2 * n_));
+    z = s_.x.head(2 * n_);
+    for (int k = 0; k < 4; ++k) z -= s_.lamS(k) * kinv_.cwiseProduct(Gt_.col(k).head(2 * n_));
     q1.noalias() = model_->guideModalVectors(1) * z.head(n_);
     q2.noalias() = model_->guideModalVectors(2) * z.segment(n_, n_);
     return;
   }
-  q1.noalias() = model_->guideModalVectors(1) * x_.head(n_);
-  q2.noalias() = model_->guideModalVectors(2) * x_.segment(n_, n_);
+  q1.noalias() = model_->guideModalVectors(1) * s_.x.head(n_);
+  q2.noalias() = model_->guideModalVectors(2) * s_.x.segment(n_, n_);
 }
 
 void FastSolver::residualSleeveLoads(SleeveLoads& out) const {
@@ -567,12 +523,12 @@ void FastSolver::residualSleeveLoads(SleeveLoads& out) const {
     out.count = 0;
     return;
   }
-  const double l = kin_.l, b = l + 2.0 * model_->params().h;
+  const double l = s_.kin.l, b = l + 2.0 * model_->params().h;
   out.count = 4;
   out.rope = {1, 2, 2, 1};  // g1..g4
   out.x = {l, l, b, b};
   // The quasi-static (spring) part of the sleeve forces deflects the high modes.
-  out.f = {lamS_(0), lamS_(1), lamS_(2), lamS_(3)};
+  out.f = {s_.lamS(0), s_.lamS(1), s_.lamS(2), s_.lamS(3)};
 }
 
 void FastSolver::lateralState(VectorXd& q, VectorXd& qd) const {
@@ -580,17 +536,17 @@ void FastSolver::lateralState(VectorXd& q, VectorXd& qd) const {
   qd.resize(N_);
   const MatrixXd& V1 = model_->guideModalVectors(1);
   const MatrixXd& V2 = model_->guideModalVectors(2);
-  q.head(n_) = V1 * x_.head(n_);
-  q.segment(n_, n_) = V2 * x_.segment(n_, n_);
-  q.tail(2) = x_.tail(2);
-  qd.head(n_) = V1 * xd_.head(n_);
-  qd.segment(n_, n_) = V2 * xd_.segment(n_, n_);
-  qd.tail(2) = xd_.tail(2);
+  q.head(n_) = V1 * s_.x.head(n_);
+  q.segment(n_, n_) = V2 * s_.x.segment(n_, n_);
+  q.tail(2) = s_.x.tail(2);
+  qd.head(n_) = V1 * s_.xd.head(n_);
+  qd.segment(n_, n_) = V2 * s_.xd.segment(n_, n_);
+  qd.tail(2) = s_.xd.tail(2);
 }
 
 bool FastSolver::finite() const {
-  return x_.allFinite() && xd_.allFinite() && xdd_.allFinite() && y_.allFinite() && yd_.allFinite() &&
-         ydd_.allFinite() && std::isfinite(lambda0_) && lam_.allFinite();
+  return s_.x.allFinite() && s_.xd.allFinite() && s_.xdd.allFinite() && s_.y.allFinite() && s_.yd.allFinite() &&
+         s_.ydd.allFinite() && std::isfinite(s_.lambda0) && s_.lam.allFinite();
 }
 
 }  // namespace hoist

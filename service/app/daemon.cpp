@@ -156,44 +156,30 @@ void Daemon::applyRealtimeSettings() {
 }
 
 bool Daemon::openInput() {
-  // udpm:// (and LCM's default): our own receive path, which dispatches only
-  // the subscribed channels by exact name and stores nothing per channel
-  // name seen (LCM 1.3.1 would; udpm_receiver.hpp).  Other providers go
-  // through LCM (literal names, regex-escaped).
-  UdpmUrl udpm;
-  std::string why;
-  if (!parseUdpmUrl(opt_.lcm_url, udpm, why)) {
-    for (auto& s : shafts_) s->subscribe();
-    // A provider that could not connect (tcpq:// with no server) has no
-    // descriptor: say which URL, instead of a bare "assign: Bad file descriptor".
-    const int fd = lcm_.getFileno();
-    if (fd < 0) {
-      out_->error("cannot receive from LCM at {}: the provider has no connection (is its server running?)",
-                  bus::describeLcmUrl(opt_.lcm_url));
-      return false;
-    }
-    lcm_fd_.assign(fd);
-    return true;
-  }
-  receiver_ = std::make_unique<UdpmReceiver>();
-  // Without recv_buf_size in the URL the buffer holds 200 ms of every
-  // shaft's inputs (about 2 KiB of kernel memory per datagram on
-  // loopback), at least 1 MiB and at most 64 MiB.
+  // The receive path for the URL (hoist/bus/subscriber.hpp): for udpm:// (and
+  // LCM's default) our own, which dispatches only the subscribed channels by
+  // exact name and stores nothing per channel name seen (LCM 1.3.1 would);
+  // other providers go through LCM.  Without recv_buf_size in the URL the
+  // udpm buffer holds 200 ms of every shaft's inputs (about 2 KiB of kernel
+  // memory per datagram on loopback), at least 1 MiB and at most 64 MiB.
   double inputs_per_s = 0.0;
   for (const auto& s : shafts_) inputs_per_s += s->config().service.rate;
   const double want = std::clamp(0.2 * inputs_per_s * 2048.0, 1048576.0, 67108864.0);
-  if (!receiver_->open(udpm, why, static_cast<int>(want))) {
-    out_->error("cannot open the LCM input socket for {}: {}", bus::describeLcmUrl(opt_.lcm_url), why);
+  std::string why;
+  if (!input_.open(opt_.lcm_url, why, static_cast<int>(want))) {
+    out_->error("{}", why);
     return false;
   }
-  for (auto& s : shafts_) {
-    s->subscribe(receiver_.get());
-    s->setIgnoredCounter(&ignored_);
+  for (auto& s : shafts_) s->subscribe(&input_);
+  lcm_fd_.assign(input_.fd());
+  if (const UdpmReceiver* rx = input_.udpm()) {
+    for (auto& s : shafts_) s->setIgnoredCounter(&ignored_);
+    UdpmUrl udpm;
+    parseUdpmUrl(opt_.lcm_url, udpm, why);
+    out_->info("input socket: receive buffer {} KiB granted ({} KiB asked{})", rx->rcvbuf() / 1024,
+               (udpm.recv_buf_size > 0 ? udpm.recv_buf_size : static_cast<int>(want)) / 1024,
+               udpm.recv_buf_size > 0 ? ", recv_buf_size of the URL" : "");
   }
-  lcm_fd_.assign(receiver_->fd());
-  out_->info("input socket: receive buffer {} KiB granted ({} KiB asked{})", receiver_->rcvbuf() / 1024,
-             (udpm.recv_buf_size > 0 ? udpm.recv_buf_size : static_cast<int>(want)) / 1024,
-             udpm.recv_buf_size > 0 ? ", recv_buf_size of the URL" : "");
   return true;
 }
 
@@ -339,14 +325,7 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
     return;
   }
   // Drain what is queued, bounded so the timers are never starved.
-  if (receiver_) {
-    drainInput();
-  } else {
-    const auto t0 = Clock::now();
-    for (int i = 0; i < 256; ++i)
-      if (lcm_.handleTimeout(0) <= 0) break;
-    split_.receive += nanos(Clock::now() - t0);
-  }
+  drainInput();
   if (!stopping_) armLcm();
 }
 
@@ -377,8 +356,8 @@ void Daemon::flushOutputs() {
 
 void Daemon::drainInput() {
   const auto t0 = Clock::now();
-  receiver_->drain(256);
-  ignored_ = receiver_->ignored() + receiver_->malformed();
+  input_.drain(256);
+  if (const UdpmReceiver* rx = input_.udpm()) ignored_ = rx->ignored() + rx->malformed();
   const std::int64_t ns = nanos(Clock::now() - t0);
   ns_receive_ += ns;
   split_.receive += ns;
@@ -434,7 +413,7 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
     if (miss) [[unlikely]] noteMissShaft(*miss, g, i, period_us);
     if (++i % kDrainEvery == 0) {
       flushOutputs();
-      if (receiver_) drainInput();
+      if (input_.udpm()) drainInput();
     }
   }
   flushOutputs();
@@ -629,7 +608,7 @@ bool Daemon::writeReport() const {
   f.stop_reason = stop_reason_;
   f.realtime = rt_;
   f.log_lines_dropped = static_cast<std::int64_t>(log_.dropped());
-  f.receiver = receiver_.get();
+  f.receiver = input_.udpm();
   f.sender = sender_.get();
   f.ns_ticks = ns_ticks_;
   f.ns_receive = ns_receive_;

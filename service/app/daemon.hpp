@@ -42,8 +42,8 @@
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
-#include "hoist/bus/udpm_receiver.hpp"
-#include "udpm_sender.hpp"
+#include "hoist/bus/subscriber.hpp"
+#include "hoist/bus/udpm_sender.hpp"
 
 namespace hoist::svc {
 
@@ -130,7 +130,7 @@ class Daemon {
   void logStarted();             ///< one start line per shaft
 
   void armLcm();
-  void drainInput();  ///< the own receive path: read what is queued (timed)
+  void drainInput();  ///< the receive path: dispatch what is queued (timed)
   void flushOutputs();  ///< the own publisher: send what the tick queued (timed)
   void onLcmReadable(const boost::system::error_code& ec);
   void armOutWatch();
@@ -160,8 +160,8 @@ class Daemon {
   RtLog log_;
   boost::asio::io_context io_;
   lcm::LCM lcm_;
-  std::unique_ptr<UdpmReceiver> receiver_;  ///< own receive path for udpm URLs (udpm_receiver.hpp); else LCM's
-  std::int64_t ignored_ = 0;                 ///< receiver_->ignored(), mirrored for the health reports
+  bus::Subscriber input_{lcm_};  ///< the receive path: own for udpm URLs (hoist/bus/subscriber.hpp), else LCM's
+  std::int64_t ignored_ = 0;     ///< the udpm receiver's ignored + malformed, mirrored for the health reports
   static constexpr std::size_t kDrainEvery = 16;  ///< shafts stepped between two drains within a tick
   // cost split (report): steady-clock ns in the ticks (without the drains
   // inside them) and in the drains; process CPU time at start

@@ -22,9 +22,11 @@
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
 #include "shaft_context.hpp"
-#include "udpm_sender.hpp"
+#include "hoist/bus/udpm_sender.hpp"
 
 namespace hoist::svc {
+
+using bus::UdpmSender;
 
 class ShaftOutputs {
  public:

@@ -55,7 +55,7 @@
 #include "shaft_health.hpp"
 #include "shaft_inputs.hpp"
 #include "shaft_outputs.hpp"
-#include "udpm_sender.hpp"
+#include "hoist/bus/udpm_sender.hpp"
 
 namespace hoist::svc {
 

@@ -5,11 +5,16 @@
 #   2. nothing under service/ or io/ includes a header from tools/: no include
 #      path naming tools/, and no include that resolves only to a header under
 #      tools/ (e.g. "hoist/study/sweep.hpp" or "timing_report.hpp");
-#   3. nothing under tools/ includes a header from service/: no include path
-#      into service/ ("../../service/app/daemon.hpp"), and no include that
-#      resolves only to a header under service/ (e.g. "hoist/service/alarms.hpp"
+#   3. nothing under tools/, msgs/ or rt/ includes a header from service/: no
+#      include path into service/ ("../../service/app/daemon.hpp"), and no
+#      include that resolves only to a header under service/ (e.g.
+#      "hoist/service/alarms.hpp", from any library folder service/<lib>/include,
 #      or "shaft_twin.hpp").  What the tools share with the daemon is the
-#      contract in msgs/contract.
+#      contract in msgs/contract;
+#   4. msgs/ and rt/ include nothing from tools/ either (as rule 2);
+#   5. no tool includes "hoist/bus/udpm_receiver.hpp" itself: the choice
+#      between our udpm receive path and LCM's is made once, by
+#      hoist::bus::Subscriber ("hoist/bus/subscriber.hpp").
 # Also: model/ includes only its own headers and system/Eigen headers.
 #   cmake -DROOT=<source dir> -DMODEL_LINKS='Eigen3::Eigen' -P check_layers.cmake
 # Prints "LAYER VIOLATION: ..." for each broken rule and fails.
@@ -51,8 +56,10 @@ endforeach()
 list(REMOVE_DUPLICATES _tool_names)
 
 # Include directories a service/ or io/ file may legitimately reach.
-set(_allowed_dirs "${ROOT}/model/include" "${ROOT}/io/include" "${ROOT}/msgs/include"
-                  "${ROOT}/service/include" "${ROOT}/service/app")
+file(GLOB _service_incs LIST_DIRECTORIES true "${ROOT}/service/*/include")  # one per library of service/
+file(GLOB _msgs_incs LIST_DIRECTORIES true "${ROOT}/msgs/*/include")  # msgs/contract, msgs/udpm
+set(_allowed_dirs "${ROOT}/model/include" "${ROOT}/io/include" "${ROOT}/msgs/include" ${_msgs_incs}
+                  "${ROOT}/rt/include" "${ROOT}/service/include" ${_service_incs} "${ROOT}/service/app")
 
 function(_includes file out)
   file(STRINGS "${file}" _lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]")
@@ -65,8 +72,8 @@ function(_includes file out)
   set(${out} "${_incs}" PARENT_SCOPE)
 endfunction()
 
-# ---- rule 2: service/ and io/ include nothing from tools/ ------------------
-foreach(layer service io)
+# ---- rules 2 and 4: service/, io/, msgs/ and rt/ include nothing from tools/ --
+foreach(layer service io msgs rt)
   file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/${layer}/*.hpp" "${ROOT}/${layer}/*.h"
        "${ROOT}/${layer}/*.cpp")
   foreach(f IN LISTS _files)
@@ -94,15 +101,15 @@ foreach(layer service io)
   endforeach()
 endforeach()
 
-# ---- rule 3: tools/ includes nothing from service/ --------------------------
+# ---- rule 3: tools/, msgs/ and rt/ include nothing from service/ ------------
 file(GLOB_RECURSE _svc_headers LIST_DIRECTORIES false RELATIVE "${ROOT}/service"
      "${ROOT}/service/*.hpp" "${ROOT}/service/*.h")
 set(_svc_names "")
 foreach(h IN LISTS _svc_headers)
   get_filename_component(_name "${h}" NAME)
   list(APPEND _svc_names "${_name}")
-  if(h MATCHES "^include/(.+)$")                # service/include/hoist/service/...
-    list(APPEND _svc_names "${CMAKE_MATCH_1}")
+  if(h MATCHES "^([^/]+/)?include/(.+)$")       # service/<lib>/include/hoist/service/...
+    list(APPEND _svc_names "${CMAKE_MATCH_2}")
   endif()
   if(h MATCHES "^[^/]+/(.+)$")                  # relative to service/<x>/
     list(APPEND _svc_names "${CMAKE_MATCH_1}")
@@ -114,12 +121,17 @@ list(REMOVE_DUPLICATES _svc_names)
 file(GLOB _tool_dirs LIST_DIRECTORIES true "${ROOT}/*/include" "${ROOT}/msgs/*/include" "${ROOT}/tools/*"
      "${ROOT}/tools/*/include" "${ROOT}/tools/*/src")
 list(FILTER _tool_dirs EXCLUDE REGEX "^${ROOT}/service/")
-file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/tools/*.hpp" "${ROOT}/tools/*.h" "${ROOT}/tools/*.cpp")
+file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/tools/*.hpp" "${ROOT}/tools/*.h" "${ROOT}/tools/*.cpp"
+     "${ROOT}/msgs/*.hpp" "${ROOT}/msgs/*.h" "${ROOT}/msgs/*.cpp" "${ROOT}/rt/*.hpp" "${ROOT}/rt/*.h" "${ROOT}/rt/*.cpp")
 foreach(f IN LISTS _files)
   file(RELATIVE_PATH _rel "${ROOT}" "${f}")
   get_filename_component(_dir "${f}" DIRECTORY)
   _includes("${f}" _incs)
   foreach(inc IN LISTS _incs)
+    # rule 5: the receive path is chosen in one place
+    if(_rel MATCHES "^tools/" AND inc STREQUAL "hoist/bus/udpm_receiver.hpp")
+      _violation("${_rel} includes \"${inc}\": a tool takes its receive path from hoist/bus/subscriber.hpp")
+    endif()
     if(inc MATCHES "(^|\\.\\./)service/")
       _violation("${_rel} includes \"${inc}\" (a path into service/)")
       continue()
@@ -155,4 +167,5 @@ endforeach()
 if(_violations GREATER 0)
   message(FATAL_ERROR "check_layers: ${_violations} layer violation(s); see README.md, Development")
 endif()
-message("check_layers: OK (hoist_model links: ${MODEL_LINKS}; no tools/ header in service/ or io/; no service/ header in tools/)")
+message("check_layers: OK (hoist_model links: ${MODEL_LINKS}; no tools/ header in service/, io/, msgs/ or rt/; "
+        "no service/ header in tools/, msgs/ or rt/; tools receive through hoist/bus/subscriber.hpp)")

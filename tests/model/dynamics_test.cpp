@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hoist/fast_solver.hpp"
+#include "hoist/guide_rope_envelope.hpp"
 #include "hoist/paper_solver.hpp"
 #include "hoist/simulator.hpp"
 #include "exact_static.hpp"

@@ -10,6 +10,7 @@
 #include <cstdio>
 
 #include "hoist/fast_solver.hpp"
+#include "hoist/guide_rope_envelope.hpp"
 #include "hoist/simulator.hpp"
 
 using namespace hoist;

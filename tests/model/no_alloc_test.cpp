@@ -4,6 +4,7 @@
 #include <new>
 
 #include "hoist/fast_solver.hpp"
+#include "hoist/guide_rope_envelope.hpp"
 #include "hoist/forecast.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/scenario.hpp"

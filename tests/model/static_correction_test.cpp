@@ -13,6 +13,7 @@
 
 #include "exact_static.hpp"
 #include "hoist/fast_solver.hpp"
+#include "hoist/guide_rope_envelope.hpp"
 #include "hoist/paper_solver.hpp"
 #include "hoist/simulator.hpp"
 #include "hoist/solver.hpp"
@@ -622,37 +623,6 @@ TEST(StaticCorrection, PaperMethodRefusesIt) {
   EXPECT_THROW(PaperSolver(std::make_shared<const ShaftModel>(p)), std::invalid_argument);
   p.static_correction = false;
   EXPECT_NO_THROW(PaperSolver(std::make_shared<const ShaftModel>(p)));
-}
-
-}  // namespace
-
-namespace {
-
-TEST(FastLongitudinal, FusedStepMatrixMatchesThePreviousForm) {
-  // The cost lever: E built in one pass from the constant matrices, Ek never
-  // formed.  Same equations, different rounding: x_c and lambda_0 agree to
-  // round-off over the paper's trip (the hoisting rope's kHz modes included).
-  for (int n : {10, 50}) {
-    ShaftParams p;
-    p.n = n;
-    auto model = std::make_shared<const ShaftModel>(p);
-    FastSolver a(model), b(model);
-    b.setFusedLongitudinal(false);
-    const HoistProfile prof = HoistProfile::trapezoid();
-    a.initialize(0.0, prof.at(0.0));
-    b.initialize(0.0, prof.at(0.0));
-    double worst = 0, scale = 0;
-    for (int k = 1; k <= 6000; ++k) {
-      const double t = 0.01 * k;
-      a.step(t, prof.at(t));
-      b.step(t, prof.at(t));
-      worst = std::max({worst, std::abs(a.response().x_c - b.response().x_c) / 1e-3,
-                        std::abs(a.response().lambda[0] - b.response().lambda[0]) / 1e4});
-      scale = std::max(scale, std::abs(b.response().x_c));
-    }
-    EXPECT_LT(worst, 1e-9) << "n = " << n;
-    EXPECT_GT(scale, 1e-4);
-  }
 }
 
 }  // namespace

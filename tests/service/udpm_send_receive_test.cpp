@@ -1,16 +1,15 @@
 // hoist-twind's own udpm receive path (msgs/udpm/include/hoist/bus/udpm_receiver.hpp),
 // for many shafts per process: the receive buffer it asks for is granted, and the kernel's drop count
 // (SO_RXQ_OVFL) accounts for every datagram that did not fit.  Real UDP
-// multicast on loopback, port 7871.  And its own publisher (udpm_sender.hpp).
+// multicast on loopback, port 7871.  And its own publisher (hoist/bus/udpm_sender.hpp).
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 
 #include "hoist/bus/udpm_receiver.hpp"
-#include "udpm_sender.hpp"
+#include "hoist/bus/udpm_sender.hpp"
 
-using namespace hoist::svc;
 using namespace hoist::bus;
 
 namespace {

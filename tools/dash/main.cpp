@@ -22,7 +22,7 @@
 #include <spdlog/spdlog.h>
 
 #include "hoist/bus/lcm_util.hpp"
-#include "hoist/bus/udpm_receiver.hpp"
+#include "hoist/bus/subscriber.hpp"
 #include "hoist/msg/codec.hpp"
 #include "src/hub.hpp"
 #include "src/server.hpp"
@@ -207,26 +207,16 @@ int main(int argc, char** argv) {
       },
       wallNs);
   LcmPump pump{&lcm, &hub};
-  // udpm:// (and LCM's default): our own receive path, which stores nothing
-  // per channel name (LCM 1.3.1 caches every name it ever receives, so a
-  // sender cycling names would grow this process without bound;
-  // hoist/bus/udpm_receiver.hpp).  LCM then only publishes.  Other
-  // providers: LCM's receive path.
+  // The receive path for the URL (our own for udpm://, LCM's otherwise:
+  // hoist/bus/subscriber.hpp); LCM's ".*HOIST_.*" (anchored): any name containing HOIST_.
+  hoist::bus::Subscriber rx(lcm);
   std::string rx_why;
-  std::unique_ptr<hoist::bus::UdpmReceiver> rx = hoist::bus::openUdpmReceiver(url, rx_why);
-  if (!rx_why.empty()) {
+  if (!rx.open(url, rx_why)) {
     std::fprintf(stderr, "hoist-dash: %s\n", rx_why.c_str());
     return 1;
   }
-  {
-    if (rx) {
-      // LCM's ".*HOIST_.*" (anchored): any name containing HOIST_.
-      rx->addMatching([](std::string_view n) { return n.find("HOIST_") != std::string_view::npos; },
-                      [&pump](const lcm::ReceiveBuffer* rb, const std::string& ch) { pump.onMessage(rb, ch); });
-    } else {
-      lcm.subscribe(".*HOIST_.*", &LcmPump::onMessage, &pump);
-    }
-  }
+  rx.addMatching([](std::string_view n) { return n.find("HOIST_") != std::string_view::npos; }, ".*HOIST_.*",
+                 [&pump](const lcm::ReceiveBuffer* rb, const std::string& ch) { pump.onMessage(rb, ch); });
   hub.requestAlarmStates();  // alarms raised before this start: their states now
 
   net::io_context io;
@@ -247,16 +237,11 @@ int main(int argc, char** argv) {
   }
 
   // LCM: its socket in the same loop.
-  net::posix::stream_descriptor lcm_fd(io, ::dup(rx ? rx->fd() : lcm.getFileno()));
+  net::posix::stream_descriptor lcm_fd(io, ::dup(rx.fd()));
   std::function<void()> waitLcm = [&]() {
     lcm_fd.async_wait(net::posix::stream_descriptor::wait_read, [&](boost::system::error_code e) {
       if (e) return;
-      if (rx) {
-        rx->drain(1000);
-      } else {
-        for (int i = 0; i < 1000 && lcm.handleTimeout(0) > 0; ++i) {
-        }
-      }
+      rx.drain(1000);
       waitLcm();
     });
   };

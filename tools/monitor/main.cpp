@@ -40,7 +40,6 @@
 // rejects more).
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
-#include <poll.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -60,7 +59,7 @@
 #include "hoist/health_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
-#include "hoist/bus/udpm_receiver.hpp"
+#include "hoist/bus/subscriber.hpp"
 #include "hoist/msg/codec.hpp"
 
 namespace {
@@ -333,31 +332,19 @@ int main(int argc, char** argv) {
   const hoist::bus::Channels ch(prefix);
   mon.cage_channel_ = ch.cage;
   mon.stale_s_ = stale;
-  // udpm:// (and LCM's default): our own receive path, exact names, nothing
-  // stored per channel name (hoist/bus/udpm_receiver.hpp); else LCM's, with
-  // literal names: subscribe() takes a regular expression, and a prefix
-  // "mine.1/" must not show the shaft "mineX1/".
+  // The receive path for the URL (our own for udpm://, LCM's otherwise,
+  // exact names either way: hoist/bus/subscriber.hpp).
+  hoist::bus::Subscriber rx(lcm);
   std::string rx_why;
-  std::unique_ptr<hoist::bus::UdpmReceiver> rx = hoist::bus::openUdpmReceiver(url, rx_why);
-  if (!rx_why.empty()) {
+  if (!rx.open(url, rx_why)) {
     std::fprintf(stderr, "hoist-monitor: %s\n", rx_why.c_str());
     return 1;
   }
-  {
-    if (rx) {
-      rx->add(ch.cage, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onCage(rb, c); });
-      rx->add(ch.alarm, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onAlarm(rb, c); });
-      rx->add(ch.health, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onHealth(rb, c); });
-      rx->add(ch.forecast, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onForecast(rb, c); });
-      rx->add(ch.estimate, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onEstimate(rb, c); });
-    } else {
-      lcm.subscribe(hoist::bus::regexEscape(ch.cage), &Monitor::onCage, &mon);
-      lcm.subscribe(hoist::bus::regexEscape(ch.alarm), &Monitor::onAlarm, &mon);
-      lcm.subscribe(hoist::bus::regexEscape(ch.health), &Monitor::onHealth, &mon);
-      lcm.subscribe(hoist::bus::regexEscape(ch.forecast), &Monitor::onForecast, &mon);
-      lcm.subscribe(hoist::bus::regexEscape(ch.estimate), &Monitor::onEstimate, &mon);
-    }
-  }
+  rx.add(ch.cage, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onCage(rb, c); });
+  rx.add(ch.alarm, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onAlarm(rb, c); });
+  rx.add(ch.health, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onHealth(rb, c); });
+  rx.add(ch.forecast, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onForecast(rb, c); });
+  rx.add(ch.estimate, [&mon](const lcm::ReceiveBuffer* rb, const std::string& c) { mon.onEstimate(rb, c); });
   struct sigaction sa {};
   sa.sa_handler = onSignal;
   sigaction(SIGINT, &sa, nullptr);
@@ -365,7 +352,6 @@ int main(int argc, char** argv) {
 
   const auto start = Clock::now();
   auto next = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period));
-  const int fd = rx ? rx->fd() : lcm.getFileno();
   while (!g_stop) {
     const auto now = Clock::now();
     if (duration > 0.0 && now - start >= std::chrono::duration<double>(duration)) break;
@@ -376,12 +362,7 @@ int main(int argc, char** argv) {
       continue;
     }
     const int wait_ms = static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(next - now).count()) + 1;
-    pollfd p{fd, POLLIN, 0};
-    const int r = ::poll(&p, 1, std::min(wait_ms, 200));
-    if (r > 0) {
-      if (rx) rx->drain(256);
-      else lcm.handle();
-    }
+    rx.poll(std::min(wait_ms, 200), 256);
   }
   return 0;
 }

@@ -36,7 +36,9 @@
 namespace hoist {
 
 /// Everything FastSolver needs to continue integrating bit-identically from
-/// one instant (the forecast's copy of the twin).  Vectors are sized once by
+/// one instant (the forecast's copy of the twin).  It IS the solver's state:
+/// FastSolver keeps its own in one FastSolverState, so saving and restoring
+/// are plain assignments and a new state field cannot be forgotten in either.  Vectors are sized once by
 /// FastSolverState(n) (or the first saveState()); saving into and restoring
 /// from a state of the same n allocates nothing, and so does copying one
 /// state into another of the same n (Eigen assignment keeps the buffers).
@@ -105,7 +107,7 @@ class FastSolver final : public Solver {
   void initialize(double t0, const Kinematics& k0, InitialState init) override;
   using Solver::initialize;
   void step(double t1, const Kinematics& k1) override;
-  const CageResponse& response() const override { return resp_; }
+  const CageResponse& response() const override { return s_.response; }
   void guideRopeCoordinates(VectorXd& q1, VectorXd& q2) const override;
   void residualSleeveLoads(SleeveLoads& out) const override;
   bool finite() const override;
@@ -116,8 +118,8 @@ class FastSolver final : public Solver {
   /// from the next step() on (a forecast from the load estimator's state).
   /// initialize() does not reset it.  saveState/restoreState carry it.
   void setLoad(double Fa, double moment);
-  double loadForce() const { return fa_; }
-  double loadMoment() const { return moment_; }
+  double loadForce() const { return s_.Fa; }
+  double loadMoment() const { return s_.moment; }
 
   // ---- snapshot (look-ahead forecasts) -------------------------------------
   /// Copies the integration state into `s` (no allocation when s was sized
@@ -133,24 +135,19 @@ class FastSolver final : public Solver {
   void lateralState(VectorXd& q, VectorXd& qd) const;
   /// Fixed-point sweeps used by the last longitudinal solve, and how many
   /// solves fell back to the dense LU since initialize().
-  int lastLongitudinalIterations() const { return last_iters_; }
-  long longitudinalFallbacks() const { return fallbacks_; }
+  int lastLongitudinalIterations() const { return s_.last_iters; }
+  long longitudinalFallbacks() const { return s_.fallbacks; }
   /// Longitudinal state: hoisting-rope modal coordinates q0 and rates.
-  const VectorXd& hoistingRopeCoordinates() const { return y_; }
-  const VectorXd& hoistingRopeRates() const { return yd_; }
-  /// The longitudinal step matrix E built in one pass from the constant
-  /// matrices (default), or, false, the previous form (Ek built, applied, scaled
-  /// and added to): kept to benchmark the two side by side and to test that
-  /// they agree.
-  void setFusedLongitudinal(bool on) { fused_ = on; }
+  const VectorXd& hoistingRopeCoordinates() const { return s_.y; }
+  const VectorXd& hoistingRopeRates() const { return s_.yd; }
   /// Static correction active, and the sleeves' residual flexibility R(l) at
   /// the current position (zero without the correction) [m/N].
   bool staticCorrection() const { return corr_; }
-  const Eigen::Matrix4d& residualFlexibility() const { return R_; }
+  const Eigen::Matrix4d& residualFlexibility() const { return s_.R; }
   /// The high modes' wave impedance at each sleeve, 2 sqrt(T rho2) [N s/m],
   /// and the spring (quasi-static) part of the sleeve forces, R^-1 (-G q).
-  const Eigen::Vector4d& residualDamping() const { return Zd_; }
-  const Eigen::Vector4d& residualSpringForces() const { return lamS_; }
+  const Eigen::Vector4d& residualDamping() const { return s_.Zd; }
+  const Eigen::Vector4d& residualSpringForces() const { return s_.lamS; }
   /// Scales the sleeves' dashpot Z (default 1; 0 removes it, leaving the
   /// residual springs alone).  A sensitivity knob for tests and studies
   /// (docs/model.md: the response is insensitive to 0.25 Z .. 2 Z); takes
@@ -161,56 +158,44 @@ class FastSolver final : public Solver {
  private:
   void fillConstraintRows(double l);                 // G_ (4 x N) at l
   void fillConstraintRowDerivatives(double l);       // Gl_, Gll_ (init only)
-  void fillResidualFlexibility(double l);            // R_ at l (after fillConstraintRows)
+  void fillResidualFlexibility(double l);            // s_.R at l (after fillConstraintRows)
   // KKT solve  S qdd - G^T lam = r,  G qdd + c R lam = d  (c = 0: rigid sleeves).
   void solveLateral(const VectorXd& Sd, const VectorXd& r, const Eigen::Vector4d& d, double c);
-  void longitudinalOperators(const Kinematics& k);  // Ek_ and F0_ at k
+  void longitudinalOperators(const Kinematics& k);  // Ek_ and F0_ at k (initialize(); step() builds E fused)
   void longitudinalLoads(const Kinematics& k);      // F0_ at k
   void updateResponse(double t, const Kinematics& k);
 
+  /// The whole integration state (time, kinematics, lateral and longitudinal
+  /// coordinates, multipliers, the static correction's sleeve terms, the
+  /// response): saveState()/restoreState() are plain assignments of it.
+  /// Everything else below is constant model data or per-step workspace.
+  FastSolverState s_;
   GeneralizedAlpha ga_;
   /// Velocities at t0 consistent with the constraints when v(t0) != 0 (see .cpp).
   void consistentInitialVelocity(double v);
   int n_ = 0, N_ = 0;  // modes per rope; lateral size 2n + 2
-  double t_ = 0.0;
-  Kinematics kin_;
   double h_cached_ = -1.0;
 
   // lateral constants (modal coordinates), state and workspace
   VectorXd Md_, Cd_, Kd_, F_;        // diagonal M, C, K and load
-  VectorXd x_, xd_, xdd_, xa_;        // state, rate, acceleration, pseudo-acceleration
   VectorXd Sd_;                       // M + h gamma ca C + h^2 beta ca K (diagonal)
   // Constraint Jacobian stored transposed (N x 4, contiguous columns g1..g4)
   // and its l-derivatives (used for consistent initial accelerations).
   Eigen::Matrix<double, Eigen::Dynamic, 4> Gt_, Glt_, Gllt_;
   Eigen::Matrix<double, Eigen::Dynamic, 4> Y_;  // S^-1 G^T
   VectorXd sa_, sb_, xhat_, vhat_, r_, tmp_;
-  Eigen::Vector4d lam_;
   bool corr_ = false;                 // static correction
-  Eigen::Matrix4d R_ = Eigen::Matrix4d::Zero();  // residual flexibility at the sleeves
-  Eigen::Matrix4d Rc_ = Eigen::Matrix4d::Zero(); // step compliance (R^-1 + Z/h)^-1
-  Eigen::Vector4d Zd_ = Eigen::Vector4d::Zero(); // wave impedance 2 sqrt(T rho2) at each sleeve
   double zscale_ = 1.0;                           // setResidualDampingScale
-  Eigen::Vector4d delta_ = Eigen::Vector4d::Zero();  // residual displacement -G x at the last step
-  Eigen::Vector4d lamS_ = Eigen::Vector4d::Zero();   // spring part of lam: R lamS = delta
   VectorXd kinv_;                     // 1 / kappa (rope entries)
   mutable VectorXd zs_;               // guideRopeCoordinates workspace (2n)
 
   // longitudinal
   VectorXd u_;                        // U0_i(1)
-  VectorXd y_, yd_, ydd_, ya_;        // q0 state
   MatrixXd S0_, Ek_;                  // step matrix, velocity/accel-dependent stiffness
   Eigen::PartialPivLU<MatrixXd> lu_;
   VectorXd yhat_, yvhat_, r0_, F0_;
   VectorXd k2_, Pd_, w_, res_, dy_;  // k_i^2, diagonal of P, P^-1 u, residual, update
-  int last_iters_ = 0;
-  long fallbacks_ = 0;
-  bool fused_ = true;
   Forcing forcing_ = Forcing::Full;
-  double lambda0_ = 0.0;
-  double fa_ = 0.0, moment_ = 0.0;    // the eccentric load (setLoad)
-
-  CageResponse resp_;
 
   // initialize() workspace, sized in the constructor so that re-initializing
   // (a new winder stream, recovery from a model fault) allocates nothing.

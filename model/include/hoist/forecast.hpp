@@ -28,6 +28,7 @@
 
 #include "hoist/clearance.hpp"
 #include "hoist/fast_solver.hpp"
+#include "hoist/guide_rope_envelope.hpp"
 #include "hoist/scenario.hpp"
 
 namespace hoist {

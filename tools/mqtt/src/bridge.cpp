@@ -25,7 +25,7 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
-#include "hoist/bus/udpm_receiver.hpp"
+#include "hoist/bus/subscriber.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/estimate_t.hpp"
 #include "hoist/forecast_t.hpp"
@@ -97,9 +97,9 @@ struct Bridge::Impl {
   // ---- LCM ---------------------------------------------------------------------
   std::string lcm_url;
   lcm::LCM lcm;
-  /// udpm://: our own receive path (nothing stored per channel name; LCM
-  /// 1.3.1 caches every name it receives, hoist/bus/udpm_receiver.hpp).
-  std::unique_ptr<hoist::bus::UdpmReceiver> rx;
+  /// The receive path for lcm_url (ours for udpm://: nothing stored per
+  /// channel name; LCM's otherwise): hoist/bus/subscriber.hpp.
+  hoist::bus::Subscriber rx{lcm};
 
   // ---- shafts ------------------------------------------------------------------
   struct AlarmState {
@@ -235,26 +235,20 @@ struct Bridge::Impl {
     discover = cfg.channel_prefixes.empty();
     for (const auto& p : cfg.channel_prefixes) addShaft(p, true);
     std::string why;
-    rx = hoist::bus::openUdpmReceiver(lcm_url, why);
-    if (!why.empty()) throw std::runtime_error(why);
-    if (rx) {
-      rx->addMatching(
-          [](std::string_view n) {
-            auto ends = [&](std::string_view suffix) {
-              return n.size() >= suffix.size() && n.substr(n.size() - suffix.size()) == suffix;
-            };
-            return ends(kChannelCage) || ends(kChannelHealth) || ends(kChannelAlarm) || ends(kChannelForecast) ||
-                   ends(kChannelEstimate);
-          },
-          [this](const lcm::ReceiveBuffer* rb, const std::string& channel) { onLcm(rb, channel); });
-    } else {
-      // One subscription for every shaft:
-      // ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM|HOIST_FORECAST|HOIST_ESTIMATE)" (LCM anchors it).
-      lcm.subscribe(".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" +
-                        std::string(kChannelAlarm) + "|" + std::string(kChannelForecast) + "|" +
-                        std::string(kChannelEstimate) + ")",
-                    &Impl::onLcm, this);
-    }
+    if (!rx.open(lcm_url, why)) throw std::runtime_error(why);
+    // One subscription for every shaft; as LCM's regular expression (anchored):
+    // ".*(HOIST_CAGE|HOIST_HEALTH|HOIST_ALARM|HOIST_FORECAST|HOIST_ESTIMATE)".
+    rx.addMatching(
+        [](std::string_view n) {
+          auto ends = [&](std::string_view suffix) {
+            return n.size() >= suffix.size() && n.substr(n.size() - suffix.size()) == suffix;
+          };
+          return ends(kChannelCage) || ends(kChannelHealth) || ends(kChannelAlarm) || ends(kChannelForecast) ||
+                 ends(kChannelEstimate);
+        },
+        ".*(" + std::string(kChannelCage) + "|" + std::string(kChannelHealth) + "|" + std::string(kChannelAlarm) +
+            "|" + std::string(kChannelForecast) + "|" + std::string(kChannelEstimate) + ")",
+        [this](const lcm::ReceiveBuffer* rb, const std::string& channel) { onLcm(rb, channel); });
 
     mosq = mosquitto_new(client_id.c_str(), /*clean_session=*/true, this);
     if (!mosq) throw std::runtime_error("mosquitto_new failed: " + std::string(std::strerror(errno)));
@@ -1428,7 +1422,7 @@ struct Bridge::Impl {
                  : sp          ? "accepted as DCMD writes of Alarms/<KIND>/{Ack,Shelve,Unshelve}"
                                : "accepted on hoist/<shaft>/cmd/ack",
                  discover ? "discovered from their *HOIST_{HEALTH,CAGE,ALARM} channels" : std::to_string(shafts.size()) + " configured");
-    const int lcm_fd = rx ? rx->fd() : lcm.getFileno();
+    const int lcm_fd = rx.fd();
     while (!stop) {
       auto now = Clock::now();
       if (conn == Conn::Disconnected && now >= next_attempt) tryConnect();
@@ -1449,12 +1443,7 @@ struct Bridge::Impl {
 
       if (n > 0 && (fds[0].revents & POLLIN)) {
         // Drain what is there, bounded so the broker side is never starved.
-        if (rx) {
-          rx->drain(256);
-        } else {
-          for (int i = 0; i < 256 && lcm.handleTimeout(0) > 0; ++i) {
-          }
-        }
+        rx.drain(256);
       }
       if (conn != Conn::Disconnected) {
         const int rc = mosquitto_loop(mosq, 0, 1);

@@ -142,7 +142,8 @@ class UdpmReceiver final : public InputRouter {
   std::int64_t received_ = 0, ignored_ = 0, malformed_ = 0;
 };
 
-/// The tools' receive path for `url`: an opened UdpmReceiver for udpm://
+/// The udpm half of hoist::bus::Subscriber's choice (subscriber.hpp, which
+/// the programs use): an opened UdpmReceiver for udpm://
 /// (and LCM's default); nullptr with `why` empty for other providers (use
 /// LCM's subscribe); nullptr with `why` set when the socket cannot be opened
 /// (the message names the URL).  `default_rcvbuf` [bytes]: as open()'s.

@@ -1,5 +1,5 @@
 // hoist-twind's own udpm publisher: see udpm_sender.hpp.
-#include "udpm_sender.hpp"
+#include "hoist/bus/udpm_sender.hpp"
 
 #include <arpa/inet.h>
 #include <cerrno>
@@ -7,7 +7,7 @@
 #include <netinet/in.h>
 #include <unistd.h>
 
-namespace hoist::svc {
+namespace hoist::bus {
 
 namespace {
 constexpr std::uint32_t kMagicShort = 0x4c433032;  // "LC02"
@@ -106,4 +106,4 @@ int UdpmSender::flush() {
   return failed;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::bus

@@ -1,4 +1,4 @@
-// udpm_sender.hpp -- hoist-twind's own publisher for LCM's UDP multicast
+// hoist/bus/udpm_sender.hpp -- hoist-twind's own publisher for LCM's UDP multicast
 // transport (udpm://), batching the per-tick outputs into sendmmsg calls.
 //
 // Why: with hundreds of shafts, publishing HOIST_CAGE is one
@@ -26,9 +26,7 @@
 
 #include "hoist/bus/udpm_receiver.hpp"
 
-namespace hoist::svc {
-
-using bus::UdpmUrl;
+namespace hoist::bus {
 
 class UdpmSender {
  public:
@@ -70,4 +68,4 @@ class UdpmSender {
   std::int64_t sent_ = 0, calls_ = 0;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::bus

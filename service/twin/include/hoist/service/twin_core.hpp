@@ -52,6 +52,7 @@
 #include "hoist/service/input_validator.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/plausibility.hpp"
+#include "hoist/guide_rope_envelope.hpp"
 #include "hoist/solver.hpp"
 
 namespace hoist::svc {

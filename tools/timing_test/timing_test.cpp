@@ -3,7 +3,7 @@
 // Threads: the feeder (own LCM instance, publish only, absolute schedule on
 // CLOCK_MONOTONIC, signals blocked) and the main thread (the listener:
 // HOIST_HEALTH and HOIST_CAGE of every prefix, progress, signals).  The
-// listener receives udpm:// through hoist::bus::UdpmReceiver (exact channel
+// listener receives udpm:// through hoist::bus::Subscriber's UdpmReceiver (exact channel
 // names, nothing stored per name: a sender cycling through channel names
 // cannot grow it, unlike LCM 1.3.1's receive path), with an 8 MiB socket
 // buffer for the outputs of hundreds of shafts; other LCM providers through
@@ -28,10 +28,8 @@
 #include <lcm/lcm-cpp.hpp>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <thread>
 
-#include <poll.h>
 
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
@@ -39,7 +37,7 @@
 #include "hoist/msg/codec.hpp"
 #include "hoist/profile.hpp"
 #include "hoist/bus/lcm_util.hpp"
-#include "hoist/bus/udpm_receiver.hpp"
+#include "hoist/bus/subscriber.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/winder_t.hpp"
 #include "timing_test.hpp"
@@ -374,29 +372,21 @@ int runTimingTest(const TimingTestOptions& o) {
   };
 
   const std::string& rx_url = o.lcm_url_out.empty() ? o.lcm_url : o.lcm_url_out;
+  // The listener's receive path for rx_url (ours for udpm://, else an LCM
+  // instance of its own): hoist/bus/subscriber.hpp.
+  hoist::bus::Subscriber rx;
   std::string rx_why;
-  std::unique_ptr<hoist::bus::UdpmReceiver> urx = hoist::bus::openUdpmReceiver(rx_url, rx_why, 8 << 20);
-  if (!rx_why.empty()) {
+  if (!rx.open(rx_url, rx_why, 8 << 20)) {
     std::cerr << "hoist-timing-test: " << rx_why << "\n";
     return 1;
   }
-  std::optional<lcm::LCM> lrx;  // other providers than udpm://
-  if (!urx) lrx.emplace(rx_url);
   lcm::LCM tx(o.lcm_url);
-  if ((lrx && !lrx->good()) || !tx.good()) {
-    std::cerr << "hoist-timing-test: cannot open LCM at "
-              << hoist::bus::describeLcmUrl(lrx && !lrx->good() ? rx_url : o.lcm_url) << "\n";
+  if (!tx.good()) {
+    std::cerr << "hoist-timing-test: cannot open LCM at " << hoist::bus::describeLcmUrl(o.lcm_url) << "\n";
     return 1;
   }
   // Wait up to `ms` for datagrams and dispatch what arrived.
-  auto receive = [&](int ms) {
-    if (lrx) {
-      lrx->handleTimeout(ms);
-      return;
-    }
-    pollfd p{urx->fd(), POLLIN, 0};
-    if (::poll(&p, 1, ms) > 0) urx->drain(4096);
-  };
+  auto receive = [&](int ms) { rx.poll(ms, 4096); };
   const RoundTrip trip(o.l0, o.travel, o.vmax, o.amax);
 
   Run run(o);
@@ -415,14 +405,9 @@ int runTimingTest(const TimingTestOptions& o) {
   for (auto& s : run.shafts) {
     const std::string health = hoist::bus::channel(s->res.prefix, hoist::bus::kChannelHealth);
     const std::string cage = hoist::bus::channel(s->res.prefix, hoist::bus::kChannelCage);
-    if (urx) {
-      Shaft* sh = s.get();
-      urx->add(health, [sh](const lcm::ReceiveBuffer* rb, const std::string& c) { sh->onHealth(rb, c); });
-      urx->add(cage, [sh](const lcm::ReceiveBuffer* rb, const std::string& c) { sh->onCage(rb, c); });
-    } else {
-      lrx->subscribe(hoist::bus::regexEscape(health), &Shaft::onHealth, s.get());
-      lrx->subscribe(hoist::bus::regexEscape(cage), &Shaft::onCage, s.get());
-    }
+    Shaft* sh = s.get();
+    rx.add(health, [sh](const lcm::ReceiveBuffer* rb, const std::string& c) { sh->onHealth(rb, c); });
+    rx.add(cage, [sh](const lcm::ReceiveBuffer* rb, const std::string& c) { sh->onCage(rb, c); });
   }
 
   struct sigaction sa {};

@@ -1,0 +1,67 @@
+// hoist/guide_rope_envelope.hpp -- the guide ropes' largest lateral
+// deflection over the shaft (the e_guide of hoist/clearance.hpp), from any
+// Solver's state: GuideRopeEnvelope for the real-time path (precomputed
+// tables, no allocation), maxGuideRopeDeflection for one-off use.
+#pragma once
+
+#include <cstdint>
+
+#include "hoist/solver.hpp"
+
+namespace hoist {
+
+/// Largest |y_i(x)| over both guide ropes, sampled at `samples` evenly spaced
+/// depths (uses a precomputed table; no allocation after the first call for a
+/// given solver is NOT guaranteed -- use GuideRopeEnvelope for real time).
+double maxGuideRopeDeflection(const Solver& s, int samples = 401);
+
+/// Real-time helper: precomputed sine table (and, for the static correction,
+/// S_r(x) of both ropes) on a fixed depth grid; evaluate() and
+/// evaluateBounded() allocate nothing.
+class GuideRopeEnvelope {
+ public:
+  GuideRopeEnvelope(const ShaftModel& model, int samples = 401);
+  /// Largest |y1|, |y2| over the grid for the solver's current state (the
+  /// exact envelope: a samples x n product per rope).  Also becomes the
+  /// reference of evaluateBounded().
+  double evaluate(const Solver& s);
+  /// The envelope without the samples x n product on most calls: an upper
+  /// bound E of evaluate()'s value with  evaluate() <= E <= evaluate() +
+  /// tolerance  (tolerance in metres; <= 0 or not finite: always exact).
+  /// From the last exact evaluation (values E1_0, E2_0, sine coordinates
+  /// q_0, sleeve loads f_0 at depths a_0), for every depth x of rope r
+  ///   |y_r(x) - y_r,0(x)| <= D_r = sum_i max|U_i| |q_i - q_0,i|
+  ///       + sum_k [ G_r(a_k, a_k) |f_k - f_0,k| + |f_0,k| |a_k - a_0,k| / min T_r ]
+  /// (G_r(x, a) <= G_r(a, a), |dG_r/da| <= 1 / T_r(a)), so the envelope lies
+  /// in [E_r0 - D_r, E_r0 + D_r]; E = max_r (E_r0 + D_r) is returned while
+  /// 2 max_r D_r <= tolerance, otherwise the envelope is evaluated exactly
+  /// (and becomes the new reference).  Cost of a bounded call: the solver's
+  /// guide coordinates and O(n).
+  double evaluateBounded(const Solver& s, double tolerance);
+  /// Whether the last evaluate()/evaluateBounded() was exact.
+  bool lastExact() const { return last_exact_; }
+  std::int64_t exactEvaluations() const { return exact_count_; }
+  std::int64_t boundedEvaluations() const { return bounded_count_; }
+  const VectorXd& depths() const { return x_; }
+  /// The shapes of the last EXACT evaluation.
+  const VectorXd& y1() const { return y1_; }
+  const VectorXd& y2() const { return y2_; }
+
+ private:
+  double exact(const Solver& s, const SleeveLoads& loads);
+  VectorXd x_;
+  MatrixXd table_;  // samples x n
+  VectorXd umax_;   // max over the grid of |U_i|
+  VectorXd S1_, S2_;  // S_r(x) on the grid (Green's function of the sleeve loads)
+  double SL1_ = 0.0, SL2_ = 0.0;
+  double lip1_ = 0.0, lip2_ = 0.0;  // 1 / min_x T_r(x): bound of |dG_r(x, a)/da|
+  VectorXd q1_, q2_, y1_, y2_;
+  // reference of evaluateBounded(): the last exact evaluation
+  bool have_ref_ = false, last_exact_ = true;
+  VectorXd q1r_, q2r_;
+  SleeveLoads ref_loads_;
+  double e1r_ = 0.0, e2r_ = 0.0;
+  std::int64_t exact_count_ = 0, bounded_count_ = 0;
+};
+
+}  // namespace hoist

@@ -1,0 +1,3 @@
+// fixture: rt/ including a daemon header
+#include "shaft_twin.hpp"
+#include <cstdint>

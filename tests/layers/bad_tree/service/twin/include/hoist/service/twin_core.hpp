@@ -1,0 +1,1 @@
+// fixture: a daemon header in a library folder of service/ (service/<lib>/include)
