@@ -1,12 +1,13 @@
-// Cost of one look-ahead forecast (issue 17): one scenario integrated over a
-// 20-s horizon from the paper trip's state at t = 20 s, at the daemon's
-// defaults (output step 0.01 s, 2.5-ms substeps, 401-point guide-rope
-// envelope per output step).  The counter `ms_per_horizon_s` is the figure
+// Cost of one look-ahead forecast: one scenario integrated over a 20-s
+// horizon from the paper trip's state at t = 20 s, exact (output step
+// 0.01 s, 2.5-ms substeps, 401-point guide-rope envelope per output step)
+// or economical (economicalForecast: the daemon's default).  The counter `ms_per_horizon_s` is the figure
 // docs/lookahead.md reports: milliseconds of CPU per scenario per second of
 // horizon.
 //
 //   build/bin/hoist-forecast-bench
 //   build/bin/hoist-forecast-bench --benchmark_filter=Estop/50
+//   build/bin/hoist-forecast-bench --benchmark_filter='/25/25/'   (exact vs economical at n = 25)
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -40,7 +41,10 @@ void forecastBench(benchmark::State& state, Kind kind) {
   simulate(s, HoistProfile::trapezoid(), so, {});
   FastSolverState st(p.n);
   s.saveState(st);
-  ForecastWorkspace ws(model, o);
+  // Third argument 1: the economical forecast (the daemon's default,
+  // [forecast] exact = false) from the same snapshot.
+  const bool economical = state.range(2) != 0;
+  ForecastWorkspace ws(model, economical ? economicalForecast(o, p.n) : o);
   ForecastSummary out;
   for (auto _ : state) {
     MotionProfile sc;
@@ -53,6 +57,7 @@ void forecastBench(benchmark::State& state, Kind kind) {
     benchmark::DoNotOptimize(out.min_clearance);
   }
   state.counters["n"] = p.n;
+  state.counters["modes"] = ws.forecastModes();
   state.counters["steps"] = static_cast<double>(ws.steps() * ws.substeps());
   // seconds per (scenario x horizon second), shown in ms by the factor.
   state.counters["ms_per_horizon_s"] =
@@ -64,15 +69,18 @@ void BM_ForecastEstop(benchmark::State& s) { forecastBench(s, Kind::Estop); }
 void BM_ForecastContinue(benchmark::State& s) { forecastBench(s, Kind::Continue); }
 void BM_ForecastPlan(benchmark::State& s) { forecastBench(s, Kind::Plan); }
 
-// Args: n, max_step in 0.1 ms (25 = the daemon's default 2.5 ms; 100 = no substeps).
-BENCHMARK(BM_ForecastEstop)->Args({20, 25})->Args({50, 25})->Args({50, 100})->Unit(benchmark::kMillisecond);
+// Args: n, max_step in 0.1 ms (25 = the daemon's default 2.5 ms; 100 = no
+// substeps), economical (0: the exact forecast; 1: economicalForecast, which
+// sets its own step, modes and envelope).
+BENCHMARK(BM_ForecastEstop)->Args({20, 25, 0})->Args({50, 25, 0})->Args({50, 100, 0})->Unit(benchmark::kMillisecond);
 // The converged setting for the tilt (README: n = 200); a few iterations suffice.
-BENCHMARK(BM_ForecastEstop)->Args({200, 25})->Unit(benchmark::kMillisecond)->Iterations(2);
-BENCHMARK(BM_ForecastContinue)->Args({20, 25})->Args({50, 25})->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ForecastPlan)->Args({50, 25})->Unit(benchmark::kMillisecond);
-// The converged setting of issue 13 (n = 25, static correction on; helper conv).
-BENCHMARK(BM_ForecastEstop)->Args({25, 25})->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ForecastPlan)->Args({25, 25})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForecastEstop)->Args({200, 25, 0})->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_ForecastContinue)->Args({20, 25, 0})->Args({50, 25, 0})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForecastPlan)->Args({50, 25, 0})->Unit(benchmark::kMillisecond);
+// The converged setting (n = 25, static correction on), exact and
+// economical side by side; and the example configuration's n = 50.
+BENCHMARK(BM_ForecastEstop)->Args({25, 25, 0})->Args({25, 25, 1})->Args({50, 25, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ForecastPlan)->Args({25, 25, 0})->Args({25, 25, 1})->Args({50, 25, 1})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
