@@ -104,6 +104,8 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   fr.number("plan_timeout", f.plan_timeout);
   fr.integer("workers", f.workers);
   fr.integer("series_points", f.series_points);
+  fr.boolean("exact", f.exact);
+  fr.integer("modes", f.modes);
   fr.run();
   try {
     f.validate(s.rate);
@@ -169,7 +171,8 @@ std::string toToml(const TwinConfig& c) {
      << "\nhorizon = " << Num{f.horizon} << "\nestop_decel = " << Num{f.estop_decel}
      << "\nestop_jerk = " << Num{f.estop_jerk} << "\nvmax = " << Num{f.vmax} << "\namax = " << Num{f.amax}
      << "\njerk = " << Num{f.jerk} << "\nplan_timeout = " << Num{f.plan_timeout}
-     << "\nworkers = " << f.workers << "\nseries_points = " << f.series_points << "\n";
+     << "\nworkers = " << f.workers << "\nseries_points = " << f.series_points
+     << "\nexact = " << (f.exact ? "true" : "false") << "\nmodes = " << f.modes << "\n";
   os << "\n" << hoist::io::toToml(hoist::io::EstimatorConfig{c.estimator.enabled, c.estimator.settings});
   return os.str();
 }
