@@ -47,12 +47,12 @@ std::shared_ptr<const ShaftModel> forecastModel(const std::shared_ptr<const Shaf
 
 }  // namespace
 
-ForecastOptions economicalForecast(const ForecastOptions& exact, int model_modes) {
+ForecastOptions economicalForecast(const ForecastOptions& exact, int model_modes, int modes) {
   ForecastOptions o = exact;
   o.dt = 0.01;
   o.max_step = 0.0;
-  o.modes = std::min(model_modes, 10);
-  o.envelope_points = 101;
+  o.modes = std::max(1, std::min(model_modes, modes));
+  o.envelope_points = std::min(101, exact.envelope_points);
   o.envelope_tolerance = 1e-4;
   return o;
 }
@@ -184,15 +184,19 @@ void forecast(ForecastWorkspace& ws, const FastSolverState& start, const MotionP
     throw std::invalid_argument("forecast: start state has " + std::to_string(start.modes()) +
                                 " modes, the workspace's model " + std::to_string(ws.n_start_));
   if (ws.reduced_) {
-    // A non-finite start cannot be projected (initialize checks l): say so.
-    if (!std::isfinite(start.t) || !(start.kin.l > 0.0 && start.kin.l < s.model().params().maxRopeLength()) ||
-        !std::isfinite(start.kin.v) || !std::isfinite(start.kin.a) || !start.x.allFinite() || !start.y.allFinite() ||
-        !start.xd.allFinite() || !start.yd.allFinite() || !start.xdd.allFinite() || !start.ydd.allFinite() ||
-        !start.xa.allFinite() || !start.ya.allFinite() || !start.lam.allFinite() || !std::isfinite(start.lambda0)) {
+    // A start that cannot be projected (initialize needs a finite state
+    // inside the shaft) is reported as the exact path would find it.
+    const bool finite = std::isfinite(start.t) && std::isfinite(start.kin.l) && std::isfinite(start.kin.v) &&
+                        std::isfinite(start.kin.a) && start.x.allFinite() && start.y.allFinite() &&
+                        start.xd.allFinite() && start.yd.allFinite() && start.xdd.allFinite() &&
+                        start.ydd.allFinite() && start.xa.allFinite() && start.ya.allFinite() &&
+                        start.lam.allFinite() && std::isfinite(start.lambda0);
+    const bool inside = start.kin.l > 0.0 && start.kin.l < s.model().params().maxRopeLength();
+    if (!finite || !inside) {
       out = ForecastSummary{};
       out.t_start = start.t;
       out.horizon = o.horizon;
-      out.status = ForecastStatus::NonFinite;
+      out.status = finite ? ForecastStatus::LeftShaft : ForecastStatus::NonFinite;
       return;
     }
     ws.project(start);

@@ -163,3 +163,39 @@ TEST(ForecastFidelity, ModesAreCheckedAgainstTheModel) {
   EXPECT_THROW(forecast(ws, other, estopProfile(0.0, Kinematics{100.0, 0.0, 0.0}, 3.0, 10.0), out),
                std::invalid_argument);
 }
+
+TEST(ForecastFidelity, StoppedForecastsOnTheReducedModel) {
+  // The reduced model stops where the exact one does: a scenario that runs
+  // out of the shaft (left_shaft at the same instant), a non-finite start
+  // (non_finite, nothing integrated).
+  auto m = model(12);
+  ForecastOptions ex = exactOptions();
+  ex.horizon = 60.0;
+  const ForecastOptions ec = economicalForecast(ex, 12, 6);
+  ForecastWorkspace wx(m, ex), wc(m, ec);
+  ASSERT_EQ(wc.forecastModes(), 6);
+  const std::vector<FastSolverState> snaps = snapshots(m, {20.0});
+  const FastSolverState& st = snaps[0];
+  // Cruising on at 5 m/s past the bottom (137.5 m at t0 = 20 s: the end
+  // L - 2h is reached about 49 s later).
+  ForecastSummary a, b;
+  MotionProfile out;
+  out.reset(st.t, st.kin);
+  out.appendAccel(100.0, 0.0);
+  forecast(wx, st, out, a);
+  forecast(wc, st, out, b);
+  EXPECT_EQ(a.status, ForecastStatus::LeftShaft);
+  EXPECT_EQ(b.status, ForecastStatus::LeftShaft);
+  EXPECT_NEAR(b.t_reached, a.t_reached, 1e-9);
+  EXPECT_LT(a.t_reached, 55.0);
+  FastSolverState bad = st;
+  bad.x(0) = NAN;
+  forecast(wc, bad, out, b);
+  EXPECT_EQ(b.status, ForecastStatus::NonFinite);
+  EXPECT_EQ(b.steps, 0);
+  bad = st;
+  bad.kin.l = m->params().maxRopeLength() + 1.0;
+  forecast(wc, bad, out, b);
+  EXPECT_EQ(b.status, ForecastStatus::LeftShaft);
+  EXPECT_EQ(b.steps, 0);
+}

@@ -52,13 +52,14 @@ struct ForecastOptions {
   void validate() const;
 };
 
-/// The economical forecast's defaults (the daemon's `[forecast] exact =
-/// false`): output step 0.01 s without substeps, min(n, 10) modes per rope,
-/// 101 envelope depths, bounded to 0.1 mm.  `exact` keeps the
-/// horizon, limits and series of `exact` and changes only the fidelity.
+/// The economical forecast (the daemon's default, `[forecast] exact =
+/// false`): output step 0.01 s without substeps, min(model_modes, modes)
+/// modes per rope, min(101, exact.envelope_points) envelope depths bounded to
+/// 0.1 mm (an upper bound: clearances err on the safe side by at most that).
+/// Keeps the horizon, limits and series of `exact`; changes only the fidelity.
 /// Checked against the exact forecast by tests/model/forecast_fidelity_test.cpp
 /// (docs/lookahead.md, "Cost").
-ForecastOptions economicalForecast(const ForecastOptions& exact, int model_modes);
+ForecastOptions economicalForecast(const ForecastOptions& exact, int model_modes, int modes = 10);
 
 enum class ForecastStatus {
   Ok = 0,        ///< integrated to the horizon
