@@ -65,6 +65,43 @@ void forecastBench(benchmark::State& state, Kind kind) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+/// The daemon's work per shaft and forecast instant: both scenarios (estop,
+/// continue along the plan) from one snapshot, the snapshots alternating
+/// between two instants (t = 20 s and 20.01 s) so that every pair starts
+/// from a new state (the economical forecast projects it once per pair).
+/// CPU time per iteration = CPU per second per shaft at [forecast] rate 1 Hz.
+void BM_ForecastPair(benchmark::State& state) {
+  ShaftParams p;
+  p.n = static_cast<int>(state.range(0));
+  auto model = std::make_shared<const ShaftModel>(p);
+  ForecastOptions o;
+  o.horizon = 20.0;
+  FastSolver s(model);
+  SimulationOptions so;
+  so.dt = o.dt;
+  so.max_step = o.max_step;
+  so.t_end = 20.0;
+  simulate(s, HoistProfile::trapezoid(), so, {});
+  FastSolverState st[2] = {FastSolverState(p.n), FastSolverState(p.n)};
+  s.saveState(st[0]);
+  s.step(20.01, HoistProfile::trapezoid().at(20.01));
+  s.saveState(st[1]);
+  const bool economical = state.range(1) != 0;
+  ForecastWorkspace ws(model, economical ? economicalForecast(o, p.n) : o);
+  ForecastSummary e, c;
+  MotionProfile plan;
+  long i = 0;
+  for (auto _ : state) {
+    const FastSolverState& x = st[i++ & 1];
+    forecast(ws, x, estopProfile(x.t, x.kin, 3.0, 10.0), e);
+    planProfile(x.t, x.kin, TripPlan{300.0, 5.0, 1.0, 1.0}, p.maxRopeLength(), plan);
+    forecast(ws, x, plan, c);
+    benchmark::DoNotOptimize(e.min_clearance + c.min_clearance);
+  }
+  state.counters["n"] = p.n;
+  state.counters["modes"] = ws.forecastModes();
+}
+
 void BM_ForecastEstop(benchmark::State& s) { forecastBench(s, Kind::Estop); }
 void BM_ForecastContinue(benchmark::State& s) { forecastBench(s, Kind::Continue); }
 void BM_ForecastPlan(benchmark::State& s) { forecastBench(s, Kind::Plan); }
@@ -81,6 +118,8 @@ BENCHMARK(BM_ForecastPlan)->Args({50, 25, 0})->Unit(benchmark::kMillisecond);
 // economical side by side; and the example configuration's n = 50.
 BENCHMARK(BM_ForecastEstop)->Args({25, 25, 0})->Args({25, 25, 1})->Args({50, 25, 1})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ForecastPlan)->Args({25, 25, 0})->Args({25, 25, 1})->Args({50, 25, 1})->Unit(benchmark::kMillisecond);
+// Both scenarios per instant (args: n, economical): CPU per second per shaft at 1 Hz.
+BENCHMARK(BM_ForecastPair)->Args({25, 0})->Args({25, 1})->Args({50, 1})->Args({200, 1})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

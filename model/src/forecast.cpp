@@ -67,6 +67,8 @@ ForecastWorkspace::ForecastWorkspace(std::shared_ptr<const ShaftModel> model, co
     full_ = std::make_unique<FastSolver>(model);
     ref_ = FastSolverState(n_start_);
     red_ = FastSolverState(solver_.model().n());
+    projected_ = FastSolverState(solver_.model().n());
+    last_start_ = FastSolverState(n_start_);  // valid = false: nothing projected yet
     dev_ = VectorXd::Zero(2 * n_start_ + 2);
     q_ = VectorXd::Zero(n_start_);
     sa_ = sb_ = zm_ = wm_ = VectorXd::Zero(solver_.model().n());
@@ -88,7 +90,25 @@ ForecastWorkspace::ForecastWorkspace(std::shared_ptr<const ShaftModel> model, co
   envelope_.evaluateBounded(solver_, opt_.envelope_tolerance);
 }
 
+namespace {
+
+bool sameState(const FastSolverState& a, const FastSolverState& b) {
+  auto eq = [](const VectorXd& u, const VectorXd& v) { return u.size() == v.size() && (u.array() == v.array()).all(); };
+  return a.valid && b.valid && a.t == b.t && a.kin.l == b.kin.l && a.kin.v == b.kin.v && a.kin.a == b.kin.a &&
+         eq(a.x, b.x) && eq(a.xd, b.xd) && eq(a.xdd, b.xdd) && eq(a.xa, b.xa) && eq(a.y, b.y) && eq(a.yd, b.yd) &&
+         eq(a.ydd, b.ydd) && eq(a.ya, b.ya) && a.lam == b.lam && a.lamS == b.lamS && a.delta == b.delta &&
+         a.lambda0 == b.lambda0;
+}
+
+}  // namespace
+
 void ForecastWorkspace::project(const FastSolverState& start) {
+  // The same start as the last forecast's (the other scenario of one
+  // snapshot): its projection is known.
+  if (sameState(start, last_start_)) {
+    solver_.restoreState(projected_);
+    return;
+  }
   // Both models' equilibria at the start kinematics (allocation-free:
   // initialize() works in buffers sized at construction).
   full_->initialize(start.t, start.kin, InitialState::Static);
@@ -173,6 +193,8 @@ void ForecastWorkspace::project(const FastSolverState& start) {
   red_.lambda0 = start.lambda0;
   red_.response = start.response;
   solver_.restoreState(red_);
+  last_start_ = start;  // same sizes: copies, no allocation
+  projected_ = red_;
 }
 
 void forecast(ForecastWorkspace& ws, const FastSolverState& start, const MotionProfile& scenario,

@@ -132,6 +132,9 @@ class ForecastWorkspace {
   // solver and state, the projected state, workspaces
   std::unique_ptr<FastSolver> full_;
   FastSolverState ref_, red_;
+  // the last start projected and its projection (both scenarios of one
+  // snapshot share it: the two static solves are made once)
+  FastSolverState last_start_, projected_;
   VectorXd dev_, q_, sa_, sb_, zm_, wm_, fa_, fb_, zn_, wn_;
   long steps_ = 0;
   int substeps_ = 1;
