@@ -97,7 +97,7 @@ bool sameState(const FastSolverState& a, const FastSolverState& b) {
   return a.valid && b.valid && a.t == b.t && a.kin.l == b.kin.l && a.kin.v == b.kin.v && a.kin.a == b.kin.a &&
          eq(a.x, b.x) && eq(a.xd, b.xd) && eq(a.xdd, b.xdd) && eq(a.xa, b.xa) && eq(a.y, b.y) && eq(a.yd, b.yd) &&
          eq(a.ydd, b.ydd) && eq(a.ya, b.ya) && a.lam == b.lam && a.lamS == b.lamS && a.delta == b.delta &&
-         a.lambda0 == b.lambda0;
+         a.lambda0 == b.lambda0 && a.Fa == b.Fa && a.moment == b.moment;
 }
 
 }  // namespace
@@ -109,8 +109,12 @@ void ForecastWorkspace::project(const FastSolverState& start) {
     solver_.restoreState(projected_);
     return;
   }
-  // Both models' equilibria at the start kinematics (allocation-free:
-  // initialize() works in buffers sized at construction).
+  // Both models' equilibria at the start kinematics under the start's load
+  // (a forecast from the load estimate carries its own; initialize() keeps
+  // the load set) -- allocation-free: initialize() works in buffers sized at
+  // construction.
+  full_->setLoad(start.Fa, start.moment);
+  solver_.setLoad(start.Fa, start.moment);
   full_->initialize(start.t, start.kin, InitialState::Static);
   full_->saveState(ref_);
   solver_.initialize(start.t, start.kin, InitialState::Static);

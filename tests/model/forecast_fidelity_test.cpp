@@ -29,9 +29,11 @@ struct Worst {
 /// The twin's state at each of `instants` along the paper trip (the
 /// daemon's step: 0.01 s ticks in 2.5-ms substeps).
 std::vector<FastSolverState> snapshots(const std::shared_ptr<const ShaftModel>& model,
-                                       const std::vector<double>& instants) {
+                                       const std::vector<double>& instants, double load_scale = 1.0) {
   const HoistProfile trip = HoistProfile::trapezoid();
   FastSolver s(model);
+  const ShaftParams& p = model->params();
+  s.setLoad(load_scale * p.Fa, load_scale * p.Fa * p.b);  // the state carries it (a forecast from the load estimate)
   s.initialize(0.0, trip.at(0.0));
   std::vector<FastSolverState> out;
   long k = 0;
@@ -119,6 +121,22 @@ TEST(ForecastFidelity, EconomicalFromAFiftyModeTwin) {
   EXPECT_LE(w.lambda0_min, 0.02);
   EXPECT_LE(w.lambda0_max, 0.02);
   std::printf("n = 50: largest differences: min clearance %.3f %% of the gap, lambda_0 min %.3f %%, max %.3f %%\n",
+              100 * w.clearance, 100 * w.lambda0_min, 100 * w.lambda0_max);
+}
+
+TEST(ForecastFidelity, EconomicalUnderTheStartsOwnLoad) {
+  // A start under another eccentric load than the model's (what a forecast
+  // from the load estimate gets): both forecasts continue under it, and the
+  // economical one projects against equilibria under it too.
+  auto m = model(25);
+  const ForecastOptions ex = exactOptions();
+  const std::vector<FastSolverState> snaps = snapshots(m, {2.0, 20.0, 52.5}, 1.6);
+  ASSERT_EQ(snaps[0].Fa, 1.6 * m->params().Fa);
+  const Worst w = compare(m, snaps, ex, economicalForecast(ex, 25));
+  EXPECT_LE(w.clearance, 0.02);
+  EXPECT_LE(w.lambda0_min, 0.02);
+  EXPECT_LE(w.lambda0_max, 0.02);
+  std::printf("load x 1.6: largest differences: min clearance %.3f %% of the gap, lambda_0 min %.3f %%, max %.3f %%\n",
               100 * w.clearance, 100 * w.lambda0_min, 100 * w.lambda0_max);
 }
 

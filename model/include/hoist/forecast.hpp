@@ -149,7 +149,8 @@ class ForecastWorkspace {
 /// static equilibrium at start.kin (FastSolver::initialize, Static) plus the
 /// start's deviation from the full model's equilibrium there, truncated to
 /// the first `modes` sine coordinates of each rope (guide ropes through
-/// their modal bases; cage coordinates and sleeve forces as they are).  The
+/// their modal bases; cage coordinates and sleeve forces as they are), both
+/// equilibria under the start's load (start.Fa, start.moment).  The
 /// step-0 record is the start's own response.  Allocation-free; throws
 /// std::invalid_argument only if `start` does not fit the workspace.
 void forecast(ForecastWorkspace& ws, const FastSolverState& start, const MotionProfile& scenario,
