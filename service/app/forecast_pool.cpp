@@ -18,7 +18,8 @@ ForecastOptions optionsFor(const TwinConfig& cfg) {
   fo.series_points = cfg.forecast.series_points;
   fo.limits = {cfg.alarms.gap_pos_y, cfg.alarms.gap_neg_y, cfg.alarms.guide_rope_gap,
                cfg.alarms.warning_fraction, cfg.alarms.critical_fraction};
-  return fo;
+  // The twin's own step (exact) or the economical forecast (the default).
+  return cfg.forecast.exact ? fo : economicalForecast(fo, cfg.shaft.n, cfg.forecast.modes);
 }
 
 ForecastResult resultPrototype() { return ForecastResult{}; }

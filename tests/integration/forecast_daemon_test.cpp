@@ -299,6 +299,7 @@ class ForecastExactness : public ::testing::Test {
   /// Feeds the whole run once (shared by the tests of this suite).
   static void SetUpTestSuite() {
     cfg_ = demoShaft(kModes, ClockMode::Input);
+    cfg_.forecast.exact = true;  // the twin's own step: equal to its later outputs to round-off
     cfg_.forecast.rate = 0.2;  // forecasts at t = 0, 5, ..., 20 s, ...
     cfg_.forecast.horizon = kHorizon;
     cfg_.forecast.estop_decel = 3.0;

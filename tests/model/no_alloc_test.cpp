@@ -80,8 +80,10 @@ TEST(NoAlloc, ReinitializeAllocatesNothing) {
 TEST(NoAlloc, SnapshotAndForecastAllocateNothing) {
   // Look-ahead: the loop saves a snapshot (into a preallocated state), the
   // worker builds the scenarios and runs the forecasts: none of it allocates
-  // once the workspace is set up.
-  for (int n : {10, 50}) {
+  // once the workspace is set up.  Both the exact forecast and the
+  // economical one (at n = 50 a reduced model and the projected start).
+  for (int n : {10, 50})
+  for (bool economical : {false, true}) {
     ShaftParams p;
     p.n = n;
     p.Tb2 = 32000;
@@ -89,7 +91,7 @@ TEST(NoAlloc, SnapshotAndForecastAllocateNothing) {
     FastSolver s(model);
     ForecastOptions o;
     o.horizon = 3.0;
-    ForecastWorkspace ws(model, o);
+    ForecastWorkspace ws(model, economical ? economicalForecast(o, n) : o);
     FastSolverState snap(n), copy(n);
     ForecastSummary out;
     MotionProfile plan;
@@ -114,7 +116,7 @@ TEST(NoAlloc, SnapshotAndForecastAllocateNothing) {
       s.restoreState(snap);
     }
     Eigen::internal::set_is_malloc_allowed(true);
-    EXPECT_EQ(allocationCount() - before, 0) << "n = " << n;
+    EXPECT_EQ(allocationCount() - before, 0) << "n = " << n << (economical ? " (economical)" : "");
     EXPECT_TRUE(std::isfinite(acc));
   }
 }

@@ -161,13 +161,18 @@ TEST(ServiceConfig, DaemonReadsTheStaticCorrection) {
 
 TEST(ForecastConfig, DefaultsReadAndPrinted) {
   TwinConfig c = parse("");
-  EXPECT_FALSE(c.forecast.enabled);
+  // On by default, economical (the exact forecast on request).
+  EXPECT_TRUE(c.forecast.enabled);
+  EXPECT_FALSE(c.forecast.exact);
+  EXPECT_EQ(c.forecast.modes, 10);
   EXPECT_EQ(c.forecast.rate, 1.0);
   EXPECT_EQ(c.forecast.horizon, 20.0);
   EXPECT_EQ(c.forecast.workers, 1);
-  c = parse("[forecast]\nenabled = true\nrate = 0.5\nhorizon = 12.5\nestop_decel = 2.5\nestop_jerk = 8\n"
-            "vmax = 12\namax = 0.8\nworkers = 2\nseries_points = 40\n");
-  EXPECT_TRUE(c.forecast.enabled);
+  c = parse("[forecast]\nenabled = false\nrate = 0.5\nhorizon = 12.5\nestop_decel = 2.5\nestop_jerk = 8\n"
+            "vmax = 12\namax = 0.8\nworkers = 2\nseries_points = 40\nexact = true\nmodes = 7\n");
+  EXPECT_FALSE(c.forecast.enabled);
+  EXPECT_TRUE(c.forecast.exact);
+  EXPECT_EQ(c.forecast.modes, 7);
   EXPECT_EQ(c.forecast.rate, 0.5);
   EXPECT_EQ(c.forecast.horizon, 12.5);
   EXPECT_EQ(c.forecast.estop_decel, 2.5);
@@ -177,7 +182,9 @@ TEST(ForecastConfig, DefaultsReadAndPrinted) {
   EXPECT_EQ(c.forecast.workers, 2);
   EXPECT_EQ(c.forecast.series_points, 40);
   const TwinConfig d = parse(toToml(c));
-  EXPECT_TRUE(d.forecast.enabled);
+  EXPECT_FALSE(d.forecast.enabled);
+  EXPECT_TRUE(d.forecast.exact);
+  EXPECT_EQ(d.forecast.modes, 7);
   EXPECT_EQ(d.forecast.horizon, 12.5);
   EXPECT_EQ(d.forecast.amax, 0.8);
   EXPECT_EQ(d.forecast.series_points, 40);
@@ -203,6 +210,10 @@ TEST(ForecastConfig, BadValuesNameTheKeyAndLine) {
   expectKey("[forecast]\nworkers = 1.5\n", "forecast.workers: must be an integer");
   expectKey("[forecast]\nseries_points = 65\n", "forecast.series_points");
   expectKey("[forecast]\nhorizn = 20\n", "forecast.horizn");
+  expectKey("[forecast]\nexact = \"yes\"\n", "test.toml:2: forecast.exact");
+  expectKey("[forecast]\nmodes = 0\n", "test.toml:2: forecast.modes");
+  expectKey("[forecast]\nmodes = 1001\n", "forecast.modes");
+  expectKey("[forecast]\nmodes = 2.5\n", "forecast.modes: must be an integer");
 }
 
 // The rope-force alarm keys are validated like every key; the

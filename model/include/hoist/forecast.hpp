@@ -39,10 +39,28 @@ struct ForecastOptions {
   double max_step = 0.0025;  ///< largest integration substep [s] ([service] max_step; 0: dt itself)
   int envelope_points = 401; ///< guide-rope depth samples ([service] envelope_points)
   int series_points = 50;    ///< decimated series length, 1..ForecastSummary::kMaxSeries
+  /// Modes per rope of the forecast's own model (0: the model's n, the exact
+  /// forecast).  1..n-1: a reduced model of the same shaft; the start state
+  /// is projected onto it (see forecast()).  Must be <= the model's n.
+  int modes = 0;
+  /// The guide-rope envelope as GuideRopeEnvelope::evaluateBounded with this
+  /// tolerance [m] (an upper bound of the deflection, at most this much
+  /// above it: clearances err on the safe side); 0: evaluated exactly at
+  /// every output step.
+  double envelope_tolerance = 0.0;
   ClearanceLimits limits;    ///< gaps and alarm fractions ([alarms])
   /// Throws std::invalid_argument naming the field at fault.
   void validate() const;
 };
+
+/// The economical forecast (the daemon's default, `[forecast] exact =
+/// false`): output step 0.01 s without substeps, min(model_modes, modes)
+/// modes per rope, min(101, exact.envelope_points) envelope depths bounded to
+/// 0.1 mm (an upper bound: clearances err on the safe side by at most that).
+/// Keeps the horizon, limits and series of `exact`; changes only the fidelity.
+/// Checked against the exact forecast by tests/model/forecast_fidelity_test.cpp
+/// (docs/lookahead.md, "Cost").
+ForecastOptions economicalForecast(const ForecastOptions& exact, int model_modes, int modes = 10);
 
 enum class ForecastStatus {
   Ok = 0,        ///< integrated to the horizon
@@ -93,14 +111,32 @@ class ForecastWorkspace {
   /// Output steps to the horizon, and substeps per output step.
   long steps() const { return steps_; }
   int substeps() const { return substeps_; }
-  /// The forecast's solver (holds the end state after forecast()).
+  /// The forecast's solver (holds the end state after forecast()); its model
+  /// has options().modes modes when those are fewer than the model's n.
   const FastSolver& solver() const { return solver_; }
+  /// Modes per rope of the snapshots forecast() accepts (the model's n).
+  int startModes() const { return n_start_; }
+  /// Modes per rope the forecast integrates (n, or options().modes).
+  int forecastModes() const { return solver_.model().n(); }
 
  private:
   friend void forecast(ForecastWorkspace&, const FastSolverState&, const MotionProfile&, ForecastSummary&);
+  /// Reduced model: start -> red_ (the reduced model's equilibrium at the
+  /// start kinematics plus the start's deviation from the full model's).
+  void project(const FastSolverState& start);
   ForecastOptions opt_;
+  int n_start_ = 0;
+  bool reduced_ = false;
   FastSolver solver_;
   GuideRopeEnvelope envelope_;
+  // reduced model only (empty otherwise): the full model's equilibrium
+  // solver and state, the projected state, workspaces
+  std::unique_ptr<FastSolver> full_;
+  FastSolverState ref_, red_;
+  // the last start projected and its projection (both scenarios of one
+  // snapshot share it: the two static solves are made once)
+  FastSolverState last_start_, projected_;
+  VectorXd dev_, q_, sa_, sb_, zm_, wm_, fa_, fb_, zn_, wn_;
   long steps_ = 0;
   int substeps_ = 1;
 };
@@ -109,7 +145,14 @@ class ForecastWorkspace {
 /// with the same parameters) to the horizon and fills `out`.  The scenario
 /// should start at start.t from start.kin (estopProfile / planProfile /
 /// continueProfile(start.t, start.kin, ...)); its kinematics at start.t are
-/// not used (the state's own are).  Allocation-free; throws
+/// not used (the state's own are).  With options().modes < n the forecast
+/// runs on the reduced model from the projected start: the reduced model's
+/// static equilibrium at start.kin (FastSolver::initialize, Static) plus the
+/// start's deviation from the full model's equilibrium there, truncated to
+/// the first `modes` sine coordinates of each rope (guide ropes through
+/// their modal bases; cage coordinates and sleeve forces as they are), both
+/// equilibria under the start's load (start.Fa, start.moment).  The
+/// step-0 record is the start's own response.  Allocation-free; throws
 /// std::invalid_argument only if `start` does not fit the workspace.
 void forecast(ForecastWorkspace& ws, const FastSolverState& start, const MotionProfile& scenario,
               ForecastSummary& out);

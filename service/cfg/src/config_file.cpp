@@ -111,6 +111,8 @@ const Key<FC> kForecastKeys[] = {
     real("plan_timeout", &FC::plan_timeout),
     integer("workers", &FC::workers),
     integer("series_points", &FC::series_points),
+    boolean("exact", &FC::exact),
+    integer("modes", &FC::modes),
 };
 
 /// Registers every key of `keys` on `r`, setting the members of `out`.

@@ -100,6 +100,7 @@ void ForecastConfig::validate(double service_rate) const {
   checkRange("plan_timeout", plan_timeout, 0.0, 3600.0, true, f);
   checkRange("workers", workers, 1, 16, false, f);
   checkRange("series_points", series_points, 1, 64, false, f);
+  checkRange("modes", modes, 1, kMaxModes, false, f);
 }
 
 }  // namespace hoist::svc
