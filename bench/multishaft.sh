@@ -20,7 +20,9 @@
 # --daemon (repeatable; default this=build/bin/hoist-twind): the binaries to
 #   compare, each run side by side (interleaved) for every setting and N; extra
 #   key=value pairs go into the [service] section of its configs (e.g.
-#   envelope_tolerance=0), except estimator=true, which turns the load
+#   envelope_tolerance=0), except forecast=true, which turns the look-ahead
+#   forecasts on ([forecast] enabled; without it every config says
+#   enabled = false, as the daemon's default is on), and estimator=true, which turns the load
 #   estimator on ([estimator] enabled; the feeder sends no sensor samples, so
 #   this is the cost of its per-tick step without the O(1) updates).  The feeder (--feeder PATH; default this build's
 #   hoist-replay) is the same for every daemon.
@@ -120,11 +122,15 @@ for setting in "${settings[@]}"; do
       bin="${spec%%,*}"
       extra=""
       est_section=""
+      # Forecasts off unless forecast=true (they default to on in the daemon)
+      fc_section="[forecast]"$'\n'"enabled = false"$'\n'
       if [[ "$spec" == *,* ]]; then
         IFS=',' read -r -a kvs <<< "${spec#*,}"
         for kv in "${kvs[@]}"; do
           # estimator=true: the load estimator on ([estimator] enabled, its own section)
           if [[ "${kv%%=*}" == estimator ]]; then est_section="[estimator]"$'\n'"enabled = ${kv#*=}"$'\n'; continue; fi
+          # forecast=true: the look-ahead forecasts on ([forecast] enabled, the defaults otherwise)
+          if [[ "${kv%%=*}" == forecast ]]; then fc_section="[forecast]"$'\n'"enabled = ${kv#*=}"$'\n'; continue; fi
           extra+="${kv%%=*} = ${kv#*=}"$'\n'
         done
       fi
@@ -135,8 +141,8 @@ for setting in "${settings[@]}"; do
       outline=""
       [[ $same_url -eq 0 ]] && outline="lcm_url_out = \"$url_out\""$'\n'
       for ((i = 1; i <= N; i++)); do
-        printf '[model]\nmodes = %s\nstatic_correction = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n%s%s%s' \
-          "$modes" "$corr_toml" "$rate" "$max_step" "$i" "$outline" "$extra" "$est_section" > "$cfgdir/shaft$i.toml"
+        printf '[model]\nmodes = %s\nstatic_correction = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n%s%s%s%s' \
+          "$modes" "$corr_toml" "$rate" "$max_step" "$i" "$outline" "$extra" "$est_section" "$fc_section" > "$cfgdir/shaft$i.toml"
         cfgs+=(--config "$cfgdir/shaft$i.toml")
       done
       echo "[multishaft] n = $modes (correction $corr), N = $N, daemon $name: daemon (all threads) on CPU $daemon_cpu, feeder on CPU $feeder_cpu, $seconds s ..." >&2

@@ -183,7 +183,7 @@ class Daemon {
   std::unique_ptr<MissLog> misses_;        ///< every deadline miss (preallocated ring)
   std::int64_t misses_logged_ = 0;         ///< misses_->total() at the last miss-log line
   std::unique_ptr<boost::asio::steady_timer> miss_log_timer_;  ///< the miss-log second
-  /// The one forecast pool of the process (issue 17): serves every shaft with
+  /// The one forecast pool of the process: serves every shaft with
   /// [forecast] enabled and --clock wall.  Declared after shafts_ so that it
   /// stops (joins its workers) before the jobs it serves are destroyed.
   std::unique_ptr<ForecastPool> pool_;

@@ -1,6 +1,6 @@
 // The live load estimator ([estimator] enabled in hoist-twind) against the
 // offline one (hoist-estimate) on the same data, over real UDP multicast on
-// loopback (port 7871): hoist-sim writes the measurements of a shaft whose
+// loopback (ports 8140-8142): hoist-sim writes the measurements of a shaft whose
 // load differs from the config, hoist-replay --measurements publishes them,
 // the daemon runs --clock input, and every HOIST_ESTIMATE equals
 // hoist-estimate's row to 1e-12.  Also: the alarms say where they came from,
@@ -59,7 +59,7 @@ class EstimatorDaemon : public LcmProcessTest {};
 }  // namespace
 
 TEST_F(EstimatorDaemon, LiveEstimateEqualsHoistEstimateOnTheSameData) {
-  start(7871, "EstimatorDaemon", {"HOIST_HEALTH"});
+  start(8140, "EstimatorDaemon", {"HOIST_HEALTH"});
   const std::string truth = (dir_ / "truth.toml").string(), cfg = (dir_ / "twin.toml").string();
   {
     std::ofstream t(truth);
@@ -143,7 +143,7 @@ TEST_F(EstimatorDaemon, LiveEstimateEqualsHoistEstimateOnTheSameData) {
 // HOIST_HEALTH carries our instance id but an old utime.  The daemon says so
 // (DUPLICATE_PUBLISHER, a log line naming the replay) instead of staying quiet.
 TEST_F(EstimatorDaemon, AReplayedRecordingOfThisTwinIsDetected) {
-  start(7872, "ReplayedOutputs", {"HOIST_HEALTH"});
+  start(8141, "ReplayedOutputs", {"HOIST_HEALTH"});
   listener_->subscribe("HOIST_ALARM");
   std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--clock", "wall"};
   auto d = startDaemonAndWait(*listener_, argv, (dir_ / "twind.log").string());
@@ -186,7 +186,7 @@ TEST(DaemonLcmUrl, TcpqWithoutServerNamesTheUrl) {
 // configured load.  (That the shifted state is exactly the state under the
 // other load, and its forecast that load's forecast, is LoadSuperposition.*.)
 TEST_F(EstimatorDaemon, ForecastsStartFromTheEstimatedLoad) {
-  start(7873, "EstimatorForecast", {"HOIST_HEALTH"});
+  start(8142, "EstimatorForecast", {"HOIST_HEALTH"});
   const std::string truth = (dir_ / "truth.toml").string(), cfg = (dir_ / "twin.toml").string();
   {
     // The true load leans the other way from the configured one (1000 N at +1 m).

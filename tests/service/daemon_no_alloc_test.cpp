@@ -205,8 +205,10 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
 
   EXPECT_EQ(allocs, 0) << "heap allocations on the loop thread after start-up";
   // The watched window did the real work.
-  EXPECT_GT(a1.ticks - a0.ticks, 2500);
-  EXPECT_GT(b1.ticks - b0.ticks, 250);
+  // (3.3 s at 1 kHz and 100 Hz: 3300 and 330 ticks on an idle machine; a
+  // loaded one skips some -- the point is that the loop ran, alarms and all)
+  EXPECT_GT(a1.ticks - a0.ticks, 1000);
+  EXPECT_GT(b1.ticks - b0.ticks, 100);
   EXPECT_GT(a1.accepted - a0.accepted, 1500);
   EXPECT_GT(b1.accepted - b0.accepted, 1500);
   EXPECT_GT(a1.alarm_events - a0.alarm_events, 4) << logs.str();

@@ -1,7 +1,7 @@
 // hoist-twind's own udpm receive path (msgs/udpm/include/hoist/bus/udpm_receiver.hpp),
 // for many shafts per process: the receive buffer it asks for is granted, and the kernel's drop count
 // (SO_RXQ_OVFL) accounts for every datagram that did not fit.  Real UDP
-// multicast on loopback, port 7871.  And its own publisher (hoist/bus/udpm_sender.hpp).
+// multicast on loopback, port 8143.  And its own publisher (hoist/bus/udpm_sender.hpp).
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -14,7 +14,7 @@ using namespace hoist::bus;
 
 namespace {
 
-const char* kUrl = "udpm://239.255.76.67:7871?ttl=0";
+const char* kUrl = "udpm://239.255.76.67:8143?ttl=0";
 
 long rmemMax() {
   std::ifstream f("/proc/sys/net/core/rmem_max");

@@ -84,10 +84,12 @@ for (const [topic, fields] of Object.entries(expect)) {
   const pub = start("forecast-pub", process.env.HOIST_FORECAST_PUB, [lcm, "", "3", "100"], dir);
   const res = await pub.exited;
   check(res.code === 0, `synthetic forecasts published (${pub.out.trim().split("\n").length} lines)`);
-  await waitFor(() => forecasts.length >= 3, 5000, "3 HOIST_FORECAST messages");
-  const f = forecasts[0];
+  // (the test's daemon forecasts too -- on by default -- with its own instance id)
+  const synthetic = () => forecasts.filter((x) => x.instance_id === 4242);
+  await waitFor(() => synthetic().length >= 3, 5000, "3 HOIST_FORECAST messages");
+  const f = synthetic()[0];
   const [e, o] = f.scenarios;
-  check(forecasts.length === 3 && f.seq === 0 && f.num_scenarios === 2 && e.name === "estop" && e.t_critical === 2.5 &&
+  check(synthetic().length === 3 && f.seq === 0 && f.num_scenarios === 2 && e.name === "estop" && e.t_critical === 2.5 &&
         e.t_warning === 1.5 && e.min_clearance === 0.0125 && e.series_t.length === 50 && e.series_lambda0_max.length === 50 &&
         o.name === "<img src=x onerror=alert(1)>\u001b[2J" && o.t_critical === -1 && o.series_t.length === 20,
         "forecasts arrive whole, nested scenarios and series intact; the lying one (num_points 30000) was dropped");
