@@ -111,18 +111,23 @@ TEST(DaemonStarts, SixtyFourFirstInputsInOnePeriodStartAtMostKPerTick) {
   Daemon d(std::move(opt), captureLogger(logs));
   hoist::test::Listener listener(url_out);
   ASSERT_TRUE(listener.good());
-  listener.subscribe("s[0-9]+/HOIST_(CAGE|HEALTH)");
+  // One subscription per shaft: each has its own LCM receive queue (30
+  // messages), so a slow listener (a sanitizer build) loses nothing.
+  for (int i = 0; i < kShafts; ++i) listener.subscribe("s" + std::to_string(i) + "/HOIST_(CAGE|HEALTH)");
   ASSERT_TRUE(d.start()) << logs.str();
   loopFor(d, listener, 0.2s);  // idle: no input yet
   for (int i = 0; i < kShafts; ++i) EXPECT_FALSE(d.shaft(i).starting());
 
-  // Every shaft's winder stream, 100 Hz for 1.2 s, all in the same period.
-  std::atomic<bool> fed{false};
+  // Every shaft's winder stream, 100 Hz from the same period on.
+  // (The stream goes on until the test has seen every shaft start and run:
+  // on a slow machine -- a sanitizer build -- the last starts come after
+  // 1.2 s, and a twin whose input has stopped publishes no cage state.)
+  std::atomic<bool> fed{false}, stop_feed{false};
   std::thread feeder([&] {
     lcm::LCM out(url);
     const std::int64_t u0 = nowUs();
     const auto t0 = std::chrono::steady_clock::now();
-    for (int k = 0; k < 120; ++k) {
+    for (int k = 0; k < 2000 && !(k >= 120 && stop_feed); ++k) {
       std::this_thread::sleep_until(t0 + std::chrono::milliseconds(10 * k));
       for (int i = 0; i < kShafts; ++i) {
         winder_t m{};
@@ -141,9 +146,11 @@ TEST(DaemonStarts, SixtyFourFirstInputsInOnePeriodStartAtMostKPerTick) {
       if (d.shaft(i).startTick() < 0) return false;
     return true;
   };
-  while (!(fed && allStarted()) && std::chrono::steady_clock::now() < until) loopFor(d, listener, 20ms);
+  while (!allStarted() && std::chrono::steady_clock::now() < until) loopFor(d, listener, 20ms);
+  loopFor(d, listener, 0.3s);  // a health message and a cage state of each shaft after its start
+  stop_feed = true;
+  while (!fed) loopFor(d, listener, 20ms);
   feeder.join();
-  loopFor(d, listener, 0.3s);  // a health message of each shaft after its start
   d.requestStop("test over");
   d.finish();
 
