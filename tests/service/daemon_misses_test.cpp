@@ -1,6 +1,6 @@
 // The daemon's miss record and its start budget, in-process over loopback
 // multicast (ports 8020-8023; outputs on their own port):
-//   * many twins whose first inputs arrive in the same period start at most
+//   * many twins (32) whose first inputs arrive in the same period start at most
 //     [service] max_starts_per_tick per tick, all within a bounded number of
 //     ticks, and report HOIST_HEALTH.starting (and publish no HOIST_CAGE)
 //     while they wait;
@@ -48,6 +48,7 @@ TwinConfig smallShaft(const std::string& prefix) {
   c.service.shape_rate = 0.0;
   c.service.envelope_points = 21;
   c.service.shape_points = 11;
+  c.forecast.enabled = false;  // (on by default; not what these tests are about)
   return c;
 }
 
@@ -91,11 +92,14 @@ TEST(MissLog, KeepsTheLatestRecordsAndCountsTheDropped) {
   EXPECT_EQ(log->worst()->seq, n - 5) << "the record of lateness 1e9 was dropped; the worst kept one is 5e6";
 }
 
-TEST(DaemonStarts, SixtyFourFirstInputsInOnePeriodStartAtMostKPerTick) {
+TEST(DaemonStarts, ThirtyTwoFirstInputsInOnePeriodStartAtMostKPerTick) {
   const std::string url = hoist::test::urlFor(8020), url_out = hoist::test::urlFor(8021);
   std::string why;
   if (!hoist::test::loopbackMulticastWorks(url, why)) GTEST_FAIL() << why << ".\n" << hoist::test::kMulticastHelp;
-  constexpr int kShafts = 64, kBudget = 2;
+  // (32 shafts, one start per tick: the starts take 32 ticks, as 64 at two
+  // per tick would, at half the stepping cost -- a TSan build steps 64 small
+  // twins slower than real time.)
+  constexpr int kShafts = 32, kBudget = 1;
   std::ostringstream logs;
   DaemonOptions opt;
   for (int i = 0; i < kShafts; ++i) {
