@@ -140,6 +140,20 @@ def main():
                    f"{'—' if drops is None else drops} | {bare_cell(x['bare'])} | {verdict(x['md'])} "
                    f"([report]({os.path.relpath(x['md'], a.out_dir)})) |")
     out.append("")
+    fc_rows = [x for x in rows if x["r"] and any("forecasts" in s for s in x["r"]["shafts"])]
+    if fc_rows:
+        out.append("Forecasts (rows with `[forecast] enabled`; from the daemon's run report): done, snapshots the "
+                   "workers never took (`dropped`: a newer one replaced it, i.e. the workers fell behind), "
+                   "instants skipped (degraded state).")
+        out.append("")
+        for x in fc_rows:
+            sh = x["r"]["shafts"]
+            done = sum(s.get("forecasts", 0) for s in sh)
+            dropped = sum(s.get("forecasts_dropped", 0) for s in sh)
+            skipped = sum(s.get("forecasts_skipped", 0) for s in sh)
+            out.append(f"- {x['n']} twins, `{x['name']}`: {done} done ({done / max(1, len(sh)):.1f} per shaft), "
+                       f"{dropped} dropped, {skipped} skipped")
+        out.append("")
     out.append("\"CPU used\": the process's user + system time over the run (100 % = the whole core); \"steal\": "
                "time the hypervisor gave the daemon's virtual CPU to something else (`/proc/stat`); \"inputs "
                "lost\": sequence gaps seen by the daemon (every shaft's stream is contiguous; a rejected input, e.g. by "
@@ -200,15 +214,17 @@ def main():
                    "µs per twin per tick; at 100 Hz, 300 twins per core need at most 33 µs.")
         out.append("")
         out.append("| setting | twins | daemon | " + " | ".join(p[1] for p in PHASES) +
-                   " | total (process CPU) | envelope exact / all |")
-        out.append("|---|---|---|" + "---|" * (len(PHASES) + 2))
+                   " | total (process CPU) | envelope exact / all | deferred (longest, ticks) |")
+        out.append("|---|---|---|" + "---|" * (len(PHASES) + 3))
         for x in split_rows:
             c = x["r"]["cost_split_us_per_twin_tick"]
             ev = c.get("envelope_exact", 0) + c.get("envelope_bounded", 0)
             frac = f"{100.0 * c.get('envelope_exact', 0) / ev:.1f} %" if ev else "—"
+            dfr = (f"{c['envelope_deferred']} ({c.get('envelope_longest_deferral', '?')})"
+                   if "envelope_deferred" in c else "—")
             out.append(f"| n = {x['setting'].replace(':', ', correction ')} | {x['n']} | {x['name']} | " +
                        " | ".join(f"{c.get(k, float('nan')):.2f}" for k, _ in PHASES) +
-                       f" | {c.get('process_cpu', float('nan')):.2f} | {frac} |")
+                       f" | {c.get('process_cpu', float('nan')):.2f} | {frac} | {dfr} |")
         out.append("")
     # perf profiles (bench/multishaft.sh --perf NAME): the largest count of each setting.
     for setting in dict.fromkeys(x["setting"] for x in rows):

@@ -97,6 +97,17 @@ spargs=()
 "$bin/hoist-mqtt" --broker "$broker" --lcm-url "$url" --cage-rate 1 --client-id hoist-mqtt-demo "${spargs[@]}" \
   2> "$logdir/hoist-mqtt.log" &
 pids+=($!)
+# Wait (at most 15 s) until the daemon runs -- its start-up measures a tick,
+# which a loaded machine makes slow, and inputs sent before that are only
+# queued -- and the bridge has found the shaft and subscribed to its
+# commands; otherwise the replay's outputs arrive in one burst at the end
+# and the operator's command may come before the bridge listens.
+wait_for_line() {  # FILE TEXT
+  for _ in $(seq 150); do grep -q -- "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done
+  echo "demo-mqtt.sh: no \"$2\" in $1 after 15 s; going on" >&2
+}
+wait_for_line "$logdir/hoist-twind.log" "hoist-twind started"
+wait_for_line "$logdir/hoist-mqtt.log" "shaft 'default'"
 if [[ $sparkplug -eq 1 ]]; then
   echo "== mosquitto_sub -t 'spBv1.0/#' -F '%t (%l bytes) %x'  (Sparkplug B: protobuf, shown as hex, cut to 160 characters)"
   mosquitto_sub -h 127.0.0.1 -p "$bport" -t 'spBv1.0/#' -F '%t (%l bytes) %x' > >(cut -c1-160) &

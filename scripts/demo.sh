@@ -137,7 +137,14 @@ echo "== daemon: $bin/hoist-twind --config $config --clock $clock --lcm-url '$ur
 daemon_pid=$!
 "$bin/hoist-monitor" --lcm-url "$url" &
 monitor_pid=$!
-sleep 1.0
+# The replay starts once the daemon runs (its start-up measures a tick, which
+# a loaded machine makes slow): at most 15 s, then anyway.
+for _ in $(seq 150); do
+  grep -q "hoist-twind started" "$logdir/hoist-twind.log" 2>/dev/null && break
+  kill -0 "$daemon_pid" 2>/dev/null || break
+  sleep 0.1
+done
+sleep 0.3
 if ! kill -0 "$daemon_pid" 2>/dev/null; then
   echo "demo.sh: hoist-twind failed to start:" >&2
   cat "$logdir/hoist-twind.log" >&2

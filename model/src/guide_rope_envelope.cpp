@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace hoist {
@@ -63,11 +64,17 @@ double GuideRopeEnvelope::exact(const Solver& s, const SleeveLoads& loads) {
   ref_loads_ = loads;
   have_ref_ = true;
   last_exact_ = true;
+  last_deferred_ = false;
+  deferred_run_ = 0;
   ++exact_count_;
   return std::max(e1r_, e2r_);
 }
 
 double GuideRopeEnvelope::evaluateBounded(const Solver& s, double tolerance) {
+  return evaluateBounded(s, tolerance, -std::numeric_limits<double>::infinity());
+}
+
+double GuideRopeEnvelope::evaluateBounded(const Solver& s, double tolerance, double defer_below) {
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return evaluate(s);
   s.guideRopeCoordinates(q1_, q2_);
   SleeveLoads loads;
@@ -85,11 +92,24 @@ double GuideRopeEnvelope::evaluateBounded(const Solver& s, double tolerance) {
                      std::fabs(ref_loads_.f[k]) * std::fabs(loads.x[k] - ref_loads_.x[k]) * (r == 1 ? lip1_ : lip2_);
     (r == 1 ? d1 : d2) += d;
   }
-  // Not (2 D <= tolerance) also catches a non-finite state: exact then.
-  if (!(2.0 * std::max(d1, d2) <= tolerance)) return exact(s, loads);
+  const double bound = std::max(e1r_ + d1, e2r_ + d2);
+  // Not (2 D <= tolerance) also catches a non-finite state: exact then --
+  // unless the caller defers it and the (wider, still rigorous) bound is
+  // below defer_below (false for NaN).
+  if (!(2.0 * std::max(d1, d2) <= tolerance)) {
+    if (!(bound < defer_below)) return exact(s, loads);
+    last_exact_ = false;
+    last_deferred_ = true;
+    ++deferred_count_;
+    ++deferred_run_;
+    longest_deferral_ = std::max(longest_deferral_, deferred_run_);
+    return bound;
+  }
   last_exact_ = false;
+  last_deferred_ = false;
+  deferred_run_ = 0;
   ++bounded_count_;
-  return std::max(e1r_ + d1, e2r_ + d2);
+  return bound;
 }
 
 double maxGuideRopeDeflection(const Solver& s, int samples) {

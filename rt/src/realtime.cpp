@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <sys/mman.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 namespace hoist::rt {
@@ -111,6 +112,22 @@ RealtimeOutcome applyRealtime(const RealtimeRequest& req) {
       o.affinity = "not set";
   }
   return o;
+}
+
+bool yieldToRealtimeLoop(int nice, std::string* why) {
+  sched_param sp{};
+  sp.sched_priority = 0;
+  if (const int e = pthread_setschedparam(pthread_self(), SCHED_OTHER, &sp); e != 0) {
+    if (why) *why = "SCHED_OTHER: " + errnoText(e);
+    return false;
+  }
+  // setpriority(PRIO_PROCESS, tid) sets the nice value of one thread on Linux.
+  const int value = nice < 0 ? 0 : (nice > 19 ? 19 : nice);
+  if (::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), value) != 0) {
+    if (why) *why = "nice " + std::to_string(value) + ": " + errnoText(errno);
+    return false;
+  }
+  return true;
 }
 
 std::string RealtimeOutcome::summary() const {

@@ -69,6 +69,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     shafts_.back()->attachLoop(&split_, misses_.get(), static_cast<int>(i));
     const double rate = opt_.shafts[i].service.rate;
     const int budget = opt_.shafts[i].service.max_starts_per_tick;
+    const int env_budget = opt_.shafts[i].service.max_exact_envelopes_per_tick;
     RateGroup*& g = by_rate[rate];
     if (!g) {
       groups_.push_back(std::make_unique<RateGroup>());
@@ -78,8 +79,10 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
       g->timer = std::make_unique<asio::steady_timer>(io_);
       g->index = static_cast<int>(groups_.size() - 1);
       g->start_budget = budget > 0 ? budget : std::numeric_limits<int>::max();
-    } else if (budget > 0) {
-      g->start_budget = std::min(g->start_budget, budget);
+      g->envelope_budget = env_budget > 0 ? env_budget : std::numeric_limits<int>::max();
+    } else {
+      if (budget > 0) g->start_budget = std::min(g->start_budget, budget);
+      if (env_budget > 0) g->envelope_budget = std::min(g->envelope_budget, env_budget);
     }
     g->shafts.push_back(shafts_.back().get());
     g->ids.push_back(static_cast<int>(i));
@@ -239,8 +242,9 @@ void Daemon::watchOutputGroup() {
 void Daemon::startForecasts() {
   if (!pool_ || pool_->empty()) return;
   pool_->start();
-  out_->info("look-ahead forecasts: {} shaft(s) on one pool of {} worker thread(s)", pool_->jobs(),
-             pool_->workers());
+  out_->info("look-ahead forecasts: {} shaft(s) on one pool of {} worker thread(s) (SCHED_OTHER, nice {}: they "
+             "give way to the loop)",
+             pool_->jobs(), pool_->workers(), ForecastPool::kWorkerNice);
 }
 
 void Daemon::unblockStopSignals() {
@@ -404,12 +408,12 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   g.cpu_at = cpu_now;
   const std::int64_t work0 = split_.sum();
   const double period_us = duration<double, std::micro>(g.period).count();
-  // Deferred starts: at most the group's budget in this tick.
-  int starts_left = g.start_budget;
+  // Deferred starts and exact envelopes: at most the group's budgets in this tick.
+  TickAllowance left{g.start_budget, g.envelope_budget};
   const auto ns_rx0 = ns_receive_, ns_fl0 = ns_flush_;
   std::size_t i = 0;
   for (ShaftTwin* s : g.shafts) {
-    s->tick(k, deadline, skipped, starts_left);
+    s->tick(k, deadline, skipped, left);
     if (miss) [[unlikely]] noteMissShaft(*miss, g, i, period_us);
     if (++i % kDrainEvery == 0) {
       flushOutputs();

@@ -111,6 +111,9 @@ class Daemon {
     /// Deferred starts per tick: the smallest [service] max_starts_per_tick
     /// of the group (0 there = no budget).
     int start_budget = 0;
+    /// Exact guide-rope envelopes per tick: the smallest [service]
+    /// max_exact_envelopes_per_tick of the group (0 there = no budget).
+    int envelope_budget = 0;
     // The miss record: the loop's split and the time when this schedule's
     // previous tick began.
     LoopSplit split_at{};

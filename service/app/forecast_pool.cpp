@@ -5,6 +5,8 @@
 #include <cmath>
 #include <exception>
 
+#include "hoist/rt/realtime.hpp"
+
 namespace hoist::svc {
 
 namespace {
@@ -116,6 +118,10 @@ void ForecastPool::stop() {
 }
 
 void ForecastPool::workerMain() {
+  // Created by the loop thread, this thread has inherited its SCHED_FIFO
+  // priority: at equal priority a forecast of milliseconds would hold the
+  // loop off its deadline on a shared CPU.  Give way first.
+  if (hoist::rt::yieldToRealtimeLoop(kWorkerNice)) yielded_.fetch_add(1, std::memory_order_release);
   while (!quit_.load(std::memory_order_acquire)) {
     const std::uint32_t seen = wake_.load(std::memory_order_acquire);
     bool ran = false;

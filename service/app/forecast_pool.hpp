@@ -113,6 +113,11 @@ class ForecastPool {
   bool empty() const { return jobs_.empty(); }
   std::size_t jobs() const { return jobs_.size(); }
   int workers() const { return workers_; }
+  /// Workers that have given way to the loop (hoist::rt::yieldToRealtimeLoop:
+  /// SCHED_OTHER, nice kWorkerNice) -- each does so first thing.
+  int workersYielded() const { return yielded_.load(std::memory_order_acquire); }
+  /// The workers' nice value: below the loop (SCHED_FIFO, or nice 0 without).
+  static constexpr int kWorkerNice = 10;
   void start();
   void stop();
   /// Loop thread, after posting a snapshot: wake a worker (lock-free).
@@ -128,6 +133,7 @@ class ForecastPool {
   std::vector<std::thread> threads_;
   std::atomic<std::uint32_t> wake_{0};
   std::atomic<bool> quit_{false};
+  std::atomic<int> yielded_{0};
 };
 
 }  // namespace hoist::svc

@@ -1,6 +1,7 @@
 // The daemon's run report: see run_report.hpp.
 #include "run_report.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -31,7 +32,8 @@ nlohmann::ordered_json histogramJson(const LatencyHistogram& h) {
 /// timer wake-ups, Asio, the kernel's share of the work not inside those
 /// calls, the log thread.
 nlohmann::ordered_json costSplit(const RunFacts& f) {
-  std::int64_t model = 0, env = 0, publish = 0, shaft_ticks = 0, exact = 0, bounded = 0;
+  std::int64_t model = 0, env = 0, publish = 0, shaft_ticks = 0, exact = 0, bounded = 0, deferred = 0;
+  int longest = 0;
   for (const ShaftTwin* sp : f.shafts) {
     const ShaftRunStats st = sp->runStats();
     model += st.ns_model;
@@ -40,6 +42,8 @@ nlohmann::ordered_json costSplit(const RunFacts& f) {
     shaft_ticks += st.ticks;
     exact += st.envelope_exact;
     bounded += st.envelope_bounded;
+    deferred += st.envelope_deferred;
+    longest = std::max(longest, st.envelope_longest_deferral);
   }
   const double cpu = static_cast<double>(f.cpu_ns);
   const double per = shaft_ticks > 0 ? 1e-3 / static_cast<double>(shaft_ticks) : 0.0;
@@ -54,7 +58,9 @@ nlohmann::ordered_json costSplit(const RunFacts& f) {
           {"timer_and_rest", per * (cpu - static_cast<double>(f.ns_ticks + f.ns_receive + f.ns_flush))},
           {"process_cpu", per * cpu},
           {"envelope_exact", exact},
-          {"envelope_bounded", bounded}};
+          {"envelope_bounded", bounded},
+          {"envelope_deferred", deferred},
+          {"envelope_longest_deferral", longest}};
 }
 
 nlohmann::ordered_json splitJson(const MissRecord& r) {
@@ -131,6 +137,13 @@ nlohmann::ordered_json shaftJson(const ShaftTwin& sp) {
   o["publish_failures"] = s.publish_failures;
   o["nonfinite_withheld"] = s.nonfinite_blocked;
   o["starts_deferred"] = s.starts_deferred;
+  if (c.forecast.enabled) {
+    // Whether the forecasts kept up: done, snapshots the workers never took
+    // (replaced by a newer one), instants skipped (degraded state).
+    o["forecasts"] = s.forecasts;
+    o["forecasts_dropped"] = s.forecasts_dropped;
+    o["forecasts_skipped"] = s.forecasts_skipped;
+  }
   o["step_us"] = histogramJson(*s.step);
   o["late_us"] = histogramJson(*s.late);
   return o;

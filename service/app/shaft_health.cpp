@@ -221,6 +221,8 @@ ShaftRunStats ShaftHealth::runStats() const {
   s.ns_tick = st.ns_tick;
   s.envelope_exact = core.envelope().exactEvaluations();
   s.envelope_bounded = core.envelope().boundedEvaluations();
+  s.envelope_deferred = core.envelope().deferredEvaluations();
+  s.envelope_longest_deferral = core.envelope().longestDeferral();
   s.forecasts = st.forecasts;
   s.forecasts_dropped = st.forecasts_dropped;
   s.forecasts_skipped = st.forecasts_skipped;

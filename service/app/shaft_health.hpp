@@ -45,6 +45,10 @@ struct ShaftRunStats {
   // publishing (encode + sendmsg of every output); the whole tick() call.
   std::int64_t ns_model = 0, ns_envelope = 0, ns_publish = 0, ns_tick = 0;
   std::int64_t envelope_exact = 0, envelope_bounded = 0;  ///< envelope evaluations
+  /// Envelope evaluations deferred by the per-tick budget (a wider bound,
+  /// [service] max_exact_envelopes_per_tick), and the longest run of them.
+  std::int64_t envelope_deferred = 0;
+  int envelope_longest_deferral = 0;
   std::int64_t starts_deferred = 0;    ///< starts that waited for the start budget
   std::int64_t ns_start = 0;           ///< steady-clock ns in deferred starts (in ns_model too)
 };

@@ -23,6 +23,8 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
   // Wall clock: the first input's (and a new stream's) static solve waits
   // for the daemon's per-tick start budget ([service] max_starts_per_tick).
   ctx_.core.deferStarts(ctx_.cfg.service.clock == ClockMode::Wall && ctx_.cfg.service.max_starts_per_tick > 0);
+  // Likewise the exact guide-rope envelopes, per tick across the schedule.
+  envelope_budget_ = ctx_.cfg.service.clock == ClockMode::Wall && ctx_.cfg.service.max_exact_envelopes_per_tick > 0;
 }
 
 void ShaftTwin::attachLoop(LoopSplit* split, const MissLog* misses, int phase) {
@@ -80,7 +82,7 @@ void ShaftTwin::publishHealth(bool final_report) {
   health_.endWindow(m, wall, final_report);
 }
 
-void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, int& starts_left) {
+void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, TickAllowance& left) {
   ShaftStats& st = ctx_.stats;
   TwinCore& core = ctx_.core;
   LoopSplit* split = ctx_.split;
@@ -99,12 +101,15 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
 
   if (core.clock() == ClockMode::Wall) {
     const double t = static_cast<double>(k) / ctx_.cfg.service.rate;
-    if (core.startPending()) startWithinBudget(t, wall, starts_left);
+    // (The budget is this tick's: held by the core only within it.)
+    core.setEnvelopeBudget(envelope_budget_ ? &left.exact_envelopes : nullptr);
+    if (core.startPending()) startWithinBudget(t, wall, left.starts);
     const auto t0 = Clock::now();
     const std::int64_t env0 = core.envelopeNanos();
     if (ctx_.hooks.slow_tick_at >= 0.0) [[unlikely]] slowTickHook(wall);
     const TickResult r = core.tick(t, wall);
     core.housekeeping(wall);
+    core.setEnvelopeBudget(nullptr);
     const auto t1 = Clock::now();
     st.ns_model += nanos(t1 - t0);
     if (split) {

@@ -65,6 +65,13 @@ using bus::RawHandler;
 using bus::UdpmReceiver;
 using bus::UdpmUrl;
 
+/// What one tick of the daemon's schedule may still spend across its
+/// shafts (each a count that the shafts take from in shaft order).
+struct TickAllowance {
+  int starts = 0;           ///< deferred starts ([service] max_starts_per_tick)
+  int exact_envelopes = 0;  ///< exact guide-rope envelopes ([service] max_exact_envelopes_per_tick)
+};
+
 class ShaftTwin {
  public:
   using Clock = std::chrono::steady_clock;
@@ -114,9 +121,11 @@ class ShaftTwin {
   /// One period of the schedule: deadline index k (model time k / rate with
   /// --clock wall), the deadline this tick was scheduled for (lateness is
   /// measured from it), and how many deadlines the schedule skipped just
-  /// before k (missed ticks).  `starts_left`: the tick's remaining start
-  /// budget; a pending start (TwinCore::startPending) takes one, or waits.
-  void tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, int& starts_left);
+  /// before k (missed ticks).  `left`: what the tick may still spend across
+  /// the schedule's shafts; a pending start (TwinCore::startPending) takes
+  /// one start or waits, and each exact guide-rope envelope takes one of
+  /// exact_envelopes (TwinCore::setEnvelopeBudget).
+  void tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, TickAllowance& left);
   /// The twin's start waits for the start budget (HOIST_HEALTH.starting).
   bool starting() const { return ctx_.core.startPending(); }
   /// This shaft took part in miss record `seq`, `late_us` late.
@@ -151,6 +160,7 @@ class ShaftTwin {
   bool slow_tick_done_ = false;                  ///< TestHooks::slow_tick_at has fired
   /// A pending start within the tick's budget (model time t of the tick).
   void startWithinBudget(double t, double wall, int& starts_left);
+  bool envelope_budget_ = false;  ///< [service] max_exact_envelopes_per_tick applies (wall clock, > 0)
   void slowTickHook(double wall);                ///< TestHooks::slow_tick_at
 };
 

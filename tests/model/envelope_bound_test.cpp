@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "hoist/fast_solver.hpp"
 #include "hoist/guide_rope_envelope.hpp"
@@ -89,4 +90,53 @@ TEST(EnvelopeBound, ZeroToleranceIsExactEveryTime) {
   // A non-finite tolerance is exact too.
   EXPECT_EQ(fast.evaluateBounded(s, std::nan("")), exact.evaluate(s));
   EXPECT_TRUE(fast.lastExact());
+}
+
+// Deferral (evaluateBounded with defer_below: the daemon's per-tick budget of
+// exact evaluations): a deferred value is the same rigorous bound, only wider
+// than the tolerance, so it is never below the exact envelope; a deferral
+// level of -inf is the two-argument form exactly; a value at or above the
+// level is never deferred.
+TEST(EnvelopeBound, DeferredBoundsStayAboveTheExactEnvelope) {
+  for (bool corr : {true, false}) {
+    ShaftParams p;
+    p.n = 20;
+    p.static_correction = corr;
+    auto model = std::make_shared<const ShaftModel>(p);
+    FastSolver s(model);
+    GuideRopeEnvelope exact(*model, 401), plain(*model, 401), never(*model, 401), always(*model, 401),
+        capped(*model, 401);
+    const double tol = 3e-4;
+    double worst_under = 0.0, worst_over = 0.0, cap = 0.0;
+    SimulationOptions opt;
+    opt.dt = 0.01;
+    opt.max_step = 0.01;
+    bool first = true;
+    simulate(s, HoistProfile::trapezoid(), opt, [&](const CageResponse&) {
+      const double e = exact.evaluate(s);
+      ASSERT_EQ(never.evaluateBounded(s, tol, -std::numeric_limits<double>::infinity()),
+                plain.evaluateBounded(s, tol));
+      const double a = always.evaluateBounded(s, tol, std::numeric_limits<double>::infinity());
+      worst_under = std::max(worst_under, e - a);
+      worst_over = std::max(worst_over, a - e);
+      if (first) cap = 2.0 * e + 1e-3;
+      first = false;
+      const double c = capped.evaluateBounded(s, tol, cap);
+      if (capped.lastDeferred()) ASSERT_LT(c, cap);
+      ASSERT_GE(c, e - 1e-15);
+    });
+    EXPECT_EQ(never.exactEvaluations(), plain.exactEvaluations());
+    EXPECT_EQ(never.deferredEvaluations(), 0);
+    EXPECT_LE(worst_under, 1e-15) << "a deferred bound fell below the exact envelope";
+    EXPECT_EQ(always.exactEvaluations(), 1) << "always deferring: only the first (no reference yet) is exact";
+    EXPECT_GT(always.deferredEvaluations(), 0);
+    EXPECT_GT(worst_over, tol) << "the deferred bounds did get wider than the tolerance";
+    EXPECT_GT(capped.exactEvaluations(), 1) << "above the level the evaluation is exact";
+    EXPECT_GT(capped.deferredEvaluations(), 0);
+    std::printf("correction %s: always deferring, the bound is at most %.3f mm above the exact envelope (%lld "
+                "deferred); deferring below %.3f mm: %lld exact, %lld deferred\n",
+                corr ? "on" : "off", worst_over * 1e3, static_cast<long long>(always.deferredEvaluations()),
+                cap * 1e3, static_cast<long long>(capped.exactEvaluations()),
+                static_cast<long long>(capped.deferredEvaluations()));
+  }
 }

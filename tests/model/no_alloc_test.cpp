@@ -28,7 +28,7 @@ TEST(NoAlloc, FastStepAndEnvelopeAllocateNothing) {
     p.Tb2 = 32000;  // distinct ropes: both modal bases in use
     auto model = std::make_shared<const ShaftModel>(p);
     FastSolver s(model);
-    GuideRopeEnvelope env(*model, 401), bounded(*model, 401);
+    GuideRopeEnvelope env(*model, 401), bounded(*model, 401), deferring(*model, 401);
     const HoistProfile prof = HoistProfile::trapezoid();
     s.initialize(0.0, prof.at(0.0));
     s.step(0.01, prof.at(0.01));  // first step may size nothing new, but allow it
@@ -40,8 +40,11 @@ TEST(NoAlloc, FastStepAndEnvelopeAllocateNothing) {
       s.step(t, prof.at(t));
       acc += env.evaluate(s);
       acc += bounded.evaluateBounded(s, 3e-4);  // the bounded envelope, exact and bounded calls
+      // ... and deferring every other step (the daemon's spent budget)
+      acc += deferring.evaluateBounded(s, 3e-4, k % 2 ? 1.0 : -1.0);
     }
     EXPECT_GT(bounded.boundedEvaluations(), 0) << "n = " << n;
+    EXPECT_GT(deferring.deferredEvaluations(), 0) << "n = " << n;
     EXPECT_GT(bounded.exactEvaluations(), 0) << "n = " << n;
     Eigen::internal::set_is_malloc_allowed(true);
     EXPECT_EQ(allocationCount() - before, 0) << "n = " << n;

@@ -7,7 +7,11 @@
 //   * a slow tick injected on purpose (TestHooks::slow_tick_at) is a miss
 //     whose record -- in the daemon, in HOIST_HEALTH and in the run report --
 //     puts the lost time in the model step;
-//   * the ring keeps the latest records and counts the dropped ones.
+//   * the ring keeps the latest records and counts the dropped ones;
+//   * lockstep shafts on a moving trip share the schedule's budget of exact
+//     guide-rope envelopes ([service] max_exact_envelopes_per_tick): the
+//     schedule with a budget defers some, the one without defers none
+//     (ports 8024-8025).
 // No wall-clock-tight assertions: bounds are in ticks, and times are checked
 // only against the injected delay with a wide margin.
 #include <gtest/gtest.h>
@@ -23,6 +27,7 @@
 
 #include "daemon.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/profile.hpp"
 #include "hoist/winder_t.hpp"
 #include "lcm_fixtures.hpp"
 
@@ -298,4 +303,74 @@ TEST(DaemonMisses, ASlowTickIsRecordedWithItsSplitInHealthAndReport) {
   EXPECT_TRUE(in_report);
   EXPECT_GE(jm["worst"]["late_us"].get<double>(), 1e4);
   fs::remove_all(dir);
+}
+
+TEST(DaemonEnvelopes, LockstepShaftsOnAMovingTripShareTheExactEnvelopeBudget) {
+  const std::string url = hoist::test::urlFor(8024), url_out = hoist::test::urlFor(8025);
+  std::string why;
+  if (!hoist::test::loopbackMulticastWorks(url, why)) GTEST_FAIL() << why << ".\n" << hoist::test::kMulticastHelp;
+  // Two schedules of 6 shafts each, all fed the same accelerating trip:
+  // at 100 Hz one exact envelope per tick across its shafts, at 50 Hz no
+  // budget.  (The bounded envelope of one such twin needs an exact refresh
+  // on a few % of its steps, all of them on the same steps.)
+  constexpr int kPerGroup = 6;
+  std::ostringstream logs;
+  DaemonOptions opt;
+  for (int i = 0; i < 2 * kPerGroup; ++i) {
+    TwinConfig c = smallShaft("e" + std::to_string(i) + "/");
+    c.shaft.n = 12;
+    c.service.rate = i < kPerGroup ? 100.0 : 50.0;
+    c.service.max_exact_envelopes_per_tick = i < kPerGroup ? 1 : 0;
+    c.service.max_starts_per_tick = 0;
+    opt.shafts.push_back(c);
+    opt.labels.push_back("e" + std::to_string(i));
+  }
+  opt.lcm_url = url;
+  opt.lcm_url_out = url_out;
+  Daemon d(std::move(opt), captureLogger(logs));
+  ASSERT_TRUE(d.start()) << logs.str();
+  std::atomic<bool> fed{false};
+  std::thread feeder([&] {
+    lcm::LCM out(url);
+    const HoistProfile prof = HoistProfile::trapezoid();
+    const std::int64_t u0 = nowUs();
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < 400; ++k) {  // 4 s from the start of the trip at 100 Hz
+      std::this_thread::sleep_until(t0 + std::chrono::milliseconds(10 * k));
+      const Kinematics kin = prof.at(prof.startTime() + 0.01 * k);
+      winder_t m{};
+      m.utime = u0 + 10000 * k;
+      m.seq = k;
+      m.v = kin.v;
+      m.a = kin.a;
+      m.has_length = true;
+      m.length = kin.l;
+      for (int i = 0; i < 2 * kPerGroup; ++i) out.publish("e" + std::to_string(i) + "/HOIST_WINDER", &m);
+    }
+    fed = true;
+  });
+  hoist::test::Listener listener(url_out);
+  ASSERT_TRUE(listener.good());
+  while (!fed) loopFor(d, listener, 20ms);
+  feeder.join();
+  d.requestStop("test over");
+  d.finish();
+
+  std::int64_t deferred[2] = {0, 0}, exact[2] = {0, 0}, bounded[2] = {0, 0};
+  for (int i = 0; i < 2 * kPerGroup; ++i) {
+    const ShaftRunStats st = d.shaft(i).runStats();
+    const int g = i < kPerGroup ? 0 : 1;
+    deferred[g] += st.envelope_deferred;
+    exact[g] += st.envelope_exact;
+    bounded[g] += st.envelope_bounded;
+    EXPECT_EQ(st.envelope_deferred > 0, st.envelope_longest_deferral > 0) << i;
+  }
+  std::printf("with a budget of 1 per tick: %lld exact, %lld bounded, %lld deferred; without: %lld exact, %lld "
+              "bounded, %lld deferred\n",
+              static_cast<long long>(exact[0]), static_cast<long long>(bounded[0]),
+              static_cast<long long>(deferred[0]), static_cast<long long>(exact[1]),
+              static_cast<long long>(bounded[1]), static_cast<long long>(deferred[1]));
+  EXPECT_GT(bounded[0] + bounded[1], 0) << logs.str();
+  EXPECT_GT(deferred[0], 0) << "lockstep shafts needed more than one exact envelope on some tick";
+  EXPECT_EQ(deferred[1], 0) << "no budget, no deferral";
 }

@@ -38,10 +38,30 @@ class GuideRopeEnvelope {
   /// (and becomes the new reference).  Cost of a bounded call: the solver's
   /// guide coordinates and O(n).
   double evaluateBounded(const Solver& s, double tolerance);
+  /// evaluateBounded(s, tolerance), except that where the bound has grown
+  /// wider than the tolerance the exact evaluation may be DEFERRED: the
+  /// wider bound E = max_r (E_r0 + D_r) is returned as it is (still
+  /// evaluate() <= E, now possibly more than `tolerance` above it) if
+  /// E < defer_below; otherwise, or without a reference or bound (a changed
+  /// set of sleeve loads, a non-finite state), the evaluation is exact.
+  /// For a caller that must spread exact evaluations over time (the daemon's
+  /// per-tick budget, [service] max_exact_envelopes_per_tick) and knows a
+  /// level below which the value changes no decision (an alarm's clear
+  /// level).  defer_below = -inf: never defer (the two-argument form).
+  double evaluateBounded(const Solver& s, double tolerance, double defer_below);
   /// Whether the last evaluate()/evaluateBounded() was exact.
   bool lastExact() const { return last_exact_; }
+  /// Whether the last evaluateBounded() returned a deferred (wider) bound.
+  bool lastDeferred() const { return last_deferred_; }
   std::int64_t exactEvaluations() const { return exact_count_; }
+  /// Bounds within the tolerance (deferred ones not included).
   std::int64_t boundedEvaluations() const { return bounded_count_; }
+  /// Deferred bounds (wider than the tolerance) since construction.
+  std::int64_t deferredEvaluations() const { return deferred_count_; }
+  /// Deferred bounds in a row now (0 after an exact or in-tolerance one),
+  /// and the longest such run since construction.
+  int deferredRun() const { return deferred_run_; }
+  int longestDeferral() const { return longest_deferral_; }
   const VectorXd& depths() const { return x_; }
   /// The shapes of the last EXACT evaluation.
   const VectorXd& y1() const { return y1_; }
@@ -57,11 +77,12 @@ class GuideRopeEnvelope {
   double lip1_ = 0.0, lip2_ = 0.0;  // 1 / min_x T_r(x): bound of |dG_r(x, a)/da|
   VectorXd q1_, q2_, y1_, y2_;
   // reference of evaluateBounded(): the last exact evaluation
-  bool have_ref_ = false, last_exact_ = true;
+  bool have_ref_ = false, last_exact_ = true, last_deferred_ = false;
   VectorXd q1r_, q2r_;
   SleeveLoads ref_loads_;
   double e1r_ = 0.0, e2r_ = 0.0;
-  std::int64_t exact_count_ = 0, bounded_count_ = 0;
+  std::int64_t exact_count_ = 0, bounded_count_ = 0, deferred_count_ = 0;
+  int deferred_run_ = 0, longest_deferral_ = 0;
 };
 
 }  // namespace hoist

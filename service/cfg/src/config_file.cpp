@@ -78,6 +78,7 @@ const Key<SC> kServiceKeys[] = {
     integer("max_catchup_periods", &SC::max_catchup_periods),
     integer("max_commands_per_tick", &SC::max_commands_per_tick),
     integer("max_starts_per_tick", &SC::max_starts_per_tick),
+    integer("max_exact_envelopes_per_tick", &SC::max_exact_envelopes_per_tick),
 };
 
 using AC = AlarmConfig;

@@ -55,6 +55,7 @@ void ServiceConfig::validate() const {
   checkRange("max_catchup_periods", max_catchup_periods, 1, 1000);
   checkRange("max_commands_per_tick", max_commands_per_tick, 1, 1000);
   checkRange("max_starts_per_tick", max_starts_per_tick, 0, 100000);
+  checkRange("max_exact_envelopes_per_tick", max_exact_envelopes_per_tick, 0, 100000);
   if (max_step > 0.0) {
     // Never clamp in silence: the longest interval one step may have to
     // cover (a tick's catch-up, or an input interval with --clock input)

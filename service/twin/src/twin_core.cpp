@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace hoist::svc {
@@ -219,6 +220,7 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
       solver_(solver ? std::move(solver) : defaultSolver(cfg)),
       envelope_(solver_->model(), cfg.service.envelope_points),
       envelope_tol_(cfg.service.envelope_tolerance * cfg.alarms.guide_rope_gap),
+      envelope_defer_below_((cfg.alarms.warning_fraction - cfg.alarms.deadband) * cfg.alarms.guide_rope_gap),
       shape_(solver_->model(), cfg.service.shape_points),
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
@@ -392,11 +394,16 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
     if (ok) {
       const CageResponse& r = solver_->response();
       // The deflection alarm's envelope: exact, or a conservative bound
-      // within envelope_tol_ of it (service.envelope_tolerance).
+      // within envelope_tol_ of it (service.envelope_tolerance), or -- with
+      // the caller's budget of exact evaluations spent -- a wider bound that
+      // no GUIDE_ROPE alarm can tell from the exact one (setEnvelopeBudget).
       const auto e0 = std::chrono::steady_clock::now();
-      double gdef = envelope_.evaluateBounded(*solver_, envelope_tol_);
+      const bool defer = envelope_budget_ && *envelope_budget_ <= 0;
+      double gdef = envelope_.evaluateBounded(*solver_, envelope_tol_,
+                                              defer ? envelope_defer_below_ : -std::numeric_limits<double>::infinity());
       // Never fault on a bound: look exactly first.
       if (!(gdef <= bounds_.lateral) && !envelope_.lastExact()) gdef = envelope_.evaluate(*solver_);
+      if (envelope_budget_ && envelope_.lastExact()) --*envelope_budget_;
       envelope_ns_ += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - e0).count();
       out_.t = publishedTime(t);
       out_.kin = r.kin;

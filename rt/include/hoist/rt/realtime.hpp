@@ -5,7 +5,9 @@
 //   * SCHED_FIFO at a priority in [1, 99] (needs CAP_SYS_NICE or
 //     RLIMIT_RTPRIO; inside containers often refused);
 //   * CPU affinity to a list of CPUs (pthread_setaffinity_np).
-// Other threads (LCM's receive thread, the log writer) keep their settings.
+// Other threads (LCM's receive thread, the log writer) keep their settings;
+// threads created by this one afterwards inherit them, so a helper that
+// computes (a forecast worker) calls yieldToRealtimeLoop() first.
 #pragma once
 
 #include <string>
@@ -33,5 +35,16 @@ std::vector<int> parseCpuList(const std::string& text, const std::string& what);
 
 /// Apply `req` to the calling thread (and, for mlockall, the process).
 RealtimeOutcome applyRealtime(const RealtimeRequest& req);
+
+/// Helper-thread side: the CALLING thread gives way to the real-time loop.
+/// A thread created by the loop thread after applyRealtime() inherits its
+/// SCHED_FIFO priority, and two SCHED_FIFO threads of one priority on one
+/// CPU do not preempt each other: a helper computing for milliseconds (a
+/// forecast worker) would hold the loop off its deadline.  This sets
+/// SCHED_OTHER and then nice `nice` ([0, 19]; a larger value is always
+/// allowed, so this needs no privilege), so that the loop preempts the
+/// helper at once with SCHED_FIFO and outweighs it without.  Returns false,
+/// with the reason in *why (if given), when either call failed.
+bool yieldToRealtimeLoop(int nice, std::string* why = nullptr);
 
 }  // namespace hoist::rt

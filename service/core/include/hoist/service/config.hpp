@@ -82,6 +82,16 @@ struct ServiceConfig {
   /// among the shafts of a schedule; 0 = no budget (start at once, in the
   /// input handler), [0, 100000].
   int max_starts_per_tick = 8;
+  /// --clock wall: exact guide-rope envelope evaluations (envelope_points x
+  /// n per rope, about 20 us at n = 25) per tick of the daemon's schedule.
+  /// Once they are spent, a twin whose bounded envelope has drifted past
+  /// envelope_tolerance keeps that wider, still rigorous bound for a tick or
+  /// more -- only while it lies below the GUIDE_ROPE WARNING alarm's clear
+  /// level, so no alarm decides differently (TwinCore::setEnvelopeBudget);
+  /// near a threshold it is exact regardless.  Hundreds of twins in lockstep
+  /// then refresh over a few ticks instead of in one.  The smallest value
+  /// among a schedule's shafts; 0 = no budget, [0, 100000].
+  int max_exact_envelopes_per_tick = 32;
 
   void validate() const;  ///< throws std::invalid_argument "service.<key>: why" (the reader adds file:line)
 };

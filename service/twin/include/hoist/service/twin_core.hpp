@@ -208,6 +208,23 @@ class TwinCore {
   /// The deflection alarm's envelope (service.envelope_tolerance: exact or
   /// bounded evaluations, GuideRopeEnvelope::evaluateBounded).
   const GuideRopeEnvelope& envelope() const { return envelope_; }
+  /// The caller's budget of exact envelope evaluations (the daemon's per-tick
+  /// [service] max_exact_envelopes_per_tick across a schedule's shafts), or
+  /// null: no budget (the default).  Each exact evaluation decrements
+  /// *left; while *left <= 0 an evaluation whose bound has grown wider than
+  /// envelope_tolerance is deferred (GuideRopeEnvelope::evaluateBounded with
+  /// defer_below) if that wider bound is below envelopeDeferBelow(): the
+  /// GUIDE_ROPE alarms then decide exactly as with the exact envelope (both
+  /// values are under the WARNING alarm's clear level), and the published
+  /// guide_deflection is still never below the exact envelope, only looser
+  /// than the tolerance for those steps.  Anything else is exact regardless.
+  /// The pointer is held until set again; the caller owns the int.
+  void setEnvelopeBudget(int* left) { envelope_budget_ = left; }
+  /// The deflection below which an envelope evaluation may be deferred [m]:
+  /// (alarms.warning_fraction - alarms.deadband) x alarms.guide_rope_gap, the
+  /// GUIDE_ROPE WARNING alarm's clear level (below it neither GUIDE_ROPE
+  /// alarm can change state, pend or stay raised).
+  double envelopeDeferBelow() const { return envelope_defer_below_; }
   /// Time spent in the envelope (exact or bounded) since construction [ns]
   /// (steady clock around each evaluation: the daemon's cost split).
   std::int64_t envelopeNanos() const { return envelope_ns_; }
@@ -285,6 +302,8 @@ class TwinCore {
   std::unique_ptr<Solver> solver_;
   GuideRopeEnvelope envelope_;
   double envelope_tol_ = 0.0;  // [m]: service.envelope_tolerance x alarms.guide_rope_gap
+  double envelope_defer_below_ = 0.0;  // [m]: envelopeDeferBelow()
+  int* envelope_budget_ = nullptr;     // setEnvelopeBudget()
   std::int64_t envelope_ns_ = 0;
   GuideRopeEnvelope shape_;
   InputValidator validator_;
