@@ -15,6 +15,7 @@
 #include <regex>
 
 #include "lcm_fixtures.hpp"
+#include "tcp.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
@@ -26,33 +27,6 @@ using namespace hoist::test;
 using json = nlohmann::json;
 
 namespace {
-
-/// A free TCP port on 127.0.0.1 (bound, read back, released).
-int freePort() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof a;
-  int port = -1;
-  if (::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) == 0)
-    port = ntohs(a.sin_port);
-  ::close(s);
-  return port;
-}
-
-bool tcpOpen(int port) {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(s);
-  return ok;
-}
 
 /// A mosquitto broker on 127.0.0.1:port, no persistence (a restart loses the
 /// retained messages, as a broker without a persistence file does).
@@ -205,7 +179,7 @@ bool isWarningActive(const json& j) {
 TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
   dir_ = testDir("mqtt_state_alarms");
   const std::string url = urlFor(7931);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   broker.start();
   Client early(broker.port(), "early");
   ASSERT_TRUE(early.connected());
@@ -385,7 +359,7 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
 TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
   dir_ = testDir("mqtt_restart");
   const std::string url = urlFor(7932);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   const auto bcfg = (dir_ / "bridge.toml").string();
   std::ofstream(bcfg) << "[broker]\nreconnect_min = 0.1\nreconnect_max = 0.5\n[bridge]\nhealth_period = 0.5\n"
                          "[buffer]\nmax_messages = 15\n";
@@ -469,7 +443,7 @@ TEST_F(MqttBridge, BrokerDownAtStartAndRestarted) {
 TEST_F(MqttBridge, NoCommandsIgnoresCommands) {
   dir_ = testDir("mqtt_no_commands");
   const std::string url = urlFor(7933);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   broker.start();
   const auto bcfg = (dir_ / "bridge.toml").string();
   std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\n";
@@ -529,7 +503,7 @@ TEST_F(MqttBridge, TlsWithPasswordFile) {
   std::filesystem::permissions(path("server.key"), std::filesystem::perms::owner_read | std::filesystem::perms::group_read |
                                                        std::filesystem::perms::others_read);
   // Listener 1: plain, anonymous (the test's client); listener 2: TLS + password (the bridge).
-  const int plain = freePort(), tls = freePort();
+  const int plain = freeTcpPort(), tls = freeTcpPort();
   std::ofstream(path("mosquitto.conf")) << "per_listener_settings true\npersistence false\nlog_dest stdout\n"
                                         << "listener " << plain << " 127.0.0.1\nallow_anonymous true\n"
                                         << "listener " << tls << " 127.0.0.1\nallow_anonymous false\n"
@@ -583,7 +557,7 @@ TEST_F(MqttBridge, TlsWithPasswordFile) {
 TEST_F(MqttBridge, RetainedFloodedAndAmbiguousCommandsAreRefused) {
   dir_ = testDir("mqtt_cmd_hardening");
   const std::string url = urlFor(7935);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   broker.start();
   Client c(broker.port(), "c");
   ASSERT_TRUE(c.connected());
@@ -687,7 +661,7 @@ hoist::health_t forgedHealth(std::int64_t instance) {
 TEST_F(MqttBridge, DiscoveryIsNotPoisoned) {
   dir_ = testDir("mqtt_discovery");
   const std::string url = urlFor(7936);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   broker.start();
   Client c(broker.port(), "c");
   ASSERT_TRUE(c.connected());
@@ -775,7 +749,7 @@ TEST_F(MqttBridge, DiscoveryIsNotPoisoned) {
 TEST_F(MqttBridge, DiscoveryFullTableIsReported) {
   dir_ = testDir("mqtt_discovery_full");
   const std::string url = urlFor(7937);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   broker.start();
   Client c(broker.port(), "c");
   ASSERT_TRUE(c.connected());
@@ -836,7 +810,7 @@ hoist::alarm_t alarmEvent(const std::string& kind, int event, bool active) {
 TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
   dir_ = testDir("mqtt_results");
   const std::string url = urlFor(7938);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   broker.start();
   Client c(broker.port(), "c");
   ASSERT_TRUE(c.connected());
@@ -933,7 +907,7 @@ TEST_F(MqttBridge, PasswordFromSystemdCredential) {
   dir_ = testDir("mqtt_credentials");
   auto path = [&](const char* f) { return (dir_ / f).string(); };
   ASSERT_EQ(runProcess({HOIST_MOSQUITTO_PASSWD, "-b", "-c", path("passwd"), "hoist", "cr3d-pw"}, path("pw.log"), 30s), 0);
-  const int port = freePort(), plain = freePort();
+  const int port = freeTcpPort(), plain = freeTcpPort();
   std::ofstream(path("mosquitto.conf")) << "per_listener_settings true\npersistence false\nlog_dest stdout\n"
                                         << "listener " << plain << " 127.0.0.1\nallow_anonymous true\n"
                                         << "listener " << port << " 127.0.0.1\nallow_anonymous false\n"
@@ -1070,7 +1044,7 @@ TEST_F(MqttBridge, EstimateAtTheCageRateNotRetained) {
 TEST_F(MqttBridge, AnAlarmRaisedBeforeTheBridgeStartsAppearsAtOnce) {
   dir_ = testDir("mqtt_alarm_at_start");
   const std::string url = urlFor(8001);
-  Broker broker(dir_, freePort());
+  Broker broker(dir_, freeTcpPort());
   broker.start();
   Client c(broker.port(), "c");
   ASSERT_TRUE(c.connected());

@@ -35,6 +35,7 @@
 #include <thread>
 
 #include "lcm_fixtures.hpp"
+#include "tcp.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
@@ -50,17 +51,6 @@ namespace {
 /// restarts after minutes must find its port free; an ephemeral port may
 /// meanwhile be some client connection's source port).
 constexpr int kPortPlain = 18640, kPortRestart = 18641, kPortCentre = 18642, kPortSite = 18643, kPortCorrupt = 18644;
-
-bool tcpOpen(int port) {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(s);
-  return ok;
-}
 
 double envSeconds(const char* name, double dflt) {
   const char* v = std::getenv(name);

@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "lcm_fixtures.hpp"
+#include "tcp.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
@@ -33,17 +34,6 @@ using namespace hoist::test;
 using json = nlohmann::json;
 
 namespace {
-
-bool tcpOpen(int port) {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(s);
-  return ok;
-}
 
 /// The last lines of a log (failure messages stay readable).
 std::string tail(const std::string& path, std::size_t bytes = 3000) {
