@@ -489,7 +489,10 @@ TEST_F(MqttSparkplug, PrimaryHostGatesBirthsAndStoredDataIsHistorical) {
   ASSERT_EQ(pub.publish("north/HOIST_CAGE", &c1), 0);
   std::this_thread::sleep_for(700ms);
   EXPECT_TRUE(ofType("NBIRTH").empty()) << tail(host_log_);
-  const std::int64_t t0 = 1'800'000'000'000;
+  // (STATE timestamps are the host's wall clock: the bridge ignores one more
+  // than Node::kStateFutureMs ahead of its own.)
+  const std::int64_t t0 = std::chrono::duration_cast<std::chrono::milliseconds>(
+                             std::chrono::system_clock::now().time_since_epoch()).count();
   command("state scada true " + std::to_string(t0));
   ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 5s)) << tail(host_log_);
   EXPECT_TRUE(cageDdata(c1.seq, true)) << "stored before the births: sent after them, is_historical";

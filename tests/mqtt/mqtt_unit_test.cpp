@@ -523,4 +523,43 @@ TEST(MqttSparkplugCore, PrimaryHostState) {
   EXPECT_EQ(state("not json"), In::StateIgnored);
   EXPECT_EQ(state(R"({"online": "yes", "timestamp": 1})"), In::StateIgnored);
   EXPECT_EQ(n.subscriptions().back(), "spBv1.0/STATE/scada");
+  EXPECT_EQ(n.stateIgnored(), 3);
+  // A forged STATE from the far future is ignored (with the wall clock given),
+  // so it cannot make the genuine host's next STATE "older".
+  auto stateAt = [&](const std::string& j, std::uint64_t now_ms) {
+    return n.onMessage("spBv1.0/STATE/scada", j.data(), j.size(), 1024, true, out, now_ms);
+  };
+  const std::uint64_t now = 1'800'000'000'000;
+  EXPECT_EQ(stateAt(R"({"online": false, "timestamp": 4611686018427387904})", now), In::StateIgnored);
+  EXPECT_EQ(stateAt(R"({"online": true, "timestamp": )" + std::to_string(now + sp::Node::kStateFutureMs + 1) + "}", now),
+            In::StateIgnored);
+  EXPECT_EQ(stateAt(R"({"online": true, "timestamp": )" + std::to_string(now) + "}", now), In::HostOnline)
+      << "the genuine host is not locked out";
+  EXPECT_EQ(n.stateIgnored(), 5);
+}
+
+// A Rebirth request (NCMD) within kRebirthMinMs of the births is held and
+// done when the interval has passed; further requests merge into it: a flood
+// (one NCMD may carry 150 Rebirth metrics) costs at most two births per
+// interval, and a host that missed the births still gets them.
+TEST(MqttSparkplugCore, RebirthRequestsAreHeldAndMergedWithinTheInterval) {
+  sp::Node n({"G", "E", "", "v", 0.0, {}});
+  n.device("north");
+  const std::uint64_t t0 = 1'800'000'000'000, gap = sp::Node::kRebirthMinMs;
+  EXPECT_TRUE(n.acceptRebirth(t0)) << "before any birth";
+  ASSERT_EQ(n.births({}, t0).size(), 2u);
+  int at_once = 0;
+  for (int i = 0; i < 150; ++i)
+    if (n.acceptRebirth(t0 + 10)) ++at_once;  // 150 Rebirth metrics in one NCMD, just after the births
+  EXPECT_EQ(at_once, 0);
+  EXPECT_EQ(n.rebirthsCoalesced(), 150);
+  EXPECT_FALSE(n.rebirthDue(t0 + gap - 1));
+  EXPECT_TRUE(n.rebirthDue(t0 + gap)) << "the held request is done once the interval has passed";
+  EXPECT_FALSE(n.rebirthDue(t0 + gap + 1)) << "... once";
+  n.births({}, t0 + gap);
+  EXPECT_FALSE(n.acceptRebirth(t0 + gap + 1)) << "the new births restart the interval";
+  n.births({}, t0 + gap + 5);  // births for another reason (a new session) answer the held request
+  EXPECT_FALSE(n.rebirthDue(t0 + 3 * gap));
+  EXPECT_TRUE(n.acceptRebirth(t0 + 3 * gap));
+  EXPECT_EQ(n.rebirthsCoalesced(), 151);
 }

@@ -779,8 +779,16 @@ struct Bridge::Impl {
   void onSparkplugMessage(const struct mosquitto_message* m) {
     std::vector<sparkplug::Command> cmds;
     const auto in = sp->onMessage(m->topic, m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
-                                  static_cast<std::size_t>(cfg.max_command_bytes), m->retain, cmds);
+                                  static_cast<std::size_t>(cfg.max_command_bytes), m->retain, cmds, nowMs());
     using In = sparkplug::Node::Inbound;
+    if (in == In::StateIgnored) {
+      std::int64_t suppressed = 0;
+      if (log_limit.allow(kCmdLog, sinceStart(Clock::now()), suppressed))
+        spdlog::warn("Sparkplug: a STATE on {} ignored (not a STATE payload, older than the last one, or stamped "
+                     "more than {} s ahead of this clock: check both clocks); {} so far [{} similar suppressed]",
+                     printable(m->topic), sparkplug::Node::kStateFutureMs / 1000, sp->stateIgnored(), suppressed);
+      return;
+    }
     if (in == In::HostOnline) {
       if (!sp_session) {
         spdlog::info("Sparkplug: primary host '{}' is online", cfg.sp_primary_host_id);
@@ -809,6 +817,16 @@ struct Bridge::Impl {
       std::int64_t suppressed = 0;
       const bool may_log = log_limit.allow(kCmdLog, sinceStart(now), suppressed);
       if (c.what == sparkplug::Command::What::Rebirth) {
+        // Within kRebirthMinMs of the births a request is held and merged
+        // (sparkplug::Node::acceptRebirth): one NCMD may carry 150 Rebirth
+        // metrics, and each birth queues NBIRTH and every DBIRTH.
+        if (!sp->acceptRebirth(nowMs())) {
+          if (may_log)
+            spdlog::info("Sparkplug: rebirth requested (NCMD) less than {} s after the births: held, and done "
+                         "when that interval has passed ({} requests held or merged so far) [{} similar suppressed]",
+                         sparkplug::Node::kRebirthMinMs / 1000.0, sp->rebirthsCoalesced(), suppressed);
+          continue;
+        }
         ++sp_rebirths;
         ++cmd_forwarded;
         if (may_log) spdlog::info("Sparkplug: rebirth requested (NCMD)");
@@ -1036,6 +1054,8 @@ struct Bridge::Impl {
                         {"bdseq", sp->bdSeq()},
                         {"births", sp_births},
                         {"rebirths", sp_rebirths},
+                        {"rebirths_coalesced", sp->rebirthsCoalesced()},
+                        {"state_ignored", sp->stateIgnored()},
                         {"host_offline", sp_host_offline}};
     j["stale_cage"] = {{"marked", stale_marked}, {"dropped", stale_dropped}};
     if (journal)
@@ -1453,6 +1473,10 @@ struct Bridge::Impl {
           if (conn == Conn::Connected) lost(why);
           else if (conn == Conn::Connecting) failed(why);
         }
+      }
+      if (sp && sp_session && sp->rebirthDue(nowMs())) {  // a Rebirth held by acceptRebirth
+        ++sp_rebirths;
+        sparkplugBirths();
       }
       flushJournal();
       flushOutbox();

@@ -44,6 +44,9 @@ std::vector<std::string> Node::subscriptions() const {
 }
 
 std::vector<OutMsg> Node::births(const NodeCounters& c, std::uint64_t now_ms) {
+  births_ms_ = now_ms;
+  born_ = true;
+  rebirth_held_ = false;  // these births answer any held Rebirth
   std::vector<OutMsg> out;
   out.push_back(make(nodeTopic(opt_.group, "NBIRTH", opt_.edge), nodeBirth(bd_seq_ < 0 ? 0 : bd_seq_, opt_.version, c, now_ms),
                      MsgClass::Alarm));
@@ -183,14 +186,31 @@ void Node::deviceCommands(const std::string& device_id, const Payload& p, std::v
   }
 }
 
+bool Node::acceptRebirth(std::uint64_t now_ms) {
+  if (!born_ || now_ms >= births_ms_ + kRebirthMinMs) return true;
+  rebirth_held_ = true;
+  ++rebirths_coalesced_;
+  return false;
+}
+
+bool Node::rebirthDue(std::uint64_t now_ms) {
+  if (!rebirth_held_ || now_ms < births_ms_ + kRebirthMinMs) return false;
+  rebirth_held_ = false;
+  return true;
+}
+
 Node::Inbound Node::onMessage(const std::string& topic, const void* data, std::size_t size, std::size_t max_bytes,
-                              bool retained, std::vector<Command>& out) {
+                              bool retained, std::vector<Command>& out, std::uint64_t now_ms) {
   if (waitsForHost() && topic == stateTopic(opt_.primary_host)) {
     bool online = false;
     std::uint64_t ts = 0;
-    if (!parseState(data, size, online, ts)) return Inbound::StateIgnored;
-    // Sparkplug 3.0: an offline STATE older than the last online one is ignored.
-    if (ts < host_ts_) return Inbound::StateIgnored;
+    // Sparkplug 3.0: an offline STATE older than the last online one is
+    // ignored; so is one from the far future (a forgery would lock the
+    // genuine host out) and anything that is not a STATE.
+    if (!parseState(data, size, online, ts) || ts < host_ts_ || (now_ms > 0 && ts > now_ms + kStateFutureMs)) {
+      ++state_ignored_;
+      return Inbound::StateIgnored;
+    }
     host_ts_ = ts;
     host_online_ = online;
     return online ? Inbound::HostOnline : Inbound::HostOffline;

@@ -86,9 +86,26 @@ class Node {
   // ---- inbound -----------------------------------------------------------------
   enum class Inbound : std::uint8_t { NotOurs, Commands, HostOnline, HostOffline, StateIgnored };
   /// Classifies one received message: NCMD/DCMD (commands appended to `out`),
-  /// or the primary host's STATE.
+  /// or the primary host's STATE.  `now_ms` (wall clock; 0 = unchecked): a
+  /// STATE stamped more than kStateFutureMs after it is ignored -- else one
+  /// forged far-future STATE would make every genuine one "older" until a
+  /// restart.  Every ignored STATE is counted (stateIgnored()).
   Inbound onMessage(const std::string& topic, const void* data, std::size_t size, std::size_t max_bytes,
-                    bool retained, std::vector<Command>& out);
+                    bool retained, std::vector<Command>& out, std::uint64_t now_ms = 0);
+  static constexpr std::uint64_t kStateFutureMs = 600'000;
+  std::int64_t stateIgnored() const { return state_ignored_; }
+  /// A Rebirth request (NCMD) at `now_ms`: true = do the births now.  Within
+  /// kRebirthMinMs of the last births it is held instead (false), and any
+  /// further requests merge into the held one, which rebirthDue() releases
+  /// when the interval has passed: a host that missed the births still gets
+  /// them, and a flood (one NCMD may carry 150 Rebirth metrics, each birth
+  /// queues NBIRTH and every DBIRTH) costs at most two births per interval.
+  /// Held and merged requests are counted (rebirthsCoalesced()).
+  bool acceptRebirth(std::uint64_t now_ms);
+  /// A held Rebirth whose interval has passed: true once (do the births).
+  bool rebirthDue(std::uint64_t now_ms);
+  static constexpr std::uint64_t kRebirthMinMs = 2'000;
+  std::int64_t rebirthsCoalesced() const { return rebirths_coalesced_; }
 
   const NodeOptions& options() const { return opt_; }
 
@@ -101,6 +118,9 @@ class Node {
   unsigned seq_ = 0;
   bool host_online_ = false;
   std::uint64_t host_ts_ = 0;
+  std::uint64_t births_ms_ = 0;  // wall time of the last births()
+  bool born_ = false, rebirth_held_ = false;
+  std::int64_t state_ignored_ = 0, rebirths_coalesced_ = 0;
   NodeCounters last_counters_;
   struct Dev {
     std::string shaft, id;
