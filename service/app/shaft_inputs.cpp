@@ -396,16 +396,26 @@ bool ShaftInputs::decodeSensor(const lcm::ReceiveBuffer* rbuf, Msg& m, const cha
   return false;
 }
 
-bool ShaftInputs::sensorSeqNewer(std::int64_t seq, std::int64_t& last, const char* channel) {
-  // A sequence that goes back (by less than a restart's jump) is an old or replayed sample.
-  if (last >= 0 && seq <= last && seq > last - 1000) {
-    std::snprintf(text_, sizeof text_, "seq %lld not after %lld", static_cast<long long>(seq),
-                  static_cast<long long>(last));
-    rejectSensor(channel, text_);
-    return false;
+bool ShaftInputs::sensorSeqNewer(std::int64_t seq, SensorSequence& sq, const char* channel) {
+  const std::int64_t last = sq.last;
+  switch (sq.next(seq)) {
+    case SensorSequence::Verdict::Accept: return true;
+    case SensorSequence::Verdict::Old:
+      std::snprintf(text_, sizeof text_, "seq %lld not after %lld", static_cast<long long>(seq),
+                    static_cast<long long>(last));
+      rejectSensor(channel, text_);
+      return false;
+    case SensorSequence::Verdict::Restart: {
+      std::int64_t suppressed = 0;
+      if (log_limit_.allow(kLogSensor, ctx_.wallNow(), suppressed))
+        ctx_.log.warn("{}{}: the sequence restarts at seq {} (after {}): a restarted sender, or {} samples in a row "
+                      "behind one that was ahead [{} similar suppressed]",
+                      ctx_.tag, channel, static_cast<long long>(seq), static_cast<long long>(last),
+                      SensorSequence::kResyncAfter, suppressed);
+      return true;
+    }
   }
-  last = seq;
-  return true;
+  return false;
 }
 
 void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {

@@ -90,7 +90,7 @@ class ShaftInputs {
   void rejectSensor(const char* channel, const char* detail);
   template <class Msg>
   bool decodeSensor(const lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel);  // checked decode, or reject
-  bool sensorSeqNewer(std::int64_t seq, std::int64_t& last, const char* channel);  // seq after `last`, or reject
+  bool sensorSeqNewer(std::int64_t seq, SensorSequence& sq, const char* channel);  // SensorSequence, or reject
   void handlerFailed(const char* what, const char* channel);
   void logReject(RejectReason r, const char* detail);
   void rejectPlan(PlanReject r, const char* detail);

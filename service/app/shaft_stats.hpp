@@ -10,6 +10,7 @@
 #include "hoist/service/forecast_rules.hpp"
 #include "hoist/service/health.hpp"
 #include "hoist/service/input_validator.hpp"
+#include "hoist/service/sensor_sequence.hpp"
 
 namespace hoist::svc {
 
@@ -62,7 +63,7 @@ struct ShaftStats {
   std::int64_t plans_accepted = 0;          ///< trip plans accepted
   std::int64_t sensor_accepted = 0;         ///< cage IMU and rope-load samples handed to the estimator
   std::int64_t sensor_rejected = 0;         ///< ... refused (undecodable, implausible, old seq)
-  std::int64_t imu_seq = -1, rope_seq = -1; ///< the last accepted sample's seq of each sensor
+  SensorSequence imu_seq, rope_seq;         ///< each sensor's sequence rule (hoist/service/sensor_sequence.hpp)
   double last_imu_wall = -1.0, last_rope_wall = -1.0;  ///< when (wall clock [s]; < 0: never)
   std::array<std::int64_t, kPlanRejectReasons> plan_rejects{};  ///< trip plans rejected, per reason
 

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "hoist/service/input_validator.hpp"
+#include "hoist/service/sensor_sequence.hpp"
 
 using namespace hoist::svc;
 
@@ -127,4 +128,40 @@ TEST(InputCounters, CountByReason) {
   EXPECT_EQ(c.count(RejectReason::Decode), 2);
   EXPECT_EQ(c.rejectedTotal(), 3);
   EXPECT_STREQ(toString(RejectReason::LengthJump), "length_jump");
+}
+
+// A sensor channel's sequence (HOIST_CAGE_IMU, HOIST_ROPE_LOAD): old samples
+// are rejected; a sender that restarts (a jump back of kRestartJump or more)
+// is followed at once; one forged sample far ahead costs the genuine sender
+// at most kResyncAfter - 1 samples, not the whole gap.
+TEST(SensorSequence, OldRejectedRestartFollowedForgeryBounded) {
+  using V = SensorSequence::Verdict;
+  SensorSequence s;
+  EXPECT_EQ(s.next(10), V::Accept) << "the first sample";
+  EXPECT_EQ(s.next(11), V::Accept);
+  EXPECT_EQ(s.next(11), V::Old) << "a repeat";
+  EXPECT_EQ(s.next(5), V::Old) << "a replayed sample";
+  EXPECT_EQ(s.next(14), V::Accept) << "gaps are fine";
+  EXPECT_EQ(s.next(0), V::Old);
+  s = SensorSequence{};
+  EXPECT_EQ(s.next(5000), V::Accept);
+  EXPECT_EQ(s.next(3), V::Restart) << "the sender restarted";
+  EXPECT_EQ(s.next(4), V::Accept);
+  // One forged sample 500 ahead of the genuine stream (seq 5, 6, ...).
+  EXPECT_EQ(s.next(504), V::Accept);
+  int lost = 0;
+  std::int64_t seq = 5;
+  while (s.next(seq) == V::Old) {
+    ++lost;
+    ++seq;
+    ASSERT_LT(lost, 100) << "the genuine sender stays locked out";
+  }
+  EXPECT_EQ(lost, SensorSequence::kResyncAfter - 1);
+  EXPECT_EQ(s.last, seq);
+  EXPECT_EQ(s.next(seq + 1), V::Accept) << "and is followed from then on";
+  // Isolated old samples in a good stream do not add up to a resync.
+  for (int i = 0; i < 3 * SensorSequence::kResyncAfter; ++i) {
+    EXPECT_EQ(s.next(s.last - 1), V::Old);
+    EXPECT_EQ(s.next(s.last + 1), V::Accept);
+  }
 }
