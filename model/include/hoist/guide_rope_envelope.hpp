@@ -58,9 +58,8 @@ class GuideRopeEnvelope {
   std::int64_t boundedEvaluations() const { return bounded_count_; }
   /// Deferred bounds (wider than the tolerance) since construction.
   std::int64_t deferredEvaluations() const { return deferred_count_; }
-  /// Deferred bounds in a row now (0 after an exact or in-tolerance one),
-  /// and the longest such run since construction.
-  int deferredRun() const { return deferred_run_; }
+  /// The longest run of deferred bounds in a row since construction (a run
+  /// ends at an exact or in-tolerance evaluation).
   int longestDeferral() const { return longest_deferral_; }
   const VectorXd& depths() const { return x_; }
   /// The shapes of the last EXACT evaluation.

@@ -220,13 +220,16 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
       solver_(solver ? std::move(solver) : defaultSolver(cfg)),
       envelope_(solver_->model(), cfg.service.envelope_points),
       envelope_tol_(cfg.service.envelope_tolerance * cfg.alarms.guide_rope_gap),
-      envelope_defer_below_((cfg.alarms.warning_fraction - cfg.alarms.deadband) * cfg.alarms.guide_rope_gap),
       shape_(solver_->model(), cfg.service.shape_points),
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
       range_(validLengthRange(cfg.shaft)),
       bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))) {
   cfg_.service.validate();
+  // Envelope evaluations may be deferred below the GUIDE_ROPE WARNING
+  // alarm's clear level: taken from that alarm's own settings.
+  const AlarmSettings& gw = alarms_.find(AlarmKind::GuideRope, AlarmLevel::Warning)->settings();
+  envelope_defer_below_ = gw.threshold - gw.deadband;
   if (!range_.contains(cfg_.shaft.l0))
     throw std::invalid_argument("hoisting_rope.initial_length: " + std::to_string(cfg_.shaft.l0) +
                                 " m is outside the model's valid range [" + std::to_string(range_.lo) + ", " +
