@@ -40,6 +40,9 @@ required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
 # Its Sparkplug B mode: nanopb's generator (runs at build time; pulls protoc
 # and python3-protobuf) and its library.  Without them: no Sparkplug mode.
 required+=(nanopb libnanopb-dev)
+# The Python module `import hoist` (python/, docs/python.md): pybind11 builds it,
+# numpy holds its arrays, pytest runs tests/python, matplotlib draws the doc's example.
+required+=(pybind11-dev python3-pybind11 python3-dev python3-numpy python3-pytest python3-matplotlib)
 # Java bindings let lcm-spy decode the hoist channels (jchart2d draws its
 # plots; xvfb lets the test open its window headless); clang gives the
 # fuzzers; dpkg-dev gives dpkg-shlibdeps for the .deb (cpack -G DEB);

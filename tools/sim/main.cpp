@@ -49,6 +49,7 @@
 #include "hoist/io/estimator_config.hpp"
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
+#include "hoist/io/sim_run.hpp"
 #include "hoist/scenario.hpp"
 #include "hoist/shaft_model.hpp"
 #include "hoist/plausibility.hpp"
@@ -280,22 +281,18 @@ int run(const Options& o) {
   if (!o.sensor_noise.empty()) noise = parseSensorNoise(o.sensor_noise);
   if (!o.write_measurements.empty() && o.method == "paper")
     throw UsageError("--write-measurements needs the cage's rates, which only --method fast computes");
-  if (o.modes != 0) p.n = o.modes;
-  if (!o.initial.empty() && o.initial != "config") p.initial = o.initial == "rest" ? hoist::InitialState::Rest : hoist::InitialState::Static;
-  if (o.rho_inf >= 0.0) p.rho_inf = o.rho_inf;
-  if (o.method == "paper") {
-    // The paper's method is the paper's literal truncation.
-    if (o.static_correction == "on")
-      throw UsageError("--method paper has no static correction: use --static-correction off (or --method fast)");
-    p.static_correction = false;
-  } else if (!o.static_correction.empty()) {
-    p.static_correction = o.static_correction == "on";
-  }
-  try {
-    p.validate();
-  } catch (const hoist::ParamError& e) {
-    throw UsageError(std::string("invalid parameter (from the command line) ") + e.what());
-  }
+  // The run options -> parameters, end time, in-shaft check and simulator
+  // options: hoist/io/sim_run.hpp, shared with the Python module.
+  hoist::io::SimRunOptions ro;
+  ro.dt = o.dt;
+  ro.max_step = o.max_step;
+  ro.t_end = o.t_end;
+  ro.rho_inf = o.rho_inf;
+  ro.modes = o.modes;
+  ro.initial = o.initial;
+  ro.method = o.method;
+  ro.static_correction = o.static_correction;
+  hoist::io::applySimOverrides(p, ro);
   if (o.print_config) {
     std::cout << hoist::io::toToml(p);
     return 0;
@@ -335,10 +332,7 @@ int run(const Options& o) {
   if (o.out.empty() && o.write_measurements.empty())
     throw UsageError("--out FILE.csv is required (or --write-measurements, or --write-profile / --print-config alone)");
   const double t0 = profile.startTime();
-  if (!std::isfinite(o.t_end)) throw UsageError("--t-end " + num(o.t_end) + ": must be a finite time in seconds");
-  const double t_end = o.t_end < 0 ? profile.endTime() : o.t_end;
-  if (!(t_end > t0))
-    throw UsageError("--t-end " + num(t_end) + ": must be after the profile start (" + num(t0) + " s)");
+  const double t_end = hoist::io::simEndTime(profile, o.t_end);
   // How much output this is, before anything is allocated or written.
   const double steps_d = std::round((t_end - t0) / o.dt);
   const std::string t_end_opt = "--t-end " + num(t_end) + (o.t_end < 0 ? " (the profile's end)" : "");
@@ -346,30 +340,9 @@ int run(const Options& o) {
     throw UsageError(t_end_opt + ": " + num(steps_d) + " output steps at --dt " + num(o.dt) + " s, more than " +
                      num(kMaxOutputSteps) + " (" + bytesText(kMaxOutputSteps * kBytesPerRow) +
                      " of CSV); shorten --t-end or raise --dt");
-  {
-    // Only the part that will be simulated must stay in the shaft.
-    if (t_end + o.dt >= profile.endTime()) {
-      hoist::io::checkProfileInShaft(profile, p, o.profile);
-    } else {
-      std::vector<hoist::ProfileSample> part;
-      for (const auto& s : profile.samples())
-        if (s.t <= t_end + o.dt) part.push_back(s);
-      if (part.size() >= 2) hoist::io::checkProfileInShaft(hoist::HoistProfile(part), p, o.profile);
-      else hoist::io::checkProfileInShaft(profile, p, o.profile);
-    }
-  }
-  hoist::SimulationOptions sim;
-  sim.dt = o.dt;
-  sim.max_step = o.max_step;
-  sim.t_end = t_end;
-  sim.method = o.method == "paper" ? hoist::Method::Paper : hoist::Method::Fast;
-  sim.initial = p.initial;
+  hoist::io::checkSimulatedPartInShaft(profile, p, t_end, o.dt, o.profile);
   int sub = 1;
-  try {
-    sub = hoist::substepsFor(sim);
-  } catch (const std::exception& e) {
-    throw UsageError(std::string("--max-step: ") + e.what());
-  }
+  const hoist::SimulationOptions sim = hoist::io::simulationOptions(ro, p, t_end, sub);
   std::vector<double> shape_times;
   if (!o.shape_out.empty()) {
     shape_times = parseTimes(o.shape_times);
@@ -633,6 +606,9 @@ int main(int argc, char** argv) {
     std::cerr << "hoist-sim: error: " << e.what() << "\n";
     return 2;
   } catch (const UsageError& e) {
+    std::cerr << "hoist-sim: error: " << e.what() << "\n";
+    return 2;
+  } catch (const hoist::io::OptionError& e) {
     std::cerr << "hoist-sim: error: " << e.what() << "\n";
     return 2;
   } catch (const hoist::io::WriteError& e) {

@@ -1,0 +1,168 @@
+"""hoist -- hoist-twin's shaft model, simulator and load estimator from Python.
+
+The same code as the programs (hoist-sim, hoist-estimate), with numpy arrays
+in and out and batch runs on C++ threads with the GIL released::
+
+    import hoist
+    cfg = hoist.Config.from_file("shaft.toml")       # or hoist.Config.paper()
+    cfg.set("load.eccentric_force", 1500.0)
+    r = hoist.simulate(cfg, profile="paper", t_end=20.0)
+    r["theta"].max()                                  # numpy arrays, hoist-sim's CSV columns
+
+    runs = hoist.simulate_batch([cfg.copy().set("guide_ropes.preload", [T, T])
+                                 for T in (2e4, 3e4, 4e4)], threads=2)
+
+See docs/python.md for the worked example and every function's contract.
+"""
+from collections.abc import Mapping as _Mapping
+import os as _os
+
+from . import _hoist
+from ._hoist import (Config, InputError, ConfigError, ProfileError, MeasurementError,  # noqa: F401
+                     RunError, __version__)
+
+__all__ = ["Config", "Result", "simulate", "simulate_batch", "InputError", "ConfigError",
+           "ProfileError", "MeasurementError", "RunError", "__version__"]
+
+
+class Result(_Mapping):
+    """The rows of a run: a read-only mapping from column name to a 1-d numpy array.
+
+    ``r["theta"]``, ``r.columns`` (the names in the programs' CSV order),
+    ``len(r)`` (number of columns), ``r.rows`` (number of rows), ``r.to_pandas()``.
+    A simulation's Result also has ``r.shapes`` (a Result with hoist-sim's
+    shape columns t, x, y1, y2, or None) and ``r.info`` (the run's modes,
+    substeps, initial state and static correction).  The arrays own their
+    memory (no per-element copies); they are writable, so copy before changing.
+    """
+
+    def __init__(self, columns, shapes=None, info=None):
+        self._data = dict(columns)
+        self.shapes = Result(shapes) if shapes is not None else None
+        self.info = dict(info or {})
+
+    def __getitem__(self, name):
+        try:
+            return self._data[name]
+        except KeyError:
+            raise KeyError(f"{name!r}: no such column; columns: {', '.join(self._data)}") from None
+
+    def __iter__(self):
+        return iter(self._data)
+
+    def __len__(self):
+        return len(self._data)
+
+    @property
+    def columns(self):
+        """The column names, in the programs' CSV order."""
+        return list(self._data)
+
+    @property
+    def rows(self):
+        """The number of rows (0 for no columns)."""
+        return len(next(iter(self._data.values()))) if self._data else 0
+
+    def to_pandas(self):
+        """The columns as a pandas.DataFrame (needs pandas)."""
+        try:
+            import pandas
+        except ImportError as e:
+            raise ImportError("Result.to_pandas() needs pandas (apt-get install python3-pandas)") from e
+        return pandas.DataFrame(self._data, columns=self.columns)
+
+    def __repr__(self):
+        return f"Result({self.rows} rows: {', '.join(self._data)})"
+
+
+def _check_profile(profile):
+    return _os.fspath(profile) if isinstance(profile, _os.PathLike) else profile
+
+
+def simulate(cfg, profile="paper", *, dt=0.01, max_step=0.0025, t_end=None, modes=None, initial=None,
+             method="fast", static_correction=None, rho_inf=None, shape_times=(), shape_points=401,
+             progress=None):
+    """Run the shaft model over a hoist profile: hoist-sim from Python.
+
+    Parameters are hoist-sim's options (same defaults, same checks, same
+    numbers to the last bit):
+
+    cfg : Config
+        The shaft (Config.paper(), Config.from_file(path), ...).
+    profile : str, os.PathLike, (t, v, a[, l]) or {"t":..., "v":..., "a":...[, "l":...]}
+        A SPEC ("paper", "trapezoid:vmax=5,travel=250", "scurve:...", "estop:...",
+        "rest:t_end=60"), a profile CSV path, or numpy arrays [s, m/s, m/s^2, m];
+        without l, l is integrated from v starting at hoisting_rope.initial_length.
+        Arrays are checked as a CSV would be (hoist.ProfileError names the row:
+        line = index + 2).
+    dt : float
+        Output step [s], in [1e-6, 1].
+    max_step : float
+        Largest integration step [s] (each dt is split into equal substeps); 0: dt.
+    t_end : float or None
+        End time [s]; None: the profile's end.
+    modes : int or None
+        Assumed modes per rope (overrides model.modes).
+    initial : "static", "rest", "config" or None
+        Initial state (None/"config": the config's model.initial).
+    method : "fast" or "paper"
+        The structured KKT solver, or the paper's literal partition.
+    static_correction : bool, "on", "off" or None
+        Residual guide-rope flexibility (None: the config's; method="paper" needs off).
+    rho_inf : float or None
+        Generalized-alpha spectral radius (overrides model.rho_inf).
+    shape_times : sequence of float
+        Times [s] at which the guide-rope shapes are taken (hoist-sim --shape-times).
+    shape_points : int
+        Depth samples per shape.
+    progress : callable(fraction) or None
+        Called about every 50 ms from the calling thread.
+
+    Returns
+    -------
+    Result
+        hoist-sim's CSV columns t, l, v, a, x_c, y_c, theta, lambda_0..lambda_4;
+        r.shapes (t, x, y1, y2) when shape_times is given; r.info.
+
+    Raises
+    ------
+    ConfigError, ProfileError (InputError, a ValueError: .source, .line, .key),
+    ValueError (an option, named), RunError (the state became non-finite or
+    implausible: the message names the time and the quantity),
+    KeyboardInterrupt (Ctrl-C stops the run).
+
+    The GIL is released while the model runs.
+    """
+    cols, shapes, info = _hoist._simulate(cfg, _check_profile(profile), dt, max_step, t_end, modes,
+                                          initial or "", method, static_correction, rho_inf,
+                                          list(shape_times), shape_points, progress)
+    return Result(cols, shapes, info)
+
+
+def simulate_batch(configs, profile="paper", *, threads=0, progress=None, dt=0.01, max_step=0.0025,
+                   t_end=None, modes=None, initial=None, method="fast", static_correction=None,
+                   rho_inf=None, shape_times=(), shape_points=401):
+    """Run simulate() for every configuration, on C++ threads with the GIL released.
+
+    configs : sequence of Config
+        One run each, all with the same profile and options (those of simulate()).
+    threads : int
+        Worker threads; 0 (default): one per hardware thread.
+    progress : callable(done, total) or None
+        Called from the calling thread whenever runs have finished.
+
+    Returns the list of Results, in the order of `configs`.
+
+    One failing configuration cancels the others and raises its error (the
+    first by index), with the message starting "simulate_batch: configs[i]:"
+    and the attribute .index = i; no result is returned.  Ctrl-C stops every
+    run and raises KeyboardInterrupt; every thread has ended when it does.
+    """
+    configs = list(configs)
+    for i, c in enumerate(configs):
+        if not isinstance(c, Config):
+            raise TypeError(f"simulate_batch: configs[{i}] is a {type(c).__name__}, not a hoist.Config")
+    out = _hoist._simulate_batch(configs, _check_profile(profile), threads, progress, dt, max_step, t_end,
+                                 modes, initial or "", method, static_correction, rho_inf,
+                                 list(shape_times), shape_points)
+    return [Result(c, s, i) for c, s, i in out]

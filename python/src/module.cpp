@@ -1,0 +1,18 @@
+// hoist._hoist: the C++ half of the Python package `hoist` (issue 34,
+// docs/python.md).  The public API, its docstrings and the Result type are in
+// python/hoist/__init__.py; this module gives Config, the exceptions and the
+// runs (_simulate, _simulate_batch, _estimate).
+#include <pybind11/pybind11.h>
+
+#include "config_py.hpp"
+#include "errors.hpp"
+#include "hoist/version.hpp"
+#include "simulate_py.hpp"
+
+PYBIND11_MODULE(_hoist, m) {
+  m.doc() = "hoist-twin's model and tools from Python (the C++ half; use the package `hoist`).";
+  m.attr("__version__") = hoist::kVersionString;
+  hoist::python::bindErrors(m);
+  hoist::python::bindConfig(m);
+  hoist::python::bindSimulate(m);
+}
