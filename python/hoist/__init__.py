@@ -19,9 +19,9 @@ import os as _os
 
 from . import _hoist
 from ._hoist import (Config, InputError, ConfigError, ProfileError, MeasurementError,  # noqa: F401
-                     RunError, __version__)
+                     RunError, __version__, ESTIMATE_COLUMNS)
 
-__all__ = ["Config", "Result", "simulate", "simulate_batch", "InputError", "ConfigError",
+__all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "InputError", "ConfigError",
            "ProfileError", "MeasurementError", "RunError", "__version__"]
 
 
@@ -166,3 +166,30 @@ def simulate_batch(configs, profile="paper", *, threads=0, progress=None, dt=0.0
                                  modes, initial or "", method, static_correction, rho_inf,
                                  list(shape_times), shape_points)
     return [Result(c, s, i) for c, s, i in out]
+
+
+def estimate(cfg, measurements, *, modes=None, max_step=None, progress=None):
+    """Estimate the eccentric load from recorded data: hoist-estimate from Python.
+
+    cfg : Config
+        The twin's shaft and its [sensors]/[estimator] settings (a daemon
+        configuration read with Config.from_file keeps them).
+    measurements : str, os.PathLike or dict of arrays
+        hoist-estimate's measurement CSV (t,l,v,a[,f_y,omega,rope_load]), or a
+        dict with those column names; a nan in a sensor column is a row without
+        that sample (an empty CSV field).  Checked as the CSV is
+        (hoist.MeasurementError names the column and the line = index + 2).
+    modes : int or None
+        Assumed modes per rope (overrides model.modes; hoist-estimate --modes).
+    max_step : float or None
+        Largest integration step [s]; None: the config's [service] max_step,
+        else 0.0025 s (hoist-estimate --max-step).
+    progress : callable(fraction) or None
+
+    Returns a Result with hoist-estimate's output columns (ESTIMATE_COLUMNS),
+    one row per measurement row, the same numbers as hoist-estimate writes; a
+    value not observed (its sensor not seen yet) is nan with its sigma; the
+    flags and counters are floats (0.0/1.0, counts).  The GIL is released.
+    """
+    cols = _hoist._estimate(cfg, _check_profile(measurements), modes, max_step, progress)
+    return Result(cols)

@@ -7,6 +7,7 @@
 #include "config_py.hpp"
 #include "errors.hpp"
 #include "hoist/version.hpp"
+#include "estimate_py.hpp"
 #include "simulate_py.hpp"
 
 PYBIND11_MODULE(_hoist, m) {
@@ -15,4 +16,5 @@ PYBIND11_MODULE(_hoist, m) {
   hoist::python::bindErrors(m);
   hoist::python::bindConfig(m);
   hoist::python::bindSimulate(m);
+  hoist::python::bindEstimate(m);
 }

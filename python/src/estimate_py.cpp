@@ -1,0 +1,190 @@
+// hoist._hoist._estimate: hoist-estimate from Python (the wrapper with the
+// docstring: python/hoist/__init__.py).  The input checks and the NIS-window
+// sizing are hoist-estimate's (tools/estimate/main.cpp) so that both give the
+// same numbers; the columns are its output columns, in its order, with nan for
+// a value not observed (the test compares both on the same files).
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <optional>
+#include <sstream>
+
+#include <pybind11/stl.h>
+
+#include "arrays.hpp"
+#include "config_py.hpp"
+#include "errors.hpp"
+#include "estimate_py.hpp"
+#include "hoist/io/profile.hpp"
+#include "hoist/io/sim_run.hpp"
+#include "hoist/load_estimator.hpp"
+#include "tasks.hpp"
+
+namespace py = pybind11;
+
+namespace hoist::python {
+
+namespace {
+
+struct Cell {
+  const char* name;
+  std::function<double(const LoadEstimate&, const EstimatorCounters&)> get;
+};
+
+/// nan unless observed (hoist-estimate's rule: seen and sigma >= 0).
+double obs(double v, double sigma, bool seen) { return seen && sigma >= 0.0 ? v : std::nan(""); }
+
+const std::vector<Cell>& cells() {
+  using E = LoadEstimate;
+  using C = EstimatorCounters;
+  static const std::vector<Cell> c = {
+      {"t", [](const E& e, const C&) { return e.t; }},
+      {"l", [](const E& e, const C&) { return e.kin.l; }},
+      {"Fa", [](const E& e, const C&) { return obs(e.Fa, e.sigma_Fa, e.fa_observed); }},
+      {"b", [](const E& e, const C&) { return obs(e.b, e.sigma_b, e.fa_observed && e.moment_observed); }},
+      {"moment", [](const E& e, const C&) { return obs(e.moment, e.sigma_moment, e.moment_observed); }},
+      {"sigma_Fa", [](const E& e, const C&) { return obs(e.sigma_Fa, e.sigma_Fa, e.fa_observed); }},
+      {"sigma_moment", [](const E& e, const C&) { return obs(e.sigma_moment, e.sigma_moment, e.moment_observed); }},
+      {"y_c", [](const E& e, const C&) { return e.y_c; }},
+      {"theta", [](const E& e, const C&) { return e.theta; }},
+      {"sigma_y_c", [](const E& e, const C&) { return e.sigma_y_c; }},
+      {"sigma_theta", [](const E& e, const C&) { return e.sigma_theta; }},
+      {"lambda_0", [](const E& e, const C&) { return e.lambda[0]; }},
+      {"lambda_1", [](const E& e, const C&) { return e.lambda[1]; }},
+      {"lambda_2", [](const E& e, const C&) { return e.lambda[2]; }},
+      {"lambda_3", [](const E& e, const C&) { return e.lambda[3]; }},
+      {"lambda_4", [](const E& e, const C&) { return e.lambda[4]; }},
+      {"nis", [](const E& e, const C&) { return e.nis; }},
+      {"nis_window", [](const E& e, const C&) { return e.nis_window; }},
+      {"mismatch", [](const E& e, const C&) { return e.mismatch ? 1.0 : 0.0; }},
+      {"sigma_b", [](const E& e, const C&) { return obs(e.sigma_b, e.sigma_b, e.fa_observed && e.moment_observed); }},
+      {"x_c", [](const E& e, const C&) { return e.x_c; }},
+      {"sigma_x_c", [](const E& e, const C&) { return e.sigma_x_c; }},
+      {"sigma_lambda_0", [](const E& e, const C&) { return e.sigma_lambda[0]; }},
+      {"sigma_lambda_1", [](const E& e, const C&) { return e.sigma_lambda[1]; }},
+      {"sigma_lambda_2", [](const E& e, const C&) { return e.sigma_lambda[2]; }},
+      {"sigma_lambda_3", [](const E& e, const C&) { return e.sigma_lambda[3]; }},
+      {"sigma_lambda_4", [](const E& e, const C&) { return e.sigma_lambda[4]; }},
+      {"theta_open", [](const E& e, const C&) { return e.theta_open; }},
+      {"nis_dof", [](const E& e, const C&) { return static_cast<double>(e.nis_dof); }},
+      {"nis_lower", [](const E& e, const C&) { return e.nis_lower; }},
+      {"nis_upper", [](const E& e, const C&) { return e.nis_upper; }},
+      {"nis_bound", [](const E& e, const C&) { return e.nis_bound; }},
+      {"drift", [](const E& e, const C&) { return e.drift; }},
+      {"nis_exceeded", [](const E& e, const C&) { return e.nis_exceeded ? 1.0 : 0.0; }},
+      {"drift_exceeded", [](const E& e, const C&) { return e.drift_exceeded ? 1.0 : 0.0; }},
+      {"sensors", [](const E& e, const C&) { return static_cast<double>(e.sensors); }},
+      {"fa_observed", [](const E& e, const C&) { return e.fa_observed ? 1.0 : 0.0; }},
+      {"moment_observed", [](const E& e, const C&) { return e.moment_observed ? 1.0 : 0.0; }},
+      {"accepted", [](const E&, const C& c) { return static_cast<double>(c.accepted); }},
+      {"gated", [](const E&, const C& c) { return static_cast<double>(c.gated); }},
+      {"load_changes", [](const E&, const C& c) { return static_cast<double>(c.load_changes); }},
+      {"implausible", [](const E&, const C& c) { return static_cast<double>(c.implausible); }},
+  };
+  return c;
+}
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+py::dict estimate(const Config& cfg, const py::object& measurements, std::optional<int> modes,
+                  std::optional<double> max_step_opt, const py::object& progress) {
+  ShaftParams p = cfg.params;
+  const io::EstimatorConfig ec = cfg.estimator();
+  if (max_step_opt && !(*max_step_opt >= 0.0 && *max_step_opt <= 10.0))
+    throw py::value_error("max_step: " + fmt(*max_step_opt) + " is not in [0, 10]");
+  const double max_step = max_step_opt ? *max_step_opt : cfg.serviceMaxStep();
+  if (modes) {
+    if (*modes < 1 || *modes > kMaxModes)
+      throw py::value_error("modes: " + std::to_string(*modes) + " is not in [1, " + std::to_string(kMaxModes) + "]");
+    p.n = *modes;
+  }
+  // Measurements: a CSV path, or named arrays written as that CSV (same reader, same checks).
+  std::vector<MeasurementSample> samples;
+  std::string source;
+  const py::module_ os = py::module_::import("os");
+  if (py::isinstance<py::str>(measurements) || py::isinstance(measurements, os.attr("PathLike"))) {
+    source = py::str(os.attr("fspath")(measurements));
+    samples = io::readMeasurementsCsvFile(source);
+  } else if (py::isinstance<py::dict>(measurements)) {
+    std::vector<std::string> names;
+    std::vector<py::object> arrays;
+    for (const auto& [k, v] : measurements.cast<py::dict>()) {
+      names.push_back(py::str(k));
+      arrays.push_back(py::reinterpret_borrow<py::object>(v));
+    }
+    source = "<measurement arrays>";
+    std::istringstream in(columnsCsv(names, arrays, "measurements"));
+    samples = io::readMeasurementsCsv(in, source);
+  } else {
+    throw py::type_error("measurements: expected a CSV path or a dict of arrays (t, l, v, a[, f_y, omega, rope_load])");
+  }
+  {
+    std::vector<ProfileSample> ps(samples.size());
+    for (std::size_t i = 0; i < samples.size(); ++i) ps[i] = {samples[i].t, samples[i].k};
+    io::checkProfileInShaft(HoistProfile(std::move(ps)), p, source);
+  }
+  // The NIS window holds one entry per sample: sized for the data's rate, as hoist-estimate does.
+  EstimatorSettings set = ec.settings;
+  double min_dt = samples[1].t - samples[0].t;
+  for (std::size_t i = 2; i < samples.size(); ++i) min_dt = std::min(min_dt, samples[i].t - samples[i - 1].t);
+  const double rate = std::ceil(1.0 / min_dt - 1e-9);
+  if (rate > set.max_rate) {
+    if (rate > 100000.0 || set.nis_window * rate > 5.0e6)
+      throw py::value_error("measurements " + source + ": rows as close as " + fmt(min_dt) + " s apart (" + fmt(rate) +
+                            " Hz) are too fast for estimator.nis_window = " + fmt(set.nis_window) +
+                            " s (at most 5e6 window entries, 100 kHz)");
+    set.max_rate = static_cast<int>(rate);
+  }
+  try {
+    for (std::size_t i = 1; i < samples.size(); ++i) substepCount(samples[i].t - samples[i - 1].t, max_step);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error("max_step " + fmt(max_step) + ": " + e.what());
+  }
+
+  const auto& cs = cells();
+  std::vector<std::vector<double>> cols(cs.size());
+  for (auto& c : cols) c.reserve(samples.size());
+  std::atomic<double> fraction{0.0};
+  struct Stop {};
+  const TaskOutcome out = runTasks(
+      1, 1,
+      [&](std::size_t, const std::atomic<bool>& cancel) {
+        try {
+          estimateRecorded(
+              p, set, max_step, samples,
+              [&](const LoadEstimate& e, const EstimatorCounters& c) {
+                if (cancel.load(std::memory_order_relaxed)) throw Stop{};
+                for (std::size_t k = 0; k < cs.size(); ++k) cols[k].push_back(cs[k].get(e, c));
+              },
+              [&](double f) { fraction.store(f); });
+        } catch (const std::domain_error& e) {
+          throw RunError(std::string("the model left its domain: ") + e.what());
+        } catch (const Stop&) {
+        }
+      },
+      [&](std::size_t) {
+        if (!progress.is_none()) progress(fraction.load());
+      });
+  if (out.errors[0]) raise(out.errors[0]);
+  py::dict d;
+  for (std::size_t k = 0; k < cs.size(); ++k) d[cs[k].name] = toNumpy(std::move(cols[k]));
+  return d;
+}
+
+}  // namespace
+
+void bindEstimate(py::module_& m) {
+  m.def("_estimate", &estimate, py::arg("cfg"), py::arg("measurements"), py::arg("modes"), py::arg("max_step"),
+        py::arg("progress"));
+  py::list names;
+  for (const auto& c : cells()) names.append(c.name);
+  m.attr("ESTIMATE_COLUMNS") = names;
+}
+
+}  // namespace hoist::python
