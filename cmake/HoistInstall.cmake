@@ -22,6 +22,7 @@
 #   P/share/java/hoist_msgs.jar the Java message classes (lcm-spy, Java clients)
 #   P/share/doc/hoist-twin/     README, CHANGELOG, docs/, examples (demo.toml, read_twin.py)
 #   P/share/hoist-twin/dash/web the dashboard's web files, when tools/dash/web exists
+#   P/lib/python3/dist-packages/hoist  the Python module (python/CMakeLists.txt), when HOIST_PYTHON
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -205,6 +206,10 @@ set(CPACK_DEBIAN_PACKAGE_SECTION "science")
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)  # Depends: from the programs' shared libraries (dpkg-shlibdeps)
 # lcm-spy (hoist-lcm-spy) needs a JRE and the two jars; find_package(hoist) the -dev packages.
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "liblcm-java, libjchart2d-java, default-jre-headless | java-runtime-headless")
+if(HOIST_PYTHON)
+  # import hoist (python/): the system's python3 and numpy.
+  string(APPEND CPACK_DEBIAN_PACKAGE_RECOMMENDS ", python3, python3-numpy")
+endif()
 set(CPACK_DEBIAN_PACKAGE_SUGGESTS
     "liblcm-dev, libeigen3-dev, libtomlplusplus-dev, pkg-config, liblcm-bin, python3")
 set(CPACK_DEBIAN_PACKAGE_HOMEPAGE "https://example.invalid/hoist-twin")

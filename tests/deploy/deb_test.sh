@@ -95,6 +95,15 @@ if command -v readelf >/dev/null 2>&1; then
 fi
 grep -q "^ExecStart=/usr/bin/hoist-twind" "$work/root/usr/lib/systemd/system/hoist-twind@.service" ||
   fail "the packaged unit does not run /usr/bin/hoist-twind"
+# The Python module (python/, when built): in the system python3's dist-packages, importable and running.
+if ls "$build"/python/hoist/_hoist*.so >/dev/null 2>&1; then
+  grep -q " ./usr/lib/python3/dist-packages/hoist/__init__.py\$" "$work/contents.txt" || fail "hoist/__init__.py missing"
+  grep -q " ./usr/lib/python3/dist-packages/hoist/_hoist.*\.so\$" "$work/contents.txt" || fail "the hoist extension is missing"
+  PYTHONPATH="$work/root/usr/lib/python3/dist-packages" /usr/bin/python3 -c \
+    "import hoist; assert hoist.simulate(hoist.Config.paper(), t_end=1.0, modes=4).rows == 101" ||
+    fail "the packaged Python module does not import and run"
+  echo "ok: import hoist from the package"
+fi
 if command -v apt-get >/dev/null 2>&1; then
   apt-get install --simulate --no-install-recommends "$deb" >"$work/apt.log" 2>&1 ||
     { cat "$work/apt.log"; fail "apt-get cannot resolve the package's dependencies"; }
