@@ -56,15 +56,21 @@ void splitKey(const std::string& key, std::string& section, std::string& name, i
 
 /// A Python value as a TOML node; the readers then check its type as they check a file's.
 std::unique_ptr<toml::node> toNode(const py::handle& v, const std::string& key) {
-  if (py::isinstance<py::bool_>(v)) return std::make_unique<toml::value<bool>>(v.cast<bool>());
-  if (py::isinstance<py::int_>(v) || (py::hasattr(v, "__index__") && !py::isinstance<py::float_>(v)))
-    return std::make_unique<toml::value<int64_t>>(py::int_(py::reinterpret_borrow<py::object>(v)).cast<int64_t>());
-  if (py::isinstance<py::float_>(v) || py::hasattr(v, "__float__"))
-    return std::make_unique<toml::value<double>>(py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>());
+  const auto obj = py::reinterpret_borrow<py::object>(v);
+  if (py::isinstance<py::bool_>(v) || py::type::of(v).attr("__name__").cast<std::string>() == "bool_")
+    return std::make_unique<toml::value<bool>>(v.cast<bool>());
   if (py::isinstance<py::str>(v)) return std::make_unique<toml::value<std::string>>(v.cast<std::string>());
-  if (py::isinstance<py::sequence>(v)) {
+  // numpy scalars count as the Python numbers they stand for (int64 -> integer, float64 -> float).
+  const bool is_seq = py::isinstance<py::sequence>(v) || py::hasattr(v, "tolist");
+  const bool scalar = !is_seq || (py::hasattr(v, "ndim") && obj.attr("ndim").cast<int>() == 0);
+  if (scalar && (py::isinstance<py::int_>(v) || (py::hasattr(v, "__index__") && !py::isinstance<py::float_>(v))))
+    return std::make_unique<toml::value<int64_t>>(py::int_(obj).cast<int64_t>());
+  if (scalar && (py::isinstance<py::float_>(v) || py::hasattr(v, "__float__")))
+    return std::make_unique<toml::value<double>>(py::float_(obj).cast<double>());
+  if (is_seq) {
+    const py::object items = py::hasattr(v, "tolist") ? obj.attr("tolist")() : obj;
     auto arr = std::make_unique<toml::array>();
-    for (const auto& e : py::reinterpret_borrow<py::sequence>(v)) {
+    for (const auto& e : items) {
       auto n = toNode(e, key);
       n->visit([&](auto&& x) { arr->push_back(std::move(x)); });
     }
@@ -179,15 +185,21 @@ py::object getValue(const Config& c, const std::string& key) {
   throw py::key_error("Config.get: " + key + ": unknown key" + (near.empty() ? "" : " (did you mean '" + near + "'?)"));
 }
 
-/// The whole configuration as TOML: the shaft (every key) and the file's other sections.
-std::string toTomlText(const Config& c) {
-  std::string out = io::toToml(c.params);
+/// The sections of the table that are not the shaft's ([service], [estimator], ...).
+toml::table otherSections(const toml::table& tbl) {
   toml::table rest;
-  for (const auto& [k, n] : c.tbl) {
+  for (const auto& [k, n] : tbl) {
     bool shaft = false;
     for (auto s : kParamSections) shaft = shaft || k.str() == s;
     if (!shaft) rest.insert(k, n);
   }
+  return rest;
+}
+
+/// The whole configuration as TOML: the shaft (every key) and the file's other sections.
+std::string toTomlText(const Config& c) {
+  std::string out = io::toToml(c.params);
+  const toml::table rest = otherSections(c.tbl);
   if (!rest.empty()) {
     std::ostringstream os;
     os << rest;
@@ -219,7 +231,9 @@ void bindConfig(py::module_& m) {
       .def("copy", [](const Config& c) { return c; }, "An independent copy.")
       .def("__copy__", [](const Config& c) { return c; })
       .def("__deepcopy__", [](const Config& c, py::dict) { return c; }, py::arg("memo"))
-      .def("__eq__", [](const Config& a, const Config& b) { return a.params == b.params && a.tbl == b.tbl; })
+      .def("__eq__", [](const Config& a, const Config& b) {
+             return a.params == b.params && otherSections(a.tbl) == otherSections(b.tbl);
+           }, py::is_operator(), "Same shaft and the same other sections (the source is not compared).")
       .def_readonly("source", &Config::source, "Where the configuration came from.")
       .def_static("keys",
                   [] {

@@ -63,6 +63,8 @@ void raise(std::exception_ptr e, const std::string& prefix, long index) {
     setError(PyExc_MemoryError, prefix + "out of memory", nullptr, index);
   } catch (const std::exception& x) {
     setError(g_run, prefix + x.what(), nullptr, index);
+  } catch (...) {
+    setError(g_run, prefix + "unexpected failure (not a std::exception)", nullptr, index);
   }
 }
 

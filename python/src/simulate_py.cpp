@@ -112,7 +112,13 @@ py::tuple simulateOne(const Config& cfg, const py::object& profile, double dt, d
   std::atomic<long> steps{0};
   std::optional<RunResult> result;
   const TaskOutcome out = runTasks(
-      1, 1, [&](std::size_t, const std::atomic<bool>& cancel) { result = runSimulation(spec, src, cancel, &steps); },
+      1, 1, [&](std::size_t, const std::atomic<bool>& cancel) {
+        try {
+          result = runSimulation(spec, src, cancel, &steps);
+        } catch (const Cancelled&) {
+          // Only Ctrl-C or a raising progress cancels a single run: runTasks raises that.
+        }
+      },
       [&](std::size_t) {
         if (!progress.is_none()) progress(std::min(1.0, static_cast<double>(steps.load()) / static_cast<double>(rows)));
       });
@@ -138,7 +144,13 @@ py::list simulateBatch(const std::vector<const Config*>& configs, const py::obje
   std::size_t last_done = static_cast<std::size_t>(-1);
   const TaskOutcome out = runTasks(
       specs.size(), threads,
-      [&](std::size_t i, const std::atomic<bool>& cancel) { results[i] = runSimulation(specs[i], src, cancel); },
+      [&](std::size_t i, const std::atomic<bool>& cancel) {
+        try {
+          results[i] = runSimulation(specs[i], src, cancel);
+        } catch (const Cancelled&) {
+          // Stopped because another run failed (or Ctrl-C): that one is reported.
+        }
+      },
       [&](std::size_t done) {
         if (progress.is_none() || done == last_done) return;
         last_done = done;
