@@ -33,7 +33,7 @@ def test_batch_equals_single_runs_in_order():
 
 def test_one_bad_configuration_raises_naming_it_and_returns_nothing():
     cfgs = preload_sweep(5)
-    cfgs[3] = cfgs[3].copy().set("hoisting_rope.initial_length", 200.0)  # the paper trip leaves the shaft
+    cfgs[3] = cfgs[3].copy().set("hoisting_rope.initial_length", 383.5)  # the trip leaves the shaft at 1.5 s
     with pytest.raises(hoist.ProfileError) as e:
         hoist.simulate_batch(cfgs, "paper", threads=2, **FAST)
     assert e.value.index == 3

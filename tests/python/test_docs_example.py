@@ -24,7 +24,9 @@ def test_worked_example_runs(tmp_path, hoist_sim):
     run([hoist_sim, "--config", truth, "--profile", "paper", "--t-end", "20",
          "--write-measurements", tmp_path / "trip.csv", "-q"])
     (tmp_path / "example.py").write_text(example_code())
-    env = dict(os.environ, MPLBACKEND="Agg")
+    import hoist
+    # The hoist under test, whatever the cwd (PYTHONPATH may be relative).
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONPATH=os.path.dirname(os.path.dirname(hoist.__file__)))
     p = subprocess.run([sys.executable, "example.py"], cwd=tmp_path, capture_output=True, text=True, env=env,
                        timeout=240)
     assert p.returncode == 0, p.stdout + p.stderr
