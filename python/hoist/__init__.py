@@ -21,7 +21,7 @@ from . import _hoist
 from ._hoist import (Config, InputError, ConfigError, ProfileError, MeasurementError,  # noqa: F401
                      RunError, __version__, ESTIMATE_COLUMNS)
 
-__all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "InputError", "ConfigError",
+__all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "read_log", "InputError", "ConfigError",
            "ProfileError", "MeasurementError", "RunError", "__version__"]
 
 
@@ -193,3 +193,67 @@ def estimate(cfg, measurements, *, modes=None, max_step=None, progress=None):
     """
     cols = _hoist._estimate(cfg, _check_profile(measurements), modes, max_step, progress)
     return Result(cols)
+
+
+def _log2csv_program():
+    """hoist-log2csv: $HOIST_LOG2CSV, the build tree's (build/bin next to build/python), else the PATH's."""
+    import shutil
+    env = _os.environ.get("HOIST_LOG2CSV")
+    if env:
+        return env
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    built = _os.path.join(here, "..", "..", "bin", "hoist-log2csv")
+    if _os.access(built, _os.X_OK):
+        return _os.path.normpath(built)
+    found = shutil.which("hoist-log2csv")
+    if not found:
+        raise FileNotFoundError("read_log needs the program hoist-log2csv (package hoist-twin, or set HOIST_LOG2CSV)")
+    return found
+
+
+def _read_csv_columns(path):
+    import csv
+    import numpy as np
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        return {}
+    header, body = rows[0], rows[1:]
+    cols = {}
+    for k, name in enumerate(header):
+        values = [r[k] if k < len(r) else "" for r in body]
+        try:
+            cols[name] = np.array([float(v) if v != "" else np.nan for v in values], dtype=np.float64)
+        except ValueError:
+            cols[name] = np.array(values, dtype=object)  # names: alarm levels, events, scenario names
+    return cols
+
+
+def read_log(path, *, lenient=False):
+    """Read an LCM log (lcm-logger's file) into arrays per channel: hoist-log2csv from Python.
+
+    path : str or os.PathLike
+        The log file.
+    lenient : bool
+        hoist-log2csv --lenient (skip what it would refuse).
+
+    Returns a dict from CSV name (the channel, e.g. "HOIST_CAGE_STATE"; a
+    channel whose type changes midway also gives "CHANNEL.<type>", a forecast
+    channel "CHANNEL.series") to a Result with hoist-log2csv's columns (float64
+    arrays; text columns such as alarm levels as object arrays).
+
+    The log is decoded by hoist-log2csv itself (the project's one validating
+    reader and codec), found as $HOIST_LOG2CSV, next to the build tree, or on
+    PATH; its error (exit status 2) is raised as hoist.InputError naming the file.
+    """
+    import subprocess
+    import tempfile
+    path = _os.fspath(path)
+    with tempfile.TemporaryDirectory(prefix="hoist-read-log-") as out:
+        cmd = [_log2csv_program(), path, "--out-dir", out] + (["--lenient"] if lenient else [])
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        if p.returncode != 0:
+            msg = p.stderr.strip() or f"hoist-log2csv exited {p.returncode}"
+            raise (InputError if p.returncode == 2 else RunError)(msg)
+        return {name[:-4]: Result(_read_csv_columns(_os.path.join(out, name)))
+                for name in sorted(_os.listdir(out)) if name.endswith(".csv")}
