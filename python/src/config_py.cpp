@@ -218,16 +218,43 @@ void bindConfig(py::module_& m) {
       .def_static("paper", [] { return makeConfig(toml::table{}, "<paper>"); },
                   "The paper's shaft (Wang et al. 2016, Section 3): every key at its default.")
       .def_static("from_file", [](const std::string& path) { return makeConfig(io::loadTomlFile(path), path); },
-                  py::arg("path"), "Read a shaft TOML (or hoist-twind's configuration).")
+                  py::arg("path"), "from_file(path) -> Config\n\n"
+                  "Read a shaft TOML or hoist-twind's configuration, exactly as hoist-sim and hoist-estimate\n"
+                  "do: missing keys take the paper's values; [service], [alarms], [forecast], [sensors],\n"
+                  "[estimator] are accepted.  Raises hoist.ConfigError with the programs' message and\n"
+                  ".source (file), .line and .key (e.g. 'cage.mass').")
       .def_static("from_toml",
                   [](const std::string& text, const std::string& source) {
                     return makeConfig(io::parseToml(text, source), source);
                   },
                   py::arg("text"), py::arg("source") = "<string>", "Parse TOML text.")
       .def("set", &setValue, py::arg("key"), py::arg("value"), py::return_value_policy::reference_internal,
-           "Set a dotted key and validate as the file reader does; returns self.")
-      .def("get", &getValue, py::arg("key"), "The value of a dotted key.")
-      .def("to_toml", &toTomlText, "The configuration as TOML text.")
+           "set(key, value) -> self\n\n"
+           "Set one value by its dotted TOML key and validate the whole configuration as the file\n"
+           "reader does (type, bounds, relations such as 2 h < L):\n\n"
+           "    cfg.set(\"load.eccentric_force\", 1500.0)\n"
+           "    cfg.set(\"guide_ropes.preload\", [31e3, 29e3]).set(\"guide_ropes.preload[1]\", 30e3)\n"
+           "    cfg.set(\"model.modes\", 25).set(\"model.initial\", \"rest\")\n\n"
+           "Keys: Config.keys() (the shaft: hoisting_rope, guide_ropes, cage, load, model) and the\n"
+           "[sensors]/[estimator] keys of hoist-twind's file.  Values: float, int, bool, str, a list\n"
+           "(numpy scalars and arrays too).  Raises hoist.ConfigError naming the key (.key) and\n"
+           "leaves the configuration unchanged.  Returns self, so calls chain.")
+      .def("get", &getValue, py::arg("key"),
+           "get(key) -> value\n\n"
+           "The value of a dotted key: float, int (model.modes), bool (model.static_correction),\n"
+           "str (model.initial) or a list (guide_ropes.preload); 'guide_ropes.preload[1]' is one\n"
+           "element.  Other sections ([service], [sensors], ...) as the file has them, the\n"
+           "estimator's defaults when absent.  Raises KeyError for an unknown key.")
+      .def("to_toml", &toTomlText,
+           "The configuration as TOML text: every shaft key (as hoist-sim --print-config) and the\n"
+           "file's other sections; Config.from_toml reads it back equal.")
+      .def("__repr__",
+           [](const Config& c) {
+             return "<hoist.Config from " + c.source + ": n = " + std::to_string(c.params.n) + ", preload = [" +
+                    py::str(py::float_(c.params.Tb1)).cast<std::string>() + ", " +
+                    py::str(py::float_(c.params.Tb2)).cast<std::string>() + "] N, Fa = " +
+                    py::str(py::float_(c.params.Fa)).cast<std::string>() + " N>";
+           })
       .def("copy", [](const Config& c) { return c; }, "An independent copy.")
       .def("__copy__", [](const Config& c) { return c; })
       .def("__deepcopy__", [](const Config& c, py::dict) { return c; }, py::arg("memo"))
