@@ -121,3 +121,13 @@ def test_a_progress_callback_that_raises_stops_the_batch():
 
     with pytest.raises(RuntimeError, match="stop here"):
         hoist.simulate_batch(preload_sweep(6), threads=1, **FAST, progress=boom)
+
+
+def test_ctrl_c_stops_a_single_run():
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        hoist.simulate(hoist.Config.paper(), modes=200, max_step=0.001)  # tens of seconds of work
+    timer.join()
+    assert time.perf_counter() - t0 < 5.0
