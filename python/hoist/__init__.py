@@ -21,7 +21,7 @@ from . import _hoist
 from ._hoist import (Config, InputError, ConfigError, ProfileError, MeasurementError,  # noqa: F401
                      RunError, __version__, ESTIMATE_COLUMNS)
 
-__all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "read_log", "InputError", "ConfigError",
+__all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "read_log", "sweep", "InputError", "ConfigError",
            "ProfileError", "MeasurementError", "RunError", "__version__"]
 
 
@@ -257,3 +257,48 @@ def read_log(path, *, lenient=False):
             raise (InputError if p.returncode == 2 else RunError)(msg)
         return {name[:-4]: Result(_read_csv_columns(_os.path.join(out, name)))
                 for name in sorted(_os.listdir(out)) if name.endswith(".csv")}
+
+
+def sweep(cfg, key, values, profile="paper", *, threads=0, progress=None, keep_runs=False, **options):
+    """Sweep one configuration key over `values` in one batch: peak responses as arrays.
+
+    cfg : Config
+        The base shaft (not changed).
+    key : str
+        A dotted key for Config.set ("cage.mass", "load.eccentric_force", ...);
+        "guide_ropes.preload" sets both ropes to each value (an array key takes
+        a list value per run instead: pass lists in `values`).
+    values : sequence
+        One run per value, validated by Config.set before anything runs
+        (hoist.ConfigError names the key and, in .index, which value).
+    profile, threads, progress, **options
+        As simulate_batch (dt, max_step, t_end, modes, initial, method, ...).
+    keep_runs : bool
+        Also return the runs' Results under "runs".
+
+    Returns a dict of numpy arrays, one entry per value: "value" and
+    "peak_<column>" = max |column| over the run for x_c, y_c, theta and
+    lambda_0..lambda_4, with "t_peak_<column>" the time it is reached (first
+    occurrence).  These are hoist-sim's summary peaks; hoist-study's staged
+    metrics (per-stage peaks, frequencies, figures) stay in hoist-study.
+    """
+    import numpy as np
+    configs = []
+    for i, v in enumerate(values):
+        value = v
+        if key == "guide_ropes.preload" and np.ndim(v) == 0:
+            value = [v, v]
+        try:
+            configs.append(cfg.copy().set(key, value))
+        except ConfigError as e:
+            e.index = i
+            raise
+    runs = simulate_batch(configs, profile, threads=threads, progress=progress, **options)
+    out = {"value": np.array([v if np.ndim(v) == 0 else np.nan for v in values], dtype=np.float64)}
+    for c in ("x_c", "y_c", "theta", "lambda_0", "lambda_1", "lambda_2", "lambda_3", "lambda_4"):
+        k = [int(np.argmax(np.abs(r[c]))) for r in runs]
+        out["peak_" + c] = np.array([abs(r[c][i]) for r, i in zip(runs, k)], dtype=np.float64)
+        out["t_peak_" + c] = np.array([r["t"][i] for r, i in zip(runs, k)], dtype=np.float64)
+    if keep_runs:
+        out["runs"] = runs
+    return out

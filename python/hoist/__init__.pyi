@@ -110,3 +110,15 @@ def estimate(
 ) -> Result: ...
 
 def read_log(path: Union[str, os.PathLike[str]], *, lenient: bool = False) -> dict[str, Result]: ...
+
+def sweep(
+    cfg: Config,
+    key: str,
+    values: Sequence[Any],
+    profile: ProfileArg = "paper",
+    *,
+    threads: int = 0,
+    progress: Optional[Callable[[int, int], object]] = None,
+    keep_runs: bool = False,
+    **options: Any,
+) -> dict[str, Any]: ...

@@ -31,4 +31,6 @@ def test_stubs_name_every_public_function_with_the_same_keywords():
     for name, node in defs.items():
         real = inspect.signature(getattr(hoist, name))
         stub_names = [a.arg for a in node.args.args + node.args.kwonlyargs]
+        if node.args.kwarg:
+            stub_names.append(node.args.kwarg.arg)
         assert stub_names == list(real.parameters), name

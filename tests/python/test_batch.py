@@ -131,3 +131,18 @@ def test_ctrl_c_stops_a_single_run():
         hoist.simulate(hoist.Config.paper(), modes=200, max_step=0.001)  # tens of seconds of work
     timer.join()
     assert time.perf_counter() - t0 < 5.0
+
+
+def test_sweep_gives_the_batch_peaks_as_arrays():
+    base = hoist.Config.paper()
+    preloads = [2.0e4, 3.0e4, 4.0e4]
+    s = hoist.sweep(base, "guide_ropes.preload", preloads, keep_runs=True, threads=2, **FAST)
+    assert np.array_equal(s["value"], preloads)
+    for r, peak, t_peak in zip(s["runs"], s["peak_theta"], s["t_peak_theta"]):
+        k = int(np.argmax(np.abs(r["theta"])))
+        assert peak == abs(r["theta"][k]) and t_peak == r["t"][k]
+    assert np.all(np.diff(s["peak_theta"]) < 0)
+    assert base.get("guide_ropes.preload") == [3.0e4, 3.0e4]  # the base is not changed
+    with pytest.raises(hoist.ConfigError) as e:
+        hoist.sweep(base, "cage.mass", [800.0, -1.0], **FAST)
+    assert e.value.index == 1 and e.value.key == "cage.mass"
