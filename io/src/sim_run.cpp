@@ -1,6 +1,7 @@
 // hoist-sim's run options -> a run (hoist/io/sim_run.hpp).
 #include "hoist/io/sim_run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -57,6 +58,23 @@ void checkSimulatedPartInShaft(const HoistProfile& profile, const ShaftParams& p
     if (s.t <= t_end + dt) part.push_back(s);
   if (part.size() >= 2) checkProfileInShaft(HoistProfile(part), p, source);
   else checkProfileInShaft(profile, p, source);
+}
+
+HoistProfile estopRun(const HoistProfile& profile, double t_end, double estop_at, double decel, double jerk,
+                      double dt, MotionProfile* stop_out) {
+  const double p_end = t_end < 0 ? profile.endTime() : t_end;
+  if (!std::isfinite(estop_at) || estop_at < profile.startTime() || estop_at >= p_end)
+    throw OptionError("--estop-at: " + std::to_string(estop_at) + " s is outside the run [" +
+                      std::to_string(profile.startTime()) + ", " + std::to_string(p_end) + ") s");
+  const double T = profile.startTime() + std::round((estop_at - profile.startTime()) / dt) * dt;
+  MotionProfile stop;
+  try {
+    stop = estopProfile(T, profile.at(T), decel, jerk);
+  } catch (const std::invalid_argument& e) {
+    throw OptionError(std::string("--estop-decel/--estop-jerk: ") + e.what());
+  }
+  if (stop_out) *stop_out = stop;
+  return spliceProfile(profile, T, stop, dt, std::max(p_end, profile.endTime()));
 }
 
 SimulationOptions simulationOptions(const SimRunOptions& o, const ShaftParams& p, double t_end, int& substeps) {

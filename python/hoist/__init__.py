@@ -81,7 +81,7 @@ def _check_profile(profile):
 
 def simulate(cfg, profile="paper", *, dt=0.01, max_step=0.0025, t_end=None, modes=None, initial=None,
              method="fast", static_correction=None, rho_inf=None, shape_times=(), shape_points=401,
-             progress=None):
+             estop_at=None, estop_decel=3.0, estop_jerk=10.0, progress=None):
     """Run the shaft model over a hoist profile: hoist-sim from Python.
 
     Parameters are hoist-sim's options (same defaults, same checks, same
@@ -115,6 +115,12 @@ def simulate(cfg, profile="paper", *, dt=0.01, max_step=0.0025, t_end=None, mode
         Times [s] at which the guide-rope shapes are taken (hoist-sim --shape-times).
     shape_points : int
         Depth samples per shape.
+    estop_at, estop_decel, estop_jerk : float
+        An emergency stop at estop_at [s] (rounded to an output step): the
+        profile up to it, then the look-ahead forecast's "estop" scenario
+        (|a| builds up at estop_jerk [m/s^3] to estop_decel [m/s^2] against
+        the motion, eases off so that v and a reach 0 together, then rest).
+        The run equals the twin's e-stop forecast made at that time.
     progress : callable(fraction) or None
         Called about every 50 ms from the calling thread.
 
@@ -135,13 +141,15 @@ def simulate(cfg, profile="paper", *, dt=0.01, max_step=0.0025, t_end=None, mode
     """
     cols, shapes, info = _hoist._simulate(cfg, _check_profile(profile), dt, max_step, t_end, modes,
                                           initial or "", method, static_correction, rho_inf,
-                                          list(shape_times), shape_points, progress)
+                                          list(shape_times), shape_points, estop_at, estop_decel, estop_jerk,
+                                          progress)
     return Result(cols, shapes, info)
 
 
 def simulate_batch(configs, profile="paper", *, threads=0, progress=None, dt=0.01, max_step=0.0025,
                    t_end=None, modes=None, initial=None, method="fast", static_correction=None,
-                   rho_inf=None, shape_times=(), shape_points=401):
+                   rho_inf=None, shape_times=(), shape_points=401, estop_at=None, estop_decel=3.0,
+                   estop_jerk=10.0):
     """Run simulate() for every configuration, on C++ threads with the GIL released.
 
     configs : sequence of Config
@@ -164,7 +172,7 @@ def simulate_batch(configs, profile="paper", *, threads=0, progress=None, dt=0.0
             raise TypeError(f"simulate_batch: configs[{i}] is a {type(c).__name__}, not a hoist.Config")
     out = _hoist._simulate_batch(configs, _check_profile(profile), threads, progress, dt, max_step, t_end,
                                  modes, initial or "", method, static_correction, rho_inf,
-                                 list(shape_times), shape_points)
+                                 list(shape_times), shape_points, estop_at, estop_decel, estop_jerk)
     return [Result(c, s, i) for c, s, i in out]
 
 

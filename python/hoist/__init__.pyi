@@ -79,6 +79,9 @@ def simulate(
     rho_inf: Optional[float] = None,
     shape_times: Sequence[float] = (),
     shape_points: int = 401,
+    estop_at: Optional[float] = None,
+    estop_decel: float = 3.0,
+    estop_jerk: float = 10.0,
     progress: Optional[Callable[[float], object]] = None,
 ) -> Result: ...
 
@@ -98,6 +101,9 @@ def simulate_batch(
     rho_inf: Optional[float] = None,
     shape_times: Sequence[float] = (),
     shape_points: int = 401,
+    estop_at: Optional[float] = None,
+    estop_decel: float = 3.0,
+    estop_jerk: float = 10.0,
 ) -> list[Result]: ...
 
 def estimate(

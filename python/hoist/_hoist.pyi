@@ -10,10 +10,12 @@ ESTIMATE_COLUMNS: list[str]
 def _simulate(cfg: Config, profile: Any, dt: float, max_step: float, t_end: Optional[float],
               modes: Optional[int], initial: str, method: str, static_correction: Any,
               rho_inf: Optional[float], shape_times: list[float], shape_points: int,
+              estop_at: Optional[float], estop_decel: float, estop_jerk: float,
               progress: Any) -> tuple[dict[str, Any], Optional[dict[str, Any]], dict[str, Any]]: ...
 def _simulate_batch(configs: list[Config], profile: Any, threads: int, progress: Any, dt: float,
                     max_step: float, t_end: Optional[float], modes: Optional[int], initial: str, method: str,
                     static_correction: Any, rho_inf: Optional[float], shape_times: list[float],
-                    shape_points: int) -> list[tuple[dict[str, Any], Optional[dict[str, Any]], dict[str, Any]]]: ...
+                    shape_points: int, estop_at: Optional[float], estop_decel: float,
+                    estop_jerk: float) -> list[tuple[dict[str, Any], Optional[dict[str, Any]], dict[str, Any]]]: ...
 def _estimate(cfg: Config, measurements: Any, modes: Optional[int], max_step: Optional[float],
               progress: Any) -> dict[str, Any]: ...

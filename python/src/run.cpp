@@ -37,7 +37,10 @@ RunResult runSimulation(const RunSpec& spec, const ProfileSource& profile_src, c
   RunResult res;
   ShaftParams p = spec.params;
   io::applySimOverrides(p, spec.options);
-  const HoistProfile profile = profile_src.load(p.l0);
+  HoistProfile profile = profile_src.load(p.l0);
+  if (spec.estop)
+    profile = io::estopRun(profile, spec.options.t_end, spec.estop_at, spec.estop_decel, spec.estop_jerk,
+                           spec.options.dt);
   const double t0 = profile.startTime();
   const double t_end = io::simEndTime(profile, spec.options.t_end);
   io::checkSimulatedPartInShaft(profile, p, t_end, spec.options.dt, profile_src.name());

@@ -38,6 +38,8 @@ struct RunSpec {
   io::SimRunOptions options;   ///< hoist-sim's options
   std::vector<double> shape_times;  ///< --shape-times (empty: no shapes)
   int shape_points = 401;           ///< --shape-points
+  bool estop = false;               ///< --estop-at given
+  double estop_at = 0.0, estop_decel = 3.0, estop_jerk = 10.0;  ///< --estop-at, --estop-decel, --estop-jerk
 };
 
 struct RunResult {

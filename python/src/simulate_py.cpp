@@ -88,7 +88,27 @@ struct Common {
   io::SimRunOptions options;
   std::vector<double> shape_times;
   int shape_points = 401;
+  std::optional<double> estop_at;
+  double estop_decel = 3.0, estop_jerk = 10.0;
+
+  RunSpec spec(const ShaftParams& p) const {
+    RunSpec s{p, options, shape_times, shape_points};
+    s.estop = estop_at.has_value();
+    s.estop_at = estop_at.value_or(0.0);
+    s.estop_decel = estop_decel;
+    s.estop_jerk = estop_jerk;
+    return s;
+  }
 };
+
+/// --estop-at, --estop-decel, --estop-jerk (hoist-sim's ranges).
+void estopOptions(Common& c, std::optional<double> at, double decel, double jerk) {
+  if (!(decel >= 1e-6 && decel <= 100.0)) throw py::value_error("estop_decel: must be in [1e-06, 100] m/s^2");
+  if (!(jerk >= 1e-6 && jerk <= 1e6)) throw py::value_error("estop_jerk: must be in [1e-06, 1e+06] m/s^3");
+  c.estop_at = at;
+  c.estop_decel = decel;
+  c.estop_jerk = jerk;
+}
 
 Common common(double dt, double max_step, std::optional<double> t_end, std::optional<int> modes,
               const std::string& initial, const std::string& method, const py::object& static_correction,
@@ -103,10 +123,12 @@ Common common(double dt, double max_step, std::optional<double> t_end, std::opti
 py::tuple simulateOne(const Config& cfg, const py::object& profile, double dt, double max_step,
                       std::optional<double> t_end, std::optional<int> modes, const std::string& initial,
                       const std::string& method, const py::object& static_correction, std::optional<double> rho_inf,
-                      std::vector<double> shape_times, int shape_points, const py::object& progress) {
-  const Common c = common(dt, max_step, t_end, modes, initial, method, static_correction, rho_inf,
-                          std::move(shape_times), shape_points);
-  const RunSpec spec{cfg.params, c.options, c.shape_times, c.shape_points};
+                      std::vector<double> shape_times, int shape_points, std::optional<double> estop_at,
+                      double estop_decel, double estop_jerk, const py::object& progress) {
+  Common c = common(dt, max_step, t_end, modes, initial, method, static_correction, rho_inf,
+                    std::move(shape_times), shape_points);
+  estopOptions(c, estop_at, estop_decel, estop_jerk);
+  const RunSpec spec = c.spec(cfg.params);
   const ProfileSource src = profileSource(profile);
   const long rows = progress.is_none() ? 0 : std::max(1L, expectedRows(spec, src));
   std::atomic<long> steps{0};
@@ -130,15 +152,17 @@ py::list simulateBatch(const std::vector<const Config*>& configs, const py::obje
                        const py::object& progress, double dt, double max_step, std::optional<double> t_end,
                        std::optional<int> modes, const std::string& initial, const std::string& method,
                        const py::object& static_correction, std::optional<double> rho_inf,
-                       std::vector<double> shape_times, int shape_points) {
-  const Common c = common(dt, max_step, t_end, modes, initial, method, static_correction, rho_inf,
-                          std::move(shape_times), shape_points);
+                       std::vector<double> shape_times, int shape_points, std::optional<double> estop_at,
+                       double estop_decel, double estop_jerk) {
+  Common c = common(dt, max_step, t_end, modes, initial, method, static_correction, rho_inf,
+                    std::move(shape_times), shape_points);
+  estopOptions(c, estop_at, estop_decel, estop_jerk);
   const ProfileSource src = profileSource(profile);
   std::vector<RunSpec> specs;
   specs.reserve(configs.size());
   for (std::size_t i = 0; i < configs.size(); ++i) {
     if (!configs[i]) throw py::type_error("simulate_batch: configs[" + std::to_string(i) + "] is None, not a Config");
-    specs.push_back(RunSpec{configs[i]->params, c.options, c.shape_times, c.shape_points});
+    specs.push_back(c.spec(configs[i]->params));
   }
   std::vector<std::optional<RunResult>> results(specs.size());
   std::size_t last_done = static_cast<std::size_t>(-1);
@@ -172,11 +196,13 @@ py::list simulateBatch(const std::vector<const Config*>& configs, const py::obje
 void bindSimulate(py::module_& m) {
   m.def("_simulate", &simulateOne, py::arg("cfg"), py::arg("profile"), py::arg("dt"), py::arg("max_step"),
         py::arg("t_end"), py::arg("modes"), py::arg("initial"), py::arg("method"), py::arg("static_correction"),
-        py::arg("rho_inf"), py::arg("shape_times"), py::arg("shape_points"), py::arg("progress"));
+        py::arg("rho_inf"), py::arg("shape_times"), py::arg("shape_points"), py::arg("estop_at"),
+        py::arg("estop_decel"), py::arg("estop_jerk"), py::arg("progress"));
   m.def("_simulate_batch", &simulateBatch, py::arg("configs"), py::arg("profile"), py::arg("threads"),
         py::arg("progress"), py::arg("dt"), py::arg("max_step"), py::arg("t_end"), py::arg("modes"),
         py::arg("initial"), py::arg("method"), py::arg("static_correction"), py::arg("rho_inf"),
-        py::arg("shape_times"), py::arg("shape_points"));
+        py::arg("shape_times"), py::arg("shape_points"), py::arg("estop_at"), py::arg("estop_decel"),
+        py::arg("estop_jerk"));
 }
 
 }  // namespace hoist::python

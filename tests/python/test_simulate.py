@@ -26,6 +26,9 @@ def assert_same(result, csv, columns=COLUMNS):
      dict(t_end=4.0, modes=6, method="paper", static_correction=False)),
     (["--t-end", "3", "--modes", "10", "--rho-inf", "0.5", "--static-correction", "off"],
      dict(t_end=3.0, modes=10, rho_inf=0.5, static_correction="off")),
+    # The e-stop forecast: the paper trip cut at 6.004 s (rounded to 6.0), stopped at 2.5 m/s^2 and 8 m/s^3.
+    (["--t-end", "12", "--modes", "8", "--estop-at", "6.004", "--estop-decel", "2.5", "--estop-jerk", "8"],
+     dict(t_end=12.0, modes=8, estop_at=6.004, estop_decel=2.5, estop_jerk=8.0)),
 ])
 def test_same_numbers_as_hoist_sim(tmp_path, hoist_sim, args, kwargs):
     cfg_path = tmp_path / "shaft.toml"
@@ -96,6 +99,8 @@ def test_result_is_a_mapping_of_numpy_arrays():
     (dict(static_correction="maybe"), ValueError, "static_correction"),
     (dict(t_end=float("nan")), ValueError, "t_end"),
     (dict(shape_times=[100.0]), ValueError, "shape_times"),
+    (dict(estop_at=5.0), ValueError, "--estop-at"),
+    (dict(estop_at=0.5, estop_decel=0.0), ValueError, "estop_decel"),
     (dict(profile="trapezoid:vmax=x"), hoist.ProfileError, "trapezoid.vmax"),
     (dict(profile="warp"), hoist.ProfileError, "warp"),
     (dict(profile=([0.0, 1.0], [0.0, 1.0])), ValueError, "t, v, a"),

@@ -304,19 +304,9 @@ int run(const Options& o) {
     // the output grid.  T is rounded to the nearest output step (the forecast
     // starts at a step of the twin), so the run equals the twin's e-stop
     // forecast made at T.
-    const double p_end = o.t_end < 0 ? profile.endTime() : o.t_end;
-    if (!std::isfinite(o.estop_at) || o.estop_at < profile.startTime() || o.estop_at >= p_end)
-      throw UsageError("--estop-at: " + std::to_string(o.estop_at) + " s is outside the run [" +
-                       std::to_string(profile.startTime()) + ", " + std::to_string(p_end) + ") s");
-    const double T =
-        profile.startTime() + std::round((o.estop_at - profile.startTime()) / o.dt) * o.dt;
     hoist::MotionProfile stop;
-    try {
-      stop = hoist::estopProfile(T, profile.at(T), o.estop_decel, o.estop_jerk);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(std::string("--estop-decel/--estop-jerk: ") + e.what());
-    }
-    profile = hoist::spliceProfile(profile, T, stop, o.dt, std::max(p_end, profile.endTime()));
+    profile = hoist::io::estopRun(profile, o.t_end, o.estop_at, o.estop_decel, o.estop_jerk, o.dt, &stop);
+    const double T = stop.startTime();
     if (!o.quiet)
       std::cerr << "hoist-sim: emergency stop at t = " << T << " s from l = " << stop.start().l
                 << " m, v = " << stop.start().v << " m/s, a = " << stop.start().a << " m/s^2: rest at t = "

@@ -11,6 +11,7 @@
 
 #include "hoist/params.hpp"
 #include "hoist/profile.hpp"
+#include "hoist/scenario.hpp"
 #include "hoist/simulator.hpp"
 
 namespace hoist::io {
@@ -47,6 +48,16 @@ double simEndTime(const HoistProfile& profile, double t_end);
 /// (output step dt) leaves the shaft (checkProfileInShaft on that part).
 void checkSimulatedPartInShaft(const HoistProfile& profile, const ShaftParams& p, double t_end, double dt,
                                const std::string& source);
+
+/// hoist-sim --estop-at T: `profile` up to T (rounded to the nearest output
+/// step dt, so the run equals the twin's e-stop forecast made at T), then the
+/// forecast's "estop" scenario (hoist/scenario.hpp estopProfile: |a| builds up
+/// at `jerk` to `decel` against the motion, holds, eases off; then rest),
+/// sampled on the output grid up to max(t_end, the profile's end).  `stop`
+/// (optional) receives the stop.  Throws OptionError ("--estop-at: ...",
+/// "--estop-decel/--estop-jerk: ...").
+HoistProfile estopRun(const HoistProfile& profile, double t_end, double estop_at, double decel, double jerk,
+                      double dt, MotionProfile* stop = nullptr);
 
 /// The simulator's options for this run; `substeps` receives the substeps
 /// per output step.  Throws OptionError ("--max-step: ...").
