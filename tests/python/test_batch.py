@@ -106,8 +106,8 @@ def test_ctrl_c_stops_a_batch_cleanly():
     t0 = time.perf_counter()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        # About 8 x 2 s of work on one thread: far longer than the 0.3 s before the signal.
-        hoist.simulate_batch(cfgs, threads=1, modes=60, t_end=60.0)
+        # 8 paper trips at n = 100 on one thread: 15 s of work or more, far longer than the 0.3 s before the signal.
+        hoist.simulate_batch(cfgs, threads=1, modes=100, t_end=60.0)
     timer.join()
     assert time.perf_counter() - t0 < 5.0
     # The module still works afterwards (no thread left running, no state left behind).
@@ -128,7 +128,7 @@ def test_ctrl_c_stops_a_single_run():
     t0 = time.perf_counter()
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        hoist.simulate(hoist.Config.paper(), modes=200, max_step=0.001)  # tens of seconds of work
+        hoist.simulate(hoist.Config.paper(), modes=200, max_step=0.0005)  # tens of seconds of work
     timer.join()
     assert time.perf_counter() - t0 < 5.0
 
