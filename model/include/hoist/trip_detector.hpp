@@ -47,6 +47,8 @@ class TripDetector {
   TripEvent update(double t, const Kinematics& k);
 
   bool moving() const { return state_ == State::Moving; }
+  /// |v| and |a| at or below rest_speed (the rest of a departure and an arrival).
+  bool still(const Kinematics& k) const;
   double departureTime() const { return t_dep_; }
   const Kinematics& departure() const { return k_dep_; }
   double arrivalTime() const { return t_arr_; }
@@ -55,7 +57,6 @@ class TripDetector {
 
  private:
   enum class State { Unknown, Rest, Moving };
-  bool still(const Kinematics& k) const;
   TripDetectorSettings set_;
   State state_ = State::Unknown;
   double t_rest_ = 0.0;          // last rest sample (the candidate departure)
