@@ -179,6 +179,14 @@ PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est
   id.dof = dof;
   id.imbalance = 0.0;
   id.sigma_imbalance = -1.0;
+  // s = s0 + P / M is a ratio: where M is barely known the first-order band
+  // is too narrow.  Not identifiable when M is within 3 sigma of zero; else
+  // the band is widened to what it would be at the low edge of M's band
+  // (the information on s grows as M^2).
+  if (id.sigma_scale > 0.0 && id.sigma_moment > 0.0) {
+    if (std::abs(M) <= 3.0 * id.sigma_moment) id.sigma_scale = -1.0;
+    else id.sigma_scale *= std::abs(M) / (std::abs(M) - 2.0 * id.sigma_moment);
+  }
   id.informative = id.sigma_scale > 0.0 && id.sigma_scale <= opt.max_sigma;
   id.loss30_separation = id.sigma_scale > 0.0 ? 0.3 / id.sigma_scale : 0.0;
   if (id.informative)
@@ -189,8 +197,9 @@ PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est
                   "moment %.0f N m)",
                   id.sigma_scale, id.loss30_separation, M);
   else
-    id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip (no information on s; moment %.0f N m)",
-                  M);
+    id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip: the moment (%.0f +- %.0f N m) is too "
+                  "close to zero to tell the preload",
+                  M, id.sigma_moment);
   id.note += "; the imbalance of the two ropes is not identifiable (the response is symmetric in them)";
   id.cpu_seconds = threadCpuSeconds() - cpu0;
   return out;
