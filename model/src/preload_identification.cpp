@@ -100,7 +100,7 @@ PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est
     std::vector<double> Hf, Hw;
   };
   std::vector<Eval> evals;
-  evals.reserve(static_cast<std::size_t>(opt.max_iterations) + 8);  // references into it stay valid
+  evals.reserve(3 * static_cast<std::size_t>(opt.max_iterations) + 12);  // references into it stay valid
   auto solveAt = [&](Eval& e) {
     Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
     Eigen::Vector2d r = Eigen::Vector2d::Zero();
@@ -154,68 +154,72 @@ PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est
     }
     solveAt(e1);
   }
-  // Parabolic search of the profile's minimum over s in [kLo, kHi].
-  constexpr double kLo = 0.2, kHi = 2.5;
+  // The profile's minimum: a coarse grid (the information on s sharpens as s
+  // falls, so the profile is far from a parabola over the whole range), then
+  // local parabolas through (c - d, c, c + d), d ~ one sigma, re-centred on
+  // their vertex until it moves less than a quarter of d.
+  constexpr double kLo = 0.3, kHi = 1.6;
+  const double grid[] = {kLo, 0.5, 0.7, 0.85, 1.0, 1.2, kHi};  // 1.0: the weights' run
+  constexpr std::size_t kGrid = sizeof grid / sizeof grid[0];
+  std::size_t k = 0;
+  for (std::size_t g = 0; g < kGrid; ++g)
+    if (evalAt(grid[g]).chi2 < evalAt(grid[k]).chi2) k = g;
   auto best = [&]() -> const Eval& {
     return *std::min_element(evals.begin(), evals.end(), [](const Eval& a, const Eval& b) { return a.chi2 < b.chi2; });
   };
-  // Vertex and curvature of the parabola through the three evaluations nearest to s_c.
-  auto parabola = [&](double s_c, double& vertex, double& curv) {
-    std::vector<const Eval*> near;
-    for (const Eval& e : evals) near.push_back(&e);
-    std::sort(near.begin(), near.end(),
-              [&](const Eval* a, const Eval* b) { return std::abs(a->s - s_c) < std::abs(b->s - s_c); });
-    const Eval &a = *near[0], &b = *near[1], &c = *near[2];
+  double s = grid[k], sig_s = -1.0;
+  bool bounded = k > 0 && k + 1 < kGrid;
+  if (bounded) {
+    // First guess of the curvature from the grid neighbours.
+    const Eval &a = evalAt(grid[k - 1]), &c = evalAt(grid[k + 1]);
+    const Eval& b = evalAt(s);
     const double d1 = (b.chi2 - a.chi2) / (b.s - a.s), d2 = (c.chi2 - b.chi2) / (c.s - b.s);
-    curv = (d2 - d1) / (c.s - a.s);  // chi2 ~ curv (s - vertex)^2 + const
-    vertex = curv > 0.0 ? 0.5 * (a.s + b.s) - d1 / (2.0 * curv) : std::numeric_limits<double>::quiet_NaN();
-  };
-  evalAt(0.85);
-  evalAt(evals[1].chi2 < evals[0].chi2 ? 0.7 : 1.15);
-  double s = best().s, curv = 0.0, vertex = 0.0;
-  bool bounded = true;
-  for (int it = 0; it < opt.max_iterations; ++it) {
-    const double sb = best().s;
-    parabola(sb, vertex, curv);
-    double next;
-    if (!(curv > 0.0)) {  // not convex here: walk downhill
-      const double other = evals.size() > 1 ? evals[evals.size() - 2].s : sb;
-      next = sb + (sb <= other ? -0.2 : 0.2);
-    } else {
-      next = std::clamp(vertex, sb - 0.3, sb + 0.3);
-    }
-    next = std::clamp(next, kLo, kHi);
-    const double tol = curv > 0.0 ? 0.1 / std::sqrt(curv) : 0.0;
-    if (std::abs(next - sb) <= std::max(tol, 1e-4)) break;
-    if (std::abs(next - sb) < 1e-9) break;  // at a bound
-    evalAt(next);
-  }
-  s = best().s;
-  bounded = s > kLo + 1e-9 && s < kHi - 1e-9;
-  // Curvature over +- one sigma about the minimum (the Delta chi2 = 1 definition).
-  parabola(s, vertex, curv);
-  double sig_s = curv > 0.0 ? 1.0 / std::sqrt(curv) : -1.0;
-  if (sig_s > 0.0 && bounded) {
-    const double d = std::clamp(sig_s, 0.005, 0.3);
-    if (s - d > kLo && s + d < kHi) {
-      const Eval& lo = evalAt(s - d);
-      const double Mlo = lo.M;
-      const Eval& hi = evalAt(s + d);
-      const double Mhi = hi.M;
-      const Eval& c = evalAt(s);
-      const double k2 = (lo.chi2 + hi.chi2 - 2.0 * c.chi2) / (d * d);  // = 2 curv
-      sig_s = k2 > 0.0 ? std::sqrt(2.0 / k2) : -1.0;
-      const double dMds = (Mhi - Mlo) / (2.0 * d);
-      id.sigma_moment = std::sqrt(c.varM + (sig_s > 0.0 ? dMds * dMds * sig_s * sig_s : 0.0));
+    const double curv = (d2 - d1) / (c.s - a.s);
+    double center = curv > 0.0 ? std::clamp(0.5 * (a.s + b.s) - d1 / (2.0 * curv), a.s, c.s) : s;
+    double d = curv > 0.0 ? std::clamp(1.0 / std::sqrt(curv), 0.02, 0.15) : 0.1;
+    for (int it = 0; it < opt.max_iterations; ++it) {
+      const Eval& lo = evalAt(center - d);
+      const Eval& mid = evalAt(center);
+      const Eval& hi = evalAt(center + d);
+      const double k2 = (lo.chi2 + hi.chi2 - 2.0 * mid.chi2) / (d * d);  // = 2 curv
+      if (!(k2 > 0.0)) {
+        sig_s = -1.0;
+        break;
+      }
+      sig_s = std::sqrt(2.0 / k2);
+      const double v = center - (hi.chi2 - lo.chi2) / (2.0 * d * k2);
+      const double dMds = (hi.M - lo.M) / (2.0 * d);
+      id.sigma_moment = std::sqrt(mid.varM + dMds * dMds * sig_s * sig_s);
+      s = center;
+      if (std::abs(v - center) <= 0.25 * d || v < kLo || v > kHi || evals.size() + 3 > evals.capacity()) {
+        if (std::abs(v - center) > 0.1 * sig_s && std::abs(v - center) < d && evals.size() < evals.capacity()) {
+          evalAt(v);
+          s = v;
+        }
+        break;
+      }
+      center = v;
+      d = std::clamp(sig_s, 0.02, 0.15);
     }
   }
+  bounded = bounded && s > kLo && s < kHi;
+  if (!(bounded && sig_s > 0.0)) s = 1.0;  // not identifiable: M at the configured preload
   const Eval& fin = evalAt(s);
   if (id.sigma_moment < 0.0) id.sigma_moment = std::sqrt(fin.varM);
+  if (!(bounded && sig_s > 0.0)) {
+    // s unknown: M's band also spans every moment the search found as
+    // plausible (within Delta chi2 = 9 of the best, over s in [0.3, 1.6]).
+    double spread = 0.0;
+    const double c_best = best().chi2;
+    for (const Eval& e : evals)
+      if (e.chi2 <= c_best + 9.0) spread = std::max(spread, std::abs(e.M - fin.M));
+    id.sigma_moment = std::sqrt(fin.varM + spread * spread);
+  }
   const double M = fin.M, chi2 = fin.chi2;
   const double inflate = dof > 0 ? std::sqrt(std::max(1.0, chi2 / dof)) : 1.0;
   for (std::size_t i = 0; i < trip.size(); ++i)
     if (trip[i].present & kSensorImuAccel) out.fitted_fy[i] = M * fin.Hf[i] + fin.o;
-  id.scale = s;
+  id.scale = bounded && sig_s > 0.0 ? s : best().s;  // not identifiable: where the search ended
   id.moment = M;
   id.sigma_scale = bounded && sig_s > 0.0 ? inflate * sig_s : -1.0;
   id.sigma_moment *= inflate;

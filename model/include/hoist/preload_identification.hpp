@@ -11,11 +11,13 @@
 // with H the response to M = 1 N m of the same n-mode model whose guide-rope
 // preloads are scaled by s.  At a given s the model is LINEAR in (M, o): one
 // weighted least squares gives the profile chi2(s) (one solver run over the
-// trip per s).  s is the minimum of that profile, found by a parabolic search
-// (s = 1, 0.85, then 0.7 or 1.15, then parabola vertices until the step is
-// below a tenth of sigma; s confined to [0.2, 2.5], a minimum on the bound is
-// reported not identifiable).  The tilt's depth shape is what separates s
-// from M: the ropes' own weight adds tension rho2 g (L - x) that does not
+// trip per s).  s is the minimum of that profile: a grid over [0.3, 1.6]
+// (the information on s sharpens as s falls, so the profile is far from a
+// parabola over that range), then local parabolas through (c - d, c, c + d),
+// d ~ one sigma, re-centred on their vertex until it moves less than d / 4.
+// A minimum on the grid's ends is reported not identifiable.  The tilt's
+// depth shape is what separates s from M: the ropes' own weight adds tension
+// rho2 g (L - x) that does not
 // scale with s.
 //
 // Weights: each sample's variance is the sensor's (EstimatorSettings::noise)
@@ -38,7 +40,7 @@
 // (sigma_imbalance = -1) with the reason in the note.
 //
 // Who calls it: TripAccumulator::finish (hoist/trip_accumulator.hpp), off the
-// real-time loop.  Allocates; 6-10 solver runs over the trip at the twin's n.
+// real-time loop.  Allocates; 10-15 solver runs over the trip at the twin's n.
 #pragma once
 
 #include <vector>
@@ -52,7 +54,7 @@ struct PreloadFitOptions {
   double max_sigma = 0.1;           ///< [condition] max_sigma: informative when sigma(s) <= this
   double accel_offset_sigma = 0.0;  ///< prior sigma of the IMU's offset [m/s^2]; 0: calibrated, not fitted
   double max_step = 0.0025;         ///< largest solver step [s] (the twin's)
-  int max_iterations = 8;           ///< parabolic steps of the search at most (one solver run each)
+  int max_iterations = 4;           ///< local parabolas at most (up to three solver runs each)
 };
 
 /// The fit and, per sample of the trip, the prediction of f_y it implies (the
