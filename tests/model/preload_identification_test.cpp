@@ -140,6 +140,8 @@ TEST(PreloadIdentification, UncalibratedOffsetWidensTheBand) {
     EXPECT_LT(std::abs(fitted.scale - 1.0), 3.0 * fitted.sigma_scale);
     EXPECT_GT(fitted.sigma_scale, cal.sigma_scale);
   }
+  EXPECT_FALSE(fitted.informative && fitted.sigma_scale <= cal.sigma_scale) << "the offset must cost information";
+  EXPECT_LT(std::abs(fitted.moment - 1000.0), 3.0 * fitted.sigma_moment) << "M's band stays honest";
   EXPECT_GT(wrong.chi2 / wrong.dof, cal.chi2 / cal.dof);
 }
 
