@@ -239,10 +239,14 @@ PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est
     id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip (sigma of s %.3g: %.1f sigma; "
                   "moment %.0f N m)",
                   id.sigma_scale, id.loss30_separation, M);
-  else
+  else if (std::abs(M) <= 3.0 * id.sigma_moment)
     id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip: the moment (%.0f +- %.0f N m) is too "
                   "close to zero to tell the preload",
                   M, id.sigma_moment);
+  else
+    id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip: the data do not bound the preload "
+                  "between %.1f and %.1f of the configured one (moment %.0f N m)",
+                  kLo, kHi, M);
   id.note += "; the imbalance of the two ropes is not identifiable (the response is symmetric in them)";
   id.cpu_seconds = threadCpuSeconds() - cpu0;
   return out;
