@@ -174,6 +174,47 @@ void Hub::maybeRequestAlarmStates(const std::string& prefix, const Json& health)
   requestAlarmStates(prefix);
 }
 
+void Hub::noteInstance(const std::string& prefix, const Json& health) {
+  const std::int64_t instance = health.value("instance_id", std::int64_t{0});
+  if (instance == 0) return;
+  auto [it, fresh] = instance_.emplace(prefix, instance);
+  if (fresh || it->second == instance) return;
+  const std::int64_t old = it->second;
+  it->second = instance;
+  // The new daemon's start on its own clock (the alarms' utimes are on it too).
+  const double uptime = health.value("uptime", 0.0);
+  const std::int64_t start = health.value("utime", std::int64_t{0}) -
+                             static_cast<std::int64_t>(std::isfinite(uptime) && uptime > 0.0 ? uptime * 1e6 : 0.0);
+  count("daemon_restarts");
+  Channel* ch = channelFor(prefix + std::string(bus::kChannelAlarm));
+  std::size_t cleared = 0;
+  if (ch != nullptr) {
+    for (auto a = ch->table.begin(); a != ch->table.end();) {
+      Json j = Json::parse(*a->second, nullptr, false);
+      if (!j.is_object() || j.value("utime", std::int64_t{0}) >= start) {
+        ++a;
+        continue;
+      }
+      // Inactive, acknowledged, not shelved: it leaves every alarm list.
+      j["event_type"] = 2;  // EVENT_CLEAR
+      j["active"] = j["shelved"] = j["latched"] = false;
+      j["acked"] = true;
+      j["shelved_for"] = 0.0;
+      j["user"] = "hoist-dash";
+      j["message"] = "cleared by hoist-dash: the daemon restarted (instance " + std::to_string(old) + " -> " +
+                     std::to_string(instance) + ")";
+      j["dash_restart_cleared"] = true;
+      alarm_ids_.erase(prefix + "\n" + a->first);
+      broadcast(*ch, std::make_shared<const std::string>(j.dump()));
+      a = ch->table.erase(a);
+      ++cleared;
+    }
+  }
+  count("alarms_cleared_restart", cleared);
+  spdlog::info("shaft '{}': new daemon instance {} (was {}): {} alarm state(s) from before its start cleared",
+               shaftName(prefix), instance, old, cleared);
+}
+
 void Hub::requestAlarmStates(const std::string& prefix) {
   // alarm_ack_t ACTION_REANNOUNCE changes nothing in the daemon (which
   // honours one a second): its answer is every alarm's current state, so an
@@ -380,7 +421,10 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
   if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
-  if (suffix == "HOIST_HEALTH" && channelFor(channel) != nullptr) maybeRequestAlarmStates(prefix, j);
+  if (suffix == "HOIST_HEALTH" && channelFor(channel) != nullptr) {
+    noteInstance(prefix, j);
+    maybeRequestAlarmStates(prefix, j);
+  }
   if (suffix == "HOIST_ALARM" && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
@@ -728,6 +772,7 @@ void Hub::removePrefix(const std::string& prefix) {
   prefix_list_.erase(pit);
   disc_.erase(prefix);
   states_asked_.erase(prefix);
+  instance_.erase(prefix);
   decimators_.erase(prefix);
   estimate_decimators_.erase(prefix);
   history_.erase(prefix);

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "hoist/msg/codec.hpp"
+#include "log_safe.hpp"
 
 namespace hoist::dash {
 
@@ -265,7 +266,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
     if (!server_.hostAllowed(sv(req[http::field::host]))) {
       const bool ws = websocket::is_upgrade(req);
       hub.count(ws ? "ws_rejected_host" : "http_rejected_host");
-      const std::string shown = msg::terminalSafe(std::string(req[http::field::host]), 80);
+      const std::string shown = logSafe(sv(req[http::field::host]), 80);
       if (server_.logAllowed())
         spdlog::warn("{} with Host '{}' refused: not a name of this dashboard (see --allow-host)",
                      ws ? "WebSocket" : "HTTP request", shown);
@@ -303,7 +304,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
         hub.count("ws_rejected_origin");
         if (server_.logAllowed())
           spdlog::warn("WebSocket from origin {} refused (see --allow-origin)",
-                       msg::terminalSafe(std::string(origin), 120));
+                       logSafe(sv(origin), 120));
         respondError(http::status::forbidden, "origin not allowed (hoist-dash --allow-origin)", false);
         return;
       }
@@ -342,7 +343,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
         return;
       case StaticFiles::Verdict::Traversal:
         hub.count("http_rejected_traversal");
-        spdlog::warn("refused path traversal: {}", target.substr(0, 200));
+        spdlog::warn("refused path traversal: {}", logSafe(target));
         respondError(http::status::forbidden, "path traversal refused", req.keep_alive());
         return;
       case StaticFiles::Verdict::BadRequest:

@@ -12,6 +12,7 @@
 // by msgs/codec (the same tables as the daemon's).
 import { FoxgloveClient } from "./vendor/foxglove-client.js";
 import { CHANNELS, alarm_t } from "./hoist_msgs.js";
+import { ALARM_UNITS } from "./alarm_units.js";
 
 (() => {
   // Channel suffixes (what follows a shaft's prefix): the wire channels of
@@ -57,6 +58,11 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     const t = Number(x).toFixed(d);
     return /^-0\.?0*$/.test(t) ? t.slice(1) : t;
   };
+  const num = (x) => typeof x === "number" && isFinite(x);
+  // Text and attributes are written only when they change (no DOM mutation
+  // without a change: the alarm rows' MutationObserver test counts them).
+  const setText = (e, t) => { if (e.textContent !== t) e.textContent = t; };
+  const setAttr = (e, k, v) => { if (e.getAttribute(k) !== v) e.setAttribute(k, v); };
   const clock = (utime) => new Date(utime / 1000).toLocaleTimeString([], { hour12: false });
   const toast = (msg, err = false) => {
     const d = el("div", { class: err ? "err" : "" }, msg);
@@ -218,7 +224,7 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
       case CH.plan: s.plan = msg; s.dirty = true; break;
       case CH.shape: s.shape = msg; s.dirty = true; break;
       case CH.alarm: onAlarm(s, msg); break;
-      case CH.health: s.health = msg; renderHealth(s); break;
+      case CH.health: s.health = msg; onInstance(s, msg); renderHealth(s); break;
       case CH.forecast: s.forecast = msg; renderForecast(s); break;
       case CH.estimateDecimated: onEstimate(s, msg); break;
     }
@@ -258,7 +264,7 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     const tab = el("button", { "data-shaft": prefix, onclick: () => select(prefix) }, el("span", { class: "dot" }), label);
     $("#tabs").append(tab);
     s = { prefix, root, banner, canvas, ro, alarmsBody, tab, lastMsg: -1e12, everData: false, cage: null, shape: null,
-          health: null, alarms: new Map(), thr: {}, dirty: true, charts: [], data: null, gap: null,
+          health: null, alarms: new Map(), rows: new Map(), instance: undefined, thr: {}, dirty: true, charts: [], data: null, gap: null,
           estBox: estimate, est: null, estCharts: [], estDirty: false, lastEst: -1e12 };
     s.estData = { x: [], th: [], hi: [], lo: [], open: [], nis: [], bound: [], nlo: [], nup: [] };
     s.data = { x: [], y_c: [], theta: [], l1: [], l2: [], l3: [], l4: [], l0: [], slk: [], ovl: [], clr: [], warn: [], crit: [], v: [], l: [] };
@@ -380,6 +386,7 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     }
     for (const k of Object.keys(old)) { old[k].length = 0; old[k].push(...fresh[k]); }
     s.historyPoints = n;
+    if (n) s.lastHistUs = Math.max(s.lastHistUs || 0, h.last_utime[n - 1]);
     s.root.dataset.historyPoints = String(n);
     s.root.dataset.historyFrom = n ? String(h.first_utime[0]) : "";
     s.dirty = true;
@@ -460,7 +467,7 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     set("t", fix(m.t, 2));
     set("l", fix(m.l, 2));
     set("y_c", fix(m.y_c * 1e3, 2));
-    set("theta", fix(m.theta * 1e3, 3));
+    renderTilt(s);
     set("v", fix(m.v, 2));
     set("min_clearance", fix(m.min_clearance * 1e3, 1));
     set("alarm_level", levelName(m.alarm_level), "lvl" + m.alarm_level);
@@ -468,7 +475,30 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     s.tab.querySelector(".dot").style.background = ["#2fbf71", "#f0b429", "#ef4444"][m.alarm_level] || "#8a96a3";
   }
 
+  // The headline tilt: what the alarms judge.  While the daemon's alarms
+  // judge the load estimate (estimate_t.in_use, a fresh estimate), the
+  // estimate's theta, with the open-loop twin's beside it; else the twin's.
+  function renderTilt(s) {
+    const e = s.est, m = s.cage;
+    const cell = $('[data-field="theta"]', s.ro);
+    if (!m) return;
+    const useEst = e && e.in_use === true && num(e.theta) && performance.now() - s.lastEst <= STALE_AFTER_MS;
+    const main = useEst ? fix(e.theta * 1e3, 3) : fix(m.theta * 1e3, 3);
+    const note = useEst ? `estimate; open loop ${fix(m.theta * 1e3, 3)}` : "";
+    if (!cell.firstChild || cell.firstChild.nodeType !== Node.TEXT_NODE) cell.prepend(document.createTextNode(""));
+    setText(cell.firstChild, main);
+    let sub = cell.querySelector(".sub");
+    if (!sub) { sub = el("span", { class: "sub", "data-field": "theta-open" }); cell.append(sub); }
+    setText(sub, note);
+    sub.hidden = !note;
+    cell.dataset.source = useEst ? "estimate" : "open-loop";
+  }
+
   // ---- alarms (ISA-18.2 states) ---------------------------------------------------
+  // One row per alarm identity (kind, level), created when the alarm enters
+  // the list and updated in place until it leaves: no row node is replaced
+  // while its alarm lives, so a click between mouse-down and mouse-up always
+  // lands on the row the operator pressed (docs/dashboard.md).
   function onAlarm(s, a) {
     for (const k of ["active", "acked", "shelved", "latched"]) a[k] = Boolean(a[k]);
     if ((a.kind === "CAGE_POS_Y" || a.kind === "CAGE_NEG_Y") && a.threshold > 0) s.thr[`${a.kind}/${a.level}`] = a.threshold;
@@ -482,7 +512,29 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
       a.dash_activation_t = raised || !prev ? a.t : prev.dash_activation_t;
       a.dash_activation_known = raised || Boolean(prev && prev.dash_activation_known);
     }
+    // When it returned to normal (RTN UNACK rows say since when).
+    a.rtnUtime = !a.active ? (prev && !prev.active && prev.rtnUtime ? prev.rtnUtime : a.utime) : 0;
     s.alarms.set(key, a);
+    renderAlarms(s);
+  }
+
+  // A new daemon instance on this shaft (health_t.instance_id changed): the
+  // alarm states of the instance that has gone are void; the new one
+  // announces its own (hoist-dash asks it to re-announce).  Events of the new
+  // instance (utime from its start on) are kept.  hoist-dash clears its own
+  // table the same way (Hub::daemonRestarted); this is the page's side.
+  function onInstance(s, h) {
+    const id = String(h.instance_id ?? "0");
+    if (id === "0") return;
+    const old = s.instance;
+    s.instance = id;
+    if (old === undefined || old === id) return;
+    const start = Number(h.utime) - Number(h.uptime) * 1e6;
+    let n = 0;
+    for (const [key, a] of s.alarms) if (!(a.utime >= start)) { s.alarms.delete(key); n++; }
+    s.root.dataset.instance = id;
+    toast(`${s.prefix || "default shaft"}: the daemon restarted (instance ${old} -> ${id})` +
+          (n ? `: ${n} alarm state(s) of the old instance cleared` : ""));
     renderAlarms(s);
   }
 
@@ -494,12 +546,22 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     return "NORMAL";
   }
 
+  // Value against threshold in the unit of the alarm's kind, from the one
+  // table beside the contract (msgs/contract/alarm_units.json -> alarm_units.js).
+  // A kind the table does not know is shown without a unit, never a wrong one.
   function fmtVal(a) {
-    if (a.kind === "INPUT_STALE" || a.kind === "MODEL_FAULT") return a.value >= 0.5 ? "on" : "off";
-    if (a.kind === "ROPE_SLACK" || a.kind === "ROPE_OVERLOAD") return `${fix(a.value / 1e3, 2)} kN / ${fix(a.threshold / 1e3, 2)} kN`;
-    // The estimator's model check: its windowed NIS (or load drift) against the bound, no unit.
-    if (a.kind === "MODEL_MISMATCH") return `${Number(a.value).toPrecision(4)} / ${Number(a.threshold).toPrecision(4)}`;
-    return `${fix(a.value * 1e3, 1)} mm / ${fix(a.threshold * 1e3, 1)} mm`;
+    const u = ALARM_UNITS[a.kind];
+    const sig = (x) => Number(x).toPrecision(4);
+    if (!u) return `${sig(a.value)} / ${sig(a.threshold)}`;
+    const one = (x, what) => {
+      const n = u.format === "sig" ? sig(x) : fix(x * (u.scale ?? 1), u.decimals ?? 1);
+      return `${n}${u.unit ? " " + u.unit : ""}${what ? " " + what : ""}`;
+    };
+    switch (u.format) {
+      case "flag": return a.value >= 0.5 ? "on" : "off";
+      case "instance": return `${u.value ? u.value + " " : ""}${fix(a.value, 0)}`;
+      default: return `${one(a.value, u.value)} / ${one(a.threshold, u.threshold)}`;
+    }
   }
 
   // Stable order: priority (CRITICAL first), then activation time (oldest
@@ -509,39 +571,83 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
   }
   const alarmName = (a) => `${a.kind} ${levelName(a.level)}`;
   const activeSince = (a) => `${a.dash_activation_known === false ? "before " : ""}${clock(a.dash_activation_utime)}`;
+  const listed = (a) => a.active || !a.acked || a.shelved;
+
+
+  function makeRow(s, key) {
+    const c = {
+      lv: el("td", { class: "lv" }), kind: el("td"), state: el("td", { class: "state" }),
+      act: el("td", { "data-field": "activation" }), actText: document.createTextNode(""),
+      re: el("span", { class: "reann", "data-field": "reannounce", hidden: "" }),
+      value: el("td", { "data-field": "value" }), valueText: document.createTextNode(""),
+      est: el("span", { class: "reann", "data-field": "from-estimate", hidden: "" }, "judged on the load estimate"),
+      user: el("td"), btns: el("td", { class: "btns cmd" }), buttons: null,
+    };
+    c.act.append(c.actText, c.re);
+    c.value.append(c.valueText, c.est);
+    const tr = el("tr", { "data-key": key });
+    tr.append(c.lv, c.kind, c.state, c.act, c.value, c.user, c.btns);
+    return { tr, c, key };
+  }
+
+  // The buttons of a row: created once (none with --read-only); each reads
+  // its alarm's identity (kind, level, activation) when pressed, never a row
+  // position.
+  function rowButtons(s, row) {
+    const want = !state.readOnly;
+    if (want === (row.c.buttons !== null)) return;
+    if (!want) { row.c.btns.textContent = ""; row.c.buttons = null; return; }
+    const mk = (label, action) => el("button", { "data-action": label.toLowerCase(),
+      onclick: () => { const a = s.alarms.get(row.key); if (a) command(s, identityOf(a), action, label); } }, label);
+    row.c.buttons = { ack: mk("Acknowledge", 1), shelve: mk("Shelve", 2), unshelve: mk("Unshelve", 3) };
+    row.c.btns.append(row.c.buttons.ack, row.c.buttons.shelve, row.c.buttons.unshelve);
+  }
+
+  const identityOf = (a) => ({ kind: a.kind, level: a.level, activation: a.dash_activation_utime, server: a.serverIdentity,
+                               name: alarmName(a), since: activeSince(a), rtn: !a.active ? clock(a.rtnUtime || a.utime) : "" });
+
+  function updateRow(s, row, a) {
+    const { tr, c } = row;
+    setAttr(tr, "class", `alarm lvl-${a.level} ${a.active ? "active" : ""} ${a.acked ? "acked" : "unacked"} ${a.shelved ? "shelved" : ""}`);
+    for (const [k, v] of [["data-kind", a.kind], ["data-level", String(a.level)], ["data-active", String(a.active)],
+                          ["data-acked", String(a.acked)], ["data-shelved", String(a.shelved)], ["data-latched", String(a.latched)],
+                          ["data-activation", String(a.dash_activation_utime)], ["data-state", stateText(a)]]) setAttr(tr, k, v);
+    setText(c.lv, levelName(a.level));
+    setText(c.kind, a.kind);
+    setAttr(c.kind, "title", a.message || "");
+    setText(c.state, stateText(a));
+    setText(c.actText, `${activeSince(a)} (t=${fix(a.dash_activation_t, 1)} s)`);
+    const re = a.dash_reannounce_utime > 0 ? ` re-announced ${clock(a.dash_reannounce_utime)}` : "";
+    setText(c.re, re);
+    c.re.hidden = !re;
+    setText(c.valueText, fmtVal(a));
+    // Newer daemons say whether the alarm judged the load estimate (alarm_t.from_estimate).
+    c.est.hidden = a.from_estimate !== true;
+    setText(c.user, a.user || "");
+    rowButtons(s, row);
+    if (c.buttons) {
+      // RTN UNACK (returned to normal, unacknowledged) is acknowledged like an active alarm.
+      c.buttons.ack.disabled = a.acked || a.shelved;
+      c.buttons.shelve.disabled = a.shelved;
+      c.buttons.unshelve.disabled = !a.shelved;
+    }
+  }
 
   function renderAlarms(s) {
     const body = s.alarmsBody;
-    body.textContent = "";
-    const rows = [...s.alarms.values()].filter((a) => a.active || !a.acked || a.shelved).sort(alarmOrder);
-    $("[data-role=no-alarms]", s.root).hidden = rows.length > 0;
-    for (const a of rows) {
-      const tr = el("tr", {
-        class: `alarm lvl-${a.level} ${a.active ? "active" : ""} ${a.acked ? "acked" : "unacked"} ${a.shelved ? "shelved" : ""}`,
-        "data-kind": a.kind, "data-level": String(a.level), "data-active": String(a.active), "data-acked": String(a.acked),
-        "data-shelved": String(a.shelved), "data-latched": String(a.latched),
-        "data-activation": String(a.dash_activation_utime),
-      });
-      const re = a.dash_reannounce_utime > 0 ? el("span", { class: "reann", "data-field": "reannounce" }, ` re-announced ${clock(a.dash_reannounce_utime)}`) : "";
-      tr.append(el("td", { class: "lv" }, levelName(a.level)),
-        el("td", { title: a.message }, a.kind),
-        el("td", { class: "state" }, stateText(a)),
-        el("td", { "data-field": "activation" }, `${activeSince(a)} (t=${fix(a.dash_activation_t, 1)} s)`, re),
-        el("td", { "data-field": "value" }, fmtVal(a),
-           // Newer daemons say whether the alarm judged the load estimate (alarm_t.from_estimate).
-           a.from_estimate === true ? el("span", { class: "reann", "data-field": "from-estimate" }, "judged on the load estimate") : ""),
-        el("td", {}, a.user || ""));
-      const btns = el("td", { class: "btns cmd" });
-      if (!state.readOnly) {
-        // Each button carries its alarm's identity (kind, level, activation),
-        // never a row position.
-        const ident = { kind: a.kind, level: a.level, activation: a.dash_activation_utime, server: a.serverIdentity, name: alarmName(a), since: activeSince(a) };
-        const mk = (label, action, enabled) => el("button", { "data-action": label.toLowerCase(), ...(enabled ? {} : { disabled: "" }),
-          onclick: () => command(s, ident, action, label) }, label);
-        btns.append(mk("Acknowledge", 1, !a.acked && !a.shelved), mk("Shelve", 2, !a.shelved), mk("Unshelve", 3, a.shelved));
-      }
-      tr.append(btns);
-      body.append(tr);
+    const alarms = [...s.alarms.values()].filter(listed).sort(alarmOrder);
+    $("[data-role=no-alarms]", s.root).hidden = alarms.length > 0;
+    const keep = new Set(alarms.map((a) => `${a.kind}/${a.level}`));
+    for (const [key, row] of s.rows) if (!keep.has(key)) { row.tr.remove(); s.rows.delete(key); }
+    let at = body.firstChild;
+    for (const a of alarms) {
+      const key = `${a.kind}/${a.level}`;
+      let row = s.rows.get(key);
+      if (!row) { row = makeRow(s, key); s.rows.set(key, row); }
+      updateRow(s, row, a);
+      // Moved only if out of place (a new row; never an existing one in a stable order).
+      if (row.tr !== at) body.insertBefore(row.tr, at);
+      else at = at.nextSibling;
     }
   }
 
@@ -551,7 +657,8 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     const cid = state.ackChannels.get(s.prefix);
     if (cid === undefined) { toast("No command channel for this shaft (read-only server?)", true); return; }
     const shelve = Number($("[data-role=shelve-s]", s.root).value);
-    const what = action === 2 ? `${label} ${ident.name} (active since ${ident.since}) for ${shelve / 60} min?` : `${label} ${ident.name} (active since ${ident.since})?`;
+    const since = ident.rtn ? `active since ${ident.since}, returned to normal at ${ident.rtn}` : `active since ${ident.since}`;
+    const what = action === 2 ? `${label} ${ident.name} (${since}) for ${shelve / 60} min?` : `${label} ${ident.name} (${since})?`;
     if (!window.confirm(what)) return;
     const cmd = { utime: 0, kind: ident.kind, level: ident.level, action, shelve_duration: action === 2 ? shelve : 0, user };
     // The server refuses the command if this alarm changed since the page drew it.
@@ -581,7 +688,6 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
 
   // Decimals that show a value to its sigma's first digit (0 for sigma >= 1).
   const sigDecimals = (sigma) => Math.min(6, Math.max(0, -Math.floor(Math.log10(sigma) + 1e-9)));
-  const num = (x) => typeof x === "number" && isFinite(x);
   function withSigma(v, sigma, scale, unit) {
     if (!num(v) || !num(sigma) || sigma < 0) return "n/a";
     const d = sigma > 0 ? sigDecimals(sigma * scale) : 3;
@@ -624,6 +730,7 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     while (cut < D.x.length && D.x[cut] < tmin) cut++;
     if (cut > 0) for (const k of Object.keys(D)) D[k].splice(0, cut);
     renderEstimate(s, e, Boolean(d.max && d.max.mismatch));
+    renderTilt(s);
     s.estDirty = true;
   }
 
@@ -631,9 +738,14 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     const box = s.estBox;
     const set = (f, text) => { $(`[data-field="est-${f}"]`, box).textContent = text; };
     box.dataset.utime = String(e.utime);
-    set("Fa", withSigma(e.Fa, e.sigma_Fa, 1, "N"));
-    set("b", withSigma(e.b, e.sigma_b, 1, "m"));
-    set("moment", withSigma(e.moment, e.sigma_moment, 1, "N·m"));
+    // estimate_t's contract: sigma < 0 is "not observed"; so is a load whose
+    // sensor was never used (fa_observed / moment_observed false), whatever
+    // its sigma (the prior's, e.g. 5000 N without a rope load cell).
+    const no = (f) => f === false || f === 0;
+    const faObs = !no(e.fa_observed), mObs = !no(e.moment_observed);
+    set("Fa", faObs ? withSigma(e.Fa, e.sigma_Fa, 1, "N") : "n/a");
+    set("b", faObs && mObs ? withSigma(e.b, e.sigma_b, 1, "m") : "n/a");
+    set("moment", mObs ? withSigma(e.moment, e.sigma_moment, 1, "N·m") : "n/a");
     set("y_c", withSigma(e.y_c, e.sigma_y_c, 1e3, "mm"));
     set("theta", `${withSigma(e.theta, e.sigma_theta, 1e3, "mrad")} (open loop ${num(e.theta_open) ? fix(e.theta_open * 1e3, 3) : "n/a"} mrad)`);
     set("nis", e.nis_dof > 0
@@ -791,12 +903,17 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     lo -= pad; hi += pad;
     const X = (t) => ml + (W - ml - mr) * t / tmax, Y = (v) => mt + (H - mt - mb) * (hi - v) / (hi - lo);
     g.font = "10px system-ui"; g.fillStyle = "#8a96a3"; g.strokeStyle = "#252c34";
-    for (let k = 0; k <= 4; k++) {
-      const v = lo + (hi - lo) * k / 4;
+    // Nice ticks labelled with as many decimals as they need (distinct), as
+    // on the trends: never "289 289 289 288".
+    const yv = splits(null, 1, lo, hi), yl = ticks(null, yv);
+    yv.forEach((v, k) => {
       g.beginPath(); g.moveTo(ml, Y(v)); g.lineTo(W - mr, Y(v)); g.stroke();
-      g.fillText(v.toPrecision(3), 2, Y(v) + 3);
-    }
-    for (let k = 0; k <= 4; k++) g.fillText(`${fix(tmax * k / 4, 0)}`, X(tmax * k / 4) - 4, H - 6);
+      g.fillText(yl[k], 2, Y(v) + 3);
+    });
+    const xv = splits(null, 0, 0, tmax), xl = ticks(null, xv);
+    xv.forEach((t, k) => g.fillText(xl[k], X(t) - 4, H - 6));
+    cv.dataset.yticks = yl.join("|");
+    cv.dataset.xticks = xl.join("|");
     for (const [v, col] of thr) {
       if (!isFinite(v)) continue;
       g.strokeStyle = col; g.setLineDash([6, 4]); g.beginPath(); g.moveTo(ml, Y(v)); g.lineTo(W - mr, Y(v)); g.stroke();
@@ -884,10 +1001,15 @@ import { CHANNELS, alarm_t } from "./hoist_msgs.js";
     const now = performance.now();
     for (const s of state.shafts.values()) {
       const age = now - s.lastMsg;
-      const st = !s.everData ? "nodata" : age > STALE_AFTER_MS ? "stale" : "ok";
+      // No cage state since the page opened, but hoist-dash's history has
+      // some (e.g. opened after an input-clock trip): STALE since its last point, not NO DATA.
+      const histOnly = !s.everData && s.lastHistUs > 0;
+      const st = !s.everData && !histOnly ? "nodata" : histOnly || age > STALE_AFTER_MS ? "stale" : "ok";
       s.banner.dataset.state = st;
+      const waiting = s.health && age <= STALE_AFTER_MS ? " (the daemon is up, waiting for winder input)" : "";
       s.banner.textContent = st === "nodata"
-        ? `NO DATA: no cage state from ${s.prefix || "the default shaft"}${s.health && age <= STALE_AFTER_MS ? " (the daemon is up, waiting for winder input)" : ""}`
+        ? `NO DATA: no cage state from ${s.prefix || "the default shaft"}${waiting}`
+        : histOnly ? `STALE: no cage state since ${clock(s.lastHistUs)}${waiting}; the trends show hoist-dash's history`
         : st === "stale" ? `STALE: no data for ${s.lastMsg < 0 ? "—" : fix(age / 1000, 1) + " s"}; values below are old` : "";
       const was = s.root.classList.contains("stale");
       s.root.classList.toggle("stale", st !== "ok");

