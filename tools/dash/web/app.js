@@ -74,7 +74,7 @@ import { ALARM_UNITS } from "./alarm_units.js";
   const state = {
     ws: null, client: null, readOnly: true, meta: {}, channels: new Map(), subs: new Map(),
     shafts: new Map(), selected: null, ackChannels: new Map(),
-    windowS: 60, notices: new Map(), historyQueue: [], historyPending: false,
+    windowS: 60, notices: new Map(), alarmEvents: 0, historyQueue: [], historyPending: false,
   };
 
   // Subscribe the next queued history once the previous one has arrived.
@@ -501,6 +501,7 @@ import { ALARM_UNITS } from "./alarm_units.js";
   // lands on the row the operator pressed (docs/dashboard.md).
   function onAlarm(s, a) {
     for (const k of ["active", "acked", "shelved", "latched"]) a[k] = Boolean(a[k]);
+    state.alarmEvents++;
     if ((a.kind === "CAGE_POS_Y" || a.kind === "CAGE_NEG_Y") && a.threshold > 0) s.thr[`${a.kind}/${a.level}`] = a.threshold;
     const key = `${a.kind}/${a.level}`;
     // The activation: hoist-dash's (kept across re-announces), else the page's own record.
@@ -533,7 +534,7 @@ import { ALARM_UNITS } from "./alarm_units.js";
     let n = 0;
     for (const [key, a] of s.alarms) if (!(a.utime >= start)) { s.alarms.delete(key); n++; }
     s.root.dataset.instance = id;
-    toast(`${s.prefix || "default shaft"}: the daemon restarted (instance ${old} -> ${id})` +
+    toast(`${s.prefix || "default shaft"}: the daemon restarted (a new instance)` +
           (n ? `: ${n} alarm state(s) of the old instance cleared` : ""));
     renderAlarms(s);
   }
@@ -633,13 +634,25 @@ import { ALARM_UNITS } from "./alarm_units.js";
     }
   }
 
+  // While a pointer is pressed on the alarm list, rows that leave it stay
+  // (greyed, buttons disabled) until it is released: the row under the
+  // operator's finger never moves between mouse-down and mouse-up.
   function renderAlarms(s) {
     const body = s.alarmsBody;
     const alarms = [...s.alarms.values()].filter(listed).sort(alarmOrder);
     $("[data-role=no-alarms]", s.root).hidden = alarms.length > 0;
     const keep = new Set(alarms.map((a) => `${a.kind}/${a.level}`));
-    for (const [key, row] of s.rows) if (!keep.has(key)) { row.tr.remove(); s.rows.delete(key); }
-    let at = body.firstChild;
+    const leaving = new Set();
+    for (const [key, row] of s.rows) {
+      if (keep.has(key)) continue;
+      if (state.pointerHeld) {
+        leaving.add(row.tr);
+        row.tr.classList.add("leaving");
+        if (row.c.buttons) for (const b of Object.values(row.c.buttons)) b.disabled = true;
+      } else { row.tr.remove(); s.rows.delete(key); }
+    }
+    const skip = (n) => { while (n && leaving.has(n)) n = n.nextSibling; return n; };
+    let at = skip(body.firstChild);
     for (const a of alarms) {
       const key = `${a.kind}/${a.level}`;
       let row = s.rows.get(key);
@@ -647,8 +660,16 @@ import { ALARM_UNITS } from "./alarm_units.js";
       updateRow(s, row, a);
       // Moved only if out of place (a new row; never an existing one in a stable order).
       if (row.tr !== at) body.insertBefore(row.tr, at);
-      else at = at.nextSibling;
+      else at = skip(at.nextSibling);
     }
+  }
+  document.addEventListener("pointerdown", (e) => { if (e.target.closest && e.target.closest(".alarms")) state.pointerHeld = true; }, true);
+  for (const ev of ["pointerup", "pointercancel"]) {
+    window.addEventListener(ev, () => {
+      if (!state.pointerHeld) return;
+      state.pointerHeld = false;
+      setTimeout(() => { for (const s of state.shafts.values()) renderAlarms(s); }, 0);  // after the click
+    }, true);
   }
 
   function command(s, ident, action, label) {
