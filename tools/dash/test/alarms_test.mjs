@@ -72,7 +72,8 @@ const before = tOpen / 1000 - hist.first;
 check(before > 3 && hist.first * 1000 >= tReplay - 2000,
       `a page opened ${((tOpen - tReplay) / 1000).toFixed(1)} s into the trip has trend points from ${before.toFixed(1)} s before it opened (${hist.n} history buckets)`);
 await page.select("#window", "30");
-await sleep(1500);
+await page.waitForFunction(() => window.hoistDash.shafts.get("").charts.every((c) => Math.abs(c.u.scales.x.max - c.u.scales.x.min - 30) < 0.01 &&
+                                                                                   (c.u.axes[1]._values || []).length > 0), { timeout: 5000 });
 const axes = await page.evaluate(() => {
   const s = window.hoistDash.shafts.get("");
   const vs = s.data.v.filter((v) => isFinite(v));
@@ -136,14 +137,10 @@ await page.type("#user", "row-test");
 const lastRow = r1[r1.length - 1];
 const [kind, level] = lastRow.id.split("/");
 const ackedBefore = await page.evaluate(() => [...document.querySelectorAll("tr.alarm")].map((tr) => `${tr.dataset.kind}/${tr.dataset.level}=${tr.dataset.acked}`));
-// (clicked inside the page: the list re-renders on every alarm event, which
-// can detach an element handle between puppeteer's look-up and its click)
-const clicked = await page.evaluate((k, l) => {
-  const b = document.querySelector(`tr.alarm[data-kind="${k}"][data-level="${l}"] button[data-action="acknowledge"]`);
-  if (!b || b.disabled) return false;
-  b.click();
-  return true;
-}, kind, level);
+// A locator: it waits for a stable, enabled button and retries a detached one.
+const ackSel = `tr.alarm[data-kind="${kind}"][data-level="${level}"] button[data-action="acknowledge"]`;
+await page.locator(ackSel).setTimeout(5000).click();
+const clicked = true;
 check(clicked, `clicked Acknowledge on the last row (${lastRow.id})`);
 await page.waitForSelector(`tr.alarm[data-kind="${kind}"][data-level="${level}"][data-acked="true"]`, { timeout: 5000 });
 const ackedAfter = await page.evaluate(() => [...document.querySelectorAll("tr.alarm")].map((tr) => `${tr.dataset.kind}/${tr.dataset.level}=${tr.dataset.acked}`));

@@ -59,7 +59,9 @@ check(true, "CAGE_POS_Y alarm raised by the daemon appears in the alarm list");
 
 // 3. Acknowledge with an operator name.
 await page.type("#user", "test-operator");
-await page.click('tr.alarm[data-kind="CAGE_POS_Y"][data-active="true"] button[data-action="acknowledge"]');
+// A locator waits for the button to be attached, visible, enabled and stable
+// (not moving) and retries if it is detached before the click: no sleeps.
+await page.locator('tr.alarm[data-kind="CAGE_POS_Y"][data-active="true"] button[data-action="acknowledge"]').setTimeout(10000).click();
 const tAck = Date.now();
 await page.waitForSelector('tr.alarm[data-kind="CAGE_POS_Y"][data-acked="true"]', { timeout: 5000 });
 check(true, `alarm turned acknowledged ${Date.now() - tAck} ms after pressing Acknowledge`);
@@ -88,7 +90,12 @@ await page.waitForFunction(() => {
   return r && r.dataset.utime;
 }, { timeout: 5000 });
 check(true, `page shows the cage state ${Date.now() - tReplay} ms after the replay started`);
-await sleep(3000);  // the cage on its way down
+// The cage on its way down: the displayed depth has changed by 5 m.
+const l0 = await page.$eval('[data-shaft=""] [data-role=readouts] [data-field="l"]', (e) => Number(e.textContent));
+await page.waitForFunction((from) => {
+  const v = Number(document.querySelector('[data-shaft=""] [data-role=readouts] [data-field="l"]').textContent);
+  return Math.abs(v - from) > 5;
+}, { timeout: 20000 }, l0);
 // 4. Depth and sway while the cage moves.
 const shown = await page.evaluate(() => {
   const r = document.querySelector('[data-shaft=""] [data-role=readouts]');
@@ -125,7 +132,9 @@ check(fc.rows.length === 2 && other && other.name.startsWith("<img") && other.cr
       "a hostile scenario name is shown as text (no element created), no violation shows 'none'");
 check(fc.clr === 70 && fc.l0 === 140, `both forecast series drawn (clearance ${fc.clr} points, lambda_0 ${fc.l0} min/max points)`);
 await page.select("#window", "10");  // the 10-s trend window for the screenshot
-await sleep(2500);
+// Drawn: every trend's x scale spans 10 s.
+await page.waitForFunction(() => window.hoistDash.shafts.get("").charts.every((c) => Math.abs(c.u.scales.x.max - c.u.scales.x.min - 10) < 0.01),
+                           { timeout: 5000 });
 await page.screenshot({ path: shot });
 console.log(`screenshot: ${shot}`);
 

@@ -148,7 +148,7 @@ const rtnSel = 'tr.alarm[data-kind="INPUT_STALE"][data-state="RTN UNACK"] button
 check(await page.$eval(rtnSel, (b) => !b.disabled), "its Acknowledge is enabled");
 const pub0 = await commandsPublished();
 const nd = dialogs.length;
-await page.locator(rtnSel).click();  // waits for a stable, enabled, visible button
+await page.locator(rtnSel).setTimeout(5000).click();  // waits for a stable, enabled, visible button
 await waitFor(async () => (await commandsPublished()) > pub0, 5000, "the RTN UNACK acknowledge to be published");
 check(dialogs.length === nd + 1 && /^Acknowledge INPUT_STALE WARNING \(active since .*, returned to normal at /.test(dialogs[nd]),
       `the confirmation says it returned to normal ("${dialogs[nd]}")`);

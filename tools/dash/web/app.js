@@ -581,7 +581,7 @@ import { ALARM_UNITS } from "./alarm_units.js";
       act: el("td", { "data-field": "activation" }), actText: document.createTextNode(""),
       re: el("span", { class: "reann", "data-field": "reannounce", hidden: "" }),
       value: el("td", { "data-field": "value" }), valueText: document.createTextNode(""),
-      est: el("span", { class: "reann", "data-field": "from-estimate", hidden: "" }, "judged on the load estimate"),
+      est: el("span", { class: "reann", "data-field": "from-estimate", hidden: "" }),
       user: el("td"), btns: el("td", { class: "btns cmd" }), buttons: null,
     };
     c.act.append(c.actText, c.re);
@@ -624,6 +624,7 @@ import { ALARM_UNITS } from "./alarm_units.js";
     setText(c.valueText, fmtVal(a));
     // Newer daemons say whether the alarm judged the load estimate (alarm_t.from_estimate).
     c.est.hidden = a.from_estimate !== true;
+    setText(c.est, c.est.hidden ? "" : "judged on the load estimate");
     setText(c.user, a.user || "");
     rowButtons(s, row);
     if (c.buttons) {
