@@ -11,6 +11,9 @@
 //               worst 40.0 mm at +6.0 s, no WARNING / CRITICAL (-1), 20 points.
 // Before the first valid message it publishes one forecast whose
 // scenarios[0].num_points claims 30000 (the checked decoder must drop it).
+// With the first valid one, a PREDICTED_CLEARANCE WARNING RAISE on
+// <prefix>HOIST_ALARM as the daemon raises it: value 19.39 s to the crossing,
+// threshold 20 s (the horizon) -- seconds, not metres.
 #include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
@@ -20,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "hoist/alarm_t.hpp"
 #include "hoist/forecast_t.hpp"
 
 namespace {
@@ -89,6 +93,21 @@ int main(int argc, char** argv) {
       lcm.publish(ch, bad.data(), static_cast<unsigned>(bad.size()));
     }
     lcm.publish(ch, b.data(), static_cast<unsigned>(b.size()));
+    if (k == 0) {
+      hoist::alarm_t a{};
+      a.utime = f.utime;
+      a.t = f.t_start;
+      a.kind = "PREDICTED_CLEARANCE";
+      a.level = hoist::alarm_t::LEVEL_WARNING;
+      a.event_type = hoist::alarm_t::EVENT_RAISE;
+      a.active = 1;
+      a.value = 19.39;
+      a.threshold = 20.0;
+      a.message = "PREDICTED_CLEARANCE WARNING raised: forecast scenario 'estop' crosses the CRITICAL clearance threshold "
+                  "in 19.4 s (horizon 20 s) [unacknowledged]";
+      a.user = "";
+      lcm.publish(prefix + "HOIST_ALARM", &a);
+    }
     std::printf("published %s seq %d (%zu bytes)\n", ch.c_str(), k, b.size());
     std::fflush(stdout);
     std::this_thread::sleep_for(std::chrono::milliseconds(period_ms));

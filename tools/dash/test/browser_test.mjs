@@ -13,7 +13,7 @@
 import fs from "node:fs";
 import path from "node:path";
 import puppeteer from "puppeteer-core";
-import { binDir, check, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
+import { binDir, check, demoConfig, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
 
 const args = process.argv.slice(2);
 const lcmPort = Number(args.find((a) => /^\d+$/.test(a)) || 7871);
@@ -28,7 +28,15 @@ const lcm = lcmUrl(lcmPort);
 // The dashboards first (the daemon announces an alarm once, then every 30 s).
 const dash = await startDash(dir, lcm, []);
 const ro = await startDash(dir, lcm, ["--read-only"], "hoist-dash-ro");
-const twin = await startTwin(dir, lcm, { replay: false });  // at rest at 50 m: the +y WARNING is on
+// The demo config without the daemon's own forecasts: the forecast panel is
+// checked against the synthetic HOIST_FORECAST below, whose scenario names
+// ("estop") the daemon's would share -- with both, the panel shows whichever
+// came last (a race that failed this test on a busy machine).
+const config = path.join(dir, "demo-noforecast.toml");
+const demoToml = fs.readFileSync(demoConfig, "utf8");
+if (/^\[forecast\]/m.test(demoToml)) fail("service/config/demo.toml has a [forecast] section now: set enabled = false there");
+fs.writeFileSync(config, `${demoToml}\n[forecast]\nenabled = false\n`);
+const twin = await startTwin(dir, lcm, { replay: false, config });  // at rest at 50 m: the +y WARNING is on
 
 const browser = await puppeteer.launch({
   executablePath: chromium, headless: true,
@@ -131,6 +139,18 @@ const other = fc.rows.find((r) => r.name !== "estop");
 check(fc.rows.length === 2 && other && other.name.startsWith("<img") && other.crit === "none" && other.warn === "none" && fc.imgs === 0,
       "a hostile scenario name is shown as text (no element created), no violation shows 'none'");
 check(fc.clr === 70 && fc.l0 === 140, `both forecast series drawn (clearance ${fc.clr} points, lambda_0 ${fc.l0} min/max points)`);
+// The forecast plots' axes: distinct tick labels (not "289 289 289 288").
+const fticks = await page.evaluate(() => [...document.querySelectorAll('[data-shaft=""] canvas.fcplot')].map((c) => ({
+  role: c.dataset.role, y: (c.dataset.yticks || "").split("|"), x: (c.dataset.xticks || "").split("|") })));
+for (const t of fticks)
+  check(t.y.length >= 3 && new Set(t.y).size === t.y.length && t.x.length >= 3 && new Set(t.x).size === t.x.length,
+        `${t.role}: distinct axis labels (y ${t.y.join(" ")}; x ${t.x.join(" ")})`);
+// PREDICTED_CLEARANCE (the forecast publisher raises it as the daemon does):
+// seconds to the crossing against the horizon, from the one table of units.
+const pcSel = 'tr.alarm[data-kind="PREDICTED_CLEARANCE"] [data-field="value"]';
+await page.waitForSelector(pcSel, { timeout: 5000 });
+const pc = await page.$eval(pcSel, (e) => e.textContent);
+check(/^\d+\.\d s to the crossing \/ \d+\.\d s horizon$/.test(pc), `PREDICTED_CLEARANCE reads in seconds: "${pc}"`);
 await page.select("#window", "10");  // the 10-s trend window for the screenshot
 // Drawn: every trend's x scale spans 10 s.
 await page.waitForFunction(() => window.hoistDash.shafts.get("").charts.every((c) => Math.abs(c.u.scales.x.max - c.u.scales.x.min - 10) < 0.01),

@@ -577,12 +577,12 @@ import { ALARM_UNITS } from "./alarm_units.js";
 
   function makeRow(s, key) {
     const c = {
-      lv: el("td", { class: "lv" }), kind: el("td"), state: el("td", { class: "state" }),
+      lv: el("td", { class: "lv" }), kind: el("td", { class: "kind" }), state: el("td", { class: "state" }),
       act: el("td", { "data-field": "activation" }), actText: document.createTextNode(""),
       re: el("span", { class: "reann", "data-field": "reannounce", hidden: "" }),
       value: el("td", { "data-field": "value" }), valueText: document.createTextNode(""),
       est: el("span", { class: "reann", "data-field": "from-estimate", hidden: "" }),
-      user: el("td"), btns: el("td", { class: "btns cmd" }), buttons: null,
+      user: el("td", { class: "user" }), btns: el("td", { class: "btns cmd" }), buttons: null,
     };
     c.act.append(c.actText, c.re);
     c.value.append(c.valueText, c.est);
