@@ -19,8 +19,9 @@
 //    restarted"), a toast says so; what is listed then is the new one's.
 // 4. The daemon's own HOIST_ESTIMATE without sensors (sigma_Fa > 0 but
 //    fa_observed false: a real daemon-style message) reads "n/a".
-// 5. The forecast plot's axis labels are distinct; no "NO DATA" above
-//    trends full of history (a page opened during an input-clock trip).
+// 5. A page opened after an input-clock trip (the daemon publishes no cage
+//    state between trips) shows STALE since the history's last point above
+//    trends full of history, not "NO DATA".
 import fs from "node:fs";
 import path from "node:path";
 import puppeteer from "puppeteer-core";
@@ -193,6 +194,28 @@ const st = (await stats(dash.url)).counters;
 check(st.daemon_restarts === 1 && st.alarms_cleared_restart >= 1, `hoist-dash counted the restart (${st.daemon_restarts}) and cleared ${st.alarms_cleared_restart} alarm(s)`);
 const rec2 = await page.evaluate(() => window.rowsRec);
 check(rec2.replaced.length === 0 && rec2.moved.length === 0, "still no row replaced or moved");
+
+// ---- 5. a page opened after an input-clock trip: STALE over the history, not NO DATA -------------
+await stop(replay);
+await stop(twind);
+const twindInput = start("hoist-twind-input", path.join(binDir, "hoist-twind"), ["--config", config, "--lcm-url", lcm, "--clock", "input"], dir);
+await sleep(500);
+if (twindInput.exitCode !== null) fail(`hoist-twind --clock input exited: ${fs.readFileSync(path.join(dir, "hoist-twind-input.log"), "utf8")}`);
+replay = start("hoist-replay-3", path.join(binDir, "hoist-replay"), replayArgs, dir);
+await page.waitForFunction(() => { const r = document.querySelector('[data-shaft=""] [data-role=readouts]'); return r && Number(r.querySelector('[data-field="l"]').textContent) > 52; }, { timeout: 15000 });
+await stop(replay);  // the trip stops: an input-clock twin publishes no more cage states
+const late = await browser.newPage();
+await late.goto(dash.url, { waitUntil: "load" });
+const banner = await late.waitForFunction(() => {
+  const s = window.hoistDash && window.hoistDash.shafts.get("");
+  const b = document.querySelector('[data-shaft=""] [data-role=stale]');
+  return s && s.historyPoints > 0 && b && b.dataset.state !== "nodata" ? { state: b.dataset.state, text: b.textContent, n: s.historyPoints } : null;
+}, { timeout: 8000 }).then((h) => h.jsonValue());
+check(banner.state === "stale" && /^STALE: no cage state since \d\d:\d\d:\d\d/.test(banner.text),
+      `a page opened after the trip shows "${banner.text}" above ${banner.n} history buckets, not NO DATA`);
+await late.close();
+await stop(twindInput);
+twind = twindInput;
 
 await page.screenshot({ path: path.join(dir, "rows.png") });
 check(errors.length === 0, `no errors in the page's console (${errors.join(" | ")})`);
