@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 #include <set>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -21,6 +22,8 @@
 #include "attack_bytes.hpp"
 #include "hub.hpp"
 #include "static_files.hpp"
+#include "server.hpp"
+#include "credential.hpp"
 
 namespace hoist::dash {
 namespace {
@@ -701,6 +704,57 @@ TEST(AlarmUnitsTest, EveryAlarmKindHasAUnitFromTheOneTable) {
   EXPECT_EQ(kinds["CAGE_POS_Y"]["unit"], "mm");
   EXPECT_EQ(kinds["CAGE_POS_Y"]["scale"], 1000);
   EXPECT_EQ(kinds["ROPE_SLACK"]["unit"], "kN");
+}
+
+// Issue 33: one local process can bind all of 127.0.0.0/8 (and ::1), one
+// remote host a whole IPv6 /64: each is one peer for the per-peer limits.
+TEST(PeerTest, LoopbackIsOnePeerAndEachIpv6Slash64IsOne) {
+  namespace ip = boost::asio::ip;
+  EXPECT_EQ(Server::peerOf(ip::make_address("127.0.0.1")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("127.0.0.2")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("127.255.3.9")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("::1")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("::ffff:127.0.0.5")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("10.1.2.3")), "10.1.2.3");
+  EXPECT_EQ(Server::peerOf(ip::make_address("::ffff:10.1.2.3")), "10.1.2.3");
+  EXPECT_NE(Server::peerOf(ip::make_address("10.1.2.3")), Server::peerOf(ip::make_address("10.1.2.4")));
+  EXPECT_EQ(Server::peerOf(ip::make_address("2001:db8:1:2::1")), "2001:db8:1:2::/64");
+  EXPECT_EQ(Server::peerOf(ip::make_address("2001:db8:1:2:ffff:ffff:ffff:ffff")), "2001:db8:1:2::/64");
+  EXPECT_EQ(Server::peerOf(ip::make_address("2001:db8:1:3::1")), "2001:db8:1:3::/64");
+  EXPECT_EQ(Server::peerOf(ip::make_address("fd00::2")), "fd00:0:0:0::/64");
+}
+
+// The token of authenticated clients: where a request presents it, and the
+// credential it is read from ($CREDENTIALS_DIRECTORY, systemd's LoadCredential=).
+TEST(PeerTest, TokenIsPresentedByBearerCookieOrQueryAndReadThroughLoadCredential) {
+  EXPECT_EQ(Server::presentedToken("Bearer abc", "", "/"), "abc");
+  EXPECT_EQ(Server::presentedToken("", "x=1; hoist_dash_token=tok; y=2", "/"), "tok");
+  EXPECT_EQ(Server::presentedToken("", "hoist_dash_tokenX=no", "/?a=1&token=q"), "q");
+  EXPECT_EQ(Server::presentedToken("Basic abc", "", "/index.html"), "");
+  const std::string dir = ::testing::TempDir() + "hoist-dash-cred";
+  std::filesystem::create_directories(dir);
+  ::setenv("CREDENTIALS_DIRECTORY", dir.c_str(), 1);
+  EXPECT_FALSE(readCredential("hoist-dash-token").found);
+  std::ofstream(dir + "/hoist-dash-token") << "0123456789abcdef0123\n";
+  Credential c = readCredential("hoist-dash-token");
+  EXPECT_TRUE(c.found && c.error.empty());
+  EXPECT_EQ(c.value, "0123456789abcdef0123");
+  std::ofstream(dir + "/short") << "abc";
+  c = readCredential("short");
+  EXPECT_TRUE(c.found && c.value.empty());
+  EXPECT_NE(c.error.find("16 to 256"), std::string::npos) << c.error;
+  EXPECT_NE(readCredential("../etc/passwd").error, "");
+  Server::Limits lim;
+  lim.token = "0123456789abcdef0123";
+  boost::asio::io_context io;
+  Hub hub(Hub::Options{}, [](const std::string&, const std::vector<std::uint8_t>&) { return true; },
+          [] { return std::uint64_t{1}; });
+  StaticFiles files;
+  Server srv(io, hub, files, lim);
+  EXPECT_TRUE(srv.tokenMatches("0123456789abcdef0123"));
+  EXPECT_FALSE(srv.tokenMatches("0123456789abcdef0124"));
+  EXPECT_FALSE(srv.tokenMatches(""));
+  ::unsetenv("CREDENTIALS_DIRECTORY");
 }
 
 TEST(StaticFilesTest, OnlyKnownFilesTraversalRefusedInEveryEncoding) {
