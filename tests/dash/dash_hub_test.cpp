@@ -732,6 +732,7 @@ TEST(PeerTest, TokenIsPresentedByBearerCookieOrQueryAndReadThroughLoadCredential
   EXPECT_EQ(Server::presentedToken("", "hoist_dash_tokenX=no", "/?a=1&token=q"), "q");
   EXPECT_EQ(Server::presentedToken("Basic abc", "", "/index.html"), "");
   const std::string dir = ::testing::TempDir() + "hoist-dash-cred";
+  std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   ::setenv("CREDENTIALS_DIRECTORY", dir.c_str(), 1);
   EXPECT_FALSE(readCredential("hoist-dash-token").found);

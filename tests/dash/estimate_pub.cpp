@@ -28,6 +28,7 @@
 #include <thread>
 
 #include "hoist/alarm_t.hpp"
+#include "raised_alarm.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/estimate_t.hpp"
 
@@ -95,17 +96,8 @@ int main(int argc, char** argv) {
       e.mismatch = 1;
       e.nis_exceeded = 1;
       if (k == 0) {
-        hoist::alarm_t a{};
-        a.utime = e.utime;
-        a.t = e.t;
-        a.kind = "MODEL_MISMATCH";
-        a.level = hoist::alarm_t::LEVEL_WARNING;
-        a.event_type = hoist::alarm_t::EVENT_RAISE;
-        a.active = 1;
-        a.value = 450.0;
-        a.threshold = 372.0;
-        a.message = "MODEL_MISMATCH WARNING raised: the shaft does not behave like its model";
-        a.user = "";
+        const hoist::alarm_t a = raisedAlarm(e.utime, e.t, "MODEL_MISMATCH", hoist::alarm_t::LEVEL_WARNING, 450.0, 372.0,
+                                             "MODEL_MISMATCH WARNING raised: the shaft does not behave like its model");
         lcm.publish(prefix + "HOIST_ALARM", &a);
       }
     } else if (mode == "norope") {

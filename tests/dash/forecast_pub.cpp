@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "hoist/alarm_t.hpp"
+#include "raised_alarm.hpp"
 #include "hoist/forecast_t.hpp"
 
 namespace {
@@ -94,18 +95,10 @@ int main(int argc, char** argv) {
     }
     lcm.publish(ch, b.data(), static_cast<unsigned>(b.size()));
     if (k == 0) {
-      hoist::alarm_t a{};
-      a.utime = f.utime;
-      a.t = f.t_start;
-      a.kind = "PREDICTED_CLEARANCE";
-      a.level = hoist::alarm_t::LEVEL_WARNING;
-      a.event_type = hoist::alarm_t::EVENT_RAISE;
-      a.active = 1;
-      a.value = 19.39;
-      a.threshold = 20.0;
-      a.message = "PREDICTED_CLEARANCE WARNING raised: forecast scenario 'estop' crosses the CRITICAL clearance threshold "
-                  "in 19.4 s (horizon 20 s) [unacknowledged]";
-      a.user = "";
+      const hoist::alarm_t a = raisedAlarm(
+          f.utime, f.t_start, "PREDICTED_CLEARANCE", hoist::alarm_t::LEVEL_WARNING, 19.39, 20.0,
+          "PREDICTED_CLEARANCE WARNING raised: forecast scenario 'estop' crosses the CRITICAL clearance threshold "
+          "in 19.4 s (horizon 20 s) [unacknowledged]");
       lcm.publish(prefix + "HOIST_ALARM", &a);
     }
     std::printf("published %s seq %d (%zu bytes)\n", ch.c_str(), k, b.size());

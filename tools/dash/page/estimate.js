@@ -1,6 +1,6 @@
 // hoist-dash page: the load-estimate panel and its trends.
 import { KEEP_S, state } from "./state.js";
-import { $, el, fix, num } from "./util.js";
+import { $, el, fix, num, keepWindow } from "./util.js";
 import { chartSize, spanAtLeast, splits, ticks, renderTilt } from "./trends.js";
 
 // ---- load estimate (only when HOIST_ESTIMATE publishes) ----------------------------
@@ -59,12 +59,7 @@ export function onEstimate(s, d) {
   } else {
     push(t1, vals(e, e.sigma_theta));
   }
-  const n = D.x.length;
-  if (n > 1 && D.x[n - 1] < D.x[n - 2]) for (const k of Object.keys(D)) D[k].splice(0, n - 1);
-  const tmin = D.x[D.x.length - 1] - KEEP_S;
-  let cut = 0;
-  while (cut < D.x.length && D.x[cut] < tmin) cut++;
-  if (cut > 0) for (const k of Object.keys(D)) D[k].splice(0, cut);
+  keepWindow(D, KEEP_S);
   renderEstimate(s, e, Boolean(d.max && d.max.mismatch));
   renderTilt(s);
   s.estDirty = true;

@@ -2,7 +2,7 @@
 // headline tilt.
 import { alarm_t } from "./hoist_msgs.js";
 import { STALE_AFTER_MS, KEEP_S, state } from "./state.js";
-import { levelName, $, el, fix, num, setText } from "./util.js";
+import { levelName, $, el, fix, num, setText, keepWindow } from "./util.js";
 import { subscribe } from "./main.js";
 
 // ---- trends -------------------------------------------------------------------
@@ -153,12 +153,7 @@ export function onCage(s, d) {
   }
   // Keep order (a restarted daemon) and length bounded.
   const D = s.data;
-  const n = D.x.length;
-  if (n > 1 && D.x[n - 1] < D.x[n - 2]) for (const k of Object.keys(D)) D[k].splice(0, n - 1);
-  const tmin = D.x[D.x.length - 1] - KEEP_S;
-  let cut = 0;
-  while (cut < D.x.length && D.x[cut] < tmin) cut++;
-  if (cut > 0) for (const k of Object.keys(D)) D[k].splice(0, cut);
+  keepWindow(D, KEEP_S);
   renderReadouts(s, last);
   s.dirty = true;
 }

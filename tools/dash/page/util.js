@@ -33,3 +33,15 @@ export const toast = (msg, err = false) => {
   setTimeout(() => d.remove(), err ? 8000 : 4000);
   while ($("#toast").children.length > 5) $("#toast").firstChild.remove();
 };
+
+// A trend's columns (x and its series, by key) kept in time order (a
+// restarted daemon's time goes back: its older points go) and to the last
+// `keepS` seconds.
+export function keepWindow(D, keepS) {
+  const n = D.x.length;
+  if (n > 1 && D.x[n - 1] < D.x[n - 2]) for (const k of Object.keys(D)) D[k].splice(0, n - 1);
+  const tmin = D.x[D.x.length - 1] - keepS;
+  let cut = 0;
+  while (cut < D.x.length && D.x[cut] < tmin) cut++;
+  if (cut > 0) for (const k of Object.keys(D)) D[k].splice(0, cut);
+}

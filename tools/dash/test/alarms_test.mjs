@@ -23,15 +23,12 @@
 //    lasts; the forged tabs leave once they age out.
 import fs from "node:fs";
 import path from "node:path";
-import puppeteer from "puppeteer-core";
 import WebSocket from "ws";
-import { binDir, check, demoConfig, fail, lcmUrl, sleep, start, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
+import { binDir, check, openBrowser, demoConfig, fail, lcmUrl, sleep, start, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
 
 const lcmPort = Number(process.argv[2] || 7983);
 const dir = workDir("alarms");
 const lcm = lcmUrl(lcmPort);
-const chromium = process.env.CHROMIUM || ["/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"].find((p) => fs.existsSync(p));
-if (!chromium) fail("no Chromium found (scripts/setup.sh installs Debian's chromium)");
 // The demo configuration, re-announcing every 2 s.
 const config = path.join(dir, "demo-reannounce.toml");
 fs.writeFileSync(config, fs.readFileSync(demoConfig, "utf8").replace(/^reannounce\s*=.*$/m, "reannounce = 2.0"));
@@ -45,21 +42,7 @@ const replay = start("hoist-replay", path.join(binDir, "hoist-replay"), ["--lcm-
 const tReplay = Date.now();
 await sleep(6000);  // history accumulates before any page is open
 
-const browser = await puppeteer.launch({
-  executablePath: chromium, headless: true,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1180"],
-  defaultViewport: { width: 1500, height: 1180 },
-});
-const page = await browser.newPage();
-const errors = [], dialogs = [];
-page.on("pageerror", (e) => errors.push(String(e)));
-page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
-page.on("dialog", async (d) => { dialogs.push(d.message()); await d.accept(); });
-process.on("uncaughtException", async (e) => {
-  console.error(`FAIL: ${e.message}`);
-  try { await page.screenshot({ path: path.join(dir, "failure.png") }); console.error(`page: ${path.join(dir, "failure.png")}`); } catch { /* gone */ }
-  process.exit(1);
-});
+const { browser, page, errors, dialogs } = await openBrowser(dir);
 const tOpen = Date.now();
 await page.goto(dash.url, { waitUntil: "load" });
 

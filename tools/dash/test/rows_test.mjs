@@ -24,15 +24,12 @@
 //    trends full of history, not "NO DATA".
 import fs from "node:fs";
 import path from "node:path";
-import puppeteer from "puppeteer-core";
-import { binDir, check, demoConfig, fail, lcmUrl, sleep, start, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
+import { binDir, check, openBrowser, demoConfig, fail, lcmUrl, sleep, start, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
 
 const lcmPort = Number(process.argv[2] || 7996);
 const seconds = Number(process.argv[3] || 60);
 const dir = workDir("rows");
 const lcm = lcmUrl(lcmPort);
-const chromium = process.env.CHROMIUM || ["/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"].find((p) => fs.existsSync(p));
-if (!chromium) fail("no Chromium found (scripts/setup.sh installs Debian's chromium)");
 console.log(`work dir ${dir}, LCM ${lcm}`);
 const config = path.join(dir, "demo-rows.toml");
 let toml = fs.readFileSync(demoConfig, "utf8").replace(/^reannounce\s*=.*$/m, "reannounce = 2.0");
@@ -48,21 +45,7 @@ if (twind.exitCode !== null) fail(`hoist-twind exited: ${fs.readFileSync(path.jo
 const replayArgs = ["--lcm-url", lcm, "--profile", "paper", "-q"];
 let replay = start("hoist-replay", path.join(binDir, "hoist-replay"), replayArgs, dir);
 
-const browser = await puppeteer.launch({
-  executablePath: chromium, headless: true,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1180"],
-  defaultViewport: { width: 1500, height: 1180 },
-});
-const page = await browser.newPage();
-const errors = [], dialogs = [];
-page.on("pageerror", (e) => errors.push(String(e)));
-page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
-page.on("dialog", async (d) => { dialogs.push(d.message()); await d.accept(); });
-process.on("uncaughtException", async (e) => {
-  console.error(`FAIL: ${e.message}`);
-  try { await page.screenshot({ path: path.join(dir, "failure.png") }); console.error(`page: ${path.join(dir, "failure.png")}`); } catch { /* gone */ }
-  process.exit(1);
-});
+const { browser, page, errors, dialogs } = await openBrowser(dir);
 await page.goto(dash.url, { waitUntil: "load" });
 await page.waitForSelector('[data-shaft=""] .alarms tbody', { timeout: 10000 });
 await page.type("#user", "rows-test");
@@ -116,8 +99,13 @@ while (Date.now() - t0 < seconds * 1000) {
       await page.mouse.up();
       if (onIt) {
         presses++;
+        // Handled: confirmed and published -- or, when the alarm was raised
+        // again between the page's drawing and the command, refused with
+        // hoist-dash's "changed since your page drew it" (the operator is told).
+        const refusedStale = () => page.evaluate((k) => [...document.querySelectorAll("#toast div")]
+          .some((d) => d.textContent.startsWith(`refused: ${k.split("/")[0]} `) && d.textContent.includes("changed since your page drew it")), key);
         const tPress = Date.now();
-        while (!(dialogs.length > nDialogs && (await commandsPublished()) > before)) {
+        while (!(dialogs.length > nDialogs && ((await commandsPublished()) > before || await refusedStale()))) {
           if (Date.now() - tPress > 5000) {
             const why = await page.evaluate(() => [...document.querySelectorAll("#toast div")].map((d) => d.textContent).join(" | "));
             fail(`press ${presses} of Acknowledge on ${key} was lost: ${dialogs.length - nDialogs} confirmation(s), ` +
@@ -137,7 +125,7 @@ const events = await page.evaluate((n) => window.hoistDash.alarmEvents - n, even
 check(events >= seconds / 2, `${events} alarm events (raises, clears, re-announces) over ${seconds} s; ${rec.added} rows added, ${rec.removed} removed`);
 check(rec.replaced.length === 0 && rec.moved.length === 0,
       `no row replaced or moved while its alarm lives (replaced: ${rec.replaced.join(",") || "none"}; moved: ${rec.moved.join(",") || "none"})`);
-check(presses >= 1 && pressesSent === presses, `every Acknowledge press held 300 ms was published (${pressesSent} of ${presses})`);
+check(presses >= 1 && pressesSent === presses, `every Acknowledge press held 300 ms was confirmed and published, or refused as stale with a message (${pressesSent} of ${presses})`);
 
 // ---- 2. RTN UNACK -----------------------------------------------------------------------
 await stop(replay);
