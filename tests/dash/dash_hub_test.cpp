@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <set>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -15,9 +18,12 @@
 #include "hoist/estimate_t.hpp"
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/msg/names.hpp"
 #include "attack_bytes.hpp"
 #include "hub.hpp"
 #include "static_files.hpp"
+#include "server.hpp"
+#include "credential.hpp"
 
 namespace hoist::dash {
 namespace {
@@ -520,6 +526,62 @@ TEST_F(HubClockTest, ActivationKeptAcrossReannouncesAndStaleCommandsRefused) {
   EXPECT_EQ(pub.size(), 1u);
 }
 
+// Issue 35 item 3: a new daemon instance on the same prefix (the daemon was
+// killed and restarted) voids the alarm states of the instance that has gone:
+// hoist-dash drops them from its table (a page opened later never sees them)
+// and sends each subscriber a CLEAR that takes the row off its list; alarms
+// of the new instance (utime from its start on) are kept, and the new
+// instance is asked to re-announce its own.  Same instance again: nothing.
+TEST_F(HubClockTest, ANewDaemonInstanceClearsTheAlarmsOfTheOneThatHasGone) {
+  Hub hub = makeTimed({""});
+  hub.requestAlarmStates();
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "HOIST_ALARM")}}}}}.dump());
+  auto healthAt = [&](std::int64_t instance, std::int64_t utime, double uptime) {
+    health_t h{};
+    h.instance_id = instance;
+    h.utime = utime;
+    h.uptime = uptime;
+    const auto b = encode(h);
+    hub.onLcm("HOIST_HEALTH", b.data(), b.size());
+  };
+  healthAt(7, 100'000'000, 100.0);  // instance 7, up since utime 0
+  alarm(hub, "CAGE_NEG_Y", 1, 50'000'000);
+  alarm(hub, "PREDICTED_CLEARANCE", 1, 60'000'000);
+  healthAt(7, 101'000'000, 101.0);
+  const auto before = c.data.size();
+  ASSERT_EQ(before, 2u);
+  // Killed at 102 s; instance 9 starts at 200 s and raises CAGE_POS_Y before its first health.
+  alarm(hub, "CAGE_POS_Y", 1, 200'500'000);
+  const auto requests = pub.size();
+  healthAt(9, 201'000'000, 1.0);
+  EXPECT_EQ(hub.counter("daemon_restarts"), 1u);
+  EXPECT_EQ(hub.counter("alarms_cleared_restart"), 2u);
+  ASSERT_EQ(c.data.size(), before + 1 + 2) << "CAGE_POS_Y, then one CLEAR per alarm of the old instance";
+  std::set<std::string> cleared;
+  for (std::size_t i = before + 1; i < c.data.size(); ++i) {
+    const Json a = Json::parse(c.data[i].substr(13));
+    EXPECT_FALSE(a["active"].get<bool>());
+    EXPECT_TRUE(a["acked"].get<bool>()) << "acknowledged and inactive: normal, off every list";
+    EXPECT_EQ(a["event_type"], 2);
+    EXPECT_NE(a["message"].get<std::string>().find("the daemon restarted"), std::string::npos);
+    cleared.insert(a["kind"].get<std::string>());
+  }
+  EXPECT_EQ(cleared, (std::set<std::string>{"CAGE_NEG_Y", "PREDICTED_CLEARANCE"}));
+  EXPECT_GT(pub.size(), requests) << "the new instance is asked to re-announce";
+  // A page subscribing now gets only the new instance's alarm.
+  RecClient late;
+  hub.addClient(late);
+  hub.onClientText(late, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 4}, {"channelId", channelId(late, "HOIST_ALARM")}}}}}.dump());
+  ASSERT_EQ(late.data.size(), 1u);
+  EXPECT_EQ(Json::parse(late.data[0].substr(13))["kind"], "CAGE_POS_Y");
+  // The same instance again clears nothing.
+  healthAt(9, 202'000'000, 2.0);
+  EXPECT_EQ(hub.counter("daemon_restarts"), 1u);
+  EXPECT_EQ(c.data.size(), before + 3);
+}
+
 // hoist-dash asks each shaft's daemon for its alarms' current states
 // (alarm_ack_t ACTION_REANNOUNCE) once its LCM receive path is open: when a
 // daemon's health first arrives (a fixed prefix), when a discovered shaft is
@@ -614,6 +676,86 @@ TEST_F(HubClockTest, HistoryIsSentOnSubscribeAndBounded) {
                                            Hub::historyFields().begin());
   EXPECT_DOUBLE_EQ(h["min"][10][yi].get<double>(), 0.0);  // min and max of each bucket
   EXPECT_DOUBLE_EQ(h["max"][10][yi].get<double>(), 0.006);
+}
+
+// Issue 35 item 4: the display unit of every alarm kind comes from one table
+// beside the contract (msgs/contract/alarm_units.json; the page imports it as
+// the generated alarm_units.js).  Every KIND_ of alarm_t.lcm has a row, each
+// row a known format; PREDICTED_CLEARANCE reads in seconds (to the crossing
+// against the horizon), not millimetres; the clearance kinds in mm.
+TEST(AlarmUnitsTest, EveryAlarmKindHasAUnitFromTheOneTable) {
+  std::ifstream in(HOIST_ALARM_UNITS_JSON);
+  ASSERT_TRUE(in) << HOIST_ALARM_UNITS_JSON;
+  const Json t = Json::parse(in, nullptr, false);
+  ASSERT_TRUE(t.is_object() && t.contains("kinds")) << "not a JSON table with \"kinds\"";
+  const Json& kinds = t["kinds"];
+  for (const auto name : msg::enums::alarm_t::kKindNames) {
+    const std::string k(name);
+    ASSERT_TRUE(kinds.contains(k)) << "alarm_units.json has no row for " << k << " (a new KIND_ of alarm_t.lcm?)";
+    const std::string f = kinds[k].value("format", "");
+    EXPECT_TRUE(f == "fixed" || f == "sig" || f == "flag" || f == "instance") << k << ": format '" << f << "'";
+    if (f == "fixed") {
+      EXPECT_TRUE(kinds[k].contains("scale") && kinds[k].contains("decimals") && kinds[k].contains("unit")) << k;
+    }
+  }
+  EXPECT_EQ(kinds.size(), msg::enums::alarm_t::kKindNames.size()) << "a row for a kind alarm_t.lcm does not have";
+  EXPECT_EQ(kinds["PREDICTED_CLEARANCE"]["unit"], "s");
+  EXPECT_EQ(kinds["PREDICTED_CLEARANCE"]["scale"], 1);
+  EXPECT_EQ(kinds["CAGE_POS_Y"]["unit"], "mm");
+  EXPECT_EQ(kinds["CAGE_POS_Y"]["scale"], 1000);
+  EXPECT_EQ(kinds["ROPE_SLACK"]["unit"], "kN");
+}
+
+// Issue 33: one local process can bind all of 127.0.0.0/8 (and ::1), one
+// remote host a whole IPv6 /64: each is one peer for the per-peer limits.
+TEST(PeerTest, LoopbackIsOnePeerAndEachIpv6Slash64IsOne) {
+  namespace ip = boost::asio::ip;
+  EXPECT_EQ(Server::peerOf(ip::make_address("127.0.0.1")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("127.0.0.2")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("127.255.3.9")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("::1")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("::ffff:127.0.0.5")), "loopback");
+  EXPECT_EQ(Server::peerOf(ip::make_address("10.1.2.3")), "10.1.2.3");
+  EXPECT_EQ(Server::peerOf(ip::make_address("::ffff:10.1.2.3")), "10.1.2.3");
+  EXPECT_NE(Server::peerOf(ip::make_address("10.1.2.3")), Server::peerOf(ip::make_address("10.1.2.4")));
+  EXPECT_EQ(Server::peerOf(ip::make_address("2001:db8:1:2::1")), "2001:db8:1:2::/64");
+  EXPECT_EQ(Server::peerOf(ip::make_address("2001:db8:1:2:ffff:ffff:ffff:ffff")), "2001:db8:1:2::/64");
+  EXPECT_EQ(Server::peerOf(ip::make_address("2001:db8:1:3::1")), "2001:db8:1:3::/64");
+  EXPECT_EQ(Server::peerOf(ip::make_address("fd00::2")), "fd00:0:0:0::/64");
+}
+
+// The token of authenticated clients: where a request presents it, and the
+// credential it is read from ($CREDENTIALS_DIRECTORY, systemd's LoadCredential=).
+TEST(PeerTest, TokenIsPresentedByBearerCookieOrQueryAndReadThroughLoadCredential) {
+  EXPECT_EQ(Server::presentedToken("Bearer abc", "", "/"), "abc");
+  EXPECT_EQ(Server::presentedToken("", "x=1; hoist_dash_token=tok; y=2", "/"), "tok");
+  EXPECT_EQ(Server::presentedToken("", "hoist_dash_tokenX=no", "/?a=1&token=q"), "q");
+  EXPECT_EQ(Server::presentedToken("Basic abc", "", "/index.html"), "");
+  const std::string dir = ::testing::TempDir() + "hoist-dash-cred";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  ::setenv("CREDENTIALS_DIRECTORY", dir.c_str(), 1);
+  EXPECT_FALSE(readCredential("hoist-dash-token").found);
+  std::ofstream(dir + "/hoist-dash-token") << "0123456789abcdef0123\n";
+  Credential c = readCredential("hoist-dash-token");
+  EXPECT_TRUE(c.found && c.error.empty());
+  EXPECT_EQ(c.value, "0123456789abcdef0123");
+  std::ofstream(dir + "/short") << "abc";
+  c = readCredential("short");
+  EXPECT_TRUE(c.found && c.value.empty());
+  EXPECT_NE(c.error.find("16 to 256"), std::string::npos) << c.error;
+  EXPECT_NE(readCredential("../etc/passwd").error, "");
+  Server::Limits lim;
+  lim.token = "0123456789abcdef0123";
+  boost::asio::io_context io;
+  Hub hub(Hub::Options{}, [](const std::string&, const std::vector<std::uint8_t>&) { return true; },
+          [] { return std::uint64_t{1}; });
+  StaticFiles files;
+  Server srv(io, hub, files, lim);
+  EXPECT_TRUE(srv.tokenMatches("0123456789abcdef0123"));
+  EXPECT_FALSE(srv.tokenMatches("0123456789abcdef0124"));
+  EXPECT_FALSE(srv.tokenMatches(""));
+  ::unsetenv("CREDENTIALS_DIRECTORY");
 }
 
 TEST(StaticFilesTest, OnlyKnownFilesTraversalRefusedInEveryEncoding) {

@@ -14,7 +14,10 @@
 //             MODEL_MISMATCH WARNING RAISE on <prefix>HOIST_ALARM (value 450,
 //             threshold 372), as the daemon raises it;
 //   norope    the rope load cell is gone: Fa and b not observed (sigma -1),
-//             sensors = IMU only.
+//             sensors = IMU only;
+//   inuse     as normal, the daemon's alarms judge the estimate (in_use), and
+//             a cage_state_t of the open-loop twin (theta = theta_open =
+//             8.3e-4 rad, l, y_c) on <prefix>HOIST_CAGE with each estimate.
 #include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
@@ -25,18 +28,20 @@
 #include <thread>
 
 #include "hoist/alarm_t.hpp"
+#include "raised_alarm.hpp"
+#include "hoist/cage_state_t.hpp"
 #include "hoist/estimate_t.hpp"
 
 int main(int argc, char** argv) {
   if (argc < 5) {
-    std::fprintf(stderr, "usage: hoist-test-estimate-pub LCM_URL PREFIX COUNT PERIOD_MS [normal|mismatch|norope]\n");
+    std::fprintf(stderr, "usage: hoist-test-estimate-pub LCM_URL PREFIX COUNT PERIOD_MS [normal|mismatch|norope|inuse]\n");
     return 2;
   }
   const std::string prefix = argv[2];
   const int count = std::atoi(argv[3]);
   const int period_ms = std::atoi(argv[4]);
   const std::string mode = argc > 5 ? argv[5] : "normal";
-  if (mode != "normal" && mode != "mismatch" && mode != "norope") {
+  if (mode != "normal" && mode != "mismatch" && mode != "norope" && mode != "inuse") {
     std::fprintf(stderr, "hoist-test-estimate-pub: unknown MODE '%s'\n", mode.c_str());
     return 2;
   }
@@ -91,17 +96,8 @@ int main(int argc, char** argv) {
       e.mismatch = 1;
       e.nis_exceeded = 1;
       if (k == 0) {
-        hoist::alarm_t a{};
-        a.utime = e.utime;
-        a.t = e.t;
-        a.kind = "MODEL_MISMATCH";
-        a.level = hoist::alarm_t::LEVEL_WARNING;
-        a.event_type = hoist::alarm_t::EVENT_RAISE;
-        a.active = 1;
-        a.value = 450.0;
-        a.threshold = 372.0;
-        a.message = "MODEL_MISMATCH WARNING raised: the shaft does not behave like its model";
-        a.user = "";
+        const hoist::alarm_t a = raisedAlarm(e.utime, e.t, "MODEL_MISMATCH", hoist::alarm_t::LEVEL_WARNING, 450.0, 372.0,
+                                             "MODEL_MISMATCH WARNING raised: the shaft does not behave like its model");
         lcm.publish(prefix + "HOIST_ALARM", &a);
       }
     } else if (mode == "norope") {
@@ -111,6 +107,25 @@ int main(int argc, char** argv) {
       e.sensors = 3;  // the IMU only
       e.rope_load_age = -1.0;
       e.fa_observed = 0;
+    }
+    if (mode == "inuse") {
+      e.in_use = 1;
+      hoist::cage_state_t c{};
+      c.utime = e.utime;
+      c.seq = k;
+      c.instance_id = e.instance_id;
+      c.t = e.t;
+      c.l = e.l;
+      c.v = e.v;
+      c.y_c = 2.9e-3;
+      c.theta = e.theta_open;
+      c.y_top = c.y_bottom = c.y_c;
+      c.clearance_pos_y = 0.016 - c.y_c;
+      c.clearance_neg_y = 0.016 + c.y_c;
+      c.clearance_guide = 0.3;
+      c.min_clearance = c.clearance_pos_y;
+      c.lambdas[0] = 31000.0;
+      lcm.publish(prefix + "HOIST_CAGE", &c);
     }
     lcm.publish(ch, &e);
     std::this_thread::sleep_for(std::chrono::milliseconds(period_ms));

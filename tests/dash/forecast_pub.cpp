@@ -11,6 +11,9 @@
 //               worst 40.0 mm at +6.0 s, no WARNING / CRITICAL (-1), 20 points.
 // Before the first valid message it publishes one forecast whose
 // scenarios[0].num_points claims 30000 (the checked decoder must drop it).
+// With the first valid one, a PREDICTED_CLEARANCE WARNING RAISE on
+// <prefix>HOIST_ALARM as the daemon raises it: value 19.39 s to the crossing,
+// threshold 20 s (the horizon) -- seconds, not metres.
 #include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
@@ -20,6 +23,8 @@
 #include <thread>
 #include <vector>
 
+#include "hoist/alarm_t.hpp"
+#include "raised_alarm.hpp"
 #include "hoist/forecast_t.hpp"
 
 namespace {
@@ -89,6 +94,13 @@ int main(int argc, char** argv) {
       lcm.publish(ch, bad.data(), static_cast<unsigned>(bad.size()));
     }
     lcm.publish(ch, b.data(), static_cast<unsigned>(b.size()));
+    if (k == 0) {
+      const hoist::alarm_t a = raisedAlarm(
+          f.utime, f.t_start, "PREDICTED_CLEARANCE", hoist::alarm_t::LEVEL_WARNING, 19.39, 20.0,
+          "PREDICTED_CLEARANCE WARNING raised: forecast scenario 'estop' crosses the CRITICAL clearance threshold "
+          "in 19.4 s (horizon 20 s) [unacknowledged]");
+      lcm.publish(prefix + "HOIST_ALARM", &a);
+    }
     std::printf("published %s seq %d (%zu bytes)\n", ch.c_str(), k, b.size());
     std::fflush(stdout);
     std::this_thread::sleep_for(std::chrono::milliseconds(period_ms));

@@ -24,6 +24,7 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/bus/subscriber.hpp"
 #include "hoist/msg/codec.hpp"
+#include "src/credential.hpp"
 #include "src/hub.hpp"
 #include "src/server.hpp"
 #include "src/static_files.hpp"
@@ -82,6 +83,8 @@ int main(int argc, char** argv) {
   double rate = 25.0, duration = 0.0;
   std::size_t max_clients = 64, max_msg = 64 * 1024, max_queue_kb = 2048, max_per_peer = 32;
   double max_peer_rate = 30.0;
+  std::string token_credential = "hoist-dash-token";
+  std::size_t reserved = 4;
   app.add_option("--bind", bind, "address to listen on (default 127.0.0.1: this machine only)");
   app.add_option("--port", port, "TCP port (default 8080; 0 = any free port, printed at start-up)")
       ->check(CLI::Range(0, 65535));
@@ -109,6 +112,14 @@ int main(int argc, char** argv) {
   app.add_option("--max-peer-rate", max_peer_rate,
                  "new connections a second from one remote address (default 30, bursts of twice that)")
       ->check(CLI::Range(1.0, 100000.0));
+  auto* tok_opt = app.add_option("--token-credential", token_credential,
+                 "name of the systemd credential (LoadCredential=NAME:FILE; read from $CREDENTIALS_DIRECTORY/NAME) "
+                 "holding the token of authenticated clients (default hoist-dash-token; used when present). "
+                 "Clients presenting it (Authorization: Bearer, or the page opened once as /?token=...) have "
+                 "--reserved-clients of their own and are never closed to make room for others");
+  app.add_option("--reserved-clients", reserved,
+                 "WebSockets kept for clients with the token, beyond --max-clients (default 4)")
+      ->check(CLI::Range(0, 1000));
   app.add_option("--max-message", max_msg, "largest accepted WebSocket message [bytes] (default 65536)")
       ->check(CLI::Range(64, 16 * 1024 * 1024));
   app.add_option("--max-queue-kb", max_queue_kb, "send queue per client before data is dropped [KiB] (default 2048)")
@@ -228,6 +239,24 @@ int main(int argc, char** argv) {
   lim.allowed_hosts = hosts;
   lim.max_per_peer = max_per_peer;
   lim.max_attempts_per_s = max_peer_rate;
+  {
+    const hoist::dash::Credential cred = hoist::dash::readCredential(token_credential);
+    if (!cred.error.empty()) {
+      std::fprintf(stderr, "hoist-dash: --token-credential %s: %s\n", token_credential.c_str(), cred.error.c_str());
+      return 2;
+    }
+    if (!cred.found && tok_opt->count() > 0) {
+      std::fprintf(stderr, "hoist-dash: --token-credential %s: no such credential ($CREDENTIALS_DIRECTORY/%s; "
+                           "systemd's LoadCredential=%s:FILE)\n", token_credential.c_str(), token_credential.c_str(),
+                   token_credential.c_str());
+      return 2;
+    }
+    lim.token = cred.value;
+    lim.reserved = reserved;
+    if (cred.found)
+      spdlog::info("authenticated clients: token from credential '{}'; {} WebSocket(s) reserved for them",
+                   token_credential, reserved);
+  }
   hoist::dash::Server server(io, hub, *files, lim);
   try {
     server.listen({addr, static_cast<unsigned short>(port)});

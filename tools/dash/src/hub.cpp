@@ -158,39 +158,6 @@ Hub::Hub(Options opt, Publisher publish, Clock clock)
   for (const auto& p : opt_.prefixes) addPrefix(p);
 }
 
-void Hub::requestAlarmStates() { request_states_ = true; }
-
-void Hub::maybeRequestAlarmStates(const std::string& prefix, const Json& health) {
-  // Once per daemon instance of a shaft: its first health (a fixed prefix)
-  // or its confirmation (a discovered one).  Into the void never (no daemon
-  // yet), and a one-shot forged prefix costs no request.
-  if (!request_states_) return;
-  const std::int64_t instance = health.value("instance_id", std::int64_t{0});
-  if (instance == 0) return;
-  if (const auto d = disc_.find(prefix); d != disc_.end() && !d->second.confirmed) return;
-  auto [it, fresh] = states_asked_.emplace(prefix, instance);
-  if (!fresh && it->second == instance) return;
-  it->second = instance;
-  requestAlarmStates(prefix);
-}
-
-void Hub::requestAlarmStates(const std::string& prefix) {
-  // alarm_ack_t ACTION_REANNOUNCE changes nothing in the daemon (which
-  // honours one a second): its answer is every alarm's current state, so an
-  // alarm raised before this dashboard started, or before the shaft was
-  // discovered, is in the alarm list at once.  Sent also with --read-only.
-  alarm_ack_t m{};
-  m.utime = static_cast<std::int64_t>(clock_() / 1000);
-  m.kind = "*";
-  m.action = alarm_ack_t::ACTION_REANNOUNCE;
-  m.user = "hoist-dash";
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
-  if (m.encode(buf.data(), 0, static_cast<int>(buf.size())) >= 0 && publish_(prefix + std::string(bus::kChannelAlarmAck), buf))
-    count("alarm_state_requests");
-  else
-    count("alarm_state_requests_failed");
-}
-
 std::uint64_t Hub::counter(const std::string& what) const {
   const auto it = counters_.find(what);
   return it == counters_.end() ? 0 : it->second;
@@ -380,7 +347,10 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
   if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
-  if (suffix == "HOIST_HEALTH" && channelFor(channel) != nullptr) maybeRequestAlarmStates(prefix, j);
+  if (suffix == "HOIST_HEALTH" && channelFor(channel) != nullptr) {
+    noteInstance(prefix, j);
+    maybeRequestAlarmStates(prefix, j);
+  }
   if (suffix == "HOIST_ALARM" && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
@@ -498,42 +468,6 @@ std::string Hub::historyOf(const std::string& prefix) const {
   }
   return out.dump();
 }
-
-void Hub::annotateAlarm(const std::string& prefix, Json& j) {
-  const std::string key = prefix + "\n" + j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
-  const int event = j.value("event_type", 0);
-  const std::int64_t utime = j.value("utime", std::int64_t{0});
-  auto it = alarm_ids_.find(key);
-  if (it == alarm_ids_.end()) {
-    if (alarm_ids_.size() >= 64 * std::max<std::size_t>(opt_.max_prefixes, 1)) {
-      count("alarm_identities_full");
-      return;
-    }
-    it = alarm_ids_.emplace(key, AlarmIdentity{utime, 0, j.value("t", 0.0), event == 1}).first;
-  } else if (event == 1) {  // EVENT_RAISE: a new activation
-    it->second = AlarmIdentity{utime, 0, j.value("t", 0.0), true};
-  }
-  if (event == 6) it->second.reannounce_utime = utime;  // EVENT_REANNOUNCE
-  AlarmIdentity& a = it->second;
-  j["dash_activation_utime"] = a.activation_utime;
-  j["dash_activation_t"] = a.activation_t;
-  j["dash_activation_known"] = a.known;
-  j["dash_reannounce_utime"] = a.reannounce_utime;
-  // Back to normal (inactive, acknowledged, not shelved): the next raise is a new activation.
-  if (!j.value("active", false) && j.value("acked", false) && !j.value("shelved", false)) alarm_ids_.erase(it);
-}
-
-namespace {
-// "HH:MM:SS UTC" of a utime (us since the epoch), for messages to operators.
-std::string utcClock(std::int64_t utime) {
-  const std::time_t t = static_cast<std::time_t>(utime / 1'000'000);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%02d:%02d:%02d UTC", tm.tm_hour, tm.tm_min, tm.tm_sec);
-  return buf;
-}
-}  // namespace
 
 std::string Hub::shaftName(const std::string& prefix) {
   std::string s = prefix;
@@ -728,6 +662,7 @@ void Hub::removePrefix(const std::string& prefix) {
   prefix_list_.erase(pit);
   disc_.erase(prefix);
   states_asked_.erase(prefix);
+  instance_.erase(prefix);
   decimators_.erase(prefix);
   estimate_decimators_.erase(prefix);
   history_.erase(prefix);
@@ -928,90 +863,6 @@ void Hub::onClientBinary(Client& c, std::string_view bytes) {
   std::uint32_t chan = 0;
   for (int i = 0; i < 4; ++i) chan |= std::uint32_t(static_cast<std::uint8_t>(bytes[1 + i])) << (8 * i);
   handleClientMessage(c, chan, bytes.substr(5));
-}
-
-void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view payload) {
-  if (opt_.read_only) {
-    count("commands_rejected_read_only");
-    status(c, 2, "rejected: hoist-dash runs --read-only; operator commands are disabled");
-    return;
-  }
-  const auto it = c.published_.find(chan);
-  if (it == c.published_.end()) {
-    count("commands_rejected_unadvertised");
-    status(c, 2, "rejected: client channel " + std::to_string(chan) + " was not advertised");
-    return;
-  }
-  Json j = Json::parse(payload.begin(), payload.end(), nullptr, false);
-  alarm_ack_t ack{};
-  std::string err;
-  if (j.is_discarded() || !j.is_object()) {
-    count("commands_rejected_invalid");
-    status(c, 2, "rejected command: payload is not a JSON object");
-    return;
-  }
-  // Optional fields (as in hoist-mqtt): utime is the server's anyway, and
-  // shelve_duration matters only for SHELVE (where validation requires it).
-  if (!j.contains("utime")) j["utime"] = 0;
-  if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
-  // The alarm the page drew (its activation): a command for an alarm that
-  // was cleared and raised again since, or is gone, is refused.
-  std::optional<std::int64_t> expect_activation;
-  if (const auto ea = j.find("activation_utime"); ea != j.end()) {
-    if (!ea->is_number_integer()) {
-      count("commands_rejected_invalid");
-      status(c, 2, "rejected command: activation_utime must be an integer (us since the epoch)");
-      return;
-    }
-    expect_activation = ea->get<std::int64_t>();
-    j.erase("activation_utime");
-  }
-  bool parsed = false;
-  try {
-    parsed = msg::fromJson(j, ack, err);
-  } catch (const std::exception& e) {
-    err = e.what();
-  }
-  if (!parsed) {
-    count("commands_rejected_invalid");
-    status(c, 2, "rejected command: " + err);
-    return;
-  }
-  if (const std::string why = validateAckFields(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.user);
-      !why.empty()) {
-    count("commands_rejected_invalid");
-    status(c, 2, "rejected command: " + why);
-    return;
-  }
-  static const char* level_names[] = {"(both levels)", "WARNING", "CRITICAL"};
-  const std::string alarm_name = ack.kind + " " + level_names[ack.level];
-  std::string since;
-  if (expect_activation) {
-    const std::string prefix = it->second.substr(0, it->second.size() - std::string(bus::kChannelAlarmAck).size());
-    const auto id = alarm_ids_.find(prefix + "\n" + ack.kind + "/" + std::to_string(ack.level));
-    if (ack.level == 0 || ack.kind == "*" || ack.kind.empty() || id == alarm_ids_.end() ||
-        id->second.activation_utime != *expect_activation) {
-      count("commands_refused_stale");
-      const std::string now = id == alarm_ids_.end() || ack.level == 0
-                                  ? "it is no longer in the list"
-                                  : "it was raised again at " + utcClock(id->second.activation_utime);
-      status(c, 2, "refused: " + alarm_name + " changed since your page drew it (" + now +
-                       "); nothing was sent -- check the alarm list and try again");
-      return;
-    }
-    since = " (active since " + utcClock(*expect_activation) + ")";
-  }
-  ack.utime = static_cast<std::int64_t>(clock_() / 1000);  // the command's time is the server's
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(ack.getEncodedSize()));
-  if (ack.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0 || !publish_(it->second, buf)) {
-    count("commands_publish_failed");
-    status(c, 2, "command not sent: LCM publish failed");
-    return;
-  }
-  count("commands_published");
-  static const char* actions[] = {"", "acknowledge", "shelve", "unshelve"};
-  status(c, 0, std::string("sent ") + actions[ack.action] + " " + alarm_name + since + " by " + ack.user + " on " +
-                   it->second);
 }
 
 }  // namespace hoist::dash

@@ -164,6 +164,11 @@ class Hub {
   void addPrefix(const std::string& prefix);
   void requestAlarmStates(const std::string& prefix);
   void maybeRequestAlarmStates(const std::string& prefix, const Json& health);
+  /// A shaft's health names another daemon instance than before: the alarm
+  /// states older than the new instance's start are void -- removed from the
+  /// table and sent to the clients as cleared ("the daemon restarted", as
+  /// hoist-mqtt does); the new instance is asked to re-announce its own.
+  void noteInstance(const std::string& prefix, const Json& health);
   void removePrefix(const std::string& prefix);
   void onDiscoveryHealth(const std::string& prefix, const Json& health);
   void noteHealth(Evidence& e, std::int64_t instance, std::uint64_t now) const;
@@ -184,6 +189,7 @@ class Hub {
 
   Options opt_;
   bool request_states_ = false;  // requestAlarmStates() was called
+  std::map<std::string, std::int64_t> instance_;      // prefix -> daemon instance of its latest health
   std::map<std::string, std::int64_t> states_asked_;  // prefix -> daemon instance asked (bounded by the prefixes)
   Publisher publish_;
   Clock clock_;

@@ -9,9 +9,11 @@
 #include <cctype>
 #include <chrono>
 #include <deque>
+#include <utility>
 #include <spdlog/spdlog.h>
 
 #include "hoist/msg/codec.hpp"
+#include "log_safe.hpp"
 
 namespace hoist::dash {
 
@@ -55,8 +57,10 @@ void setCommonHeaders(http::response<http::string_body>& res) {
 
 class WsSession : public std::enable_shared_from_this<WsSession>, public Client, public Server::Conn {
  public:
-  WsSession(tcp::socket&& s, Server& server, std::string peer_addr) : ws_(std::move(s)), server_(server) {
+  WsSession(tcp::socket&& s, Server& server, std::string peer_addr, bool authenticated)
+      : ws_(std::move(s)), server_(server) {
     peer_key = std::move(peer_addr);
+    authed = authenticated;
     ws = true;
     server_.track(this);
   }
@@ -209,8 +213,10 @@ class WsSession : public std::enable_shared_from_this<WsSession>, public Client,
 
 class HttpSession : public std::enable_shared_from_this<HttpSession>, public Server::Conn {
  public:
-  HttpSession(tcp::socket&& s, Server& server, std::string peer_addr) : stream_(std::move(s)), server_(server) {
+  HttpSession(tcp::socket&& s, Server& server, std::string peer_addr, bool on_probation)
+      : stream_(std::move(s)), server_(server) {
     peer_key = std::move(peer_addr);
+    probation = on_probation;
     server_.track(this);
   }
   ~HttpSession() override {
@@ -231,7 +237,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
     parser_.emplace();
     parser_->header_limit(8 * 1024);
     parser_->body_limit(0);
-    stream_.expires_after(std::chrono::seconds(30));
+    stream_.expires_after(std::chrono::seconds(probation ? 2 : 30));
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
   }
@@ -265,12 +271,30 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
     if (!server_.hostAllowed(sv(req[http::field::host]))) {
       const bool ws = websocket::is_upgrade(req);
       hub.count(ws ? "ws_rejected_host" : "http_rejected_host");
-      const std::string shown = msg::terminalSafe(std::string(req[http::field::host]), 80);
+      const std::string shown = logSafe(sv(req[http::field::host]), 80);
       if (server_.logAllowed())
         spdlog::warn("{} with Host '{}' refused: not a name of this dashboard (see --allow-host)",
                      ws ? "WebSocket" : "HTTP request", shown);
       respondError(http::status::forbidden,
                    "Host '" + shown + "' is not a name of this dashboard (hoist-dash --allow-host)", false);
+      return;
+    }
+    // The token: an authenticated client has the reserve; one on probation
+    // (admitted beyond its peer's limits) must present it.
+    const std::string_view presented = Server::presentedToken(
+        sv(req[http::field::authorization]), sv(req[http::field::cookie]), sv(req.target()));
+    if (!authed && server_.tokenMatches(presented)) {
+      server_.promote(this);
+      // Opened with ?token=: the browser keeps it as a cookie for the WebSocket.
+      if (sv(req.target()).find("token=") != std::string_view::npos)
+        set_cookie_ = std::string(Server::kTokenCookie) + "=" + std::string(presented) +
+                      "; Path=/; HttpOnly; SameSite=Strict";
+    }
+    if (probation && !authed) {
+      hub.count("http_rejected_probation_unauthenticated");
+      respondError(http::status::too_many_requests,
+                   "too many connections from your address; clients with the dashboard's token have a reserve "
+                   "(docs/security.md)", false);
       return;
     }
     if (websocket::is_upgrade(req)) {
@@ -303,12 +327,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
         hub.count("ws_rejected_origin");
         if (server_.logAllowed())
           spdlog::warn("WebSocket from origin {} refused (see --allow-origin)",
-                       msg::terminalSafe(std::string(origin), 120));
+                       logSafe(sv(origin), 120));
         respondError(http::status::forbidden, "origin not allowed (hoist-dash --allow-origin)", false);
         return;
       }
     }
-    if (!server_.admitWebSocket(peer_key)) {
+    if (!server_.admitWebSocket(peer_key, authed)) {
       hub.count("ws_rejected_too_many_clients");
       respondError(http::status::service_unavailable, "too many clients", false);
       return;
@@ -317,7 +341,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
     // The connection moves to the WebSocket session: counted once, there.
     server_.untrack(this);
     released_ = true;
-    std::make_shared<WsSession>(stream_.release_socket(), server_, peer_key)->run(std::move(req));
+    std::make_shared<WsSession>(stream_.release_socket(), server_, peer_key, authed)->run(std::move(req));
   }
 
   void handle(const http::request<http::string_body>& req) {
@@ -342,7 +366,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
         return;
       case StaticFiles::Verdict::Traversal:
         hub.count("http_rejected_traversal");
-        spdlog::warn("refused path traversal: {}", target.substr(0, 200));
+        spdlog::warn("refused path traversal: {}", logSafe(target));
         respondError(http::status::forbidden, "path traversal refused", req.keep_alive());
         return;
       case StaticFiles::Verdict::BadRequest:
@@ -364,6 +388,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
     auto res = std::make_shared<http::response<http::string_body>>(st, 11);
     setCommonHeaders(*res);
     res->set(http::field::content_type, type);
+    if (!set_cookie_.empty()) res->set(http::field::set_cookie, std::exchange(set_cookie_, std::string()));
     res->keep_alive(keep_alive);
     if (!head) res->body() = body;
     res->content_length(body.size());
@@ -382,6 +407,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
   beast::flat_buffer buffer_{16 * 1024};
   std::optional<http::request_parser<http::string_body>> parser_;
   bool reading_ = false, released_ = false;
+  std::string set_cookie_;  // sent with the next response (the token, opened with ?token=)
 };
 
 }  // namespace
@@ -408,177 +434,17 @@ void Server::doAccept() {
       beast::error_code rec;
       const auto ep = s.remote_endpoint(rec);
       const std::string peer = rec ? std::string() : peerOf(ep.address());
-      if (!admit(peer)) {
+      const Admission a = admit(peer);
+      if (a == Admission::Refused) {
         beast::error_code ignore;
         s.shutdown(tcp::socket::shutdown_both, ignore);
         s.close(ignore);
       } else {
-        std::make_shared<HttpSession>(std::move(s), *this, peer)->run();
+        std::make_shared<HttpSession>(std::move(s), *this, peer, a == Admission::Probation)->run();
       }
     }
     doAccept();
   });
-}
-
-std::string Server::peerOf(const net::ip::address& a) {
-  if (a.is_v6() && a.to_v6().is_v4_mapped())
-    return net::ip::make_address_v4(net::ip::v4_mapped, a.to_v6()).to_string();
-  return a.to_string();
-}
-
-void Server::track(Conn* c) {
-  c->seq = next_seq_++;
-  conns_.insert(c);
-  ++peers_[c->peer_key].conns;
-}
-
-void Server::untrack(Conn* c) {
-  if (conns_.erase(c) == 0) return;
-  const auto it = peers_.find(c->peer_key);
-  if (it != peers_.end() && it->second.conns > 0) --it->second.conns;
-}
-
-std::size_t Server::wsConnections() const {
-  std::size_t n = 0;
-  for (const Conn* c : conns_) n += c->ws ? 1 : 0;
-  return n;
-}
-
-bool Server::evictOldest(const std::string& peer, bool ws_only, bool ws_too) {
-  Conn* best = nullptr;
-  for (Conn* c : conns_) {
-    if (c->peer_key != peer) continue;
-    if (ws_only ? !c->ws : (c->ws ? !ws_too : !c->idle())) continue;
-    // Idle HTTP before WebSockets, then the oldest.
-    if (best == nullptr || (best->ws && !c->ws) || (best->ws == c->ws && c->seq < best->seq)) best = c;
-  }
-  if (best == nullptr) return false;
-  untrack(best);  // its slot is free now, whenever its handlers run
-  best->shutdown();
-  return true;
-}
-
-std::string Server::overShare(const std::string& newcomer, std::size_t cap, bool ws_only) const {
-  std::map<std::string, std::size_t> held;
-  for (const Conn* c : conns_)
-    if (!ws_only || c->ws) ++held[c->peer_key];
-  if (held.empty()) return "";
-  const std::size_t peers = held.size() + (held.count(newcomer) ? 0 : 1);
-  const double share = static_cast<double>(cap) / static_cast<double>(peers);
-  std::string top;
-  std::size_t most = 0;
-  for (const auto& [p, n] : held)
-    if (n > most) {
-      most = n;
-      top = p;
-    }
-  const std::size_t mine = held.count(newcomer) ? held.at(newcomer) : 0;
-  // Only a peer over its share, and holding more than the newcomer.
-  if (static_cast<double>(most) > share && most > mine + 1 && top != newcomer) return top;
-  return "";
-}
-
-bool Server::admit(const std::string& peer) {
-  const auto now = std::chrono::steady_clock::now();
-  if (peers_.size() > 4096) {  // forget peers with nothing open (bounded table)
-    for (auto it = peers_.begin(); it != peers_.end();)
-      it = it->second.conns == 0 ? peers_.erase(it) : std::next(it);
-  }
-  Peer& p = peers_[peer];
-  const double burst = 2.0 * limits_.max_attempts_per_s;
-  if (p.refilled.time_since_epoch().count() == 0) {
-    p.tokens = burst;
-  } else {
-    p.tokens = std::min(burst, p.tokens + limits_.max_attempts_per_s *
-                                             std::chrono::duration<double>(now - p.refilled).count());
-  }
-  p.refilled = now;
-  if (p.tokens < 1.0) {
-    hub_.count("http_rejected_peer_rate");
-    if (logAllowed())
-      spdlog::warn("connection from {} refused: more than {} new connections a second from that address", peer,
-                   limits_.max_attempts_per_s);
-    return false;
-  }
-  p.tokens -= 1.0;
-  if (p.conns >= limits_.max_per_peer) {
-    // At its cap: its own oldest idle HTTP connection makes room, else refused.
-    if (!evictOldest(peer, false, false)) {
-      hub_.count("http_rejected_peer_limit");
-      if (logAllowed())
-        spdlog::warn("connection from {} refused: it holds {} connections (--max-per-peer)", peer, p.conns);
-      return false;
-    }
-    hub_.count("http_evicted_idle");
-  }
-  const std::size_t cap = 2 * limits_.max_connections;
-  if (conns_.size() >= cap) {
-    // The reserve: room for a newcomer as long as someone holds more than its share.
-    const std::string hog = overShare(peer, cap, false);
-    if (hog.empty() || !evictOldest(hog, false, true)) {
-      hub_.count("http_rejected_too_many_connections");
-      if (logAllowed()) spdlog::warn("connection from {} refused: {} connections open", peer, conns_.size());
-      return false;
-    }
-    hub_.count("connections_evicted_over_share");
-    if (logAllowed()) spdlog::warn("closed the oldest connection of {} (over its share) to admit {}", hog, peer);
-  }
-  return true;
-}
-
-bool Server::admitWebSocket(const std::string& peer) {
-  if (wsConnections() < limits_.max_connections) return true;
-  const std::string hog = overShare(peer, limits_.max_connections, true);
-  if (hog.empty() || !evictOldest(hog, true, true)) return false;
-  hub_.count("ws_evicted_over_share");
-  if (logAllowed()) spdlog::warn("closed the oldest WebSocket of {} (over its share) to admit {}", hog, peer);
-  return true;
-}
-
-std::string Server::hostOfHeader(std::string_view h) {
-  std::string host;
-  std::string_view rest;
-  if (!h.empty() && h.front() == '[') {
-    const auto close = h.find(']');
-    if (close == std::string_view::npos) return "";
-    host = std::string(h.substr(1, close - 1));
-    rest = h.substr(close + 1);
-    if (host.empty() || host.find_first_not_of("0123456789abcdefABCDEF:.") != std::string::npos) return "";
-  } else {
-    const auto colon = h.find(':');
-    if (colon != std::string_view::npos && h.find(':', colon + 1) != std::string_view::npos) return "";  // bare IPv6
-    host = std::string(h.substr(0, colon));
-    rest = colon == std::string_view::npos ? std::string_view() : h.substr(colon);
-    if (host.empty() || host.size() > 253 ||
-        host.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789.-_") != std::string::npos)
-      return "";
-  }
-  if (!rest.empty()) {
-    if (rest.front() != ':' || rest.size() < 2 || rest.size() > 6 ||
-        rest.substr(1).find_first_not_of("0123456789") != std::string_view::npos)
-      return "";
-  }
-  for (char& c : host) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (host.size() > 1 && host.back() == '.') host.pop_back();
-  return host;
-}
-
-bool Server::hostAllowed(std::string_view host_header) const {
-  if (limits_.allowed_hosts.empty()) return true;
-  const std::string h = hostOfHeader(host_header);
-  if (h.empty()) return false;
-  for (const auto& a : limits_.allowed_hosts)
-    if (a == h) return true;
-  return false;
-}
-
-bool Server::originAllowed(std::string_view origin, std::string_view host_header) const {
-  for (const auto& a : limits_.allowed_origins)
-    if (a == "*" || origin == a) return true;
-  // The page's own origin: scheme + exactly the Host it was loaded from
-  // (a page on another port of an allowed name is another origin).
-  if (host_header.empty() || !hostAllowed(host_header)) return false;
-  return origin == "http://" + std::string(host_header) || origin == "https://" + std::string(host_header);
 }
 
 bool Server::logAllowed() {

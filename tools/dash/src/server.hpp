@@ -8,7 +8,10 @@
 // that in connections, per peer (remote address) at most `max_per_peer`
 // connections and `max_attempts_per_s` new ones a second, with a reserve: a
 // newcomer is never refused while another peer holds more than its fair
-// share (that peer's oldest connection is closed instead), incoming
+// share (that peer's oldest connection is closed instead), a peer being
+// one remote address, all of loopback (127.0.0.0/8 and ::1) or an IPv6 /64;
+// clients that present the token (Limits::token) have a reserved share and
+// are never closed to make room for others (admission.cpp); incoming
 // WebSocket messages at most `max_ws_message` bytes, and a bounded send queue
 // per client: data frames beyond `max_queue_bytes` are dropped (counted),
 // a client whose control frames overflow twice that is disconnected.
@@ -48,7 +51,21 @@ class Server {
     /// time, and new connections per second (a token bucket of twice that).
     std::size_t max_per_peer = 32;
     double max_attempts_per_s = 30.0;
+    /// Clients that present this token (Authorization: Bearer, the cookie
+    /// kTokenCookie, or ?token= which sets the cookie) are authenticated:
+    /// they count against no peer's cap or share, are never closed to make
+    /// room, and have `reserved` WebSockets of their own beyond the table
+    /// (and up to `reserved` connections on probation).  "" = none.
+    std::string token;
+    std::size_t reserved = 4;
   };
+  static constexpr std::string_view kTokenCookie = "hoist_dash_token";
+  /// The token a request presents ("" none): its Authorization: Bearer, its
+  /// cookie kTokenCookie, or its target's ?token=.
+  static std::string_view presentedToken(std::string_view authorization, std::string_view cookie,
+                                         std::string_view target);
+  /// Is `presented` the configured token?  (Constant time; false with none.)
+  bool tokenMatches(std::string_view presented) const;
   /// The host part of a Host header value, lower case, without brackets,
   /// port or trailing dot; "" when the value is malformed (a bad port, an
   /// unclosed bracket, characters no host name has).
@@ -74,8 +91,10 @@ class Server {
     /// An HTTP connection waiting for (the rest of) a request: may be
     /// closed to make room.  WebSockets and HTTP answers in flight are not idle.
     virtual bool idle() const = 0;
-    std::string peer_key;    ///< remote address ("" unknown)
+    std::string peer_key;    ///< peer (peerOf: an address, "loopback" or an IPv6 /64; "" unknown)
     bool ws = false;         ///< a WebSocket session
+    bool authed = false;     ///< presented the token (promote())
+    bool probation = false;  ///< admitted beyond its peer's limits: must authenticate in its first request
     std::uint64_t seq = 0;   ///< accept order (oldest first when evicting)
   };
   Hub& hub() { return hub_; }
@@ -84,18 +103,24 @@ class Server {
   void track(Conn* c);
   void untrack(Conn* c);
   std::size_t connections() const { return conns_.size(); }
-  std::size_t wsConnections() const;
+  std::size_t wsConnections(bool authed = false) const;
+  /// A connection presented the token: from now on it is authenticated.
+  void promote(Conn* c);
   /// A WebSocket upgrade from `peer`: true if there is room (making room by
-  /// closing the oldest WebSocket of a peer holding more than its share).
-  bool admitWebSocket(const std::string& peer);
-  /// The peer key of an address (IPv4-mapped IPv6 as IPv4).
+  /// closing the oldest WebSocket of a peer holding more than its share);
+  /// an authenticated one has the reserve.
+  bool admitWebSocket(const std::string& peer, bool authed);
+  /// The peer key of an address: IPv4-mapped IPv6 as IPv4; "loopback" for
+  /// 127.0.0.0/8 and ::1; "a:b:c:d::/64" for any other IPv6 address; else
+  /// the IPv4 address.
   static std::string peerOf(const boost::asio::ip::address& a);
   /// Rate limit of refusal log lines: at most 10 per 10 s (the rest counted).
   bool logAllowed();
 
  private:
   void doAccept();
-  bool admit(const std::string& peer);  ///< a new TCP connection: rate, per-peer cap, reserve
+  enum class Admission { Refused, Admitted, Probation };
+  Admission admit(const std::string& peer);  ///< a new TCP connection: rate, per-peer cap, reserve
   /// Closes the oldest connection of `peer` (idle HTTP first; WebSockets only
   /// if `ws_too`); false if it has none to close.
   bool evictOldest(const std::string& peer, bool ws_only, bool ws_too);
@@ -108,7 +133,8 @@ class Server {
     double tokens = 0.0;
     std::chrono::steady_clock::time_point refilled{};
   };
-  std::map<std::string, Peer> peers_;
+  std::map<std::string, Peer> peers_;  // unauthenticated connections by peer
+  std::size_t authed_ = 0, probation_ = 0;
   std::uint64_t next_seq_ = 0;
   boost::asio::io_context& io_;
   Hub& hub_;

@@ -23,15 +23,12 @@
 //    lasts; the forged tabs leave once they age out.
 import fs from "node:fs";
 import path from "node:path";
-import puppeteer from "puppeteer-core";
 import WebSocket from "ws";
-import { binDir, check, demoConfig, fail, lcmUrl, sleep, start, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
+import { binDir, check, openBrowser, demoConfig, fail, lcmUrl, sleep, start, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
 
 const lcmPort = Number(process.argv[2] || 7983);
 const dir = workDir("alarms");
 const lcm = lcmUrl(lcmPort);
-const chromium = process.env.CHROMIUM || ["/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"].find((p) => fs.existsSync(p));
-if (!chromium) fail("no Chromium found (scripts/setup.sh installs Debian's chromium)");
 // The demo configuration, re-announcing every 2 s.
 const config = path.join(dir, "demo-reannounce.toml");
 fs.writeFileSync(config, fs.readFileSync(demoConfig, "utf8").replace(/^reannounce\s*=.*$/m, "reannounce = 2.0"));
@@ -45,21 +42,7 @@ const replay = start("hoist-replay", path.join(binDir, "hoist-replay"), ["--lcm-
 const tReplay = Date.now();
 await sleep(6000);  // history accumulates before any page is open
 
-const browser = await puppeteer.launch({
-  executablePath: chromium, headless: true,
-  args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1180"],
-  defaultViewport: { width: 1500, height: 1180 },
-});
-const page = await browser.newPage();
-const errors = [], dialogs = [];
-page.on("pageerror", (e) => errors.push(String(e)));
-page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
-page.on("dialog", async (d) => { dialogs.push(d.message()); await d.accept(); });
-process.on("uncaughtException", async (e) => {
-  console.error(`FAIL: ${e.message}`);
-  try { await page.screenshot({ path: path.join(dir, "failure.png") }); console.error(`page: ${path.join(dir, "failure.png")}`); } catch { /* gone */ }
-  process.exit(1);
-});
+const { browser, page, errors, dialogs } = await openBrowser(dir);
 const tOpen = Date.now();
 await page.goto(dash.url, { waitUntil: "load" });
 
@@ -72,7 +55,8 @@ const before = tOpen / 1000 - hist.first;
 check(before > 3 && hist.first * 1000 >= tReplay - 2000,
       `a page opened ${((tOpen - tReplay) / 1000).toFixed(1)} s into the trip has trend points from ${before.toFixed(1)} s before it opened (${hist.n} history buckets)`);
 await page.select("#window", "30");
-await sleep(1500);
+await page.waitForFunction(() => window.hoistDash.shafts.get("").charts.every((c) => Math.abs(c.u.scales.x.max - c.u.scales.x.min - 30) < 0.01 &&
+                                                                                   (c.u.axes[1]._values || []).length > 0), { timeout: 5000 });
 const axes = await page.evaluate(() => {
   const s = window.hoistDash.shafts.get("");
   const vs = s.data.v.filter((v) => isFinite(v));
@@ -136,14 +120,10 @@ await page.type("#user", "row-test");
 const lastRow = r1[r1.length - 1];
 const [kind, level] = lastRow.id.split("/");
 const ackedBefore = await page.evaluate(() => [...document.querySelectorAll("tr.alarm")].map((tr) => `${tr.dataset.kind}/${tr.dataset.level}=${tr.dataset.acked}`));
-// (clicked inside the page: the list re-renders on every alarm event, which
-// can detach an element handle between puppeteer's look-up and its click)
-const clicked = await page.evaluate((k, l) => {
-  const b = document.querySelector(`tr.alarm[data-kind="${k}"][data-level="${l}"] button[data-action="acknowledge"]`);
-  if (!b || b.disabled) return false;
-  b.click();
-  return true;
-}, kind, level);
+// A locator: it waits for a stable, enabled button and retries a detached one.
+const ackSel = `tr.alarm[data-kind="${kind}"][data-level="${level}"] button[data-action="acknowledge"]`;
+await page.locator(ackSel).setTimeout(5000).click();
+const clicked = true;
 check(clicked, `clicked Acknowledge on the last row (${lastRow.id})`);
 await page.waitForSelector(`tr.alarm[data-kind="${kind}"][data-level="${level}"][data-acked="true"]`, { timeout: 5000 });
 const ackedAfter = await page.evaluate(() => [...document.querySelectorAll("tr.alarm")].map((tr) => `${tr.dataset.kind}/${tr.dataset.level}=${tr.dataset.acked}`));

@@ -6,7 +6,9 @@
 //
 //   node badinput_test.mjs [LCM_PORT]
 import crypto from "node:crypto";
+import fs from "node:fs";
 import net from "node:net";
+import path from "node:path";
 import WebSocket from "ws";
 import { check, lcmUrl, sleep, startDash, stats, stop, waitFor, workDir } from "./harness.mjs";
 
@@ -48,6 +50,23 @@ check((c.http_rejected_traversal || 0) - (before.http_rejected_traversal || 0) =
       `${targets.length} traversal attempts counted (http_rejected_traversal = ${c.http_rejected_traversal})`);
 check((await get(dash.port, "/nonexistent.js")).status === 404, "unknown file -> 404");
 check((await get(dash.port, "/%zz")).status === 400, "malformed percent escape -> 400");
+
+// 1b. Network strings in the log: a traversal whose path carries C1 controls
+// (CSI U+009B, raw and percent-encoded) and bidi controls (RLO U+202E, LRI
+// U+2066) is logged escaped, never as the raw bytes that reorder or hide
+// what an operator reads in the journal.
+{
+  const evil = Buffer.concat([Buffer.from("GET /../\u202eetc/\u2066passwd"), Buffer.from([0xc2, 0x9b]),
+                              Buffer.from("31m%C2%9B%E2%80%AE HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n")]);
+  const r = (await raw(dash.port, evil)).toString("latin1");
+  check(/^HTTP\/1\.1 403/.test(r), "a traversal with C1 and bidi characters in its path -> 403");
+  const log = await waitFor(() => {
+    const l = fs.readFileSync(path.join(dir, "hoist-dash.log"), "utf8").split("\n").filter((x) => x.includes("refused path traversal: /../"));
+    return l.find((x) => x.includes("31m")) || null;
+  }, 3000, "the traversal's log line");
+  check(!/[\u0080-\u009f\u061c\u200e\u200f\u202a-\u202e\u2066-\u2069]/.test(log) && log.includes("\\u202e") &&
+        log.includes("\\u2066") && log.includes("\\u009b"), `logged with C1 and bidi escaped: ${log.slice(log.indexOf("refused"))}`);
+}
 
 // 2. Malformed HTTP and an oversized header.
 let r = (await raw(dash.port, "GARBAGE\r\n\r\n")).toString();

@@ -13,7 +13,7 @@
 import fs from "node:fs";
 import path from "node:path";
 import puppeteer from "puppeteer-core";
-import { binDir, check, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
+import { binDir, check, demoConfig, fail, lcmUrl, readLog, sleep, start, startDash, startTwin, stop, waitFor, workDir } from "./harness.mjs";
 
 const args = process.argv.slice(2);
 const lcmPort = Number(args.find((a) => /^\d+$/.test(a)) || 7871);
@@ -28,7 +28,15 @@ const lcm = lcmUrl(lcmPort);
 // The dashboards first (the daemon announces an alarm once, then every 30 s).
 const dash = await startDash(dir, lcm, []);
 const ro = await startDash(dir, lcm, ["--read-only"], "hoist-dash-ro");
-const twin = await startTwin(dir, lcm, { replay: false });  // at rest at 50 m: the +y WARNING is on
+// The demo config without the daemon's own forecasts: the forecast panel is
+// checked against the synthetic HOIST_FORECAST below, whose scenario names
+// ("estop") the daemon's would share -- with both, the panel shows whichever
+// came last (a race that failed this test on a busy machine).
+const config = path.join(dir, "demo-noforecast.toml");
+const demoToml = fs.readFileSync(demoConfig, "utf8");
+if (/^\[forecast\]/m.test(demoToml)) fail("service/config/demo.toml has a [forecast] section now: set enabled = false there");
+fs.writeFileSync(config, `${demoToml}\n[forecast]\nenabled = false\n`);
+const twin = await startTwin(dir, lcm, { replay: false, config });  // at rest at 50 m: the +y WARNING is on
 
 const browser = await puppeteer.launch({
   executablePath: chromium, headless: true,
@@ -59,7 +67,9 @@ check(true, "CAGE_POS_Y alarm raised by the daemon appears in the alarm list");
 
 // 3. Acknowledge with an operator name.
 await page.type("#user", "test-operator");
-await page.click('tr.alarm[data-kind="CAGE_POS_Y"][data-active="true"] button[data-action="acknowledge"]');
+// A locator waits for the button to be attached, visible, enabled and stable
+// (not moving) and retries if it is detached before the click: no sleeps.
+await page.locator('tr.alarm[data-kind="CAGE_POS_Y"][data-active="true"] button[data-action="acknowledge"]').setTimeout(10000).click();
 const tAck = Date.now();
 await page.waitForSelector('tr.alarm[data-kind="CAGE_POS_Y"][data-acked="true"]', { timeout: 5000 });
 check(true, `alarm turned acknowledged ${Date.now() - tAck} ms after pressing Acknowledge`);
@@ -88,7 +98,12 @@ await page.waitForFunction(() => {
   return r && r.dataset.utime;
 }, { timeout: 5000 });
 check(true, `page shows the cage state ${Date.now() - tReplay} ms after the replay started`);
-await sleep(3000);  // the cage on its way down
+// The cage on its way down: the displayed depth has changed by 5 m.
+const l0 = await page.$eval('[data-shaft=""] [data-role=readouts] [data-field="l"]', (e) => Number(e.textContent));
+await page.waitForFunction((from) => {
+  const v = Number(document.querySelector('[data-shaft=""] [data-role=readouts] [data-field="l"]').textContent);
+  return Math.abs(v - from) > 5;
+}, { timeout: 20000 }, l0);
 // 4. Depth and sway while the cage moves.
 const shown = await page.evaluate(() => {
   const r = document.querySelector('[data-shaft=""] [data-role=readouts]');
@@ -124,8 +139,22 @@ const other = fc.rows.find((r) => r.name !== "estop");
 check(fc.rows.length === 2 && other && other.name.startsWith("<img") && other.crit === "none" && other.warn === "none" && fc.imgs === 0,
       "a hostile scenario name is shown as text (no element created), no violation shows 'none'");
 check(fc.clr === 70 && fc.l0 === 140, `both forecast series drawn (clearance ${fc.clr} points, lambda_0 ${fc.l0} min/max points)`);
+// The forecast plots' axes: distinct tick labels (not "289 289 289 288").
+const fticks = await page.evaluate(() => [...document.querySelectorAll('[data-shaft=""] canvas.fcplot')].map((c) => ({
+  role: c.dataset.role, y: (c.dataset.yticks || "").split("|"), x: (c.dataset.xticks || "").split("|") })));
+for (const t of fticks)
+  check(t.y.length >= 3 && new Set(t.y).size === t.y.length && t.x.length >= 3 && new Set(t.x).size === t.x.length,
+        `${t.role}: distinct axis labels (y ${t.y.join(" ")}; x ${t.x.join(" ")})`);
+// PREDICTED_CLEARANCE (the forecast publisher raises it as the daemon does):
+// seconds to the crossing against the horizon, from the one table of units.
+const pcSel = 'tr.alarm[data-kind="PREDICTED_CLEARANCE"] [data-field="value"]';
+await page.waitForSelector(pcSel, { timeout: 5000 });
+const pc = await page.$eval(pcSel, (e) => e.textContent);
+check(/^\d+\.\d s to the crossing \/ \d+\.\d s horizon$/.test(pc), `PREDICTED_CLEARANCE reads in seconds: "${pc}"`);
 await page.select("#window", "10");  // the 10-s trend window for the screenshot
-await sleep(2500);
+// Drawn: every trend's x scale spans 10 s.
+await page.waitForFunction(() => window.hoistDash.shafts.get("").charts.every((c) => Math.abs(c.u.scales.x.max - c.u.scales.x.min - 10) < 0.01),
+                           { timeout: 5000 });
 await page.screenshot({ path: shot });
 console.log(`screenshot: ${shot}`);
 

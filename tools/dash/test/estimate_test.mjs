@@ -134,7 +134,17 @@ check(p.Fa === "n/a" && p.b === "n/a", `not observed: Fa "${p.Fa}", b "${p.b}"`)
 check(/^IMU, \d+ ms ago$/.test(p.sensors), `only the IMU in use: "${p.sensors}"`);
 check(p.badgeState === "ok", "the badge clears with the mismatch");
 
-// 4. STALE when the estimates stop.
+// 4. The headline tilt shows what the alarms judge: while the estimate is in
+// use, the estimate's theta (0.65 mrad) with the open-loop twin's (0.830) beside it.
+await publish("inuse", 150);
+const tilt = await page.waitForFunction(() => {
+  const c = document.querySelector('[data-shaft="north/"] [data-role=readouts] [data-field="theta"]');
+  return c && c.dataset.source === "estimate" ? { text: c.firstChild.textContent, sub: c.querySelector(".sub").textContent } : null;
+}, { timeout: 3000 }).then((h) => h.jsonValue());
+check(/^0\.6[4-6]\d$/.test(tilt.text) && tilt.sub === "estimate; open loop 0.830",
+      `headline tilt is the estimate's with the open loop beside it: "${tilt.text}" (${tilt.sub})`);
+
+// 5. STALE when the estimates stop.
 await page.waitForFunction((sel) => document.querySelector(sel).dataset.state === "stale", { timeout: 4000 }, box);
 p = await panel();
 check(p.state === "stale", "the panel says STALE after the estimates stopped");

@@ -157,3 +157,29 @@ export async function startTwin(dir, lcm, { profile = "paper", config = demoConf
   if (replay) r.replay = start("hoist-replay", path.join(binDir, "hoist-replay"), ["--lcm-url", lcm, "--profile", profile, "-q"], dir);
   return r;
 }
+
+/// Debian's headless Chromium (puppeteer-core) with one 1500x1180 page:
+/// page errors and console errors collected in `errors`, dialogs accepted
+/// and their texts in `dialogs`; on an uncaught exception the test fails
+/// with the page's screenshot in dir/failure.png.
+export async function openBrowser(dir) {
+  const chromium = process.env.CHROMIUM || ["/usr/bin/chromium", "/usr/bin/chromium-browser", "/usr/bin/google-chrome"].find((p) => fs.existsSync(p));
+  if (!chromium) fail("no Chromium found (scripts/setup.sh installs Debian's chromium)");
+  const { default: puppeteer } = await import("puppeteer-core");
+  const browser = await puppeteer.launch({
+    executablePath: chromium, headless: true,
+    args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1500,1180"],
+    defaultViewport: { width: 1500, height: 1180 },
+  });
+  const page = await browser.newPage();
+  const errors = [], dialogs = [];
+  page.on("pageerror", (e) => errors.push(String(e)));
+  page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
+  page.on("dialog", async (d) => { dialogs.push(d.message()); await d.accept(); });
+  process.on("uncaughtException", async (e) => {
+    console.error(`FAIL: ${e.message}`);
+    try { await page.screenshot({ path: path.join(dir, "failure.png") }); console.error(`page: ${path.join(dir, "failure.png")}`); } catch { /* gone */ }
+    process.exit(1);
+  });
+  return { browser, page, errors, dialogs };
+}
