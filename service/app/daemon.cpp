@@ -411,13 +411,24 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   // Deferred starts and exact envelopes: at most the group's budgets in this tick.
   TickAllowance left{g.start_budget, g.envelope_budget};
   const auto ns_rx0 = ns_receive_, ns_fl0 = ns_flush_;
+  // Staleness is judged after the inputs already queued are read: a loop
+  // that wakes late (or a shaft whose tick starts late behind a slow one)
+  // must not find an input stale that waits on the socket (INPUT_STALE
+  // chatter, v = a = 0 fed to the twin).  So the socket is drained first,
+  // and again before a shaft whose tick starts more than half a period
+  // after the last drain.
+  drainInput();
+  auto drained_at = Clock::now();
   std::size_t i = 0;
   for (ShaftTwin* s : g.shafts) {
     s->tick(k, deadline, skipped, left);
     if (miss) [[unlikely]] noteMissShaft(*miss, g, i, period_us);
-    if (++i % kDrainEvery == 0) {
-      flushOutputs();
-      if (input_.udpm()) drainInput();
+    const bool every = ++i % kDrainEvery == 0;
+    const auto t_now = Clock::now();
+    if (every || t_now - drained_at > g.period / 2) {
+      if (every) flushOutputs();
+      drainInput();
+      drained_at = t_now;
     }
   }
   flushOutputs();
