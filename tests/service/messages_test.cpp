@@ -50,6 +50,37 @@ TEST(Messages, CageMappingCopiesEveryField) {
   EXPECT_EQ(m.rope_overload_threshold, 13272.0);
 }
 
+TEST(Messages, AnUnobservedLoadIsPublishedWithANegativeSigma) {
+  // estimate_t.lcm: "A sigma < 0 means not observed".  Without a rope load
+  // cell the filter still carries Fa's prior sigma (5000 N): not published.
+  LoadEstimate e;
+  e.Fa = 1000.0;
+  e.sigma_Fa = 5000.0;
+  e.moment = 150.0;
+  e.sigma_moment = 3.0;
+  e.b = 0.15;
+  e.sigma_b = 0.01;
+  e.fa_observed = false;
+  e.moment_observed = true;
+  hoist::estimate_t m{};
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, -1.0, true, m);
+  EXPECT_EQ(m.Fa, 1000.0);
+  EXPECT_LT(m.sigma_Fa, 0.0);
+  EXPECT_FALSE(m.fa_observed);
+  EXPECT_EQ(m.sigma_moment, 3.0);
+  EXPECT_LT(m.sigma_b, 0.0) << "b needs both sensors";
+  // Observed: the filter's sigma as it is; and M unobserved likewise.
+  e.fa_observed = true;
+  e.moment_observed = false;
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, true, m);
+  EXPECT_EQ(m.sigma_Fa, 5000.0);
+  EXPECT_LT(m.sigma_moment, 0.0);
+  EXPECT_LT(m.sigma_b, 0.0);
+  e.moment_observed = true;
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, true, m);
+  EXPECT_EQ(m.sigma_b, 0.01);
+}
+
 TEST(Messages, RopeForceAlarmTextStatesForceThresholdAndStaticForce) {
   AlarmConfig cfg;
   AlarmTextContext ctx;

@@ -39,12 +39,14 @@ void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double
   m.l = e.kin.l;
   m.v = e.kin.v;
   m.a = e.kin.a;
+  // estimate_t's contract: a sigma < 0 means not observed (the filter's
+  // prior sigma of an unobserved load is no measurement uncertainty).
   m.Fa = e.Fa;
-  m.sigma_Fa = e.sigma_Fa;
+  m.sigma_Fa = e.fa_observed ? e.sigma_Fa : -1.0;
   m.b = e.b;
-  m.sigma_b = e.sigma_b;
+  m.sigma_b = e.fa_observed && e.moment_observed ? e.sigma_b : -1.0;
   m.moment = e.moment;
-  m.sigma_moment = e.sigma_moment;
+  m.sigma_moment = e.moment_observed ? e.sigma_moment : -1.0;
   m.x_c = e.x_c;
   m.sigma_x_c = e.sigma_x_c;
   m.y_c = e.y_c;
