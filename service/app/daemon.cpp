@@ -283,13 +283,18 @@ void Daemon::logStarted() {
   for (const auto& sp : shafts_) {
     const ShaftTwin& s = *sp;
     const TwinConfig& c = s.config();
-    out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}{}{}, input {}, outputs {} {} {} {}, "
+    // Every channel the shaft uses (the optional ones only when configured).
+    const bus::Channels& ch = s.channels();
+    const bool est = c.estimator.enabled, fc = c.forecast.enabled;
+    std::string ins = ch.winder + " " + ch.ack, outs = ch.cage + " " + ch.shape + " " + ch.alarm + " " + ch.health;
+    if (fc) ins += " " + ch.trip_plan, outs += " " + ch.forecast;
+    if (est) ins += " " + ch.cage_imu + " " + ch.rope_load, outs += " " + ch.estimate;
+    out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}{}{}, inputs {}, outputs {}, "
                "n={} modes, L={} m, h={} m, l0={} m, instance {}",
                s.tag(), n == 1 ? "started" : "shaft",
                toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url),
                lcm_out_ ? ", outputs to " : "", lcm_out_ ? bus::describeLcmUrl(opt_.lcm_url_out) : std::string(),
-               s.channels().winder, s.channels().cage, s.channels().shape, s.channels().alarm,
-               s.channels().health, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
+               ins, outs, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
   }
   if (n > 1) out_->info("hoist-twind started: {} shafts on one loop, {} schedule(s)", n, groups_.size());
 }
