@@ -144,6 +144,20 @@ if os.path.exists(twind):
     check(all(l in desc for l in ("trace", "debug", "info", "warn", "error", "critical", "off")),
           "hoist-twind --help: --log-level lists every level it accepts (critical too)", m.group(0) if m else out)
 
+# Every channel of the generated channel table (msgs/*.lcm "@channel NAME") is in the README's
+# channel table and in hoist-twind --help.
+import glob
+channels = sorted({m.group(1) for f in glob.glob(os.path.join(src_dir, "msgs", "*.lcm"))
+                   for m in re.finditer(r"@channel (HOIST_[A-Z_]+)", open(f, encoding="utf-8").read())})
+check(len(channels) >= 11, f"{len(channels)} channels in msgs/*.lcm")
+table = {m.group(1) for m in re.finditer(r"^\| `(HOIST_[A-Z_]+)` \|", text, re.M)}
+for c in channels:
+    check(c in table, f"the README's channel table lists {c}")
+if os.path.exists(twind):
+    h = subprocess.run([twind, "--help"], capture_output=True, text=True, timeout=60, env=env).stdout
+    for c in channels:
+        check(c in h, f"hoist-twind --help names {c}")
+
 # The install: every package cpack makes is installed by the README's command and named in its text.
 build_dir = os.path.dirname(os.path.abspath(bin_dir))
 cpack_cfg = os.path.join(build_dir, "CPackConfig.cmake")
