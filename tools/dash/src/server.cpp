@@ -342,7 +342,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
         return;
       case StaticFiles::Verdict::Traversal:
         hub.count("http_rejected_traversal");
-        spdlog::warn("refused path traversal: {}", target.substr(0, 200));
+        spdlog::warn("refused path traversal: {}", msg::terminalSafe(std::string(target), 200));
         respondError(http::status::forbidden, "path traversal refused", req.keep_alive());
         return;
       case StaticFiles::Verdict::BadRequest:
