@@ -1,6 +1,6 @@
 // A loop that wakes late with inputs queued on its socket (issue 35 item 5),
 // in-process over loopback multicast (ports 7930-7931):
-//   * the winder streams at 100 Hz (INPUT_STALE after 3 periods, 30 ms);
+//   * the winder streams at 100 Hz (INPUT_STALE after 150 ms);
 //   * two shafts on one schedule; a tick of the first one takes 200 ms
 //     (TestHooks::slow_tick_at), so the second one's tick starts 200 ms late
 //     with 20 of its inputs queued on the socket;
@@ -57,6 +57,11 @@ TEST(DaemonLateWake, QueuedInputsAreReadBeforeStalenessIsJudged) {
     c.service.envelope_points = 21;
     c.service.shape_points = 11;
     c.forecast.enabled = false;
+    // INPUT_STALE after 150 ms without input: under the 200 ms of the slow
+    // tick and of the late wake-ups (so the test fails without the fix), but
+    // far over what a busy machine delays the feeder thread by.
+    c.service.stale_periods = 0.0;
+    c.service.stale_timeout = 0.15;
     opt.shafts.push_back(c);
     opt.labels.push_back(p);
   }
