@@ -274,6 +274,7 @@ class PgStore final : public Store {
                                nullptr, nullptr, 0);
     if (r && PQresultStatus(r) == want) return r;
     std::string why = r ? PQresultErrorMessage(r) : PQerrorMessage(conn_);
+    if (why.empty() && r) why = std::string("unexpected result ") + PQresStatus(PQresultStatus(r)) + " for: " + sql;
     PQclear(r);
     if (PQstatus(conn_) != CONNECTION_OK) throw Outage{why};
     while (!why.empty() && why.back() == '\n') why.pop_back();
@@ -294,7 +295,7 @@ class PgStore final : public Store {
 
   void openSchema() {
     command("BEGIN");
-    command("SELECT pg_advisory_xact_lock(7234103849)");  // one migrator at a time
+    Result(run("SELECT pg_advisory_xact_lock(7234103849)", {}, PGRES_TUPLES_OK));  // one migrator at a time
     Result t(run("SELECT to_regclass('schema_version') IS NOT NULL, to_regclass('trips') IS NOT NULL", {},
                  PGRES_TUPLES_OK));
     const bool has_version = PQgetvalue(t.r, 0, 0)[0] == 't', has_trips = PQgetvalue(t.r, 0, 1)[0] == 't';
