@@ -1,0 +1,186 @@
+// hoist-trips trend and depth-map (trips.hpp): gnuplot PNGs, as hoist-study
+// makes its figures (docs/studies.md).  Beside FILE.png go FILE.dat (the
+// data) and FILE.gp (the script: `gnuplot FILE.gp` re-renders it).  Without
+// gnuplot the data and script are written and the command fails naming the
+// package to install.
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "hoist/io/checked_file.hpp"
+#include "trips.hpp"
+
+extern char** environ;
+
+namespace hoist::trips {
+
+namespace {
+
+struct PlotFiles {
+  std::string png, dat, gp;
+};
+
+PlotFiles plotFiles(const std::string& out) {
+  if (out.size() < 5 || out.compare(out.size() - 4, 4, ".png") != 0)
+    throw UsageError("--out: '" + out + "' must name a .png file");
+  io::checkOutputPath(out, "--out");
+  const std::string stem = out.substr(0, out.size() - 4);
+  return {out, stem + ".dat", stem + ".gp"};
+}
+
+std::string quoted(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string header(const PlotFiles& f, int w, int h) {
+  std::ostringstream s;
+  s << "# Written by hoist-trips; re-render with: gnuplot " << f.gp << "\n"
+    << "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n  set terminal pngcairo size " << w << "," << h
+    << " font ',9'\n} else {\n  set terminal png size " << w << "," << h << "\n}\nset termoption noenhanced\n"
+    << "set output " << quoted(std::filesystem::absolute(f.png).string()) << "\n";
+  return s.str();
+}
+
+/// Runs gnuplot on the script; throws std::runtime_error when it is missing
+/// or fails, or wrote no image.
+void render(const PlotFiles& f) {
+  std::string gnuplot;
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "/usr/bin:/bin");
+  for (std::string dir; std::getline(ss, dir, ':');)
+    if (!dir.empty() && ::access((dir + "/gnuplot").c_str(), X_OK) == 0) {
+      gnuplot = dir + "/gnuplot";
+      break;
+    }
+  if (gnuplot.empty())
+    throw std::runtime_error("gnuplot not found (sudo apt-get install gnuplot-nox); the data and script are in " +
+                             f.dat + " and " + f.gp);
+  std::filesystem::remove(f.png);
+  const std::string script = std::filesystem::absolute(f.gp).string();
+  char* argv[] = {const_cast<char*>("gnuplot"), const_cast<char*>(script.c_str()), nullptr};
+  pid_t pid = -1;
+  if (posix_spawn(&pid, gnuplot.c_str(), nullptr, nullptr, argv, environ) != 0)
+    throw std::runtime_error("cannot run " + gnuplot);
+  int st = 0;
+  while (::waitpid(pid, &st, 0) < 0) {
+  }
+  struct stat sb {};
+  if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) throw std::runtime_error("gnuplot " + f.gp + " failed");
+  if (::stat(f.png.c_str(), &sb) != 0 || sb.st_size == 0) throw std::runtime_error("gnuplot " + f.gp + " wrote no image");
+}
+
+}  // namespace
+
+int runTrend(const Options& o) {
+  const PlotFiles f = plotFiles(o.out);
+  auto db = openDb(o, true);
+  const auto recs = selected(*db, o, false);
+  io::CheckedFile dat(f.dat, "--out (data)");
+  dat.write("# trip informative s sigma_s s_lo95 s_hi95 (hoist-trips trend, " + db->describe() + ")\n");
+  int informative = 0, attempted = 0;
+  for (const auto& r : recs) {
+    if (!r.id.attempted || r.id.sigma_scale < 0) continue;
+    ++attempted;
+    informative += r.id.informative;
+    const double s = r.id.scale, sg = r.id.sigma_scale;
+    dat.printf("%lld %d %.9g %.9g %.9g %.9g\n", static_cast<long long>(r.trip), r.id.informative ? 1 : 0, s, sg,
+               s - 1.96 * sg, s + 1.96 * sg);
+  }
+  dat.close();
+  const double warn = o.warning, crit = o.critical;
+  io::CheckedFile gp(f.gp, "--out (script)");
+  gp.write(header(f, 1000, 560));
+  const std::string d = quoted(std::filesystem::absolute(f.dat).string());
+  gp.printf("set title %s\n", quoted("Guide-rope preload scale per trip (" + db->describe() + ", shaft '" + o.shaft +
+                                     "'): " + std::to_string(informative) + " of " + std::to_string(attempted) +
+                                     " identified trips informative").c_str());
+  gp.write("set xlabel 'trip'\nset ylabel 'preload scale s (1 = configured)'\nset grid\nset key bottom left\n"
+           "set yrange [0:1.3]\n");
+  gp.printf("set arrow from graph 0, first %.6g to graph 1, first %.6g nohead dt 2 lc rgb '#d08000' lw 2\n", warn, warn);
+  gp.printf("set arrow from graph 0, first %.6g to graph 1, first %.6g nohead dt 2 lc rgb '#c00000' lw 2\n", crit, crit);
+  gp.printf("set label 'preload_warning %.2f' at graph 0.01, first %.6g offset 0,0.6 tc rgb '#d08000'\n", warn, warn);
+  gp.printf("set label 'preload_critical %.2f' at graph 0.01, first %.6g offset 0,0.6 tc rgb '#c00000'\n", crit, crit);
+  if (attempted == 0) {
+    gp.write("set label 'no trip with an identified preload' at graph 0.5, graph 0.5 center\n"
+             "set xrange [0:1]\nplot 1 with lines lc rgb '#808080' title 'nominal'\n");
+  } else {
+    gp.printf("plot %s using 1:($2 > 0 ? $5 : NaN):($2 > 0 ? $6 : NaN) with filledcurves lc rgb '#c8d8f0' "
+              "title 'per-trip 95 %% band (informative trips)', \\\n"
+              "     %s using 1:($2 > 0 ? $3 : NaN):4 with yerrorbars pt 7 ps 0.7 lc rgb '#1f4e9c' "
+              "title 's +- sigma (informative)', \\\n"
+              "     %s using 1:($2 > 0 ? NaN : $3) with points pt 6 lc rgb '#909090' "
+              "title 'not informative (sigma above max_sigma)', \\\n"
+              "     1 with lines lc rgb '#808080' dt 3 title 'nominal'\n",
+              d.c_str(), d.c_str(), d.c_str());
+  }
+  gp.close();
+  render(f);
+  if (!o.quiet)
+    std::cerr << "hoist-trips: trend of " << attempted << " trip(s) (" << informative << " informative) in " << f.png
+              << " (data " << f.dat << ", script " << f.gp << ")\n";
+  return 0;
+}
+
+int runDepthMap(const Options& o) {
+  const PlotFiles f = plotFiles(o.out);
+  auto db = openDb(o, true);
+  const auto recs = selected(*db, o, true);
+  // The grid: every trip x every bin depth seen; a cell without data is NaN
+  // (gnuplot leaves it blank).
+  std::set<long long> depths_mm;
+  double bin = 10.0;
+  for (const auto& r : recs) {
+    bin = r.depth_bin;
+    for (const auto& b : r.bins) depths_mm.insert(std::llround(b.depth_lo * 1000.0));
+  }
+  io::CheckedFile dat(f.dat, "--out (data)");
+  dat.write("# trip depth_mid " + o.value + " (hoist-trips depth-map, " + db->describe() + ")\n");
+  for (const auto& r : recs) {
+    std::map<long long, const DepthBinStats*> by;
+    for (const auto& b : r.bins) by[std::llround(b.depth_lo * 1000.0)] = &b;
+    for (long long mm : depths_mm) {
+      const auto it = by.find(mm);
+      double v = std::nan("");
+      if (it != by.end() && it->second->samples > 0)
+        v = o.value == "resid_mean" ? it->second->resid_mean
+            : o.value == "fy_rms"   ? it->second->fy_rms
+            : o.value == "fy_hf_rms" ? it->second->fy_hf_rms
+                                     : it->second->resid_rms;
+      dat.printf("%lld %.6g %.9g\n", static_cast<long long>(r.trip), mm / 1000.0 + 0.5 * r.depth_bin, v);
+    }
+    dat.write("\n");
+  }
+  dat.close();
+  io::CheckedFile gp(f.gp, "--out (script)");
+  gp.write(header(f, 1000, 700));
+  gp.printf("set title %s\n", quoted("Depth x trip: " + o.value + " of the lateral acceleration [m/s^2] (" +
+                                     db->describe() + ", shaft '" + o.shaft + "', " + std::to_string(recs.size()) +
+                                     " trips, bins of " + num(bin, 4) + " m)").c_str());
+  gp.write("set xlabel 'trip'\nset ylabel 'depth l [m]'\nset yrange [*:*] reverse\nset cblabel " +
+           quoted(o.value + " [m/s^2]") + "\nset palette defined (0 '#fff5eb', 0.5 '#fd8d3c', 1 '#7f2704')\n");
+  if (recs.empty() || depths_mm.empty())
+    gp.write("set label 'no trips with depth bins' at graph 0.5, graph 0.5 center\nset xrange [0:1]\nset yrange [0:1]\n"
+             "plot NaN notitle\n");
+  else
+    gp.printf("set style fill solid 1.0 noborder\nplot %s using 1:2:(0.5):(%.6g):3 with boxxyerror fc palette notitle\n",
+              quoted(std::filesystem::absolute(f.dat).string()).c_str(), 0.5 * bin);
+  gp.close();
+  render(f);
+  if (!o.quiet)
+    std::cerr << "hoist-trips: depth map of " << recs.size() << " trip(s) x " << depths_mm.size() << " depth bins in "
+              << f.png << "\n";
+  return 0;
+}
+
+}  // namespace hoist::trips
