@@ -16,6 +16,7 @@
 // naming file, line and key), 1 the database or a write failed.
 #include "hoist/version.hpp"
 
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <new>
@@ -143,6 +144,19 @@ int main(int argc, char** argv) {
   ingest->add_option("--modes", o.modes, "assumed modes per rope n (overrides model.modes)")->check(CLI::Range(1, 60));
   ingest->add_option("--max-step", o.max_step, "largest integration step [s] (default: [service] max_step, else 0.0025)")
       ->check(CLI::Range(0.0, 10.0));
+  ingest->add_option("--first-trip", o.first_trip,
+                     "number the trips from N (default: the shaft's next); the same N again stores nothing twice")
+      ->check(CLI::PositiveNumber);
+  ingest->add_option_function<std::string>(
+      "--wall-start",
+      [&o](const std::string& v) {
+        std::tm tm{};
+        const char* end = strptime(v.c_str(), "%Y-%m-%dT%H:%M:%S", &tm);
+        if (!end || !(*end == 0 || (*end == 'Z' && end[1] == 0)))
+          throw CLI::ValidationError("--wall-start", "'" + v + "' is not an ISO 8601 UTC time such as 2026-12-06T08:00:00Z");
+        o.wall_start_us = static_cast<std::int64_t>(timegm(&tm)) * 1000000LL;
+      },
+      "wall-clock time of the row t = 0 (ISO 8601 UTC; default: now)");
   ingest->add_flag("-q,--quiet", o.quiet, "no summary");
 
   try {

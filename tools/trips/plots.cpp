@@ -16,7 +16,10 @@
 #include <set>
 #include <sstream>
 
+#include "hoist/history/condition_config.hpp"
 #include "hoist/io/checked_file.hpp"
+#include "hoist/io/config.hpp"
+#include "hoist/preload_trend.hpp"
 #include "trips.hpp"
 
 extern char** environ;
@@ -86,25 +89,34 @@ int runTrend(const Options& o) {
   const PlotFiles f = plotFiles(o.out);
   auto db = openDb(o, true);
   const auto recs = selected(*db, o, false);
+  // The combined estimate (the daemon's GUIDE_PRELOAD_LOW filter, hoist/preload_trend.hpp) after each trip.
+  ConditionSettings cond;
+  if (!o.config.empty()) cond = history::conditionSettingsFromToml(io::loadTomlFile(o.config), o.config);
+  PreloadTrend trend(cond);
   io::CheckedFile dat(f.dat, "--out (data)");
-  dat.write("# trip informative s sigma_s s_lo95 s_hi95 (hoist-trips trend, " + db->describe() + ")\n");
+  dat.write("# trip informative s sigma_s s_lo95 s_hi95 trend trend_lo95 trend_hi95 (hoist-trips trend, " +
+            db->describe() + ")\n");
   int informative = 0, attempted = 0;
   for (const auto& r : recs) {
+    trend.add(r);
     if (!r.id.attempted || r.id.sigma_scale < 0) continue;
     ++attempted;
     informative += r.id.informative;
     const double s = r.id.scale, sg = r.id.sigma_scale;
-    dat.printf("%lld %d %.9g %.9g %.9g %.9g\n", static_cast<long long>(r.trip), r.id.informative ? 1 : 0, s, sg,
-               s - 1.96 * sg, s + 1.96 * sg);
+    const double ts = trend.valid() ? trend.scale() : std::nan(""), tsg = trend.sigma();
+    dat.printf("%lld %d %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", static_cast<long long>(r.trip), r.id.informative ? 1 : 0,
+               s, sg, s - 1.96 * sg, s + 1.96 * sg, ts, ts - 1.96 * tsg, ts + 1.96 * tsg);
   }
   dat.close();
-  const double warn = o.warning, crit = o.critical;
+  const double warn = o.warning >= 0 ? o.warning : cond.preload_warning;
+  const double crit = o.critical >= 0 ? o.critical : cond.preload_critical;
+  const auto decision = trend.decision();
   io::CheckedFile gp(f.gp, "--out (script)");
   gp.write(header(f, 1000, 560));
   const std::string d = quoted(std::filesystem::absolute(f.dat).string());
-  gp.printf("set title %s\n", quoted("Guide-rope preload scale per trip (" + db->describe() + ", shaft '" + o.shaft +
-                                     "'): " + std::to_string(informative) + " of " + std::to_string(attempted) +
-                                     " identified trips informative").c_str());
+  gp.printf("set title %s\n", quoted("Guide-rope preload scale (" + db->describe() + ", shaft '" + o.shaft + "'): " +
+                                     std::to_string(informative) + " of " + std::to_string(attempted) +
+                                     " identified trips informative\n" + decision.text).c_str());
   gp.write("set xlabel 'trip'\nset ylabel 'preload scale s (1 = configured)'\nset grid\nset key bottom left\n"
            "set yrange [0:1.3]\n");
   gp.printf("set arrow from graph 0, first %.6g to graph 1, first %.6g nohead dt 2 lc rgb '#d08000' lw 2\n", warn, warn);
@@ -115,20 +127,21 @@ int runTrend(const Options& o) {
     gp.write("set label 'no trip with an identified preload' at graph 0.5, graph 0.5 center\n"
              "set xrange [0:1]\nplot 1 with lines lc rgb '#808080' title 'nominal'\n");
   } else {
-    gp.printf("plot %s using 1:($2 > 0 ? $5 : NaN):($2 > 0 ? $6 : NaN) with filledcurves lc rgb '#c8d8f0' "
-              "title 'per-trip 95 %% band (informative trips)', \\\n"
+    gp.printf("plot %s using 1:8:9 with filledcurves lc rgb '#c8d8f0' "
+              "title 'combined estimate: 95 %% band', \\\n"
+              "     %s using 1:7 with lines lw 2 lc rgb '#1f4e9c' title 'combined estimate (weighted by information)', \\\n"
               "     %s using 1:($2 > 0 ? $3 : NaN):4 with yerrorbars pt 7 ps 0.7 lc rgb '#1f4e9c' "
-              "title 's +- sigma (informative)', \\\n"
+              "title 'trip: s +- sigma (informative)', \\\n"
               "     %s using 1:($2 > 0 ? NaN : $3) with points pt 6 lc rgb '#909090' "
               "title 'not informative (sigma above max_sigma)', \\\n"
               "     1 with lines lc rgb '#808080' dt 3 title 'nominal'\n",
-              d.c_str(), d.c_str(), d.c_str());
+              d.c_str(), d.c_str(), d.c_str(), d.c_str());
   }
   gp.close();
   render(f);
   if (!o.quiet)
     std::cerr << "hoist-trips: trend of " << attempted << " trip(s) (" << informative << " informative) in " << f.png
-              << " (data " << f.dat << ", script " << f.gp << ")\n";
+              << " (data " << f.dat << ", script " << f.gp << "). " << decision.text << "\n";
   return 0;
 }
 

@@ -37,6 +37,8 @@ struct Options {
   std::string measurements;  ///< ingest
   int modes = 0;
   double max_step = -1.0;
+  std::int64_t first_trip = 0;     ///< ingest --first-trip (0: the shaft's next)
+  std::int64_t wall_start_us = 0;  ///< ingest --wall-start (0: now)
   bool quiet = false;
 };
 
