@@ -159,6 +159,18 @@ int main(int argc, char** argv) {
       "wall-clock time of the row t = 0 (ISO 8601 UTC; default: now)");
   ingest->add_flag("-q,--quiet", o.quiet, "no summary");
 
+  if (argc > 1 && argv[1][0] != '-') {  // CLI11 would only say "A subcommand is required"
+    bool found = false;
+    std::string known;
+    for (const auto* sc : app.get_subcommands({})) {
+      found = found || sc->get_name() == argv[1];
+      known += (known.empty() ? "" : ", ") + sc->get_name();
+    }
+    if (!found) {
+      std::cerr << "hoist-trips: unknown subcommand '" << argv[1] << "' (" << known << ")\nRun with --help for more information.\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -170,8 +182,10 @@ int main(int argc, char** argv) {
   if (show->parsed() && o.format == "table") o.format = "text";
   try {
     if (ingest->parsed() && o.config.empty()) throw hoist::trips::UsageError("ingest: --config is required (the shaft and [condition])");
-    if (!o.out.empty() && o.out != "-" && !trend->parsed() && !depth->parsed()) hoist::io::checkOutputPath(o.out, "--out");
-    if (!o.bins_out.empty()) hoist::io::checkOutputPath(o.bins_out, "--bins");
+    // Output paths checked before any work (a bad one is bad input: exit 2).
+    for (const auto& [path, label] : {std::pair{o.out, "--out"}, std::pair{o.bins_out, "--bins"}})
+      if (!path.empty() && path != "-")
+        if (auto why = hoist::io::outputPathError(path, label); !why.empty()) throw hoist::trips::UsageError(why);
     if (list->parsed()) return hoist::trips::runList(o);
     if (show->parsed()) return hoist::trips::runShow(o);
     if (trend->parsed()) return hoist::trips::runTrend(o);

@@ -35,14 +35,18 @@ struct PlotFiles {
 PlotFiles plotFiles(const std::string& out) {
   if (out.size() < 5 || out.compare(out.size() - 4, 4, ".png") != 0)
     throw UsageError("--out: '" + out + "' must name a .png file");
-  io::checkOutputPath(out, "--out");
+  if (auto why = io::outputPathError(out, "--out"); !why.empty()) throw UsageError(why);
   const std::string stem = out.substr(0, out.size() - 4);
   return {out, stem + ".dat", stem + ".gp"};
 }
 
 std::string quoted(const std::string& s) {
   std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("''") : std::string(1, c);
+  for (char c : s) {
+    if (c == '\'') q += "''";
+    else if (c == '\n') q += "' . \"\\n\" . '";  // a line break in a title
+    else if (static_cast<unsigned char>(c) >= 0x20) q += c;
+  }
   return q + "'";
 }
 
@@ -114,7 +118,7 @@ int runTrend(const Options& o) {
   io::CheckedFile gp(f.gp, "--out (script)");
   gp.write(header(f, 1000, 560));
   const std::string d = quoted(std::filesystem::absolute(f.dat).string());
-  gp.printf("set title %s\n", quoted("Guide-rope preload scale (" + db->describe() + ", shaft '" + o.shaft + "'): " +
+  gp.printf("set title %s\n", quoted("Guide-rope preload scale (" + db->describe() + ", shaft " + (o.shaft.empty() ? std::string("(default)") : o.shaft) + "): " +
                                      std::to_string(informative) + " of " + std::to_string(attempted) +
                                      " identified trips informative\n" + decision.text).c_str());
   gp.write("set xlabel 'trip'\nset ylabel 'preload scale s (1 = configured)'\nset grid\nset key bottom left\n"
@@ -178,7 +182,7 @@ int runDepthMap(const Options& o) {
   io::CheckedFile gp(f.gp, "--out (script)");
   gp.write(header(f, 1000, 700));
   gp.printf("set title %s\n", quoted("Depth x trip: " + o.value + " of the lateral acceleration [m/s^2] (" +
-                                     db->describe() + ", shaft '" + o.shaft + "', " + std::to_string(recs.size()) +
+                                     db->describe() + ", shaft " + (o.shaft.empty() ? std::string("(default)") : o.shaft) + ", " + std::to_string(recs.size()) +
                                      " trips, bins of " + num(bin, 4) + " m)").c_str());
   gp.write("set xlabel 'trip'\nset ylabel 'depth l [m]'\nset yrange [*:*] reverse\nset cblabel " +
            quoted(o.value + " [m/s^2]") + "\nset palette defined (0 '#fff5eb', 0.5 '#fd8d3c', 1 '#7f2704')\n");
