@@ -50,6 +50,17 @@ std::string quoted(const std::string& s) {
   return q + "'";
 }
 
+/// `s` with line breaks at spaces so that no line is longer than `width`.
+std::string wrap(const std::string& s, std::size_t width) {
+  std::string out, line;
+  std::istringstream in(s);
+  for (std::string w; in >> w;) {
+    if (!line.empty() && line.size() + 1 + w.size() > width) out += line + "\n", line.clear();
+    line += (line.empty() ? "" : " ") + w;
+  }
+  return out + line;
+}
+
 std::string header(const PlotFiles& f, int w, int h) {
   std::ostringstream s;
   s << "# Written by hoist-trips; re-render with: gnuplot " << f.gp << "\n"
@@ -118,15 +129,15 @@ int runTrend(const Options& o) {
   io::CheckedFile gp(f.gp, "--out (script)");
   gp.write(header(f, 1000, 560));
   const std::string d = quoted(std::filesystem::absolute(f.dat).string());
-  gp.printf("set title %s\n", quoted("Guide-rope preload scale (" + db->describe() + ", shaft " + (o.shaft.empty() ? std::string("(default)") : o.shaft) + "): " +
-                                     std::to_string(informative) + " of " + std::to_string(attempted) +
-                                     " identified trips informative\n" + decision.text).c_str());
+  gp.printf("set title %s\n", quoted("Guide-rope preload scale, shaft " + (o.shaft.empty() ? std::string("(default)") : o.shaft) +
+                                     ": " + std::to_string(informative) + " of " + std::to_string(attempted) +
+                                     " identified trips informative\n" + wrap(decision.text, 130)).c_str());
   gp.write("set xlabel 'trip'\nset ylabel 'preload scale s (1 = configured)'\nset grid\nset key bottom left\n"
            "set yrange [0:1.3]\n");
   gp.printf("set arrow from graph 0, first %.6g to graph 1, first %.6g nohead dt 2 lc rgb '#d08000' lw 2\n", warn, warn);
   gp.printf("set arrow from graph 0, first %.6g to graph 1, first %.6g nohead dt 2 lc rgb '#c00000' lw 2\n", crit, crit);
-  gp.printf("set label 'preload_warning %.2f' at graph 0.01, first %.6g offset 0,0.6 tc rgb '#d08000'\n", warn, warn);
-  gp.printf("set label 'preload_critical %.2f' at graph 0.01, first %.6g offset 0,0.6 tc rgb '#c00000'\n", crit, crit);
+  gp.printf("set label 'preload_warning %.2f' at graph 0.01, first %.6g offset 0,0.6 tc rgb '#d08000' front\n", warn, warn);
+  gp.printf("set label 'preload_critical %.2f' at graph 0.01, first %.6g offset 0,0.6 tc rgb '#c00000' front\n", crit, crit);
   if (attempted == 0) {
     gp.write("set label 'no trip with an identified preload' at graph 0.5, graph 0.5 center\n"
              "set xrange [0:1]\nplot 1 with lines lc rgb '#808080' title 'nominal'\n");
@@ -181,11 +192,21 @@ int runDepthMap(const Options& o) {
   dat.close();
   io::CheckedFile gp(f.gp, "--out (script)");
   gp.write(header(f, 1000, 700));
-  gp.printf("set title %s\n", quoted("Depth x trip: " + o.value + " of the lateral acceleration [m/s^2] (" +
-                                     db->describe() + ", shaft " + (o.shaft.empty() ? std::string("(default)") : o.shaft) + ", " + std::to_string(recs.size()) +
-                                     " trips, bins of " + num(bin, 4) + " m)").c_str());
+  const std::string shaft = o.shaft.empty() ? std::string("(default)") : o.shaft;
+  gp.printf("set title %s\n", quoted("Depth x trip: " + o.value + " of the lateral acceleration f_y, shaft " + shaft + ", " +
+                                     std::to_string(recs.size()) + " trips, bins of " + num(bin, 4) + " m").c_str());
   gp.write("set xlabel 'trip'\nset ylabel 'depth l [m]'\nset yrange [*:*] reverse\nset cblabel " +
-           quoted(o.value + " [m/s^2]") + "\nset palette defined (0 '#fff5eb', 0.5 '#fd8d3c', 1 '#7f2704')\n");
+           quoted(o.value + " [m/s^2]") + "\n");
+  if (o.value == "resid_mean")  // signed: a diverging palette, symmetric about zero
+    gp.write("set palette defined (-1 '#2166ac', 0 '#f7f7f7', 1 '#b2182b')\n");
+  else
+    gp.write("set palette defined (0 '#fff5eb', 0.5 '#fd8d3c', 1 '#7f2704')\n");
+  if (!recs.empty())
+    gp.printf("set xrange [%.1f:%.1f]\n", recs.front().trip - 0.5, recs.back().trip + 0.5);
+  if (o.value == "resid_mean" && !depths_mm.empty())
+    gp.printf("stats %s using 3 nooutput\nhoist_m = (abs(STATS_min) > abs(STATS_max) ? abs(STATS_min) : abs(STATS_max))\n"
+              "if (hoist_m > 0) set cbrange [-hoist_m:hoist_m]\n",
+              quoted(std::filesystem::absolute(f.dat).string()).c_str());
   if (recs.empty() || depths_mm.empty())
     gp.write("set label 'no trips with depth bins' at graph 0.5, graph 0.5 center\nset xrange [0:1]\nset yrange [0:1]\n"
              "plot NaN notitle\n");
