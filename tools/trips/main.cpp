@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
   app.name("hoist-trips");
   app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });
   app.set_version_flag("--version", std::string("hoist-trips ") + hoist::kVersionString);
-  app.require_subcommand(1);
+  app.require_subcommand(0, 1);  // none is checked after parsing, so that an unknown option is named first
   app.footer(
       "Examples:\n"
       "  hoist-trips ingest --config shaft.toml --measurements run.csv --db sqlite:///tmp/h.sqlite\n"
@@ -177,7 +177,11 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  if (!exp->parsed() && o.format.empty()) o.format = "table";
+  if (app.get_subcommands().empty()) {
+    std::cerr << "hoist-trips: a subcommand is required (list, show, trend, depth-map, baseline, export, ingest)\n"
+                 "Run with --help for more information.\n";
+    return 2;
+  }
   if (exp->parsed() && o.format == "table") o.format = "csv";
   if (show->parsed() && o.format == "table") o.format = "text";
   try {
