@@ -48,14 +48,7 @@ StoreOptions options(const PgServer& pg, const fs::path& dir, double retry = 10.
   return o;
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const StoreError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using hoist::test::storeErrorOf;
 
 #define NEED_POSTGRES()                                                                         \
   if (PgServer::binDir().empty()) GTEST_SKIP() << "PostgreSQL is not installed (apt-get install postgresql)"
@@ -89,7 +82,7 @@ TEST(PgStore, RoundTripCredentialsMigrations) {
     s->markBaseline("", 1, true, 10);
     s->markBaseline("", 3, true, 10);
     EXPECT_EQ(s->baseline(""), (std::vector<std::int64_t>{1, 3}));
-    EXPECT_NE(errorOf([&] { s->markBaseline("", 77, true, 1); }).find("no trip 77"), std::string::npos);
+    EXPECT_NE(storeErrorOf([&] { s->markBaseline("", 77, true, 1); }).find("no trip 77"), std::string::npos);
     const std::int64_t day = 86400LL * 1000000LL;
     EXPECT_EQ(s->prune(1, sampleRecord(1).wall_end_us + day + 1), 1);
     EXPECT_EQ(s->baseline(""), (std::vector<std::int64_t>{3}));
@@ -100,7 +93,7 @@ TEST(PgStore, RoundTripCredentialsMigrations) {
   {
     auto bad = o;
     bad.password = "wrong-password";
-    const auto e = errorOf([&] { openStore(bad); });
+    const auto e = storeErrorOf([&] { openStore(bad); });
     EXPECT_NE(e.find("refused"), std::string::npos) << e;
     EXPECT_EQ(e.find("wrong-password"), std::string::npos) << e;
   }
@@ -116,11 +109,11 @@ TEST(PgStore, RoundTripCredentialsMigrations) {
   ASSERT_EQ(pg.psql("UPDATE trips SET peak_speed = 'NaN' WHERE trip = 5").status, 0);
   {
     auto s = openStore(o);
-    const auto e = errorOf([&] { s->list(); });
+    const auto e = storeErrorOf([&] { s->list(); });
     EXPECT_NE(e.find("trip 5: column peak_speed: not a finite number"), std::string::npos) << e;
   }
   ASSERT_EQ(pg.psql("UPDATE schema_version SET version = 42").status, 0);
-  EXPECT_NE(errorOf([&] { openStore(o); }).find("schema version 42 is newer"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { openStore(o); }).find("schema version 42 is newer"), std::string::npos);
 }
 
 TEST(PgStore, OutageOfTwoMinutesLosesAndDoublesNothing) {

@@ -8,9 +8,11 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 
+#include "hoist/history/store.hpp"
 #include "hoist/trip_record.hpp"
 
 namespace hoist::test {
@@ -132,6 +134,16 @@ inline void expectSameRecord(const TripRecord& a, const TripRecord& b) {
   EXPECT_EQ(a.id.dof, b.id.dof);
   EXPECT_EQ(a.id.cpu_seconds, b.id.cpu_seconds);
   EXPECT_EQ(a.id.note, b.id.note);
+}
+
+/// The message of the history::StoreError `f` throws, or "(no error)".
+inline std::string storeErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const history::StoreError& e) {
+    return e.what();
+  }
+  return "(no error)";
 }
 
 }  // namespace hoist::test

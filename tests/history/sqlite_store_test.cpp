@@ -27,14 +27,7 @@ std::string sql(const fs::path& db, const std::string& script) {
   return r.output;
 }
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const StoreError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using hoist::test::storeErrorOf;
 
 }  // namespace
 
@@ -98,13 +91,13 @@ TEST(SqliteStore, RefusesARecordItCannotStoreAndWritesNothing) {
   auto s = openSqliteStore((dir / "h.sqlite").string());
   auto r = sampleRecord(1);
   r.bins[3].fy_rms = std::nan("");
-  EXPECT_NE(errorOf([&] { s->put(r); }).find("bins[3].fy_rms: not a finite number"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { s->put(r); }).find("bins[3].fy_rms: not a finite number"), std::string::npos);
   r = sampleRecord(1);
   r.alarms = {"A;B"};
-  EXPECT_NE(errorOf([&] { s->put(r); }).find("alarms"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { s->put(r); }).find("alarms"), std::string::npos);
   r = sampleRecord(1);
   std::swap(r.bins[0], r.bins[1]);
-  EXPECT_NE(errorOf([&] { s->put(r); }).find("increasing depth"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { s->put(r); }).find("increasing depth"), std::string::npos);
   EXPECT_TRUE(s->list().empty());
   EXPECT_EQ(sql(dir / "h.sqlite", "SELECT count(*) FROM bins;"), "0\n");
 }
@@ -122,7 +115,7 @@ TEST(SqliteStore, BaselineMarksAndPrune) {
   EXPECT_EQ(s->baseline(""), (std::vector<std::int64_t>{2, 4}));
   s->markBaseline("", 4, false, 3);
   EXPECT_EQ(s->baseline(""), (std::vector<std::int64_t>{2}));
-  EXPECT_NE(errorOf([&] { s->markBaseline("", 9, true, 1); }).find("no trip 9"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { s->markBaseline("", 9, true, 1); }).find("no trip 9"), std::string::npos);
   // Retention: trips ending more than keep_days before now go, with their bins and marks.
   const std::int64_t day = 86400LL * 1000000LL;
   const std::int64_t now = sampleRecord(3).wall_end_us + 10 * day + 1;  // trips 1..3 ended > 10 days ago
@@ -158,7 +151,7 @@ TEST(SqliteStore, MigratesVersion1WithItsTrips) {
   // Read-only never migrates: it says what to do.
   sql(db, "DROP TABLE baseline; DROP INDEX trips_wall_end; UPDATE schema_version SET version = 1;");
   s.reset();
-  EXPECT_NE(errorOf([&] { openSqliteStore(db.string(), true); }).find("open it once read-write"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { openSqliteStore(db.string(), true); }).find("open it once read-write"), std::string::npos);
 }
 
 TEST(SqliteStore, RefusesNewerForeignGarbageAndMissing) {
@@ -166,20 +159,20 @@ TEST(SqliteStore, RefusesNewerForeignGarbageAndMissing) {
   const auto db = dir / "h.sqlite";
   { openSqliteStore(db.string()); }
   sql(db, "UPDATE schema_version SET version = 99;");
-  EXPECT_NE(errorOf([&] { openSqliteStore(db.string()); }).find("schema version 99 is newer"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { openSqliteStore(db.string()); }).find("schema version 99 is newer"), std::string::npos);
 
   sql(dir / "other.sqlite", "CREATE TABLE trips (x INTEGER);");
-  EXPECT_NE(errorOf([&] { openSqliteStore((dir / "other.sqlite").string()); }).find("not a hoist-twin history database"),
+  EXPECT_NE(storeErrorOf([&] { openSqliteStore((dir / "other.sqlite").string()); }).find("not a hoist-twin history database"),
             std::string::npos);
 
   { std::ofstream(dir / "garbage.sqlite") << std::string(4096, 'x'); }
-  EXPECT_NE(errorOf([&] { openSqliteStore((dir / "garbage.sqlite").string()); }).find("not a database"),
+  EXPECT_NE(storeErrorOf([&] { openSqliteStore((dir / "garbage.sqlite").string()); }).find("not a database"),
             std::string::npos);
 
-  EXPECT_NE(errorOf([&] { openSqliteStore((dir / "missing.sqlite").string(), true); }).find("no such file"),
+  EXPECT_NE(storeErrorOf([&] { openSqliteStore((dir / "missing.sqlite").string(), true); }).find("no such file"),
             std::string::npos);
   fs::create_directories(dir / "adir");
-  EXPECT_NE(errorOf([&] { openSqliteStore((dir / "adir").string()); }).find("not a regular file"), std::string::npos);
+  EXPECT_NE(storeErrorOf([&] { openSqliteStore((dir / "adir").string()); }).find("not a regular file"), std::string::npos);
 }
 
 TEST(SqliteStore, BadContentsAreAClearErrorNotACrash) {
@@ -211,7 +204,7 @@ TEST(SqliteStore, BadContentsAreAClearErrorNotACrash) {
     fs::copy_file(db, dir / "bad.sqlite", fs::copy_options::overwrite_existing);
     fs::remove(dir / "bad.sqlite-wal");
     sql(dir / "bad.sqlite", c.plant);
-    const std::string e = errorOf([&] {
+    const std::string e = storeErrorOf([&] {
       auto s = openSqliteStore((dir / "bad.sqlite").string());
       ListFilter f;
       f.with_bins = true;

@@ -53,7 +53,7 @@ class RecordQueue {
   std::int64_t rejected_ = 0;
 };
 
-/// CRC-32 (IEEE 802.3, as zlib's crc32) of `data`.
+/// CRC-32 (IEEE 802.3) of `data`: zlib's crc32.
 std::uint32_t crc32(const void* data, std::size_t n);
 
 }  // namespace hoist::history
