@@ -4,7 +4,11 @@
 // unix socket live in a fresh /tmp/hoist-pg-XXXXXX (no TCP listener), the
 // superuser `postgres` has a password (scram-sha-256), so the client's
 // credential path is exercised.  The destructor stops the server and removes
-// the folder on every exit path of the test (a failed assertion too).
+// the folder on every exit path of the test (a failed assertion too); for
+// the paths a destructor does not see (a crash, ctest's timeout kill) the
+// folder is also listed in HOIST_TEST_WORK_DIR/pg-servers/, and the CTest
+// fixture cleanup `history_pg_cleanup` (pg_cleanup.cmake) stops and removes
+// whatever is listed there after the postgres tests.
 #pragma once
 
 #include <pwd.h>
@@ -37,6 +41,9 @@ class PgServer {
     if (!::mkdtemp(tmpl)) return;
     dir_ = tmpl;
     ::chmod(dir_.c_str(), 0755);
+    std::filesystem::create_directories(std::string(HOIST_TEST_WORK_DIR) + "/pg-servers");
+    listing_ = std::string(HOIST_TEST_WORK_DIR) + "/pg-servers/" + dir_.substr(5);  // hoist-pg-XXXXXX
+    { std::ofstream(listing_) << dir_ << "\n"; }
     if (::geteuid() == 0) {
       const passwd* pw = ::getpwnam("postgres");
       if (!pw) return;
@@ -55,6 +62,7 @@ class PgServer {
   ~PgServer() {
     stop();
     if (!dir_.empty()) std::filesystem::remove_all(dir_);
+    if (!listing_.empty()) std::filesystem::remove(listing_);
   }
   PgServer(const PgServer&) = delete;
   PgServer& operator=(const PgServer&) = delete;
@@ -90,7 +98,7 @@ class PgServer {
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   }
   int port_;
-  std::string password_, bin_, dir_, as_;
+  std::string password_, bin_, dir_, as_, listing_;
   bool ok_ = false, running_ = false;
 };
 
