@@ -113,7 +113,8 @@ std::string values(std::size_t n, bool numbered) {
   std::string s;
   for (std::size_t i = 1; i <= n; ++i) {
     if (i > 1) s += ',';
-    s += numbered ? "$" + std::to_string(i) : std::string("?");
+    if (numbered) s.append("$").append(std::to_string(i));
+    else s += '?';
   }
   return s;
 }

@@ -211,7 +211,7 @@ int runExport(const Options& o) {
     out.write(history::tripColumnList() + "\n");
     for (const auto& r : recs) {
       std::string row = csvField(r.shaft) + "," + std::to_string(r.trip);
-      for (const auto& f : history::tripFields()) row += "," + valueText(f.get(r));
+      for (const auto& f : history::tripFields()) row.append(",").append(valueText(f.get(r)));
       out.write(row + "\n");
     }
   }
@@ -221,7 +221,7 @@ int runExport(const Options& o) {
     for (const auto& r : recs)
       for (std::size_t i = 0; i < r.bins.size(); ++i) {
         std::string row = csvField(r.shaft) + "," + std::to_string(r.trip) + "," + std::to_string(i);
-        for (const auto& f : history::binFields()) row += "," + valueText(f.get(r.bins[i]));
+        for (const auto& f : history::binFields()) row.append(",").append(valueText(f.get(r.bins[i])));
         bins.write(row + "\n");
       }
     bins.close();
@@ -242,7 +242,7 @@ int runBaseline(const Options& o) {
   const auto b = db->baseline(o.shaft);
   std::string s = "baseline of shaft '" + o.shaft + "': ";
   if (b.empty()) s += "none marked (the trend uses the first [condition] baseline_trips trips)";
-  for (std::size_t i = 0; i < b.size(); ++i) s += (i ? " " : "") + std::to_string(b[i]);
+  for (std::size_t i = 0; i < b.size(); ++i) s.append(i ? " " : "").append(std::to_string(b[i]));
   std::cout << s << "\n";
   return 0;
 }
