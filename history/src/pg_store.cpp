@@ -20,6 +20,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <set>
 #include <type_traits>
 
 #include "hoist/history/queue.hpp"
@@ -186,7 +187,10 @@ class PgStore final : public Store {
   }
 
   std::int64_t nextTrip(const std::string& shaft) override {
-    std::int64_t m = std::max(known_max_[shaft], queue_.maxTrip(shaft));
+    // Records a previous run left in the queue count too: read once per shaft
+    // (this process's own pushes update known_max_).
+    if (scanned_.insert(shaft).second) known_max_[shaft] = std::max(known_max_[shaft], queue_.maxTrip(shaft));
+    std::int64_t m = known_max_[shaft];
     if (connect(false)) {
       try {
         Result res(run("SELECT COALESCE(MAX(trip), 0) FROM trips WHERE shaft = $1", {shaft}, PGRES_TUPLES_OK));
@@ -381,7 +385,8 @@ class PgStore final : public Store {
   PGconn* conn_ = nullptr;
   bool tried_ = false;
   std::chrono::steady_clock::time_point last_try_{};
-  std::map<std::string, std::int64_t> known_max_;
+  std::map<std::string, std::int64_t> known_max_;  ///< the largest trip number seen per shaft (server or queue)
+  std::set<std::string> scanned_;                   ///< shafts whose queued records were read for known_max_
   StoreStats stats_;
 };
 

@@ -12,6 +12,10 @@
 // version, a database that is not ours, or garbage is refused with
 // StoreError naming the database.
 //
+// One writer per shaft (the shaft's daemon, or one hoist-trips ingest at a
+// time): trip numbers are the key, and a number assigned while PostgreSQL
+// is down is this writer's own (last seen + queued + 1).
+//
 // put(): one transaction per record (the trip row and its bins together or
 // nothing).  Idempotent on (shaft, trip): a record whose key is already
 // stored is left as it is and reported Duplicate, so a retry never doubles a
