@@ -6,6 +6,7 @@
 
 #include "hoist/io/estimator_config.hpp"
 #include "hoist/io/toml_section.hpp"
+#include "section.hpp"
 
 namespace hoist::history {
 
@@ -20,12 +21,7 @@ ConditionSettings conditionSettingsFromToml(const toml::table& root, const std::
   r.number("preload_warning", c.preload_warning);
   r.number("preload_critical", c.preload_critical);
   r.number("trend_walk", c.trend_walk);
-  r.run();
-  try {
-    c.validate();
-  } catch (const std::invalid_argument& e) {
-    io::rethrowWithLine(e.what(), source, {&r}, true);
-  }
+  detail::runValidated(r, source, [&c] { c.validate(); });
   return c;
 }
 

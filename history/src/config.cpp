@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "hoist/io/toml_section.hpp"
+#include "section.hpp"
 
 namespace hoist::history {
 
@@ -100,12 +101,7 @@ HistoryConfig historyConfigFromToml(const toml::table& root, const std::string& 
   r.string("queue_dir", [&c](const toml::node&, const std::string& v) { c.queue_dir = v; });
   r.string("password_file", [&c](const toml::node&, const std::string& v) { c.password_file = v; });
   r.number("retry_seconds", c.retry_seconds);
-  r.run();
-  try {
-    c.validate();
-  } catch (const std::invalid_argument& e) {
-    io::rethrowWithLine(e.what(), source, {&r}, true);
-  }
+  detail::runValidated(r, source, [&c] { c.validate(); });
   return c;
 }
 
