@@ -1,4 +1,4 @@
-// identifyPreload: Gauss-Newton on (M, s, o) over one trip (hoist/preload_identification.hpp).
+// identifyPreload: the profile chi2(s) over one trip, (M, o) linear at each s (hoist/preload_identification.hpp).
 #include "hoist/preload_identification.hpp"
 
 #include <time.h>
@@ -64,9 +64,9 @@ void unitMomentResponse(const ShaftParams& twin, double scale, double imbalance,
 PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est, const PreloadFitOptions& opt,
                            const std::vector<MeasurementSample>& trip) {
   if (!(opt.max_sigma > 0.0) || !(opt.accel_offset_sigma >= 0.0) || !(opt.max_step >= 0.0) ||
-      !(opt.fd_step > 0.0 && opt.fd_step < 0.5) || opt.max_iterations < 1)
+      opt.max_iterations < 1 || opt.max_iterations > 50)
     throw std::invalid_argument("identifyPreload: bad options (max_sigma > 0, accel_offset_sigma >= 0, "
-                                "max_step >= 0, 0 < fd_step < 0.5, max_iterations >= 1)");
+                                "max_step >= 0, 1 <= max_iterations <= 50)");
   const double cpu0 = threadCpuSeconds();
   PreloadFit out;
   PreloadIdentification& id = out.id;
@@ -86,99 +86,150 @@ PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est
   }
   id.attempted = true;
   const bool fit_offset = opt.accel_offset_sigma > 0.0 && n_acc > 0;
-  const int np = fit_offset ? 3 : 2;
+  const int np = fit_offset ? 2 : 1;  // linear unknowns at a given s: M (and o)
   const double sa2 = est.noise.imu_accel * est.noise.imu_accel, sw2 = est.noise.imu_rate * est.noise.imu_rate;
   const double me = est.model_error;
+  const int dof = static_cast<int>(n_acc + n_rate) - np - 1 + (fit_offset ? 1 : 0);
 
-  std::vector<double> H0f, H0w, H1f, H1w, pf(trip.size(), 0.0), pw(trip.size(), 0.0);
-  double s0 = 1.0, s = 1.0, M = 0.0, o = 0.0, chi2 = 0.0;
-  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(np, np);
-  int dof = static_cast<int>(n_acc + n_rate) - np + (fit_offset ? 1 : 0);
-  for (int it = 0; it < opt.max_iterations; ++it) {
-    const double ds = s0 * opt.fd_step;
-    unitMomentResponse(twin, s0, 0.0, opt.max_step, trip, H0f, H0w);
-    unitMomentResponse(twin, s0 + ds, 0.0, opt.max_step, trip, H1f, H1w);
-    // Linear least squares in (M, P = M (s - s0), o).
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(np, np);
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(np);
-    Eigen::VectorXd row(np);
-    auto accumulate = [&](auto&& visit) {
-      for (std::size_t i = 0; i < trip.size(); ++i) {
-        const MeasurementSample& m = trip[i];
-        if (m.present & kSensorImuAccel) {
-          row(0) = H0f[i];
-          row(1) = (H1f[i] - H0f[i]) / ds;
-          if (fit_offset) row(2) = 1.0;
-          visit(row, m.z.f_y, 1.0 / (sa2 + me * me * pf[i] * pf[i]));
-        }
-        if (m.present & kSensorImuRate) {
-          row(0) = H0w[i];
-          row(1) = (H1w[i] - H0w[i]) / ds;
-          if (fit_offset) row(2) = 0.0;
-          visit(row, m.z.omega, 1.0 / (sw2 + me * me * pw[i] * pw[i]));
-        }
-      }
-    };
-    accumulate([&](const Eigen::VectorXd& j, double z, double w) {
-      A.noalias() += w * j * j.transpose();
-      r.noalias() += w * z * j;
-    });
-    if (fit_offset) A(2, 2) += 1.0 / (opt.accel_offset_sigma * opt.accel_offset_sigma);
-    const Eigen::VectorXd p = A.ldlt().solve(r);
-    M = p(0);
-    const double P = p(1);
-    o = fit_offset ? p(2) : 0.0;
-    const double step = std::abs(M) > 0.0 ? P / M : 0.0;
-    s = s0 + step;
-    // Fisher information in (M, s, o) at the solution, the predictions, chi2.
-    Eigen::MatrixXd F = Eigen::MatrixXd::Zero(np, np);
-    chi2 = 0.0;
+  // The profile: at a given s, (M, o) by linear weighted least squares; one
+  // solver run per s.  Weights: the sensor's variance plus the model error on
+  // the prediction at s = 1 (fixed, so chi2 compares across s).
+  std::vector<double> wf(trip.size(), 1.0 / sa2), ww(trip.size(), 1.0 / sw2);
+  struct Eval {
+    double s = 1.0, chi2 = 0.0, M = 0.0, o = 0.0, varM = 0.0;
+    std::vector<double> Hf, Hw;
+  };
+  std::vector<Eval> evals;
+  evals.reserve(3 * static_cast<std::size_t>(opt.max_iterations) + 12);  // references into it stay valid
+  auto solveAt = [&](Eval& e) {
+    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d r = Eigen::Vector2d::Zero();
     for (std::size_t i = 0; i < trip.size(); ++i) {
       const MeasurementSample& m = trip[i];
-      const double dHf = (H1f[i] - H0f[i]) / ds, dHw = (H1w[i] - H0w[i]) / ds;
-      const double hf = H0f[i] + step * dHf, hw = H0w[i] + step * dHw;
       if (m.present & kSensorImuAccel) {
-        const double w = 1.0 / (sa2 + me * me * pf[i] * pf[i]);
-        row(0) = hf;
-        row(1) = M * dHf;
-        if (fit_offset) row(2) = 1.0;
-        F.noalias() += w * row * row.transpose();
-        const double pred = M * hf + o;
-        chi2 += w * (m.z.f_y - pred) * (m.z.f_y - pred);
-        out.fitted_fy[i] = pred;
+        const Eigen::Vector2d j(e.Hf[i], 1.0);
+        A += wf[i] * j * j.transpose();
+        r += wf[i] * m.z.f_y * j;
       }
       if (m.present & kSensorImuRate) {
-        const double w = 1.0 / (sw2 + me * me * pw[i] * pw[i]);
-        row(0) = hw;
-        row(1) = M * dHw;
-        if (fit_offset) row(2) = 0.0;
-        F.noalias() += w * row * row.transpose();
-        chi2 += w * (m.z.omega - M * hw) * (m.z.omega - M * hw);
+        A(0, 0) += ww[i] * e.Hw[i] * e.Hw[i];
+        r(0) += ww[i] * m.z.omega * e.Hw[i];
       }
-      pf[i] = M * hf;  // the next step's model-error weights
-      pw[i] = M * hw;
     }
-    if (fit_offset) F(2, 2) += 1.0 / (opt.accel_offset_sigma * opt.accel_offset_sigma);
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(F);
-    if (!lu.isInvertible()) {
-      cov.setConstant(std::numeric_limits<double>::infinity());
-      break;
+    if (fit_offset) {
+      A(1, 1) += 1.0 / (opt.accel_offset_sigma * opt.accel_offset_sigma);
+      const Eigen::Matrix2d C = A.inverse();
+      const Eigen::Vector2d p = C * r;
+      e.M = p(0);
+      e.o = p(1);
+      e.varM = C(0, 0);
+    } else {
+      e.M = A(0, 0) > 0.0 ? r(0) / A(0, 0) : 0.0;
+      e.o = 0.0;
+      e.varM = A(0, 0) > 0.0 ? 1.0 / A(0, 0) : std::numeric_limits<double>::infinity();
     }
-    cov = lu.inverse();
-    const double sig_s = std::sqrt(std::max(0.0, cov(1, 1)));
-    // Converged, or not identifiable (then moving s0 on a wild step is pointless).
-    if (std::abs(step) <= 0.1 * sig_s || !(sig_s < 0.5)) break;
-    s0 = std::clamp(s, 0.3, 2.0);
+    e.chi2 = fit_offset ? e.o * e.o / (opt.accel_offset_sigma * opt.accel_offset_sigma) : 0.0;
+    for (std::size_t i = 0; i < trip.size(); ++i) {
+      const MeasurementSample& m = trip[i];
+      if (m.present & kSensorImuAccel) e.chi2 += wf[i] * std::pow(m.z.f_y - e.M * e.Hf[i] - e.o, 2);
+      if (m.present & kSensorImuRate) e.chi2 += ww[i] * std::pow(m.z.omega - e.M * e.Hw[i], 2);
+    }
+  };
+  auto evalAt = [&](double sv) -> const Eval& {
+    for (const Eval& e : evals)
+      if (std::abs(e.s - sv) < 1e-9) return e;
+    Eval e;
+    e.s = sv;
+    unitMomentResponse(twin, sv, 0.0, opt.max_step, trip, e.Hf, e.Hw);
+    solveAt(e);
+    evals.push_back(std::move(e));
+    ++out.iterations;
+    return evals.back();
+  };
+  {
+    Eval& e1 = const_cast<Eval&>(evalAt(1.0));
+    for (std::size_t i = 0; i < trip.size(); ++i) {
+      wf[i] = 1.0 / (sa2 + std::pow(me * e1.M * e1.Hf[i], 2));
+      ww[i] = 1.0 / (sw2 + std::pow(me * e1.M * e1.Hw[i], 2));
+    }
+    solveAt(e1);
   }
+  // The profile's minimum: a coarse grid (the information on s sharpens as s
+  // falls, so the profile is far from a parabola over the whole range), then
+  // local parabolas through (c - d, c, c + d), d ~ one sigma, re-centred on
+  // their vertex until it moves less than a quarter of d.
+  constexpr double kLo = 0.3, kHi = 1.6;
+  const double grid[] = {kLo, 0.5, 0.7, 0.85, 1.0, 1.2, kHi};  // 1.0: the weights' run
+  constexpr std::size_t kGrid = sizeof grid / sizeof grid[0];
+  std::size_t k = 0;
+  for (std::size_t g = 0; g < kGrid; ++g)
+    if (evalAt(grid[g]).chi2 < evalAt(grid[k]).chi2) k = g;
+  auto best = [&]() -> const Eval& {
+    return *std::min_element(evals.begin(), evals.end(), [](const Eval& a, const Eval& b) { return a.chi2 < b.chi2; });
+  };
+  double s = grid[k], sig_s = -1.0;
+  bool bounded = k > 0 && k + 1 < kGrid;
+  if (bounded) {
+    // First guess of the curvature from the grid neighbours.
+    const Eval &a = evalAt(grid[k - 1]), &c = evalAt(grid[k + 1]);
+    const Eval& b = evalAt(s);
+    const double d1 = (b.chi2 - a.chi2) / (b.s - a.s), d2 = (c.chi2 - b.chi2) / (c.s - b.s);
+    const double curv = (d2 - d1) / (c.s - a.s);
+    double center = curv > 0.0 ? std::clamp(0.5 * (a.s + b.s) - d1 / (2.0 * curv), a.s, c.s) : s;
+    double d = curv > 0.0 ? std::clamp(1.0 / std::sqrt(curv), 0.02, 0.15) : 0.1;
+    for (int it = 0; it < opt.max_iterations; ++it) {
+      const Eval& lo = evalAt(center - d);
+      const Eval& mid = evalAt(center);
+      const Eval& hi = evalAt(center + d);
+      const double k2 = (lo.chi2 + hi.chi2 - 2.0 * mid.chi2) / (d * d);  // = 2 curv
+      if (!(k2 > 0.0)) {
+        sig_s = -1.0;
+        break;
+      }
+      sig_s = std::sqrt(2.0 / k2);
+      const double v = center - (hi.chi2 - lo.chi2) / (2.0 * d * k2);
+      const double dMds = (hi.M - lo.M) / (2.0 * d);
+      id.sigma_moment = std::sqrt(mid.varM + dMds * dMds * sig_s * sig_s);
+      s = center;
+      if (std::abs(v - center) <= 0.25 * d || v < kLo || v > kHi || evals.size() + 3 > evals.capacity()) {
+        if (std::abs(v - center) > 0.1 * sig_s && std::abs(v - center) < d && evals.size() < evals.capacity()) {
+          evalAt(v);
+          s = v;
+        }
+        break;
+      }
+      center = v;
+      d = std::clamp(sig_s, 0.02, 0.15);
+    }
+  }
+  bounded = bounded && s > kLo && s < kHi;
+  if (!(bounded && sig_s > 0.0)) s = 1.0;  // not identifiable: M at the configured preload
+  const Eval& fin = evalAt(s);
+  if (id.sigma_moment < 0.0) id.sigma_moment = std::sqrt(fin.varM);
+  if (!(bounded && sig_s > 0.0)) {
+    // s unknown: M's band also spans every moment the search found as
+    // plausible (within Delta chi2 = 9 of the best, over s in [0.3, 1.6]).
+    double spread = 0.0;
+    const double c_best = best().chi2;
+    for (const Eval& e : evals)
+      if (e.chi2 <= c_best + 9.0) spread = std::max(spread, std::abs(e.M - fin.M));
+    id.sigma_moment = std::sqrt(fin.varM + spread * spread);
+  }
+  const double M = fin.M, chi2 = fin.chi2;
   const double inflate = dof > 0 ? std::sqrt(std::max(1.0, chi2 / dof)) : 1.0;
-  id.scale = s;
+  for (std::size_t i = 0; i < trip.size(); ++i)
+    if (trip[i].present & kSensorImuAccel) out.fitted_fy[i] = M * fin.Hf[i] + fin.o;
+  id.scale = bounded && sig_s > 0.0 ? s : best().s;  // not identifiable: where the search ended
   id.moment = M;
-  id.sigma_scale = std::isfinite(cov(1, 1)) ? inflate * std::sqrt(std::max(0.0, cov(1, 1))) : -1.0;
-  id.sigma_moment = std::isfinite(cov(0, 0)) ? inflate * std::sqrt(std::max(0.0, cov(0, 0))) : -1.0;
+  id.sigma_scale = bounded && sig_s > 0.0 ? inflate * sig_s : -1.0;
+  id.sigma_moment *= inflate;
   id.chi2 = chi2;
   id.dof = dof;
   id.imbalance = 0.0;
   id.sigma_imbalance = -1.0;
+  // Where M is barely known, s is a ratio with heavy tails: not identifiable
+  // when M is within 3 sigma of zero.
+  if (id.sigma_scale > 0.0 && std::abs(M) <= 3.0 * id.sigma_moment) id.sigma_scale = -1.0;
   id.informative = id.sigma_scale > 0.0 && id.sigma_scale <= opt.max_sigma;
   id.loss30_separation = id.sigma_scale > 0.0 ? 0.3 / id.sigma_scale : 0.0;
   if (id.informative)
@@ -188,9 +239,14 @@ PreloadFit identifyPreload(const ShaftParams& twin, const EstimatorSettings& est
     id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip (sigma of s %.3g: %.1f sigma; "
                   "moment %.0f N m)",
                   id.sigma_scale, id.loss30_separation, M);
+  else if (std::abs(M) <= 3.0 * id.sigma_moment)
+    id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip: the moment (%.0f +- %.0f N m) is too "
+                  "close to zero to tell the preload",
+                  M, id.sigma_moment);
   else
-    id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip (no information on s; moment %.0f N m)",
-                  M);
+    id.note = fmt("this IMU cannot see a 30 %% preload loss on this trip: the data do not bound the preload "
+                  "between %.1f and %.1f of the configured one (moment %.0f N m)",
+                  kLo, kHi, M);
   id.note += "; the imbalance of the two ropes is not identifiable (the response is symmetric in them)";
   id.cpu_seconds = threadCpuSeconds() - cpu0;
   return out;

@@ -1,6 +1,7 @@
 // ShaftFingerprint: per-direction baseline of the depth bins' residual (hoist/shaft_fingerprint.hpp).
 #include "hoist/shaft_fingerprint.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -64,30 +65,39 @@ bool ShaftFingerprint::add(const TripRecord& r) {
 
 FingerprintDecision ShaftFingerprint::decision() const {
   FingerprintDecision out;
-  std::string where;
   for (TripDirection dd : {TripDirection::Down, TripDirection::Up}) {
     const Direction& d = dir(dd);
     if (d.recent.empty()) continue;
-    std::map<long, int> over;
+    std::map<long, std::pair<int, double>> over;  // bin -> (trips beyond, sum |z|)
     for (const auto& trip : d.recent)
       for (const auto& [bin, z] : trip)
-        if (std::abs(z) > cond_.fingerprint_sigma) ++over[bin];
-    for (const auto& [bin, count] : over) {
-      if (count < 2) continue;
+        if (std::abs(z) > cond_.fingerprint_sigma) {
+          ++over[bin].first;
+          over[bin].second += std::abs(z);
+        }
+    for (const auto& [bin, c] : over) {
+      if (c.first < 2) continue;
       FingerprintHit h;
       h.direction = dd;
       h.depth_lo = bin * cond_.depth_bin;
-      h.trips_over = count;
+      h.trips_over = c.first;
+      h.strength = c.second / c.first;
       const auto it = d.recent.back().find(bin);
       h.z_last = it == d.recent.back().end() ? 0.0 : it->second;
       out.hits.push_back(h);
-      char b[200];
-      std::snprintf(b, sizeof b, "%sdepth %.0f-%.0f m (%s trips: %d of the last %zu beyond %.1f sd, last z = %.1f)",
-                    where.empty() ? "" : "; ", h.depth_lo, h.depth_lo + cond_.depth_bin,
-                    dd == TripDirection::Down ? "down" : "up", count, d.recent.size(), cond_.fingerprint_sigma,
-                    h.z_last);
-      where += b;
     }
+  }
+  std::stable_sort(out.hits.begin(), out.hits.end(),
+                   [](const FingerprintHit& a, const FingerprintHit& b) { return a.strength > b.strength; });
+  std::string where;
+  for (const FingerprintHit& h : out.hits) {
+    const Direction& d = dir(h.direction);
+    char b[200];
+    std::snprintf(b, sizeof b, "%sdepth %.0f-%.0f m (%s trips: %d of the last %zu beyond %.1f sd, last z = %.1f)",
+                  where.empty() ? "" : "; also at ", h.depth_lo, h.depth_lo + cond_.depth_bin,
+                  h.direction == TripDirection::Down ? "down" : "up", h.trips_over, d.recent.size(),
+                  cond_.fingerprint_sigma, h.z_last);
+    where += b;
   }
   out.active = !out.hits.empty();
   out.text = out.active ? "the shaft left its commissioning fingerprint at " + where +

@@ -11,6 +11,18 @@
 
 namespace hoist {
 
+namespace {
+// The estimate's loads into a record's fields (sigma -1 where not observed).
+void copyLoads(const LoadEstimate& e, double& Fa, double& sFa, double& M, double& sM, double& b, double& sb) {
+  Fa = e.Fa;
+  sFa = e.fa_observed ? e.sigma_Fa : -1.0;
+  M = e.moment;
+  sM = e.moment_observed ? e.sigma_moment : -1.0;
+  b = e.b;
+  sb = e.sigma_b;
+}
+}  // namespace
+
 double conditionBandHz(const ShaftParams& p, double band_hz) {
   if (band_hz > 0.0) return band_hz;
   const double T = std::max(p.Tb1, p.Tb2) + p.rho2 * p.g * p.L;
@@ -35,12 +47,8 @@ void TripAccumulator::begin(const MeasurementSample& m, const LoadEstimate& e, d
   rec_ = TripRecord{};
   rec_.t_start = m.t;
   rec_.depth_start = m.k.l;
-  rec_.Fa_start = e.Fa;
-  rec_.sigma_Fa_start = e.fa_observed ? e.sigma_Fa : -1.0;
-  rec_.moment_start = e.moment;
-  rec_.sigma_moment_start = e.moment_observed ? e.sigma_moment : -1.0;
-  rec_.b_start = e.b;
-  rec_.sigma_b_start = e.sigma_b;
+  copyLoads(e, rec_.Fa_start, rec_.sigma_Fa_start, rec_.moment_start, rec_.sigma_moment_start, rec_.b_start,
+            rec_.sigma_b_start);
   rec_.min_clearance = std::numeric_limits<double>::infinity();
   rec_.lambda0_min = std::numeric_limits<double>::infinity();
   rec_.lambda0_max = -std::numeric_limits<double>::infinity();
@@ -84,12 +92,7 @@ TripRecord TripAccumulator::finish(double t_arrival, const Kinematics& arrival) 
   r.t_end = t_arrival;
   r.depth_end = arrival.l;
   r.direction = r.depth_end >= r.depth_start ? TripDirection::Down : TripDirection::Up;
-  r.Fa_end = last_.Fa;
-  r.sigma_Fa_end = last_.fa_observed ? last_.sigma_Fa : -1.0;
-  r.moment_end = last_.moment;
-  r.sigma_moment_end = last_.moment_observed ? last_.sigma_moment : -1.0;
-  r.b_end = last_.b;
-  r.sigma_b_end = last_.sigma_b;
+  copyLoads(last_, r.Fa_end, r.sigma_Fa_end, r.moment_end, r.sigma_moment_end, r.b_end, r.sigma_b_end);
   r.depth_bin = cond_.depth_bin;
 
   PreloadFitOptions opt;

@@ -9,21 +9,27 @@
 // trip's kinematics the measurements are
 //     f_y(t)   = M H_f(t; s) + o        omega(t) = M H_w(t; s)
 // with H the response to M = 1 N m of the same n-mode model whose guide-rope
-// preloads are scaled by s.  Linearized about s0,
-//     H(t; s) ~ H(t; s0) + (s - s0) dH/ds(t; s0)     (dH/ds by a forward difference)
-// the model is LINEAR in (M, P = M (s - s0), o): one weighted least squares
-// per Gauss-Newton step, s = s0 + P / M, and s0 moves to s until the step is
-// below a tenth of sigma(s) (two or three steps; each costs two solver runs
-// over the trip).  The tilt's depth shape is what separates s from M: the
-// ropes' own weight adds tension rho2 g (L - x) that does not scale with s.
+// preloads are scaled by s.  At a given s the model is LINEAR in (M, o): one
+// weighted least squares gives the profile chi2(s) (one solver run over the
+// trip per s).  s is the minimum of that profile: a grid over [0.3, 1.6]
+// (the information on s sharpens as s falls, so the profile is far from a
+// parabola over that range), then local parabolas through (c - d, c, c + d),
+// d ~ one sigma, re-centred on their vertex until it moves less than d / 4.
+// A minimum on the grid's ends is reported not identifiable.  The tilt's
+// depth shape is what separates s from M: the ropes' own weight adds tension
+// rho2 g (L - x) that does not
+// scale with s.
 //
 // Weights: each sample's variance is the sensor's (EstimatorSettings::noise)
 // plus (model_error x the predicted value)^2, as the load estimator does.
-// sigma(s), sigma(M): the inverse Fisher information J^T W J at the solution
-// (J the Jacobian of the predictions in (M, s, o)), times sqrt(chi2 / dof)
-// when that is above 1 (vibration the model does not carry, or a model that
-// is wrong, widens the band instead of hiding behind it).  The offset enters
-// with its prior (accel_offset_sigma) as one more observation.
+// sigma(s): the profile's curvature over +- one sigma about the minimum
+// (Delta chi2 = 1: the marginal sigma of s, M and o profiled out, without
+// the first-order linearization in s); sigma(M): its conditional variance at
+// the minimum plus (dM/ds sigma(s))^2.  Both times sqrt(chi2 / dof) when that
+// is above 1 (vibration the model does not carry, or a model that is wrong,
+// widens the band instead of hiding behind it).  The offset enters with its
+// prior (accel_offset_sigma) as one more observation.  Where M is within 3
+// sigma of zero, s is a ratio with heavy tails: reported not identifiable.
 //
 // The imbalance between the two ropes is not identifiable from the cage: the
 // model is symmetric in the two guide ropes (each has a top and a bottom
@@ -34,7 +40,7 @@
 // (sigma_imbalance = -1) with the reason in the note.
 //
 // Who calls it: TripAccumulator::finish (hoist/trip_accumulator.hpp), off the
-// real-time loop.  Allocates; about 5 solver runs over the trip at the twin's n.
+// real-time loop.  Allocates; 10-15 solver runs over the trip at the twin's n.
 #pragma once
 
 #include <vector>
@@ -48,8 +54,7 @@ struct PreloadFitOptions {
   double max_sigma = 0.1;           ///< [condition] max_sigma: informative when sigma(s) <= this
   double accel_offset_sigma = 0.0;  ///< prior sigma of the IMU's offset [m/s^2]; 0: calibrated, not fitted
   double max_step = 0.0025;         ///< largest solver step [s] (the twin's)
-  double fd_step = 0.02;            ///< relative step of s for dH/ds
-  int max_iterations = 4;           ///< Gauss-Newton steps at most
+  int max_iterations = 4;           ///< local parabolas at most (up to three solver runs each)
 };
 
 /// The fit and, per sample of the trip, the prediction of f_y it implies (the
@@ -58,6 +63,7 @@ struct PreloadFitOptions {
 struct PreloadFit {
   PreloadIdentification id;
   std::vector<double> fitted_fy;
+  int iterations = 0;  ///< solver runs over the trip (profile evaluations)
 };
 
 /// Identify s (and M, o) from `trip`: the samples from the departure (at

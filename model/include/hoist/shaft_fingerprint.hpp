@@ -16,7 +16,9 @@
 //   * SHAFT_FINGERPRINT (WARNING): a bin with |z| > fingerprint_sigma on at
 //     least 2 of the last 3 trips in the same direction.  The text names the
 //     depth (the bin [depth_lo, depth_lo + depth_bin) of the top sleeves), the
-//     direction and the z values.
+//     direction and the z values, strongest first: a local disturbance also
+//     leaves weaker hits where the oscillation it excites is still seen
+//     (after it in the direction of travel), named after it with "also".
 // Bins with fewer than min_samples samples in the trip or in fewer than two
 // baseline trips are not tested.  Pure: no I/O; the caller owns alarm state.
 #pragma once
@@ -36,11 +38,12 @@ struct FingerprintHit {
   double depth_lo = 0.0;  ///< the bin [depth_lo, depth_lo + depth_bin) [m]
   int trips_over = 0;     ///< of the last 3 trips in that direction
   double z_last = 0.0;    ///< z of the last trip in that direction
+  double strength = 0.0;  ///< mean |z| over the trips beyond the threshold (orders the hits)
 };
 
 struct FingerprintDecision {
   bool active = false;
-  std::vector<FingerprintHit> hits;  ///< every bin that meets the rule, by direction then depth
+  std::vector<FingerprintHit> hits;  ///< every bin that meets the rule, strongest first
   std::string text;
 };
 

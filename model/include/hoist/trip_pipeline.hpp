@@ -2,12 +2,13 @@
 // docs/condition-identification.md): a recorded run split into trips, one
 // TripRecord per trip with the guide-rope preload identified.
 //
-// Who calls it: hoist-trips ingest (tools/trips) on a measurement CSV, and
-// the daemon's trip worker (through the same pieces: TripDetector,
-// TripAccumulator, identifyPreload; hoist/trip_detector.hpp,
-// hoist/trip_accumulator.hpp, hoist/preload_identification.hpp).  The trend
-// and the condition alarms' decisions over many records live in
-// hoist/preload_trend.hpp and hoist/shaft_fingerprint.hpp.
+// Who calls it: hoist-trips ingest (tools/trips) on a measurement CSV.  The
+// daemon's trip worker runs the same sequence tick by tick with TripRecorder
+// (hoist/trip_recorder.hpp: TripDetector + TripAccumulator, which calls
+// identifyPreload), so a recording gives the same records live and offline.
+// The trend and the condition alarms' decisions over many records live in
+// hoist/preload_trend.hpp (GUIDE_PRELOAD_LOW) and hoist/shaft_fingerprint.hpp
+// (SHAFT_FINGERPRINT).
 //
 // Pure math: no files, no LCM, no logging.  Not real-time code: it allocates
 // and costs up to about 1 s of CPU per trip at n = 25 (the identification);
