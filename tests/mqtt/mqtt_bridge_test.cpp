@@ -1156,10 +1156,10 @@ TEST_F(MqttBridge, PerUserCommandTopicsWithTheExampleAcl) {
   }
   const int port = freeTcpPort();
   std::string conf = readFile(HOIST_MQTT_CONFIG_DIR "/mosquitto.conf");
-  auto replace = [&](const std::string& from, const std::string& to) {
-    const auto at = conf.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    conf.replace(at, from.size(), to);
+  auto replace = [&](const std::string& from, const std::string& to) {  // every occurrence
+    ASSERT_NE(conf.find(from), std::string::npos) << from;
+    for (auto at = conf.find(from); at != std::string::npos; at = conf.find(from, at + to.size()))
+      conf.replace(at, from.size(), to);
   };
   replace("listener 8883", "listener " + std::to_string(port) + " 127.0.0.1");
   replace("/etc/mosquitto/hoist.passwd", path("passwd"));
@@ -1177,6 +1177,7 @@ TEST_F(MqttBridge, PerUserCommandTopicsWithTheExampleAcl) {
                                      << "[bridge]\nchannel_prefixes = [\"north/\"]\nhealth_period = 0.3\n"
                                      << "command_rate = 0.2\ncommand_burst = 3\n";
   Listener lcm(url);
+  lcm.subscribe("north/HOIST_ALARM_ACK");
   Process bridge({HOIST_MQTT, "--config", path("bridge.toml"), "--lcm-url", url, "--client-id", "bridge-acl"},
                  log("bridge.log"));
   Client scada(port, "scada-c", "scada", "s-pw");
@@ -1218,4 +1219,54 @@ TEST_F(MqttBridge, PerUserCommandTopicsWithTheExampleAcl) {
   EXPECT_EQ(bridge.wait(5s), 0) << readFile(log("bridge.log"));
   broker.signal(SIGTERM);
   broker.wait(5s);
+}
+
+// Issue 33: a dropped alarm transition is never silent -- counted, logged
+// (rate-limited) and the bridge's health is WARNING.  The broker is down at
+// start and the memory buffer holds one alarm transition; five arrive.
+TEST_F(MqttBridge, DroppedAlarmTransitionsAreLoggedAndWarn) {
+  dir_ = testDir("mqtt_alarm_drops");
+  const std::string url = urlFor(7977);
+  const int port = freeTcpPort();
+  Broker broker(dir_, port);
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[broker]\nreconnect_min = 0.2\nreconnect_max = 0.5\n[bridge]\nhealth_period = 0.3\n"
+                      << "channel_prefixes = [\"north/\"]\n[buffer]\nmax_alarm_events = 1\n";
+  Listener lcm(url);
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-w"},
+                 log("bridge.log"));
+  std::this_thread::sleep_for(500ms);
+  for (int i = 0; i < 5; ++i) {
+    hoist::alarm_t a{};
+    a.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                  std::chrono::system_clock::now().time_since_epoch()).count();
+    a.kind = "CAGE_POS_Y";
+    a.level = 1;
+    a.active = (i % 2) == 0;
+    a.event_type = a.active ? hoist::alarm_t::EVENT_RAISE : hoist::alarm_t::EVENT_CLEAR;
+    lcm.lcm().publish("north/HOIST_ALARM", &a);
+    lcm.pump(50ms);
+  }
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (readFile(log("bridge.log")).find("alarm transitions dropped") == std::string::npos &&
+         std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(50ms);
+  const std::string text = readFile(log("bridge.log"));
+  EXPECT_NE(text.find("alarm transitions dropped from the memory buffer ([buffer] max_alarm_events = 1"),
+            std::string::npos) << text;
+  broker.start();
+  Client c(port, "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/_bridge/#");
+  // (Health messages queued before the drops arrive first: wait for a later one.)
+  auto h = c.waitJson("hoist/_bridge/bridge-w/health", [](const json& j, bool) {
+    return j["buffer"]["dropped_alarm"] == 4; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge.log"));
+  EXPECT_EQ((*h)["level"], "WARNING") << h->dump();
+  EXPECT_EQ((*h)["buffer"]["dropped_alarm"], 4) << h->dump();
+  ASSERT_EQ((*h)["warnings"].size(), 1u) << h->dump();
+  EXPECT_NE((*h)["warnings"][0].get<std::string>().find("4 alarm transitions dropped"), std::string::npos);
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+  broker.stop();
 }

@@ -126,24 +126,26 @@ void CommandGate::onMessage(const struct mosquitto_message* m) {
     // never executed; the bridge deletes it from the broker (empty retained message).
     refuse(&s, CommandReject::Retained,
            "retained messages are never executed (publish commands with retain=false); deleting it", m->topic,
-           m->payloadlen, may_log);
+           m->payloadlen, may_log, nullptr, identity);
     link_.sendRaw(m->topic, nullptr, 0, 1, true);
     return;
   }
   CommandResult r = parseAckCommand(m->payload, m->payloadlen > 0 ? static_cast<std::size_t>(m->payloadlen) : 0,
                                     static_cast<std::size_t>(cfg_.max_command_bytes), hoist::bus::wallUtime(),
                                     cfg_.max_command_age);
-  if (r.reject != CommandReject::None) return refuse(&s, r.reject, r.detail, m->topic, m->payloadlen, may_log);
+  if (r.reject != CommandReject::None)
+    return refuse(&s, r.reject, r.detail, m->topic, m->payloadlen, may_log, nullptr, identity);
   if (!identity.empty()) {
     // The broker vouched for the topic's user: it is the operator's name
     // (a payload naming someone else is refused; one naming nobody gets it).
     if (const std::string why = checkUser(identity); !why.empty())
-      return refuse(&s, CommandReject::BadUser, "the topic's user: " + why, m->topic, m->payloadlen, may_log);
+      return refuse(&s, CommandReject::BadUser, "the topic's user: " + why, m->topic, m->payloadlen, may_log, nullptr,
+                    identity);
     if (r.ack.user != identity && r.ack.user != kDefaultCommandUser)
       return refuse(&s, CommandReject::BadUser,
                     fmt::format("the payload's user '{}' is not the topic's '{}'", printable(r.ack.user),
                                 printable(identity)),
-                    m->topic, m->payloadlen, may_log);
+                    m->topic, m->payloadlen, may_log, &r.ack, identity);
     r.ack.user = identity;
   }
   execute(s, r, m->payloadlen, may_log, now, identity);
