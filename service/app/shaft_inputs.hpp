@@ -91,6 +91,7 @@ class ShaftInputs {
   template <class Msg>
   bool decodeSensor(const lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel);  // checked decode, or reject
   bool sensorSeqNewer(std::int64_t seq, SensorSequence& sq, const char* channel);  // SensorSequence, or reject
+  bool sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* channel);     // TwinCore's time verdict, or reject
   void handlerFailed(const char* what, const char* channel);
   void logReject(RejectReason r, const char* detail);
   void rejectPlan(PlanReject r, const char* detail);

@@ -33,8 +33,13 @@ void toCageMessage(const CageOutput& o, hoist::cage_state_t& m) {
 }
 
 void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double t, double imu_age,
-                       double rope_load_age, bool in_use, hoist::estimate_t& m) {
-  m.in_use = in_use;
+                       double rope_load_age, const EstimateGate& gate, double model_t, hoist::estimate_t& m) {
+  m.in_use = gate.inUse();
+  m.not_used = static_cast<int32_t>(gate.notUsed());
+  m.holding = gate.holding(model_t);
+  m.use_switches = gate.switches();
+  m.load_change_Fa = gate.lastChangeFa();
+  m.load_change_moment = gate.lastChangeM();
   m.t = t;
   m.l = e.kin.l;
   m.v = e.kin.v;
@@ -187,6 +192,23 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
                       "estimator's windowed NIS or its load drift, see HOIST_ESTIMATE); check guide-rope preloads, "
                       "sleeves and the sensors (docs/estimation.md)%s",
                       kind, level, verb, e.value, e.threshold, state);
+      break;
+    case AlarmKind::SensorFault:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: no sensor refused or disbelieved for %g s%s", kind, level,
+                      TwinCore::kSensorFaultHold, state);
+      else if (ctx.sensor_reason == SensorFaultReason::ClockOffset)
+        std::snprintf(buf, n, "%s %s %s: %s: its clock is %+.3f s from the daemon's (sensors.max_clock_offset = "
+                      "%g s); its samples are refused, the estimate goes on without them%s",
+                      kind, level, verb, toString(ctx.sensor), e.value, e.threshold, state);
+      else if (ctx.sensor_reason == SensorFaultReason::TimeBackwards)
+        std::snprintf(buf, n, "%s %s %s: %s: a sample's utime went backwards (a replay, or the sensor's clock "
+                      "stepped back); refused and counted (HOIST_HEALTH.sensor_time_backwards)%s",
+                      kind, level, verb, toString(ctx.sensor), state);
+      else
+        std::snprintf(buf, n, "%s %s %s: %s is implausible (%.4g beyond the physical bound %.4g): a sensor "
+                      "lies or fails; the alarms judge the open-loop twin%s",
+                      kind, level, verb, toString(ctx.sensor), e.value, e.threshold, state);
       break;
     case AlarmKind::PredictedSlack:
       if (e.type == AlarmEventType::Clear)
