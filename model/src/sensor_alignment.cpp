@@ -31,6 +31,10 @@ SensorValues lerp(const SensorValues& a, const SensorValues& b, double u) {
 
 bool PredictionHistory::at(double ts, SensorPrediction& out) const {
   if (count_ == 0 || !(ts >= oldest()) || !(ts <= newest())) return false;
+  if (ts == newest()) {  // the current step: exactly its prediction (no shift)
+    out = get(count_ - 1);
+    return true;
+  }
   // Binary search for the last entry at or before ts.
   std::size_t lo = 0, hi = count_ - 1;
   while (hi - lo > 1) {

@@ -2,6 +2,7 @@
 #include "hoist/service/sensor_timing.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace hoist::svc {
 
@@ -44,7 +45,7 @@ SensorVerdict SensorTiming::offer(Queue& q, std::int64_t utime, double offset, d
     ++counts_.time_backwards;
     return SensorVerdict::TimeBackwards;
   }
-  if (!std::isfinite(ts)) {
+  if (std::isnan(ts)) {
     ++counts_.too_late;
     return SensorVerdict::NoClock;
   }
@@ -68,9 +69,9 @@ SensorVerdict SensorTiming::offerRope(std::int64_t utime, double offset, double 
   return offer(rope_, utime, offset, ts, force, 0.0);
 }
 
-void SensorTiming::reset() {
+void SensorTiming::reset(bool drop_queued) {
   hist_.clear();
-  imu_.count = rope_.count = 0;
+  if (drop_queued) imu_.count = rope_.count = 0;
 }
 
 const SensorTiming::Sample* SensorTiming::due(Queue& q, double t, Sample& out) {
@@ -85,6 +86,7 @@ const SensorTiming::Sample* SensorTiming::due(Queue& q, double t, Sample& out) {
     out = q.front();
     q.pop();
     --n;
+    if (out.ts == -std::numeric_limits<double>::infinity()) out.ts = t;  // taken before the model had a time
     if (out.ts >= hist_.oldest()) return &out;
     ++counts_.too_late;  // before the kept predictions: cannot be aligned
   }

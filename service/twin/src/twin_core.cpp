@@ -105,9 +105,11 @@ class InputClock final : public ClockPolicy {
   double staleTimeout(const TwinCore& c) const override { return c.cfg_.service.stale_timeout; }
   double sensorTime(const TwinCore& c, std::int64_t utime, double, std::int64_t, double& offset) const override {
     // The daemon's clock is the winder stream's: the sample's time on it.
+    // Before the first winder input there is none: the sample is applied at
+    // the first step (as hoist-estimate applies the first row's sensors).
     if (!c.started_ || !c.have_input_) {
       offset = 0.0;
-      return std::numeric_limits<double>::quiet_NaN();
+      return -std::numeric_limits<double>::infinity();
     }
     offset = static_cast<double>(utime - c.last_.utime) * 1e-6;
     return t_base_ + static_cast<double>(utime - utime_base_) * 1e-6;
@@ -366,7 +368,7 @@ void TwinCore::initializeAt(double t, const Kinematics& k) {
     if (started_) est_->restart(t, k);
     else est_->initialize(t, k);
     est_synced_ = true;
-    timing_.reset();
+    timing_.reset(started_);  // a restart: the queued samples are of the old stream
     gate_.reset();
   }
   t_ = t;

@@ -68,12 +68,15 @@ class SensorTiming {
   /// (cover max_clock_offset at the step rate).
   SensorTiming(double max_clock_offset, std::size_t history);
 
-  /// Offer a sample taken at model time `ts` with clock offset `offset` [s].
+  /// Offer a sample taken at model time `ts` with clock offset `offset` [s]
+  /// (ts = -inf: before the model has a time; applied at its first step).
   /// f_y / omega: NaN = that channel absent.
   SensorVerdict offerImu(std::int64_t utime, double offset, double ts, double f_y, double omega);
   SensorVerdict offerRope(std::int64_t utime, double offset, double ts, double force);
-  /// The model was re-initialized: the queues and predictions are of the old stream.
-  void reset();
+  /// The model was (re-)initialized: the predictions are of the old stream;
+  /// `drop_queued`: so are the queued samples (a restart; at the first start
+  /// the samples that came first are applied at the first step).
+  void reset(bool drop_queued);
   /// The prediction at a new model step (before take()).
   void record(const SensorPrediction& p) { hist_.push(p); }
   /// The samples due at `now` (the step just recorded), aligned to it with
