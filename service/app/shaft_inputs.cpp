@@ -195,6 +195,10 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
                         "commands this tick", user, budget));
     return;
   }
+  if (cmd->action == AlarmAction::Calibrate) {
+    calibrate(*cmd, user);
+    return;
+  }
   const int n = ctx_.core.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
   const char* what = cmd->action == AlarmAction::Ack      ? "acknowledge"
                      : cmd->action == AlarmAction::Shelve ? "shelve"
@@ -226,6 +230,18 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   out_.publishAlarmEvents();
   cause.user.clear();
   cause.requested_shelve = 0.0;
+}
+
+void ShaftInputs::calibrate(const AckCommand& cmd, const std::string& user) {
+  // The live calibration: no alarm changes; audited as an effective command.
+  if (!ctx_.core.calibrate(cmd.known_fa, cmd.known_b, cmd.calibrate_duration)) {
+    logJunk(fmt::format("calibration from '{}' ignored: [estimator] is not enabled", user));
+    return;
+  }
+  ++ctx_.stats.commands_applied;
+  ctx_.log.info("{}AUDIT operator '{}': calibrate: the load is known, Fa = {} N at b = {} m (M = {} N m), for {} s "
+                "from t = {:.2f} s", ctx_.tag, user, cmd.known_fa, cmd.known_b, cmd.known_fa * cmd.known_b,
+                cmd.calibrate_duration, ctx_.core.publishedTime(ctx_.core.modelTime()));
 }
 
 void ShaftInputs::requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user) {

@@ -96,6 +96,8 @@ class ShaftInputs {
   void logReject(RejectReason r, const char* detail);
   void rejectPlan(PlanReject r, const char* detail);
   void logJunk(const std::string& what);
+  /// A valid calibration command: hand it to the model room, audit it.
+  void calibrate(const AckCommand& cmd, const std::string& user);
   /// A valid re-announce request: honour it now, or merge it into the pending one.
   void requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user);
   /// Honour the pending re-announce request if the interval allows.

@@ -175,7 +175,7 @@ void ShaftOutputs::publishEstimate(std::int64_t utime, bool batch) {
   const ShaftStats& st = ctx_.stats;
   toEstimateMessage(*e, c, ctx_.core.publishedTime(e->t), st.last_imu_wall < 0.0 ? -1.0 : wall - st.last_imu_wall,
                     st.last_rope_wall < 0.0 ? -1.0 : wall - st.last_rope_wall, ctx_.core.estimateGate(),
-                    ctx_.core.modelTime(), estimate_msg_);
+                    ctx_.core.modelTime(), ctx_.core.calibrating(), estimate_msg_);
   encodeAndPublish(ctx_.ch.estimate, estimate_msg_, estimate_buf_, batch);
   logGateEvents();
 }

@@ -33,13 +33,15 @@ void toCageMessage(const CageOutput& o, hoist::cage_state_t& m) {
 }
 
 void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double t, double imu_age,
-                       double rope_load_age, const EstimateGate& gate, double model_t, hoist::estimate_t& m) {
+                       double rope_load_age, const EstimateGate& gate, double model_t, bool calibrating,
+                       hoist::estimate_t& m) {
   m.in_use = gate.inUse();
   m.not_used = static_cast<int32_t>(gate.notUsed());
   m.holding = gate.holding(model_t);
   m.use_switches = gate.switches();
   m.load_change_Fa = gate.lastChangeFa();
   m.load_change_moment = gate.lastChangeM();
+  m.calibrating = calibrating;
   m.t = t;
   m.l = e.kin.l;
   m.v = e.kin.v;
@@ -225,12 +227,16 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
 
 std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*& why) {
   AckCommand c;
-  switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, c)) {
+  switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.known_fa, ack.known_b,
+                               ack.calibrate_duration, c)) {
     case CommandError::None: return c;
     case CommandError::UnknownKind: why = "unknown alarm kind"; break;
     case CommandError::BadLevel: why = "bad level (0 both, 1 warning, 2 critical)"; break;
-    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce)"; break;
+    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce, 5 calibrate)"; break;
     case CommandError::BadShelveDuration: why = "shelve_duration must be a finite number > 0 s"; break;
+    case CommandError::BadCalibration:
+      why = "calibrate needs known_fa in [0, 1e7] N, |known_b| <= 100 m and calibrate_duration in (0, 600] s";
+      break;
   }
   return std::nullopt;
 }

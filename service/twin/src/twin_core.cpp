@@ -309,6 +309,14 @@ SensorVerdict TwinCore::offerSensor(SensorId s, std::int64_t utime, double a, do
   return v;
 }
 
+bool TwinCore::calibrate(double Fa, double b, double duration) {
+  if (!est_ || !std::isfinite(Fa) || !std::isfinite(b) || !(duration > 0.0)) return false;
+  known_Fa_ = Fa;
+  known_b_ = b;
+  known_until_ = t_ + duration;
+  return true;
+}
+
 void TwinCore::noteSensorFault(SensorId s, SensorFaultReason r, double value, double limit) {
   sensor_fault_ = SensorFaultInfo{s, r, value, limit};
   sensor_fault_until_ = t_ + kSensorFaultHold;
@@ -675,6 +683,7 @@ int TwinCore::command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLe
     case AlarmAction::Shelve: n = alarms_.shelve(t_, kind, level, shelve_duration, events_); break;
     case AlarmAction::Unshelve: n = alarms_.unshelve(t_, kind, level, events_); break;
     case AlarmAction::Reannounce: n = alarms_.reannounce(t_, kind, level, events_); break;
+    case AlarmAction::Calibrate: break;  // not an alarm command: calibrate()
   }
   out_.alarm_level = alarms_.highestActive();
   out_.degraded = degradedNow();

@@ -26,9 +26,11 @@ void toCageMessage(const CageOutput& o, hoist::cage_state_t& m);
 /// caller's).  `t` is the published time; the ages are seconds since each
 /// sensor's last accepted sample (< 0: never).  A value that is not observed
 /// (sigma < 0) is published as 0 with sigma -1, never as NaN.  `gate`: whether
-/// the alarms judge it (in_use, not_used, holding at model time `model_t`).
+/// the alarms judge it (in_use, not_used, holding at model time `model_t`);
+/// `calibrating`: a declared known load is in force.
 void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double t, double imu_age,
-                       double rope_load_age, const EstimateGate& gate, double model_t, hoist::estimate_t& m);
+                       double rope_load_age, const EstimateGate& gate, double model_t, bool calibrating,
+                       hoist::estimate_t& m);
 
 /// What the alarm text needs besides the event.
 struct AlarmTextContext {

@@ -276,6 +276,14 @@ class TwinCore {
   SensorVerdict onCageImu(std::int64_t utime, double f_y, double omega, double wall_now, std::int64_t wall_utime);
   /// A validated rope-load sample [N], likewise.
   SensorVerdict onRopeLoad(std::int64_t utime, double force, double wall_now, std::int64_t wall_utime);
+  /// The live calibration (alarm_ack_t ACTION_CALIBRATE): the load is known
+  /// -- force Fa [N] at offset b [m] -- from now for `duration` seconds of
+  /// model time; the estimator learns the accelerometer's offset from it.
+  /// false (nothing changes): no estimator.  A new declaration replaces one
+  /// in force.
+  bool calibrate(double Fa, double b, double duration);
+  /// A declared known load is in force at the current model time.
+  bool calibrating() const { return est_ && t_ < known_until_; }
   /// The clock offset of the last offered sensor sample [s] (for the log).
   double lastSensorOffset() const { return sensor_offset_; }
   /// The last SENSOR_FAULT cause: which sensor, why, the value and its limit.
@@ -367,6 +375,7 @@ class TwinCore {
   double sensor_offset_ = 0.0;  // clock offset of the last offered sample [s]
   SensorFaultInfo sensor_fault_;
   double sensor_fault_until_ = -1.0;  // SENSOR_FAULT condition until this model time
+  double known_Fa_ = 0.0, known_b_ = 0.0, known_until_ = -1.0;  // calibrate(): the declared load, until when
   void noteSensorFault(SensorId s, SensorFaultReason r, double value, double limit);
   SensorVerdict offerSensor(SensorId s, std::int64_t utime, double a, double b, double wall_now,
                             std::int64_t wall_utime);
