@@ -232,7 +232,7 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   cause.requested_shelve = 0.0;
 }
 
-void ShaftInputs::calibrate(const AckCommand& cmd, const std::string& user) {
+void ShaftInputs::calibrate(const AlarmCommand& cmd, const std::string& user) {
   // The live calibration: no alarm changes; audited as an effective command.
   if (!ctx_.core.calibrate(cmd.known_fa, cmd.known_b, cmd.calibrate_duration)) {
     logJunk(fmt::format("calibration from '{}' ignored: [estimator] is not enabled", user));

@@ -97,7 +97,7 @@ class ShaftInputs {
   void rejectPlan(PlanReject r, const char* detail);
   void logJunk(const std::string& what);
   /// A valid calibration command: hand it to the model room, audit it.
-  void calibrate(const AckCommand& cmd, const std::string& user);
+  void calibrate(const AlarmCommand& cmd, const std::string& user);
   /// A valid re-announce request: honour it now, or merge it into the pending one.
   void requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user);
   /// Honour the pending re-announce request if the interval allows.
