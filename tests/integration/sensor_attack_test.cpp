@@ -6,8 +6,8 @@
 // state) with seeded noise.
 //   * a clock 2 s off and a utime going back: refused, counted in
 //     HOIST_HEALTH, SENSOR_FAULT names the sensor, a log line says why;
-//   * a forged load step at rest (0.1 s of IMU samples reading the opposite
-//     tilt) while CAGE_POS_Y is active: the load change is logged and the
+//   * a forged load step at rest (0.1 s of IMU samples reading no tilt)
+//     while CAGE_POS_Y is active: the load change is logged and the
 //     alarm does not clear (with clear_hold = 0 the same forgery clears it);
 //   * an absurd f_y (99 m/s^2) and rope load (1e7 N) inside the sample
 //     bounds: the estimate is not used (HOIST_ESTIMATE.in_use false,
@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <random>
 #include <thread>
 
@@ -39,11 +40,14 @@ namespace {
 constexpr std::int64_t kT0 = 1'700'000'000'000'000;
 constexpr double kRestLength = 150.0;
 
-/// The config's shaft at n = 12 (what the daemon runs).
+/// The config's shaft at n = 12 (what the daemon runs), its load 1000 N at
+/// 3 m: a static tilt that the IMU reads at 12 times its noise.
+constexpr double kOffset = 3.0;
 hoist::ShaftParams shaft() {
   hoist::ShaftParams p;
   p.n = 12;
   p.static_correction = true;
+  p.b = kOffset;
   return p;
 }
 
@@ -77,8 +81,9 @@ class SensorAttack : public LcmProcessTest {
   std::string config(double gap_pos_y, double clear_hold, const std::string& name) {
     const std::string path = (dir_ / name).string();
     std::ofstream c(path);
-    c << "[model]\nmodes = 12\n[hoisting_rope]\ninitial_length = " << kRestLength << "\n"
+    c << "[model]\nmodes = 12\n[load]\noffset = " << kOffset << "\n[hoisting_rope]\ninitial_length = " << kRestLength << "\n"
       << "[alarms]\ngap_pos_y = " << gap_pos_y << "\noff_delay = 0.0\n"
+      << "[forecast]\nenabled = false\n"  // no synchronous forecasts stalling the input clock
       << "[estimator]\nenabled = true\nclear_hold = " << clear_hold << "\n";
     return path;
   }
@@ -105,8 +110,15 @@ class SensorAttack : public LcmProcessTest {
       }
       const hoist::winder_t w = winder(static_cast<std::int64_t>(k), ut, 0.0, kRestLength);
       listener_->lcm().publish("HOIST_WINDER", &w);
-      listener_->pump(1ms);
+      listener_->pump(2ms);
     }
+  }
+  /// The last row's estimate arrived (the daemon has taken every row).
+  bool lastArrived(std::size_t rows) const {
+    const std::int64_t last = kT0 + static_cast<std::int64_t>(rows - 1) * 10'000;
+    for (const auto& e : listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE"))
+      if (e.utime == last) return true;
+    return false;
   }
   /// Genuine rows at rest with seeded noise.
   std::vector<Row> genuine(std::size_t n, unsigned seed) {
@@ -128,7 +140,7 @@ class SensorAttack : public LcmProcessTest {
     const std::string log = (dir_ / (name + ".log")).string();
     auto d = startDaemonAndWait(*listener_, {HOIST_TWIND, "--lcm-url", url_, "--config", cfg, "--clock", "input"}, log);
     publish(rows);
-    EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_ESTIMATE") >= rows.size(); }, 10s))
+    EXPECT_TRUE(listener_->waitFor([&] { return lastArrived(rows.size()); }, 10s))
         << listener_->count("HOIST_ESTIMATE") << " of " << rows.size() << "\n" << readFile(log);
     const std::size_t h0 = listener_->count("HOIST_HEALTH");
     EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > h0; }, 5s));
@@ -171,7 +183,10 @@ TEST_F(SensorAttack, AForgedStepAtRestCannotClearAnActiveAlarm) {
   start(7921, "SensorAttackForge", {"HOIST_HEALTH", "HOIST_ESTIMATE", "HOIST_ALARM"});
   const double gap = restState().excursion_pos / 0.6;  // CAGE_POS_Y WARNING on at rest, CRITICAL off
   auto rows = genuine(800, 2);
-  for (std::size_t k = 300; k < 310; ++k) rows[k].f_y = -rows[k].f_y;  // 0.1 s of the opposite tilt
+  // 0.1 s of an IMU reading no tilt (12 sigma from the genuine one): a zeroed
+  // or forged IMU; the estimate would say the cage hangs straight.
+  const double tilt = restState().z.f_y;
+  for (std::size_t k = 300; k < 310; ++k) rows[k].f_y -= tilt;
   const std::string log = run(config(gap, 2.0, "hold.toml"), rows, "hold");
   ASSERT_FALSE(alarms("CAGE_POS_Y", hoist::alarm_t::EVENT_RAISE).empty()) << log;
   EXPECT_TRUE(alarms("CAGE_POS_Y", hoist::alarm_t::EVENT_CLEAR).empty()) << log;
@@ -191,8 +206,8 @@ TEST_F(SensorAttack, AbsurdReadingsInsideTheSampleBoundsAreNotUsed) {
   }
   const std::string log = run(config(0.3, 2.0, "twin.toml"), rows, "twind");
   const auto est = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
-  ASSERT_GE(est.size(), 600u);
-  EXPECT_TRUE(est[190].in_use);
+  ASSERT_GE(est.size(), 500u);
+  EXPECT_TRUE(est[150].in_use);
   // Once the estimator took the absurd readings, its estimate is never used.
   int used_absurd = 0;
   for (const auto& e : est)
@@ -209,7 +224,7 @@ TEST_F(SensorAttack, ADelayedJitteredStreamGivesTheUndelayedEstimate) {
   // A load the config does not know: the rope reads 500 N more, the IMU the
   // genuine tilt (the estimate must move, and move the same in both runs).
   auto rows = genuine(600, 4);
-  for (Row& r : rows) r.force += 500.0;
+  for (Row& r : rows) r.force += 500.0;  // Fa = 1500 N
   const std::string cfg = config(0.3, 2.0, "twin.toml");
   run(cfg, rows, "on_time");
   const auto a = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
@@ -246,25 +261,36 @@ TEST_F(SensorAttack, ADelayedJitteredStreamGivesTheUndelayedEstimate) {
     }
     const hoist::winder_t w = winder(static_cast<std::int64_t>(k), ut, 0.0, kRestLength);
     listener_->lcm().publish("HOIST_WINDER", &w);
-    listener_->pump(1ms);
+    listener_->pump(2ms);
   }
-  EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_ESTIMATE") >= rows.size(); }, 10s));
+  EXPECT_TRUE(listener_->waitFor([&] { return lastArrived(rows.size()); }, 10s));
   const std::size_t h0 = listener_->count("HOIST_HEALTH");
   EXPECT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_HEALTH") > h0; }, 5s));
   stopDaemonCleanly(*d, log);
   const auto b = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
   const auto health = listener_->decoded<hoist::health_t>("HOIST_HEALTH");
-  ASSERT_EQ(a.size(), b.size());
   ASSERT_FALSE(health.empty());
   EXPECT_EQ(health.back().sensor_dropped, 0);
+  std::map<std::int64_t, const hoist::estimate_t*> by_utime;
+  for (const auto& e : b) by_utime[e.utime] = &e;
   int compared = 0;
-  for (std::size_t i = 100; i < a.size(); i += 50) {
-    ASSERT_EQ(a[i].utime, b[i].utime);
-    EXPECT_LT(std::abs(a[i].Fa - b[i].Fa), a[i].sigma_Fa) << "row " << i;
-    EXPECT_LT(std::abs(a[i].moment - b[i].moment), a[i].sigma_moment) << "row " << i;
+  for (std::size_t i = 100; i < a.size(); i += 25) {
+    const auto it = by_utime.find(a[i].utime);
+    if (it == by_utime.end()) continue;  // a datagram the listener lost
+    const hoist::estimate_t& l = *it->second;
+    // Two estimates of the same load agree within their sigmas (at rest the
+    // 5 N/sqrt(s) walk gives the filter a memory of about 40 samples, so the
+    // 7 samples the late one has not yet seen move it by about 0.4 sigma),
+    // and each holds the truth (the config's 1000 N + 500 N) within 3 sigma.
+    const double sF = std::hypot(a[i].sigma_Fa, l.sigma_Fa), sM = std::hypot(a[i].sigma_moment, l.sigma_moment);
+    EXPECT_LT(std::abs(a[i].Fa - l.Fa), sF) << "t " << a[i].t;
+    EXPECT_LT(std::abs(a[i].moment - l.moment), sM) << "t " << a[i].t;
+    EXPECT_LT(std::abs(l.Fa - 1500.0), 3.0 * l.sigma_Fa) << "t " << a[i].t;
     ++compared;
   }
   EXPECT_GE(compared, 9);
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(b.empty());
   EXPECT_NEAR(b.back().Fa, a.back().Fa, a.back().sigma_Fa);
   EXPECT_GT(std::abs(a.back().Fa - 1000.0), 300.0);  // it did move: the load the config does not know
 }

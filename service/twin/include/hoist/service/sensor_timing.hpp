@@ -14,8 +14,9 @@
 //   * else queued (a fixed ring per sensor) until the model reaches ts.
 // At every model step take() hands out, per sensor, the oldest queued
 // sample with ts <= now (at most one per step, as the estimator takes them;
-// more than kMaxDue due at once: the oldest are dropped, counted as
-// superseded), aligned to the step with hoist::alignToNow through the
+// the others wait for the next steps, each aligned from its own time: a
+// burst after a gap keeps its samples; more than kMaxDue due at once: the
+// oldest are dropped, counted as superseded), aligned to the step with hoist::alignToNow through the
 // recent predictions (record()).  A due sample older than the kept
 // predictions cannot be aligned: dropped, counted as too late.
 //
@@ -86,7 +87,7 @@ class SensorTiming {
   const SensorTimingCounters& counters() const { return counts_; }
   double maxClockOffset() const { return max_offset_; }
   /// Most samples due at one step that are kept for the next steps.
-  static constexpr int kMaxDue = 4;
+  static constexpr int kMaxDue = 32;
   /// Queue length per sensor.
   static constexpr int kQueue = 64;
 
