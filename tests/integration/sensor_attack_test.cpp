@@ -1,5 +1,5 @@
 // False and late sensors against the live daemon (hoist-twind --clock input,
-// [estimator] enabled) over real UDP multicast on loopback (ports 7920-7929).
+// [estimator] enabled) over real UDP multicast on loopback (ports 7920-7925).
 // The test publishes the winder and the sensors itself, a row every 10 ms of
 // sample time: the shaft at rest at 150 m with the configured load, its
 // sensors read through the sensor model (hoist::sensorModel of the static
@@ -12,8 +12,13 @@
 //   * an absurd f_y (99 m/s^2) and rope load (1e7 N) inside the sample
 //     bounds: the estimate is not used (HOIST_ESTIMATE.in_use false,
 //     not_used says why), SENSOR_FAULT, the switch is logged;
-//   * a stream delayed by 5 rows +- 2 (in order): the estimate equals the
-//     undelayed run's within its sigma.
+//   * a stream delayed by 3..7 rows (in order): the estimate equals the
+//     undelayed run's within their sigmas;
+//   * an IMU reading exactly 0 at rest while the open-loop twin raises
+//     CAGE_POS_Y: SENSOR_FAULT names the IMU, the estimate is not used, the
+//     alarm is raised and never cleared;
+//   * a rope load stuck from 3 s on: SENSOR_FAULT names it within a few
+//     seconds, the estimate is not used, the switch is logged.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -293,4 +298,40 @@ TEST_F(SensorAttack, ADelayedJitteredStreamGivesTheUndelayedEstimate) {
   ASSERT_FALSE(b.empty());
   EXPECT_NEAR(b.back().Fa, a.back().Fa, a.back().sigma_Fa);
   EXPECT_GT(std::abs(a.back().Fa - 1000.0), 300.0);  // it did move: the load the config does not know
+}
+
+TEST_F(SensorAttack, AZeroImuCannotHideTheOpenLoopAlarm) {
+  start(7924, "SensorAttackZeroImu", {"HOIST_HEALTH", "HOIST_ESTIMATE", "HOIST_ALARM"});
+  // The open-loop twin (the configured load) raises CAGE_POS_Y at rest; the
+  // IMU reads exactly 0 from the start (a dead gateway, or a forger).
+  const double gap = restState().excursion_pos / 0.6;
+  auto rows = genuine(600, 5);
+  for (Row& r : rows) r.f_y = r.omega = 0.0;
+  const std::string log = run(config(gap, 2.0, "twin.toml"), rows, "twind");
+  const auto fault = alarms("SENSOR_FAULT", hoist::alarm_t::EVENT_RAISE);
+  ASSERT_FALSE(fault.empty()) << log;
+  EXPECT_NE(fault.front().message.find("HOIST_CAGE_IMU"), std::string::npos) << fault.front().message;
+  // The alarm the open-loop twin raises is raised, and never cleared.
+  EXPECT_FALSE(alarms("CAGE_POS_Y", hoist::alarm_t::EVENT_RAISE).empty()) << log;
+  EXPECT_TRUE(alarms("CAGE_POS_Y", hoist::alarm_t::EVENT_CLEAR).empty()) << log;
+  const auto est = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
+  ASSERT_FALSE(est.empty());
+  EXPECT_FALSE(est.back().in_use);
+  EXPECT_NE(est.back().not_used & hoist::estimate_t::NOT_USED_SENSOR_FAULT, 0);
+}
+
+TEST_F(SensorAttack, AStuckRopeLoadIsFoundAndNotUsed) {
+  start(7925, "SensorAttackStuckRope", {"HOIST_HEALTH", "HOIST_ESTIMATE", "HOIST_ALARM"});
+  auto rows = genuine(700, 6);
+  for (std::size_t k = 300; k < rows.size(); ++k) rows[k].force = rows[299].force;  // stuck from 3 s on
+  const std::string log = run(config(0.3, 2.0, "twin.toml"), rows, "twind");
+  const auto est = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
+  ASSERT_GE(est.size(), 500u);
+  const auto fault = alarms("SENSOR_FAULT", hoist::alarm_t::EVENT_RAISE);
+  ASSERT_FALSE(fault.empty()) << log;
+  EXPECT_NE(fault.front().message.find("HOIST_ROPE_LOAD"), std::string::npos) << fault.front().message;
+  // Found within a few seconds (the monitor's stuck_time is 1 s).
+  EXPECT_LT(fault.front().t, 3.0 + 3.0) << fault.front().message;
+  EXPECT_FALSE(est.back().in_use);
+  EXPECT_NE(log.find("alarms now judge the open-loop twin"), std::string::npos) << log;
 }

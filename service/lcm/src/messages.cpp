@@ -207,10 +207,19 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
         std::snprintf(buf, n, "%s %s %s: %s: a sample's utime went backwards (a replay, or the sensor's clock "
                       "stepped back); refused and counted (HOIST_HEALTH.sensor_time_backwards)%s",
                       kind, level, verb, toString(ctx.sensor), state);
-      else
+      else if (ctx.sensor_reason == SensorFaultReason::Implausible)
         std::snprintf(buf, n, "%s %s %s: %s is implausible (%.4g beyond the physical bound %.4g): a sensor "
                       "lies or fails; the alarms judge the open-loop twin%s",
                       kind, level, verb, toString(ctx.sensor), e.value, e.threshold, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: %s is %s (%s; its noise %.3g against the datasheet's %.3g): a sensor "
+                      "that fails or lies; the alarms judge the open-loop twin%s",
+                      kind, level, verb, toString(ctx.sensor), toString(ctx.sensor_reason),
+                      ctx.sensor_reason == SensorFaultReason::Quiet   ? "far quieter than its own noise: flat, zeroed "
+                                                                        "or held"
+                      : ctx.sensor_reason == SensorFaultReason::Stuck ? "the very same value repeated"
+                                                                      : "far noisier than its datasheet",
+                      e.value, e.threshold, state);
       break;
     case AlarmKind::PredictedSlack:
       if (e.type == AlarmEventType::Clear)

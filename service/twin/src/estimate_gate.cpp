@@ -5,6 +5,17 @@
 
 namespace hoist::svc {
 
+void EstimateGate::pushLoad(GateEvent::Type type, double t, double Fa, double M) {
+  GateEvent e;
+  e.type = type;
+  e.t = t;
+  e.Fa0 = Fa0_;
+  e.M0 = M0_;
+  e.Fa1 = Fa;
+  e.M1 = M;
+  push(e);
+}
+
 Judgement EstimateGate::worse(const Judgement& a, const Judgement& b) const {
   Judgement w = a;
   Clearance& c = w.clearance;
@@ -54,14 +65,7 @@ const Judgement& EstimateGate::step(double t, bool usable, unsigned not_used, co
       }
       change_pending_ = true;
       changes_ = load_changes;
-      GateEvent e;
-      e.type = GateEvent::Type::LoadChange;
-      e.t = t;
-      e.Fa0 = Fa0_;
-      e.M0 = M0_;
-      e.Fa1 = Fa;
-      e.M1 = M;
-      push(e);
+      pushLoad(GateEvent::Type::LoadChange, t, Fa, M);
     }
   }
   if (holding(t)) {
@@ -72,14 +76,7 @@ const Judgement& EstimateGate::step(double t, bool usable, unsigned not_used, co
       change_pending_ = false;
       dFa_ = Fa - Fa0_;
       dM_ = M - M0_;
-      GateEvent e;
-      e.type = GateEvent::Type::LoadSettled;
-      e.t = t;
-      e.Fa0 = Fa0_;
-      e.M0 = M0_;
-      e.Fa1 = Fa;
-      e.M1 = M;
-      push(e);
+      pushLoad(GateEvent::Type::LoadSettled, t, Fa, M);
     }
   }
   in_use_ = usable;

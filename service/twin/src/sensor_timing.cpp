@@ -20,6 +20,9 @@ const char* toString(SensorFaultReason r) {
     case SensorFaultReason::ClockOffset: return "clock_offset";
     case SensorFaultReason::TimeBackwards: return "time_backwards";
     case SensorFaultReason::Implausible: return "implausible";
+    case SensorFaultReason::Quiet: return "quiet";
+    case SensorFaultReason::Stuck: return "stuck";
+    case SensorFaultReason::Noisy: return "noisy";
   }
   return "?";
 }

@@ -364,6 +364,19 @@ unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
     why |= kNotUsedImplausible;
     noteSensorFault(SensorId::Estimate, SensorFaultReason::Implausible, value, limit);
   }
+  // A sensor the estimator's monitor finds quiet, stuck or noisy
+  // (hoist/sensor_monitor.hpp): its channel lies, the estimate is not used.
+  if (e.faulty != 0) {
+    why |= kNotUsedSensorFault;
+    const bool imu = (e.fault_imu_accel | e.fault_imu_rate) != 0;
+    const unsigned bits = imu ? (e.fault_imu_accel | e.fault_imu_rate) : e.fault_rope_load;
+    const SensorFaultReason r = (bits & kFaultQuiet)   ? SensorFaultReason::Quiet
+                                : (bits & kFaultStuck) ? SensorFaultReason::Stuck
+                                                       : SensorFaultReason::Noisy;
+    const double learned = imu ? e.noise_imu_accel : e.noise_rope_load;
+    const double sheet = imu ? est_->settings().noise.imu_accel : est_->settings().noise.rope_load;
+    noteSensorFault(imu ? SensorId::CageImu : SensorId::RopeLoad, r, learned, sheet);
+  }
   return why;
 }
 

@@ -79,6 +79,8 @@ class EstimateGate {
 
  private:
   void push(const GateEvent& e) { ring_[static_cast<std::size_t>(n_events_++ % kEvents)] = e; }
+  /// A LoadChange or LoadSettled event: the load before the change, and now.
+  void pushLoad(GateEvent::Type type, double t, double Fa, double M);
   Judgement worse(const Judgement& a, const Judgement& b) const;
 
   AlarmConfig alarms_;

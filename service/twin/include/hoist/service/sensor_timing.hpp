@@ -40,6 +40,9 @@ enum class SensorFaultReason : std::uint8_t {
   ClockOffset,    ///< the sample's utime further from the daemon's clock than max_clock_offset (refused)
   TimeBackwards,  ///< a utime not after the sensor's last accepted one (refused)
   Implausible,    ///< the estimate or the state it implies outside the physical bounds (not used)
+  Quiet,          ///< far quieter than its datasheet noise: flat, zeroed or held (the estimator's sensor monitor)
+  Stuck,          ///< the very same value repeated
+  Noisy,          ///< far noisier than its datasheet
 };
 const char* toString(SensorFaultReason r);
 
