@@ -19,6 +19,9 @@ constexpr double kTimeEps = 1e-9;
 constexpr double kEnvelopeTime = 3.0;        // memory of the oscillation envelopes [s]
 constexpr double kStartTransientError = 0.1;  // rope-load model error after a start at a != 0, per N of m a
 constexpr double kJumpTransientError = 0.1;   // the same after a jump of a later on ...
+constexpr double kStepFoldTime = 60.0;      // a load change's step transient is followed this long [s]
+constexpr double kStepModelError = 0.2;     // relative model error of a step's transient (n = 25 against n = 100)
+constexpr double kMaxCatchUp = 2.0;         // the step solver catches up at most this much of the past [s]
 constexpr double kJumpTransientTime = 2.5;    // ... decaying faster (the shaft was steady before),
 constexpr double kRopeOscillationError = 0.07;  // the rope's oscillation, per N of m x_c'' (frequency error)
 constexpr double kJumpRefLength = 50.0;       // ... and less on a longer, softer rope (x 50 m / l)
@@ -84,9 +87,12 @@ LoadEstimator::LoadEstimator(const ShaftParams& twin, const EstimatorSettings& s
   ShaftParams unit = twin_;
   unit.Fa = 1.0;
   unit.b = 1.0;
-  sens_ = std::make_unique<FastSolver>(std::make_shared<const ShaftModel>(unit), Forcing::LoadOnly);
+  auto unit_model = std::make_shared<const ShaftModel>(unit);
+  sens_ = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
+  step_ = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
   Fa_c_ = twin_.Fa;
   M_c_ = twin_.Fa * twin_.b;
+  bounds_ = plausibilityBounds(twin_, 1.0);
   const auto cap = static_cast<std::size_t>(std::ceil(set_.nis_window * set_.max_rate)) + 2;
   ring_t_.assign(cap, 0.0);
   ring_nis_.assign(cap, 0.0);
@@ -148,6 +154,10 @@ void LoadEstimator::initialize(double t0, const Kinematics& k0) {
   rest_since_ = t0;
   change_t_ = -1.0;
   change_Fa0_ = change_M0_ = 0.0;
+  stepping_ = false;
+  o_Fa_ = Fa_c_;
+  o_M_ = M_c_;
+  step_e_fy_ = step_e_om_ = step_e_rope_ = 0.0;
   counts_ = {};
   est_ = {};
   twin_resp_ = sens_->response();
@@ -199,6 +209,15 @@ void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
     sens_->step(t0 + u * h, interpolate(k0, k1, h, u));
   }
   sens_->step(t1, k1);
+  if (stepping_) {
+    for (int j = 1; j < n; ++j) {
+      const double u = static_cast<double>(j) / n;
+      step_->step(t0 + u * h, interpolate(k0, k1, h, u));
+    }
+    step_->step(t1, k1);
+    if (t1 - step_t_ > kStepFoldTime) foldStep();
+  }
+  if (h > 0.0) sub_h_ = h / n;
   const bool was_moving = moving();
   t_ = t1;
   kin_ = k1;
@@ -224,30 +243,50 @@ void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
 void LoadEstimator::predict(const CageResponse& twin) {
   twin_resp_ = twin;
   const CageResponse& s = sens_->response();
-  const double dFa = Fa_ - Fa_c_, dM = M_ - M_c_;
+  const CageResponse& q = stepping_ ? step_->response() : s;
+  const double oFa = o_Fa_ - Fa_c_, oM = o_M_ - M_c_;  // 0 unless following a load change
+  const double dFa = Fa_ - o_Fa_, dM = M_ - o_M_;
   // The sensor model is linear: the sensitivities read through it (the
   // sensitivity solver's own a-term is the twin's: same kinematics).
   const SensorValues zt = sensorModel(twin, twin_.g), zs = sensorModel(s, twin_.g);
-  h_fy_ = zs.f_y;
-  h_om_ = zs.omega;
-  h_rope_ = zs.rope_load;
-  base_fy_ = zt.f_y;
-  base_om_ = zt.omega;
-  base_rope_ = zt.rope_load;
-  pred_fy_ = zt.f_y + dM * h_fy_;
-  pred_om_ = zt.omega + dM * h_om_;
-  pred_rope_ = zt.rope_load + dFa * h_rope_;
+  const SensorValues zq = stepping_ ? sensorModel(q, twin_.g) : zs;
+  h_fy_ = zq.f_y;
+  h_om_ = zq.omega;
+  h_rope_ = zq.rope_load;
+  base_fy_ = zt.f_y + oM * zs.f_y;
+  base_om_ = zt.omega + oM * zs.omega;
+  base_rope_ = zt.rope_load + oFa * zs.rope_load;
+  pred_fy_ = base_fy_ + dM * h_fy_;
+  pred_om_ = base_om_ + dM * h_om_;
+  pred_rope_ = base_rope_ + dFa * h_rope_;
+  // The step's onset is known to one sample: its response one sample early
+  // or late differs by about its change over one tick.  And the transient
+  // (the step's response less the steady one) rings the modes the n-mode
+  // model resolves least: kStepModelError of it.  Both allowed as model error.
+  if (stepping_) {
+    auto err = [](double d, double now, double prev, double steady) {
+      return std::hypot(d * (now - prev), kStepModelError * d * (now - steady));
+    };
+    if (step_fresh_) step_zq_ = zq;
+    step_fresh_ = false;
+    step_e_fy_ = err(dM, zq.f_y, step_zq_.f_y, zs.f_y);
+    step_e_om_ = err(dM, zq.omega, step_zq_.omega, zs.omega);
+    step_e_rope_ = err(dFa, zq.rope_load, step_zq_.rope_load, zs.rope_load);
+    step_zq_ = zq;
+  } else {
+    step_e_fy_ = step_e_om_ = step_e_rope_ = 0.0;
+  }
   // Envelopes (peak hold, decaying over kEnvelopeTime) of the predicted
   // oscillations: a model a few per cent off in frequency is off by up to
   // twice their amplitude a few cycles later, also at a zero crossing.
   const double dt = std::max(twin.t - env_t_, 0.0);
   env_t_ = twin.t;
   const double decay = std::exp(-dt / kEnvelopeTime);
-  const double yddot = twin.y_c_ddot + dM * s.y_c_ddot;
+  const double yddot = twin.y_c_ddot + oM * s.y_c_ddot + dM * q.y_c_ddot;
   env_fy_ = std::max(std::abs(yddot), env_fy_ * decay);
   env_om_ = std::max(std::abs(pred_om_), env_om_ * decay);
   // lambda_0 = Fa + m (g - a) - m x_c'': the rigid part is exact, m x_c'' oscillates.
-  const double xcdd = twin.x_c_ddot + dFa * s.x_c_ddot;
+  const double xcdd = twin.x_c_ddot + oFa * s.x_c_ddot + dFa * q.x_c_ddot;
   env_rope_ = std::max(twin_.m * std::abs(xcdd), env_rope_ * decay);
   // A later jump of the winder's acceleration does the same, less (the
   // shaft was in a steady state before it); a jerk-limited profile hardly.
@@ -274,7 +313,8 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   if (use_a) mon_[kImuAccel].sample(t_, f_y);
   if (use_w) mon_[kImuRate].sample(t_, omega);
   const double eps = set_.model_error;
-  const double ea = eps * (std::abs(pred_fy_) + env_fy_), ew = eps * env_om_;
+  const double ea = std::hypot(eps * (std::abs(pred_fy_) + env_fy_), step_e_fy_);
+  const double ew = std::hypot(eps * env_om_, step_e_om_);
   const double ra = set_.noise.imu_accel * set_.noise.imu_accel + ea * ea;
   const double rw = set_.noise.imu_rate * set_.noise.imu_rate + ew * ew;
   // Innovation, its covariance S = H P H^T + R (1 or 2 rows), in closed form.
@@ -290,13 +330,19 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   Eigen::Matrix2d S = covariance(PM_);
   const bool gated = (use_a && std::abs(nu(0)) > set_.gate_sigma * std::sqrt(S(0, 0))) ||
                      (use_w && std::abs(nu(1)) > set_.gate_sigma * std::sqrt(S(1, 1)));
+  if (use_a) mon_[kImuAccel].gate(t_, gated);
+  if (use_w) mon_[kImuRate].gate(t_, gated);
   if (gated) {
+    if (run_m_ == 0) gate_t0_m_ = t_;
     if (++run_m_ < set_.gate_reset) {
       ++counts_.gated;
       return false;
     }
-    loadChange();
-    S = covariance(PM_);
+    // A load change: this sample was predicted without it; the next ones
+    // are predicted with the change's step (and the re-opened loads).
+    loadChange(gate_t0_m_);
+    ++counts_.gated;
+    return false;
   }
   run_m_ = 0;
   const Eigen::Matrix2d Si = S.inverse();
@@ -304,7 +350,7 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   M_ += K * nu;
   PM_ = std::max(PM_ - (K * S * K.transpose())(0, 0), 0.0);
   {  // the short-memory estimate, same measurement
-    const double dMF = MF_ - M_c_;
+    const double dMF = MF_ - o_M_;
     const Eigen::Vector2d nuF(use_a ? f_y - (base_fy_ + dMF * h_fy_) : 0.0,
                               use_w ? omega - (base_om_ + dMF * h_om_) : 0.0);
     const Eigen::Matrix2d SF = covariance(PMF_);
@@ -344,17 +390,41 @@ void LoadEstimator::band(int ch, double nu, double S, double e) {
   tick_nis_ += s * s;
   tick_dof_ += 1;
   // f_y carries the moment's evidence at rest (the static tilt); omega only its transient.
-  if (ch == kRope ? changeAtRest(cusum_fa_, s) : ch == kImuAccel && changeAtRest(cusum_m_, s)) loadChange();
+  ChangeDetector* c = ch == kRope ? &cusum_fa_ : ch == kImuAccel ? &cusum_m_ : nullptr;
+  if (c && changeAtRest(*c, s)) loadChange(std::max(c->onset() - set_.band_block, rest_since_));
 }
 
 bool LoadEstimator::changeAtRest(ChangeDetector& c, double z) {
   if (moving() || t_ - rest_since_ + kTimeEps < set_.change_holdoff) return false;
-  return c.add(z);
+  return c.add(z, t_);
 }
 
-void LoadEstimator::loadChange() {
+void LoadEstimator::foldStep() {
+  // The transient has decayed: the step's response is the steady one's.
+  stepping_ = false;
+  o_Fa_ = Fa_c_;
+  o_M_ = M_c_;
+}
+
+void LoadEstimator::loadChange(double onset) {
   // One load changed: both its force and its moment re-open, whichever
   // channel saw it (the rope load sees Fa at once, f_y the moment slowly).
+  if (!moving()) {
+    // At rest the change is a step at `onset`: the ropes ring, and the step
+    // solver carries it.  The shaft is time-invariant at rest, so starting
+    // it at rest and stepping it to now at the rest kinematics is the same
+    // as having started it at the onset.
+    const double t0 = std::max(onset, t_ - kMaxCatchUp);
+    if (stepping_) foldStep();  // a change during a change's transient: the first one's ringing is dropped
+    step_->initialize(t0, kin_, InitialState::Rest);
+    const int n = t_ > t0 ? std::max(1, static_cast<int>(std::ceil((t_ - t0) / sub_h_ - 1e-9))) : 0;
+    for (int j = 1; j <= n; ++j) step_->step(t0 + (t_ - t0) * j / n, kin_);
+    stepping_ = true;
+    step_fresh_ = true;
+    step_t_ = t0;
+    o_Fa_ = Fa_;
+    o_M_ = M_;
+  }
   change_t_ = t_;
   change_Fa0_ = Fa_;
   change_M0_ = M_;
@@ -367,6 +437,7 @@ void LoadEstimator::loadChange() {
   run_fa_ = run_m_ = 0;
   cusum_fa_.reset();
   cusum_m_.reset();
+  rest_since_ = t_;  // the CUSUM waits change_holdoff again: the filters settle first
   ++counts_.load_changes;
   // A load cannot change while the cage moves: a change then is evidence of mismatch.
   if (moving()) trip_drift_ = std::max(trip_drift_, set_.drift_sigma + 1.0);
@@ -383,23 +454,27 @@ bool LoadEstimator::updateRopeLoad(double force) {
   // (both larger on a short, stiff rope, whose modes beyond n are the least resolved)
   const double er = kRopeOscillationError * env_rope_ * std::min(1.0, kJumpRefLength / kin_.l);
   const double R = set_.noise.rope_load * set_.noise.rope_load + er * er + start_rope_ * start_rope_ +
-                   jump_rope_ * jump_rope_;
+                   jump_rope_ * jump_rope_ + step_e_rope_ * step_e_rope_;
   const double nu = force - pred_rope_;
   double S = h_rope_ * h_rope_ * PFa_ + R;
-  if (std::abs(nu) > set_.gate_sigma * std::sqrt(S)) {
+  const bool gated = std::abs(nu) > set_.gate_sigma * std::sqrt(S);
+  mon_[kRope].gate(t_, gated);
+  if (gated) {
+    if (run_fa_ == 0) gate_t0_fa_ = t_;
     if (++run_fa_ < set_.gate_reset) {
       ++counts_.gated;
       return false;
     }
-    loadChange();
-    S = h_rope_ * h_rope_ * PFa_ + R;
+    loadChange(gate_t0_fa_);  // as in updateLateral: from the next sample on
+    ++counts_.gated;
+    return false;
   }
   run_fa_ = 0;
   const double K = PFa_ * h_rope_ / S;
   Fa_ += K * nu;
   PFa_ = std::max(PFa_ - K * K * S, 0.0);
   {  // the short-memory estimate, same measurement
-    const double nuF = force - (base_rope_ + (FaF_ - Fa_c_) * h_rope_);
+    const double nuF = force - (base_rope_ + (FaF_ - o_Fa_) * h_rope_);
     const double SF = h_rope_ * h_rope_ * PFaF_ + R;
     const double KF = PFaF_ * h_rope_ / SF;
     FaF_ += KF * nuF;
@@ -566,20 +641,48 @@ const LoadEstimate& LoadEstimator::finish() {
   // The state the estimated load implies, and its sigma (load + model error).
   const CageResponse& tw = twin_resp_;
   const CageResponse& s = sens_->response();
-  const double dFa = Fa_ - Fa_c_, dM = M_ - M_c_, eps = set_.model_error;
-  auto lateral = [&](double open, double sens, double& value, double& sigma) {
-    value = open + dM * sens;
-    sigma = std::hypot(sens * sM, eps * value);
+  const CageResponse& q = stepping_ ? step_->response() : s;
+  const double oFa = o_Fa_ - Fa_c_, oM = o_M_ - M_c_;  // 0 unless following a load change
+  const double dFa = Fa_ - o_Fa_, dM = M_ - o_M_, eps = set_.model_error;
+  auto lateral = [&](double open, double sens, double step, double& value, double& sigma) {
+    value = open + oM * sens + dM * step;
+    sigma = std::hypot(step * sM, eps * value);
   };
-  e.x_c = tw.x_c + dFa * s.x_c;
-  e.sigma_x_c = std::hypot(s.x_c * sFa, eps * e.x_c);
-  lateral(tw.y_c, s.y_c, e.y_c, e.sigma_y_c);
-  lateral(tw.theta, s.theta, e.theta, e.sigma_theta);
-  e.lambda[0] = tw.lambda[0] + dFa * s.lambda[0];
-  e.sigma_lambda[0] = std::hypot(s.lambda[0] * sFa, eps * (e.lambda[0] - (twin_.m * twin_.g + Fa_)));
-  for (int i = 1; i < 5; ++i) lateral(tw.lambda[i], s.lambda[i], e.lambda[i], e.sigma_lambda[i]);
+  e.x_c = tw.x_c + oFa * s.x_c + dFa * q.x_c;
+  e.sigma_x_c = std::hypot(q.x_c * sFa, eps * e.x_c);
+  lateral(tw.y_c, s.y_c, q.y_c, e.y_c, e.sigma_y_c);
+  lateral(tw.theta, s.theta, q.theta, e.theta, e.sigma_theta);
+  e.lambda[0] = tw.lambda[0] + oFa * s.lambda[0] + dFa * q.lambda[0];
+  e.sigma_lambda[0] = std::hypot(q.lambda[0] * sFa, eps * (e.lambda[0] - (twin_.m * twin_.g + Fa_)));
+  for (int i = 1; i < 5; ++i) lateral(tw.lambda[i], s.lambda[i], q.lambda[i], e.lambda[i], e.sigma_lambda[i]);
   e.theta_open = tw.theta;
+  judgePlausibility();
   return e;
+}
+
+void LoadEstimator::judgePlausibility() {
+  LoadEstimate& e = est_;
+  const double fa_max = twin_.payloadLimit(), b_max = twin_.offsetLimit();
+  e.implausible = "";
+  // Below zero only within 3 sigma, and only once settled (sigma under 5 %
+  // of the rating): an empty conveyance, not a payload pulled below zero.
+  if (e.fa_observed && (e.Fa + 3.0 * e.sigma_Fa < 0.0 || (e.Fa < 0.0 && e.sigma_Fa > 0.05 * fa_max)))
+    e.implausible = "Fa < 0";
+  else if (e.fa_observed && e.Fa - 3.0 * e.sigma_Fa > fa_max) e.implausible = "Fa > max_payload";
+  else if (e.moment_observed && std::abs(e.moment) - 3.0 * e.sigma_moment > fa_max * b_max)
+    e.implausible = "|M| > max_payload * max_offset";
+  else if (e.sigma_b >= 0.0 && std::abs(e.b) - 3.0 * e.sigma_b > b_max) e.implausible = "|b| > max_offset";
+  else if (!std::isfinite(e.Fa) || !std::isfinite(e.moment)) e.implausible = "non-finite";
+  else {
+    CageResponse r = twin_resp_;
+    r.x_c = e.x_c;
+    r.y_c = e.y_c;
+    r.theta = e.theta;
+    for (int i = 0; i < 5; ++i) r.lambda[i] = e.lambda[i];
+    double value = 0.0, limit = 0.0;
+    if (const char* what = implausible(r, twin_.h, bounds_, value, limit)) e.implausible = what;
+  }
+  e.plausible = e.implausible[0] == '\0';
 }
 
 }  // namespace hoist

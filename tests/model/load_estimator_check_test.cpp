@@ -221,3 +221,45 @@ TEST(LoadEstimatorCheck, AFlatButDitheredChannelIsQuiet) {
   EXPECT_LT(at, 3.5);
   EXPECT_STREQ(sensorFaultReason(mon.faults()), "quiet");
 }
+
+// Physical bounds at the model level: forged-looking inputs inside the
+// sample bounds.  Each is caught within 5 s: either the estimate is not
+// plausible (with the reason) or the gate rejects the stream and its channel
+// is flagged "rejected" -- and a payload significantly below zero (3 sigma)
+// is never reported as plausible.
+TEST(LoadEstimatorCheck, ForgedInputsAreNotPlausible) {
+  const CleanTruth tr = simulate(config(), HoistProfile::trapezoid(), {1500.0, 0.6}, 50);
+  const std::vector<MeasurementSample> genuine = measure(tr, industrial(0.5), 500);
+  struct Forgery {
+    const char* what;
+    void (*apply)(MeasurementSample&, const CleanTruth&, std::size_t);
+  };
+  const Forgery forgeries[] = {
+      {"f_y = 99 m/s^2", [](MeasurementSample& m, const CleanTruth&, std::size_t) { m.z.f_y = 99.0; }},
+      {"rope load 1e7 N", [](MeasurementSample& m, const CleanTruth&, std::size_t) { m.z.rope_load = 1e7; }},
+      {"rope load 0.3 x static",
+       [](MeasurementSample& m, const CleanTruth& t, std::size_t i) { m.z.rope_load = 0.3 * t.z[i].rope_load; }},
+  };
+  for (const Forgery& f : forgeries) {
+    std::vector<MeasurementSample> m = genuine;
+    for (std::size_t i = 0; i < m.size(); ++i)
+      if (m[i].t >= 10.0) f.apply(m[i], tr, i);
+    bool negative_plausible = false, implausible_late = true;
+    const char* reason = "";
+    estimateRecorded(config(), {}, 0.0025, m, [&](const LoadEstimate& e, const EstimatorCounters&) {
+      if (e.fa_observed && e.Fa + 3.0 * e.sigma_Fa < 0.0 && e.plausible) negative_plausible = true;
+      const bool caught = !e.plausible || e.faulty;
+      if (e.t >= 15.0 && !caught) implausible_late = false;
+      if (!e.plausible) reason = e.implausible;
+      else if (e.faulty) reason = sensorFaultReason(e.fault_imu_accel | e.fault_rope_load);
+    });
+    std::printf("[ forged: %s ] caught from 15 s on: %s (%s)\n", f.what, implausible_late ? "yes" : "NO", reason);
+    EXPECT_TRUE(implausible_late) << f.what;
+    EXPECT_FALSE(negative_plausible) << f.what;
+  }
+  // The genuine stream stays plausible throughout.
+  bool all = true;
+  estimateRecorded(config(), {}, 0.0025, genuine,
+                   [&](const LoadEstimate& e, const EstimatorCounters&) { all = all && e.plausible; });
+  EXPECT_TRUE(all);
+}

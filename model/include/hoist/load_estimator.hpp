@@ -81,6 +81,7 @@
 #include "hoist/band_innovation.hpp"
 #include "hoist/change_detector.hpp"
 #include "hoist/fast_solver.hpp"
+#include "hoist/plausibility.hpp"
 #include "hoist/sensor_monitor.hpp"
 
 namespace hoist {
@@ -173,6 +174,19 @@ struct LoadEstimate {
   double change_Fa = 0.0;    ///< its size so far: Fa now - Fa before it [N]
   double change_moment = 0.0;  ///< M now - M before it [N m]
   double change_level = 0.0; ///< the larger CUSUM statistic / its threshold (1 = a change)
+  /// Physical bounds ([load] max_payload, max_offset: ShaftParams::payloadLimit(),
+  /// offsetLimit()) and the twin's plausibility bounds (hoist/plausibility.hpp,
+  /// lateral limit 1 m) on the estimate and the state it implies.  false:
+  /// the estimate must not be used (a forged or failed sensor, or a model far
+  /// off), whatever its sigma says.  An observed load is judged 3 sigma
+  /// generously: 0 <= Fa + 3 sigma_Fa (and Fa >= 0 unless sigma_Fa < 5 % of
+  /// max_payload: an empty conveyance), Fa - 3 sigma_Fa <= max_payload,
+  /// |M| - 3 sigma_M <= max_payload max_offset, |b| - 3 sigma_b <= max_offset.
+  bool plausible = true;
+  /// Why not plausible: "Fa < 0", "Fa > max_payload", "|M| > max_payload * max_offset",
+  /// "|b| > max_offset", or the state's quantity ("y_c", "theta", "x_c",
+  /// "lambda_k", "non-finite"); "" when plausible.  A static string.
+  const char* implausible = "";
 };
 
 /// Counts since initialize().
@@ -245,21 +259,43 @@ class LoadEstimator {
   /// stepped exactly as the twin: its saved state turns the twin's state into
   /// the estimate's with hoist::addLoadResponse (forecasts from the estimate).
   const FastSolver& sensitivitySolver() const { return *sens_; }
+  /// True while a load change's transient is followed (for kStepFoldTime =
+  /// 60 s after a change at rest): the state the estimate implies is then
+  /// the steady superposition plus the step's transient, and a forecast
+  /// built from sensitivitySolver() alone omits the transient.
+  bool followingLoadChange() const { return stepping_; }
 
  private:
   bool updateLateral(double f_y, double omega, unsigned which);
-  /// A load change (CUSUM or gate_reset, either channel): re-opens Fa and M.
-  void loadChange();
+  /// A load change (CUSUM or gate_reset, either channel) that began at
+  /// `onset`: re-opens Fa and M; at rest the step solver starts.
+  void loadChange(double onset);
   /// The CUSUM of a channel at rest; true: a change.
   bool changeAtRest(ChangeDetector& c, double z);
   /// An accepted innovation of channel `ch` into its band block (NIS window, CUSUM).
   void band(int ch, double nu, double S, double e);
+  /// Stop following a load change's transient (decayed, or a restart).
+  void foldStep();
   void pushNis(double nis, int dof);
   bool moving() const;
 
   ShaftParams twin_;
   EstimatorSettings set_;
   std::unique_ptr<FastSolver> sens_;       // unit load (Fa = 1 N, M = 1 N m) since initialize(): dz/dFa, dz/dM
+  // A load change at rest is a step: the ropes ring.  step_ is the unit load
+  // applied as a step at the change's onset (started at rest), so the
+  // prediction after it is exact superposition:
+  //   z = z_twin + (o - c) dz/d(steady) + (x - o) dz/d(step),  o = the load before the change,
+  // until the transient has decayed (kStepFoldTime), then folded back.
+  std::unique_ptr<FastSolver> step_;
+  bool stepping_ = false;
+  double step_t_ = 0.0;                    // the step's onset
+  double o_Fa_ = 0.0, o_M_ = 0.0;          // origin of the step part (= the configured load when not stepping)
+  double sub_h_ = 0.0025;                  // the last advance()'s substep [s]
+  bool step_fresh_ = false;                // no step sensitivity of the previous tick yet
+  SensorValues step_zq_;                   // the step's sensitivities at the previous tick
+  double step_e_fy_ = 0.0, step_e_om_ = 0.0, step_e_rope_ = 0.0;  // model error of the onset's one-sample uncertainty
+  double gate_t0_fa_ = 0.0, gate_t0_m_ = 0.0;  // first gated sample of the current run
   double t_ = 0.0;
   Kinematics kin_;
   double Fa_c_ = 0.0, M_c_ = 0.0;          // the configured load (prior)
@@ -298,8 +334,11 @@ class LoadEstimator {
   ChangeDetector cusum_fa_, cusum_m_;      // load changes at rest
   double rest_since_ = 0.0;                // time the cage came to rest
   double change_t_ = -1.0, change_Fa0_ = 0.0, change_M0_ = 0.0;  // the last load change and the loads before it
+  PlausibilityBounds bounds_;              // the twin's, lateral limit 1 m
   LoadEstimate est_;
   EstimatorCounters counts_;
+  /// Sets est_.plausible / implausible from est_ (after the state is filled).
+  void judgePlausibility();
 };
 
 /// The offline estimator (hoist-estimate), the same sequence the daemon runs
