@@ -15,13 +15,6 @@ using namespace hoist::test;
 
 namespace {
 
-ShaftParams config() {
-  ShaftParams p;
-  p.n = 25;
-  p.static_correction = true;
-  return p;
-}
-
 // stationSequence(10): down 2 -> 57 s, rest, up from 67 s.  The load changes at 62 s.
 constexpr double kChange = 62.0, kUp = 67.0;
 

@@ -18,13 +18,6 @@ using namespace hoist::test;
 
 namespace {
 
-ShaftParams config() {
-  ShaftParams p;
-  p.n = 25;
-  p.static_correction = true;
-  return p;
-}
-
 struct Outcome {
   double first_mismatch = -1.0;  // time MODEL_MISMATCH first rose (-1: never)
   double max_nis_ratio = 0.0, max_drift = 0.0;

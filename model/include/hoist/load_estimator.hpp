@@ -46,11 +46,14 @@
 // that is right to about model_error (the n-mode twin against the continuum is
 // within 1 %) is not reported as wrong.
 //
-// Model check.  NIS_k = nu^T S^-1 nu of every accepted update, summed over a
-// sliding window of nis_window seconds, is chi-square with dof = the number
-// of scalar measurements in the window when the model is right.  MODEL_MISMATCH
-// (WARNING) is evidence of a shaft that does not behave like its model:
-//   * the window's NIS above its chi-square (1 - nis_alpha) quantile, or
+// Model check (docs/estimation.md, "The model check").  Each channel's
+// innovations are summed over blocks of band_block seconds
+// (hoist/band_innovation.hpp): vibration above the model's band cancels,
+// what the model carries adds; s^2 of each block is one dof of the windowed
+// NIS over nis_window seconds.  MODEL_MISMATCH (WARNING) is evidence of a
+// shaft that does not behave like its model:
+//   * the window's NIS above its chi-square (1 - nis_alpha) quantile and
+//     nis_margin dof, or
 //   * a load estimate that drifts during a trip (the cage moving) by more than
 //     drift_sigma times the spread the filter itself expects, or
 //   * (constancy) the estimate over the last constancy_memory seconds (a
@@ -58,17 +61,27 @@
 //     from the whole history's by more than drift_sigma times the sigma of
 //     their difference (PF - P for nested estimates): a load that seems to
 //     change with depth is a model that is wrong with depth (weak preloads).
-// Per-sample gating rejects (and counts) an innovation beyond gate_sigma;
-// gate_reset consecutive rejections are a load change, not spikes: the
-// load's covariance is re-opened to its initial value.
-//
+// The tests start after a warm-up of min_window_fill x nis_window.
+// The other side -- a sensor quieter than its own noise (zeroed, stuck,
+// held), or one whose samples the gate mostly rejects -- is judged per
+// channel by hoist/sensor_monitor.hpp: LoadEstimate::fault_*, imu_quiet,
+// rope_quiet (SENSOR_FAULT in the daemon), not by MODEL_MISMATCH.
+// Per-sample gating rejects (and counts) an innovation beyond gate_sigma.
+// Load changes: gate_reset rejections in a row, or a CUSUM on the blocks at
+// rest (hoist/change_detector.hpp), on either channel, re-open both Fa and
+// M (one load changed).  At rest the change is a step: a third solver
+// (the unit load from rest at the change's onset) carries its transient for
+// kStepFoldTime (60 s); followingLoadChange() says so.
+// Physical bounds: LoadEstimate::plausible ([load] max_payload, max_offset
+// and hoist/plausibility.hpp).
 // Observability: the rope load alone gives Fa but not b; the IMU alone gives M
 // (and so y_c, theta, lambda_1..4) but not Fa or b; both give Fa and b = M/Fa.
 // Without a sensor the estimates stay at the configured load, their sigma
 // grows with the random walk, and observed()/sensorsInUse() say so.
 //
-// Real time: every buffer is sized in the constructor; initialize(),
-// advance(), update*() and finish() allocate nothing (tested).
+// Real time: every buffer and the three solvers are sized in the
+// constructor; initialize(), advance(), update*() and finish() allocate
+// nothing, a load change included (tests/model/no_alloc_test.cpp).
 #pragma once
 
 #include <array>
@@ -148,9 +161,9 @@ struct LoadEstimate {
   double theta = 0.0, sigma_theta = 0.0;
   std::array<double, 5> lambda{}, sigma_lambda{};
   double theta_open = 0.0;                 ///< the open-loop twin's theta (configured load)
-  double nis = 0.0;          ///< NIS of this tick's updates (0 if none)
+  double nis = 0.0;          ///< NIS of the band blocks that closed this tick (0 if none)
   double nis_window = 0.0;   ///< sum over the window
-  int nis_dof = 0;           ///< scalar measurements in the window
+  int nis_dof = 0;           ///< blocks (one per channel and band_block) in the window
   double nis_lower = 0.0, nis_upper = 0.0;  ///< the window's 95 % two-sided chi-square bounds
   double nis_bound = 0.0;    ///< the MODEL_MISMATCH bound: max(1 - nis_alpha quantile, nis_margin dof)
   double drift = 0.0;        ///< largest load drift this trip [its sigma]
