@@ -6,6 +6,7 @@
 namespace hoist {
 
 const char* sensorFaultReason(unsigned bits) {
+  if (bits & kFaultRejected) return "rejected";
   if (bits & kFaultStuck) return "stuck";
   if (bits & kFaultQuiet) return "quiet";
   if (bits & kFaultNoisy) return "noisy";
@@ -40,6 +41,9 @@ void SensorMonitor::reset(const SensorMonitorSettings& s) {
   last_z_ = 0.0;
   same_since_ = 0.0;
   same_run_ = 0;
+  rej_ = 0.0;
+  rej_t_ = 0.0;
+  rej_started_ = false;
   faults_ = 0;
 }
 
@@ -59,6 +63,16 @@ void SensorMonitor::sample(double t, double z) {
   }
   if (same_run_ >= 5 && t - same_since_ >= s_.stuck_time) faults_ |= kFaultStuck;
   else if (same_run_ == 1) faults_ &= ~kFaultStuck;
+}
+
+void SensorMonitor::gate(double t, bool rejected) {
+  const double dt = rej_started_ ? t - rej_t_ : 0.0;
+  rej_started_ = true;
+  rej_t_ = t;
+  const double w = dt > 0.0 ? 1.0 - std::exp(-dt / s_.quiet_memory) : 0.0;
+  rej_ += w * ((rejected ? 1.0 : 0.0) - rej_);
+  if (rej_ > 0.5) faults_ |= kFaultRejected;
+  else if (rej_ < 0.1) faults_ &= ~kFaultRejected;
 }
 
 void SensorMonitor::innovation(double t, double nu) {

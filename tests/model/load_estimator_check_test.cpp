@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "hoist/load_estimator.hpp"
 #include "sensor_truth.hpp"
@@ -16,13 +17,6 @@ using namespace hoist;
 using namespace hoist::test;
 
 namespace {
-
-ShaftParams config() {
-  ShaftParams p;
-  p.n = 25;
-  p.static_correction = true;
-  return p;
-}
 
 struct Outcome {
   double first_mismatch = -1.0;  // time MODEL_MISMATCH first rose (-1: never)
@@ -220,4 +214,81 @@ TEST(LoadEstimatorCheck, AFlatButDitheredChannelIsQuiet) {
   EXPECT_GT(at, 1.0);
   EXPECT_LT(at, 3.5);
   EXPECT_STREQ(sensorFaultReason(mon.faults()), "quiet");
+}
+
+// Physical bounds at the model level: forged-looking inputs inside the
+// sample bounds.  Each is caught within 5 s: either the estimate is not
+// plausible (with the reason) or the gate rejects the stream and its channel
+// is flagged "rejected" -- and a payload significantly below zero (3 sigma)
+// is never reported as plausible.
+TEST(LoadEstimatorCheck, ForgedInputsAreNotPlausible) {
+  const CleanTruth tr = simulate(config(), HoistProfile::trapezoid(), {1500.0, 0.6}, 50);
+  const std::vector<MeasurementSample> genuine = measure(tr, industrial(0.5), 500);
+  struct Forgery {
+    const char* what;
+    void (*apply)(MeasurementSample&, const CleanTruth&, std::size_t);
+  };
+  const Forgery forgeries[] = {
+      {"f_y = 99 m/s^2", [](MeasurementSample& m, const CleanTruth&, std::size_t) { m.z.f_y = 99.0; }},
+      {"rope load 1e7 N", [](MeasurementSample& m, const CleanTruth&, std::size_t) { m.z.rope_load = 1e7; }},
+      {"rope load 0.3 x static",
+       [](MeasurementSample& m, const CleanTruth& t, std::size_t i) { m.z.rope_load = 0.3 * t.z[i].rope_load; }},
+  };
+  for (const Forgery& f : forgeries) {
+    std::vector<MeasurementSample> m = genuine;
+    for (std::size_t i = 0; i < m.size(); ++i)
+      if (m[i].t >= 10.0) f.apply(m[i], tr, i);
+    bool negative_plausible = false, implausible_late = true;
+    const char* reason = "";
+    estimateRecorded(config(), {}, 0.0025, m, [&](const LoadEstimate& e, const EstimatorCounters&) {
+      if (e.fa_observed && e.Fa + 3.0 * e.sigma_Fa < 0.0 && e.plausible) negative_plausible = true;
+      const bool caught = !e.plausible || e.faulty;
+      if (e.t >= 15.0 && !caught) implausible_late = false;
+      if (!e.plausible) reason = e.implausible;
+      else if (e.faulty) reason = sensorFaultReason(e.fault_imu_accel | e.fault_rope_load);
+    });
+    std::printf("[ forged: %s ] caught from 15 s on: %s (%s)\n", f.what, implausible_late ? "yes" : "NO", reason);
+    EXPECT_TRUE(implausible_late) << f.what;
+    EXPECT_FALSE(negative_plausible) << f.what;
+  }
+  // The genuine stream stays plausible throughout.
+  bool all = true;
+  estimateRecorded(config(), {}, 0.0025, genuine,
+                   [&](const LoadEstimate& e, const EstimatorCounters&) { all = all && e.plausible; });
+  EXPECT_TRUE(all);
+}
+
+// Cheap sensors and dropouts keep working: 0.04 m/s^2, 4e-3 rad/s, 60 N,
+// vibration 0.75 x, 5 % of the samples missing at random and the IMU silent
+// for 2 s mid-trip: the loads inside their 3-sigma bands, no MODEL_MISMATCH,
+// no sensor fault, plausible throughout.
+TEST(LoadEstimatorCheck, CheapSensorsAndDropoutsKeepWorking) {
+  const CleanTruth tr = simulate(config(), HoistProfile::trapezoid(), {1500.0, 0.6}, 100);
+  SensorErrors err;
+  err.white = {0.04, 4e-3, 60.0};
+  err.vibration = 0.75;
+  EstimatorSettings set;
+  set.noise = err.white;
+  for (unsigned seed : {600u, 601u}) {
+    std::vector<MeasurementSample> m = measure(tr, err, seed);
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (auto& s : m) {
+      if (u(rng) < 0.05) s.present &= ~(kSensorImuAccel | kSensorImuRate);
+      if (u(rng) < 0.05) s.present &= ~kSensorRopeLoad;
+      if (s.t > 30.0 && s.t < 32.0) s.present &= ~(kSensorImuAccel | kSensorImuRate);
+    }
+    const Outcome o = run(config(), m, set);
+    bool plausible = true;
+    estimateRecorded(config(), set, 0.0025, m,
+                     [&](const LoadEstimate& e, const EstimatorCounters&) { plausible = plausible && e.plausible; });
+    std::printf("[ cheap sensors, seed %u ] Fa %.1f +- %.1f, M %.1f +- %.1f (true 900), mismatch %s, faults %u\n", seed,
+                o.last.Fa, o.last.sigma_Fa, o.last.moment, o.last.sigma_moment,
+                o.first_mismatch >= 0.0 ? "ROSE" : "never", o.faults);
+    EXPECT_LT(o.first_mismatch, 0.0) << "seed " << seed;
+    EXPECT_EQ(o.faults, 0u) << "seed " << seed;
+    EXPECT_TRUE(plausible) << "seed " << seed;
+    EXPECT_LT(std::abs(o.last.Fa - 1500.0), 3.0 * o.last.sigma_Fa) << "seed " << seed;
+    EXPECT_LT(std::abs(o.last.moment - 900.0), 3.0 * o.last.sigma_moment) << "seed " << seed;
+  }
 }

@@ -25,6 +25,15 @@ struct Load {
   double Fa, b;
 };
 
+/// The estimator's configuration in these tests: the paper's shaft at n = 25
+/// with the static correction, the paper's load (1000 N at 1 m).
+inline ShaftParams config() {
+  ShaftParams p;
+  p.n = 25;
+  p.static_correction = true;
+  return p;
+}
+
 /// The true response, every 0.01 s: kinematics, noise-free sensor values and the true loads and state.
 struct CleanTruth {
   std::vector<double> t;

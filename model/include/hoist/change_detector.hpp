@@ -23,23 +23,30 @@ class ChangeDetector {
   ChangeDetector() = default;
   ChangeDetector(double k, double h) : k_(k), h_(h) {}
   void reset() { up_ = down_ = 0.0; }
-  /// Adds the normalized innovation z; true when a change is detected (the
-  /// statistic then starts again from 0).
-  bool add(double z) {
+  /// Adds the normalized innovation z of the data up to time t; true when a
+  /// change is detected (the statistic then starts again from 0).
+  bool add(double z, double t = 0.0) {
+    if (up_ <= 0.0) up_t_ = t;
+    if (down_ <= 0.0) down_t_ = t;
     up_ = std::max(0.0, up_ + z - k_);
     down_ = std::max(0.0, down_ - z - k_);
     if (up_ > h_ || down_ > h_) {
+      onset_ = up_ > h_ ? up_t_ : down_t_;
       reset();
       return true;
     }
     return false;
   }
+  /// The change's onset as the CUSUM estimates it: the time of the first
+  /// sample after the statistic last left zero (valid after add() returned true).
+  double onset() const { return onset_; }
   /// The larger of the two one-sided statistics (in units of h: 1 = alarm).
   double level() const { return std::max(up_, down_) / h_; }
 
  private:
   double k_ = 0.5, h_ = 12.0;
   double up_ = 0.0, down_ = 0.0;
+  double up_t_ = 0.0, down_t_ = 0.0, onset_ = 0.0;
 };
 
 }  // namespace hoist

@@ -31,6 +31,9 @@
 // * stuck: the very same value repeated for stuck_time (1 s) and at least
 //   5 samples (a float from a noisy sensor never repeats).
 // * noisy: the learned noise sigma above noisy_factor (5) times the datasheet.
+// * rejected: more than half of its samples over quiet_memory rejected by the
+//   estimator's innovation gate (cleared below a tenth): a stream that
+//   contradicts the model and the other sensors (forged, or failed high).
 #pragma once
 
 namespace hoist {
@@ -40,6 +43,7 @@ enum SensorFaultBits : unsigned {
   kFaultQuiet = 1u,  ///< far quieter than its datasheet noise (flat, zeroed, held)
   kFaultStuck = 2u,  ///< the same value repeated
   kFaultNoisy = 4u,  ///< far noisier than its datasheet
+  kFaultRejected = 8u,  ///< most of its samples rejected by the innovation gate (it contradicts the model)
 };
 /// The first reason of `bits` as a word ("quiet", "stuck", "noisy"), "" for none.
 const char* sensorFaultReason(unsigned bits);
@@ -60,6 +64,8 @@ class SensorMonitor {
   void reset(const SensorMonitorSettings& s);
   /// A finite sample `z` at time `t` (accepted or gated).
   void sample(double t, double z);
+  /// The gate's verdict on a sample at time `t` (true: rejected).
+  void gate(double t, bool rejected);
   /// The innovation `nu` of an accepted sample at time `t`.
   void innovation(double t, double nu);
   /// The learned high-frequency variance of the innovations, discounted by
@@ -88,6 +94,8 @@ class SensorMonitor {
   double var_z_ = 0.0, var_nu_ = 0.0, rel_sd_ = 0.0;
   double last_z_ = 0.0, same_since_ = 0.0;
   int same_run_ = 0;
+  double rej_ = 0.0, rej_t_ = 0.0;
+  bool rej_started_ = false;
   unsigned faults_ = 0;
 };
 
