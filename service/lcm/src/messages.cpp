@@ -256,7 +256,8 @@ void describeAlarmWhole(const AlarmEvent& e, const AlarmTextContext& ctx, char* 
                       ctx.sensor_reason == SensorFaultReason::Quiet   ? "far quieter than its own noise: flat, zeroed "
                                                                         "or held"
                       : ctx.sensor_reason == SensorFaultReason::Stuck ? "the very same value repeated"
-                                                                      : "far noisier than its datasheet",
+                      : ctx.sensor_reason == SensorFaultReason::Noisy ? "far noisier than its datasheet"
+                                                                      : "most of its samples contradict the model",
                       e.value, e.threshold, state);
       break;
     case AlarmKind::PredictedSlack:

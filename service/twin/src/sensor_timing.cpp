@@ -23,6 +23,7 @@ const char* toString(SensorFaultReason r) {
     case SensorFaultReason::Quiet: return "quiet";
     case SensorFaultReason::Stuck: return "stuck";
     case SensorFaultReason::Noisy: return "noisy";
+    case SensorFaultReason::Rejected: return "rejected";
   }
   return "?";
 }

@@ -91,6 +91,11 @@ unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
   if (value != 0.0 || limit != 0.0) {
     why |= kNotUsedImplausible;
     noteSensorFault(SensorId::Estimate, SensorFaultReason::Implausible, value, limit);
+  } else if (!e.plausible) {
+    // The estimator's own physical bounds ([load] max_payload, max_offset;
+    // reported as Fa against the payload limit).
+    why |= kNotUsedImplausible;
+    noteSensorFault(SensorId::Estimate, SensorFaultReason::Implausible, e.Fa, cfg_.shaft.payloadLimit());
   }
   // A sensor the estimator's monitor finds quiet, stuck or noisy
   // (hoist/sensor_monitor.hpp): its channel lies, the estimate is not used.
@@ -100,7 +105,8 @@ unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
     const unsigned bits = imu ? (e.fault_imu_accel | e.fault_imu_rate) : e.fault_rope_load;
     const SensorFaultReason r = (bits & kFaultQuiet)   ? SensorFaultReason::Quiet
                                 : (bits & kFaultStuck) ? SensorFaultReason::Stuck
-                                                       : SensorFaultReason::Noisy;
+                                : (bits & kFaultNoisy) ? SensorFaultReason::Noisy
+                                                       : SensorFaultReason::Rejected;
     const double learned = imu ? e.noise_imu_accel : e.noise_rope_load;
     const double sheet = imu ? est_->settings().noise.imu_accel : est_->settings().noise.rope_load;
     noteSensorFault(imu ? SensorId::CageImu : SensorId::RopeLoad, r, learned, sheet);

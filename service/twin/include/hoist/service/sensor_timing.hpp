@@ -43,6 +43,7 @@ enum class SensorFaultReason : std::uint8_t {
   Quiet,          ///< far quieter than its datasheet noise: flat, zeroed or held (the estimator's sensor monitor)
   Stuck,          ///< the very same value repeated
   Noisy,          ///< far noisier than its datasheet
+  Rejected,       ///< most of its samples rejected by the estimator's gate (it contradicts the model)
 };
 const char* toString(SensorFaultReason r);
 
