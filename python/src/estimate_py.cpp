@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <functional>
 #include <optional>
-#include <sstream>
 
 #include <pybind11/stl.h>
 
@@ -105,25 +104,8 @@ py::dict estimate(const Config& cfg, const py::object& measurements, std::option
     p.n = *modes;
   }
   // Measurements: a CSV path, or named arrays written as that CSV (same reader, same checks).
-  std::vector<MeasurementSample> samples;
   std::string source;
-  const py::module_ os = py::module_::import("os");
-  if (py::isinstance<py::str>(measurements) || py::isinstance(measurements, os.attr("PathLike"))) {
-    source = py::str(os.attr("fspath")(measurements));
-    samples = io::readMeasurementsCsvFile(source);
-  } else if (py::isinstance<py::dict>(measurements)) {
-    std::vector<std::string> names;
-    std::vector<py::object> arrays;
-    for (const auto& [k, v] : measurements.cast<py::dict>()) {
-      names.push_back(py::str(k));
-      arrays.push_back(py::reinterpret_borrow<py::object>(v));
-    }
-    source = "<measurement arrays>";
-    std::istringstream in(columnsCsv(names, arrays, "measurements"));
-    samples = io::readMeasurementsCsv(in, source);
-  } else {
-    throw py::type_error("measurements: expected a CSV path or a dict of arrays (t, l, v, a[, f_y, omega, rope_load])");
-  }
+  const std::vector<MeasurementSample> samples = measurementSamples(measurements, source);
   {
     std::vector<ProfileSample> ps(samples.size());
     for (std::size_t i = 0; i < samples.size(); ++i) ps[i] = {samples[i].t, samples[i].k};
