@@ -1,6 +1,6 @@
 // hoist._hoist._estimate: hoist-estimate from Python (the wrapper with the
 // docstring: python/hoist/__init__.py).  The input checks and the NIS-window
-// sizing are hoist-estimate's (tools/estimate/main.cpp) so that both give the
+// sizing are hoist-estimate's (io::checkRecordedRun, one function) so that both give the
 // same numbers; the columns are its output columns, in its order, with nan for
 // a value not observed (the test compares both on the same files).
 #include <algorithm>
@@ -16,7 +16,7 @@
 #include "config_py.hpp"
 #include "errors.hpp"
 #include "estimate_py.hpp"
-#include "hoist/io/profile.hpp"
+#include "hoist/io/recorded_run.hpp"
 #include "hoist/io/sim_run.hpp"
 #include "hoist/load_estimator.hpp"
 #include "tasks.hpp"
@@ -106,27 +106,14 @@ py::dict estimate(const Config& cfg, const py::object& measurements, std::option
   // Measurements: a CSV path, or named arrays written as that CSV (same reader, same checks).
   std::string source;
   const std::vector<MeasurementSample> samples = measurementSamples(measurements, source);
-  {
-    std::vector<ProfileSample> ps(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i) ps[i] = {samples[i].t, samples[i].k};
-    io::checkProfileInShaft(HoistProfile(std::move(ps)), p, source);
-  }
-  // The NIS window holds one entry per sample: sized for the data's rate, as hoist-estimate does.
-  EstimatorSettings set = ec.settings;
-  double min_dt = samples[1].t - samples[0].t;
-  for (std::size_t i = 2; i < samples.size(); ++i) min_dt = std::min(min_dt, samples[i].t - samples[i - 1].t);
-  const double rate = std::ceil(1.0 / min_dt - 1e-9);
-  if (rate > set.max_rate) {
-    if (rate > 100000.0 || set.nis_window * rate > 5.0e6)
-      throw py::value_error("measurements " + source + ": rows as close as " + fmt(min_dt) + " s apart (" + fmt(rate) +
-                            " Hz) are too fast for estimator.nis_window = " + fmt(set.nis_window) +
-                            " s (at most 5e6 window entries, 100 kHz)");
-    set.max_rate = static_cast<int>(rate);
-  }
+  // The shaft, the NIS window's rate and the substeps: hoist-estimate's checks (hoist/io/recorded_run.hpp).
+  EstimatorSettings set;
   try {
-    for (std::size_t i = 1; i < samples.size(); ++i) substepCount(samples[i].t - samples[i - 1].t, max_step);
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error("max_step " + fmt(max_step) + ": " + e.what());
+    set = io::checkRecordedRun(samples, p, ec.settings, max_step, source);
+  } catch (const io::RecordedRunError& e) {
+    throw py::value_error(e.option == io::RecordedRunError::Option::MaxStep
+                              ? "max_step " + fmt(max_step) + ": " + e.what()
+                              : "measurements " + source + ": " + e.what());
   }
 
   const auto& cs = cells();
