@@ -91,10 +91,10 @@ std::string fmt(double v) {
   return buf;
 }
 
-py::dict estimate(const Config& cfg, const py::object& measurements, std::optional<int> modes,
-                  std::optional<double> max_step_opt, const py::object& progress) {
-  ShaftParams p = cfg.params;
-  const io::EstimatorConfig ec = cfg.estimator();
+}  // namespace
+
+double recordedRunOptions(const Config& cfg, std::optional<int> modes, std::optional<double> max_step_opt,
+                          ShaftParams& p) {
   if (max_step_opt && !(*max_step_opt >= 0.0 && *max_step_opt <= 10.0))
     throw py::value_error("max_step: " + fmt(*max_step_opt) + " is not in [0, 10]");
   const double max_step = max_step_opt ? *max_step_opt : cfg.serviceMaxStep();
@@ -103,6 +103,16 @@ py::dict estimate(const Config& cfg, const py::object& measurements, std::option
       throw py::value_error("modes: " + std::to_string(*modes) + " is not in [1, " + std::to_string(kMaxModes) + "]");
     p.n = *modes;
   }
+  return max_step;
+}
+
+namespace {
+
+py::dict estimate(const Config& cfg, const py::object& measurements, std::optional<int> modes,
+                  std::optional<double> max_step_opt, const py::object& progress) {
+  ShaftParams p = cfg.params;
+  const io::EstimatorConfig ec = cfg.estimator();
+  const double max_step = recordedRunOptions(cfg, modes, max_step_opt, p);
   // Measurements: a CSV path, or named arrays written as that CSV (same reader, same checks).
   std::string source;
   const std::vector<MeasurementSample> samples = measurementSamples(measurements, source);

@@ -24,6 +24,7 @@
 #include "arrays.hpp"
 #include "config_py.hpp"
 #include "errors.hpp"
+#include "estimate_py.hpp"
 #include "hoist/history/condition_config.hpp"
 #include "hoist/history/config.hpp"
 #include "hoist/history/schema.hpp"
@@ -183,14 +184,7 @@ py::list recordTripsPy(const Config& cfg, const py::object& measurements, std::o
   ShaftParams p = cfg.params;
   const io::EstimatorConfig ec = cfg.estimator();
   const ConditionSettings cond = history::conditionSettingsFromToml(cfg.tbl, cfg.source);
-  if (max_step_opt && !(*max_step_opt >= 0.0 && *max_step_opt <= 10.0))
-    throw py::value_error("max_step: " + fmt(*max_step_opt) + " is not in [0, 10]");
-  const double max_step = max_step_opt ? *max_step_opt : cfg.serviceMaxStep();
-  if (modes) {
-    if (*modes < 1 || *modes > kMaxModes)
-      throw py::value_error("modes: " + std::to_string(*modes) + " is not in [1, " + std::to_string(kMaxModes) + "]");
-    p.n = *modes;
-  }
+  const double max_step = recordedRunOptions(cfg, modes, max_step_opt, p);
   std::string source;
   const std::vector<MeasurementSample> samples = measurementSamples(measurements, source);
   EstimatorSettings set = ec.settings;
