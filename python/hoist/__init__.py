@@ -12,6 +12,10 @@ in and out and batch runs on C++ threads with the GIL released::
     runs = hoist.simulate_batch([cfg.copy().set("guide_ropes.preload", [T, T])
                                  for T in (2e4, 3e4, 4e4)], threads=2)
 
+The trip records of the history database: hoist.trips(db_url) (a table),
+hoist.trip(db_url, n) (one record with its depth bins), hoist.record_trips(cfg,
+measurements) (the offline trip pipeline).
+
 See docs/python.md for the worked example and every function's contract.
 """
 from collections.abc import Mapping as _Mapping
@@ -19,9 +23,10 @@ import os as _os
 
 from . import _hoist
 from ._hoist import (Config, InputError, ConfigError, ProfileError, MeasurementError,  # noqa: F401
-                     RunError, __version__, ESTIMATE_COLUMNS)
+                     RunError, HistoryError, __version__, ESTIMATE_COLUMNS)
 
-__all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "read_log", "sweep", "InputError", "ConfigError",
+__all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "read_log", "sweep", "trips", "trip", "record_trips",
+           "TRIPS_COLUMNS", "HistoryError", "InputError", "ConfigError",
            "ProfileError", "MeasurementError", "RunError", "__version__"]
 
 
@@ -310,3 +315,7 @@ def sweep(cfg, key, values, profile="paper", *, threads=0, progress=None, keep_r
     if keep_runs:
         out["runs"] = runs
     return out
+
+
+# The shaft's memory (hoist/_trips.py): after Result, which it uses.
+from ._trips import trips, trip, record_trips, TRIPS_COLUMNS  # noqa: E402

@@ -8,6 +8,7 @@ import numpy.typing as npt
 
 __version__: str
 ESTIMATE_COLUMNS: list[str]
+TRIPS_COLUMNS: list[str]
 
 _Array = npt.NDArray[np.float64]
 _ArrayLike = npt.ArrayLike
@@ -32,6 +33,8 @@ class MeasurementError(InputError): ...
 
 class RunError(RuntimeError):
     index: Optional[int]
+
+class HistoryError(RuntimeError): ...
 
 class Config:
     source: str
@@ -128,3 +131,18 @@ def sweep(
     keep_runs: bool = False,
     **options: Any,
 ) -> dict[str, Any]: ...
+
+_DbUrl = Union[str, os.PathLike[str]]
+
+def trips(db_url: _DbUrl, *, shaft: Optional[str] = None) -> Result: ...
+
+def trip(db_url: _DbUrl, n: int, *, shaft: str = "") -> dict[str, Any]: ...
+
+def record_trips(
+    cfg: Config,
+    measurements: Union[str, os.PathLike[str], Mapping[str, _ArrayLike]],
+    *,
+    modes: Optional[int] = None,
+    max_step: Optional[float] = None,
+    progress: Optional[Callable[[float], object]] = None,
+) -> list[dict[str, Any]]: ...

@@ -2,7 +2,8 @@
 from typing import Any, Optional
 
 from . import (Config as Config, ConfigError as ConfigError, InputError as InputError,
-               MeasurementError as MeasurementError, ProfileError as ProfileError, RunError as RunError)
+               MeasurementError as MeasurementError, ProfileError as ProfileError, RunError as RunError,
+               HistoryError as HistoryError)
 
 __version__: str
 ESTIMATE_COLUMNS: list[str]
@@ -19,3 +20,7 @@ def _simulate_batch(configs: list[Config], profile: Any, threads: int, progress:
                     estop_jerk: float) -> list[tuple[dict[str, Any], Optional[dict[str, Any]], dict[str, Any]]]: ...
 def _estimate(cfg: Config, measurements: Any, modes: Optional[int], max_step: Optional[float],
               progress: Any) -> dict[str, Any]: ...
+def _trips(db_url: str, shaft: Optional[str]) -> dict[str, Any]: ...
+def _trip(db_url: str, n: int, shaft: str) -> dict[str, Any]: ...
+def _record_trips(cfg: Config, measurements: Any, modes: Optional[int], max_step: Optional[float],
+                  progress: Any) -> list[dict[str, Any]]: ...

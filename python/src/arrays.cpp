@@ -2,7 +2,9 @@
 #include "arrays.hpp"
 
 #include <cmath>
+#include <sstream>
 
+#include "hoist/io/estimator_config.hpp"
 #include "hoist/io/results.hpp"
 
 namespace py = pybind11;
@@ -78,6 +80,26 @@ ProfileSource profileSource(const py::object& profile) {
   }
   src.csv_text = columnsCsv(names, arrays, "profile");
   return src;
+}
+
+std::vector<MeasurementSample> measurementSamples(const py::object& measurements, std::string& source) {
+  const py::module_ os = py::module_::import("os");
+  if (py::isinstance<py::str>(measurements) || py::isinstance(measurements, os.attr("PathLike"))) {
+    source = py::str(os.attr("fspath")(measurements));
+    return io::readMeasurementsCsvFile(source);
+  }
+  if (py::isinstance<py::dict>(measurements)) {
+    std::vector<std::string> names;
+    std::vector<py::object> arrays;
+    for (const auto& [k, v] : measurements.cast<py::dict>()) {
+      names.push_back(py::str(k));
+      arrays.push_back(py::reinterpret_borrow<py::object>(v));
+    }
+    source = "<measurement arrays>";
+    std::istringstream in(columnsCsv(names, arrays, "measurements"));
+    return io::readMeasurementsCsv(in, source);
+  }
+  throw py::type_error("measurements: expected a CSV path or a dict of arrays (t, l, v, a[, f_y, omega, rope_load])");
 }
 
 }  // namespace hoist::python

@@ -5,6 +5,7 @@
 //     so the programs' CSV readers read exactly these numbers and apply
 //     exactly their checks).
 //   profileSource: hoist.simulate's `profile` argument.
+//   measurementSamples: hoist.estimate's / hoist.record_trips' `measurements`.
 #pragma once
 
 #include <string>
@@ -13,6 +14,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "hoist/load_estimator.hpp"
 #include "run.hpp"
 
 namespace hoist::python {
@@ -29,5 +31,11 @@ std::string columnsCsv(const std::vector<std::string>& names, const std::vector<
 /// A str or os.PathLike (CSV path or SPEC), a sequence (t, v, a[, l]) or a
 /// mapping with keys t, v, a[, l].
 ProfileSource profileSource(const pybind11::object& profile);
+
+/// A measurement CSV path (str or os.PathLike) or a dict of named arrays
+/// (written as that CSV: the same reader, the same checks); `source` is set
+/// to the file name or "<measurement arrays>".  io::MeasurementError for bad
+/// data, TypeError for another kind of argument.
+std::vector<MeasurementSample> measurementSamples(const pybind11::object& measurements, std::string& source);
 
 }  // namespace hoist::python

@@ -5,6 +5,8 @@
 
 #include <pybind11/stl.h>
 
+#include "hoist/history/condition_config.hpp"
+#include "hoist/history/config.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/io/error.hpp"
 
@@ -17,11 +19,11 @@ namespace {
 /// The source name of values given by Config.set (messages: "Config.set: cage.mass: ...").
 const std::string kSetSource = "Config.set";
 
-/// Sections set() may change: the shaft's and the estimator's.
+/// Sections set() may change: the shaft's, the estimator's and [condition] (hoist.record_trips).
 bool settableSection(std::string_view s) {
   for (auto k : kParamSections)
     if (s == k) return true;
-  return s == "sensors" || s == "estimator";
+  return s == "sensors" || s == "estimator" || s == "condition";
 }
 
 /// Every shaft key, for "did you mean".
@@ -113,8 +115,11 @@ py::object fieldValue(const ParamField& f, const ShaftParams& p) {
 /// Parse and validate a table as hoist-sim and hoist-estimate do.
 Config makeConfig(toml::table tbl, std::string source) {
   Config c;
-  c.params = io::shaftParamsFromToml(tbl, source, io::daemonSections());
+  // hoist-trips' sections too ([history], [condition]): its configuration loads as it stands.
+  c.params = io::shaftParamsFromToml(tbl, source, history::configSections());
   io::estimatorConfigFromToml(tbl, source);  // [sensors]/[estimator] errors now, not at estimate()
+  history::conditionSettingsFromToml(tbl, source);  // [condition]: now, not at record_trips()
+  history::historyConfigFromToml(tbl, source);
   io::serviceMaxStep(tbl, source, 0.0025);
   c.tbl = std::move(tbl);
   c.source = std::move(source);
@@ -129,6 +134,7 @@ Config& setValue(Config& c, const std::string& key, const py::handle& value) {
     std::vector<std::string> sections(kParamSections.begin(), kParamSections.end());
     sections.push_back("sensors");
     sections.push_back("estimator");
+    sections.push_back("condition");
     std::string list;
     for (const auto& s : sections) list += (list.empty() ? "" : ", ") + s;
     const std::string near = io::closestMatch(section, sections);

@@ -1,6 +1,6 @@
 // hoist._hoist._estimate: hoist-estimate from Python (the wrapper with the
 // docstring: python/hoist/__init__.py).  The input checks and the NIS-window
-// sizing are hoist-estimate's (tools/estimate/main.cpp) so that both give the
+// sizing are hoist-estimate's (io::checkRecordedRun, one function) so that both give the
 // same numbers; the columns are its output columns, in its order, with nan for
 // a value not observed (the test compares both on the same files).
 #include <algorithm>
@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <functional>
 #include <optional>
-#include <sstream>
 
 #include <pybind11/stl.h>
 
@@ -17,7 +16,7 @@
 #include "config_py.hpp"
 #include "errors.hpp"
 #include "estimate_py.hpp"
-#include "hoist/io/profile.hpp"
+#include "hoist/io/recorded_run.hpp"
 #include "hoist/io/sim_run.hpp"
 #include "hoist/load_estimator.hpp"
 #include "tasks.hpp"
@@ -92,10 +91,10 @@ std::string fmt(double v) {
   return buf;
 }
 
-py::dict estimate(const Config& cfg, const py::object& measurements, std::optional<int> modes,
-                  std::optional<double> max_step_opt, const py::object& progress) {
-  ShaftParams p = cfg.params;
-  const io::EstimatorConfig ec = cfg.estimator();
+}  // namespace
+
+double recordedRunOptions(const Config& cfg, std::optional<int> modes, std::optional<double> max_step_opt,
+                          ShaftParams& p) {
   if (max_step_opt && !(*max_step_opt >= 0.0 && *max_step_opt <= 10.0))
     throw py::value_error("max_step: " + fmt(*max_step_opt) + " is not in [0, 10]");
   const double max_step = max_step_opt ? *max_step_opt : cfg.serviceMaxStep();
@@ -104,47 +103,27 @@ py::dict estimate(const Config& cfg, const py::object& measurements, std::option
       throw py::value_error("modes: " + std::to_string(*modes) + " is not in [1, " + std::to_string(kMaxModes) + "]");
     p.n = *modes;
   }
+  return max_step;
+}
+
+namespace {
+
+py::dict estimate(const Config& cfg, const py::object& measurements, std::optional<int> modes,
+                  std::optional<double> max_step_opt, const py::object& progress) {
+  ShaftParams p = cfg.params;
+  const io::EstimatorConfig ec = cfg.estimator();
+  const double max_step = recordedRunOptions(cfg, modes, max_step_opt, p);
   // Measurements: a CSV path, or named arrays written as that CSV (same reader, same checks).
-  std::vector<MeasurementSample> samples;
   std::string source;
-  const py::module_ os = py::module_::import("os");
-  if (py::isinstance<py::str>(measurements) || py::isinstance(measurements, os.attr("PathLike"))) {
-    source = py::str(os.attr("fspath")(measurements));
-    samples = io::readMeasurementsCsvFile(source);
-  } else if (py::isinstance<py::dict>(measurements)) {
-    std::vector<std::string> names;
-    std::vector<py::object> arrays;
-    for (const auto& [k, v] : measurements.cast<py::dict>()) {
-      names.push_back(py::str(k));
-      arrays.push_back(py::reinterpret_borrow<py::object>(v));
-    }
-    source = "<measurement arrays>";
-    std::istringstream in(columnsCsv(names, arrays, "measurements"));
-    samples = io::readMeasurementsCsv(in, source);
-  } else {
-    throw py::type_error("measurements: expected a CSV path or a dict of arrays (t, l, v, a[, f_y, omega, rope_load])");
-  }
-  {
-    std::vector<ProfileSample> ps(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i) ps[i] = {samples[i].t, samples[i].k};
-    io::checkProfileInShaft(HoistProfile(std::move(ps)), p, source);
-  }
-  // The NIS window holds one entry per sample: sized for the data's rate, as hoist-estimate does.
-  EstimatorSettings set = ec.settings;
-  double min_dt = samples[1].t - samples[0].t;
-  for (std::size_t i = 2; i < samples.size(); ++i) min_dt = std::min(min_dt, samples[i].t - samples[i - 1].t);
-  const double rate = std::ceil(1.0 / min_dt - 1e-9);
-  if (rate > set.max_rate) {
-    if (rate > 100000.0 || set.nis_window * rate > 5.0e6)
-      throw py::value_error("measurements " + source + ": rows as close as " + fmt(min_dt) + " s apart (" + fmt(rate) +
-                            " Hz) are too fast for estimator.nis_window = " + fmt(set.nis_window) +
-                            " s (at most 5e6 window entries, 100 kHz)");
-    set.max_rate = static_cast<int>(rate);
-  }
+  const std::vector<MeasurementSample> samples = measurementSamples(measurements, source);
+  // The shaft, the NIS window's rate and the substeps: hoist-estimate's checks (hoist/io/recorded_run.hpp).
+  EstimatorSettings set;
   try {
-    for (std::size_t i = 1; i < samples.size(); ++i) substepCount(samples[i].t - samples[i - 1].t, max_step);
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error("max_step " + fmt(max_step) + ": " + e.what());
+    set = io::checkRecordedRun(samples, p, ec.settings, max_step, source);
+  } catch (const io::RecordedRunError& e) {
+    throw py::value_error(e.option == io::RecordedRunError::Option::MaxStep
+                              ? "max_step " + fmt(max_step) + ": " + e.what()
+                              : "measurements " + source + ": " + e.what());
   }
 
   const auto& cs = cells();

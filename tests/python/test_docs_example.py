@@ -10,7 +10,7 @@ from conftest import SOURCE, run
 
 def example_code():
     text = (SOURCE / "docs" / "python.md").read_text()
-    section = text.split("## Worked example", 1)[1]
+    section = text.split("## Worked example", 1)[1].split("\n## ", 1)[0]
     blocks = re.findall(r"```python\n(.*?)```", section, re.S)
     assert len(blocks) == 1, "docs/python.md: expected one python block under 'Worked example'"
     return blocks[0]

@@ -38,6 +38,7 @@
 #include "hoist/io/checked_file.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/io/estimator_config.hpp"
+#include "hoist/io/recorded_run.hpp"
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
 #include "hoist/load_estimator.hpp"
@@ -171,27 +172,14 @@ int run(const Options& o) {
   hoist::io::MeasurementColumns cols;
   const std::vector<hoist::MeasurementSample> samples =
       hoist::io::readMeasurementsCsvFile(o.measurements, {}, &cols);
-  {
-    std::vector<hoist::ProfileSample> ps(samples.size());
-    for (std::size_t i = 0; i < samples.size(); ++i) ps[i] = {samples[i].t, samples[i].k};
-    hoist::io::checkProfileInShaft(hoist::HoistProfile(std::move(ps)), p, o.measurements);
-  }
-  // The NIS window holds one entry per sample: size it for the file's rate.
-  hoist::EstimatorSettings set = ec.settings;
-  double min_dt = samples[1].t - samples[0].t;
-  for (std::size_t i = 2; i < samples.size(); ++i) min_dt = std::min(min_dt, samples[i].t - samples[i - 1].t);
-  const double rate = std::ceil(1.0 / min_dt - 1e-9);
-  if (rate > set.max_rate) {
-    if (rate > 100000.0 || set.nis_window * rate > 5.0e6)
-      throw UsageError("--measurements " + o.measurements + ": rows as close as " + fmt("%g", min_dt) +
-                       " s apart (" + fmt("%g", rate) + " Hz) are too fast for estimator.nis_window = " +
-                       fmt("%g", set.nis_window) + " s (at most 5e6 window entries, 100 kHz)");
-    set.max_rate = static_cast<int>(rate);
-  }
+  // The shaft, the NIS window's rate and the substeps: the checks hoist.estimate shares.
+  hoist::EstimatorSettings set;
   try {
-    for (std::size_t i = 1; i < samples.size(); ++i) hoist::substepCount(samples[i].t - samples[i - 1].t, max_step);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(std::string("--max-step ") + fmt("%g", max_step) + ": " + e.what());
+    set = hoist::io::checkRecordedRun(samples, p, ec.settings, max_step, o.measurements);
+  } catch (const hoist::io::RecordedRunError& e) {
+    throw UsageError(e.option == hoist::io::RecordedRunError::Option::MaxStep
+                         ? "--max-step " + fmt("%g", max_step) + ": " + e.what()
+                         : "--measurements " + o.measurements + ": " + e.what());
   }
   if (cols.sensors == 0 && !o.quiet)
     std::cerr << "hoist-estimate: warning: " << o.measurements
