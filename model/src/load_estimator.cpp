@@ -392,7 +392,9 @@ void LoadEstimator::pushNis(double nis, int dof) {
 }
 
 const LoadEstimate& LoadEstimator::finish() {
-  if (tick_dof_ > 0) {
+  const bool skip = skip_nis_;
+  skip_nis_ = false;
+  if (tick_dof_ > 0 && !skip) {
     if (!have_update_) {
       have_update_ = true;
       first_t_ = t_;

@@ -208,6 +208,8 @@ void ShaftOutputs::publishAlarmEvents() {
   tc.predicted_clearance_scenario = cause.predicted_clearance_scenario;
   tc.predicted_slack_scenario = cause.predicted_slack_scenario;
   tc.slack_threshold = cause.slack_threshold;
+  if (const LoadEstimate* est = core.estimate())
+    tc.mismatch_test = est->nis_exceeded ? "nis" : est->drift_exceeded ? "drift" : "";
   alarm_msg_.user.assign(cause.user);  // who caused these events ("" for the twin itself)
   RtLog& log = ctx_.log;
   const std::string& tag = ctx_.tag;

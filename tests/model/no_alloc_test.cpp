@@ -168,3 +168,34 @@ TEST(NoAlloc, LoadEstimatorTickAllocatesNothing) {
   EXPECT_EQ(allocationCount() - before, 0);
   EXPECT_TRUE(std::isfinite(acc));
 }
+
+TEST(NoAlloc, LoadEstimatorLoadChangeAllocatesNothing) {
+  // A load change at rest (the rope load steps by 1500 N): the CUSUM/gate,
+  // the step solver's start and catch-up, the band blocks and the sensor
+  // monitors run in the tick, allocation-free.
+  ShaftParams p;
+  p.n = 25;
+  auto model = std::make_shared<const ShaftModel>(p);
+  FastSolver twin(model);
+  LoadEstimator est(p, EstimatorSettings{});
+  const Kinematics rest{150.0, 0.0, 0.0};
+  twin.initialize(0.0, rest);
+  est.initialize(0.0, rest);
+  const long before = allocationCount();
+  Eigen::internal::set_is_malloc_allowed(false);
+  std::int64_t changes = 0;
+  for (int k = 1; k <= 1500; ++k) {
+    const double t = k * 0.01;
+    twin.step(t, rest);
+    est.advance(t, rest, 4);
+    est.predict(twin.response());
+    const double f = twin.response().lambda[0] + (k > 500 ? 1500.0 : 0.0) + 20.0 * ((k * 7919) % 13 - 6) / 6.0;
+    est.updateImu(0.007 + 0.002 * ((k * 31) % 7 - 3) / 3.0, 1e-4 * ((k * 17) % 5 - 2) / 2.0);
+    est.updateRopeLoad(f);
+    est.finish();
+    changes = est.counters().load_changes;
+  }
+  Eigen::internal::set_is_malloc_allowed(true);
+  EXPECT_EQ(allocationCount() - before, 0);
+  EXPECT_GE(changes, 1) << "the test must reach the load-change path";
+}

@@ -289,6 +289,9 @@ void TwinCore::estimatorStep(const CageResponse& r) {
   if (rope_pending_) est_->updateRopeLoad(rope_force_);
   imu_ = {};
   rope_pending_ = false;
+  // A tick we flag degraded (fell behind, stale, fault hold, ...) is no
+  // evidence against the model: its NIS stays out of MODEL_MISMATCH's window.
+  if (degradedNow()) est_->excludeTickFromModelCheck();
   est_->finish();
 }
 
