@@ -74,7 +74,7 @@ function render(j) {
   setAttr(root, "data-trips", String(j.trips));
   setAttr(root, "data-last-trip", last ? String(last.trip) : "");
   const rej = j.rejected > 0 ? `; ${j.rejected} record(s) rejected (${(j.rejected_notes || [])[0] || ""})` : "";
-  setText($("#cond-status"), `${j.trips} trip(s) of shaft '${j.shaft}' in ${j.db}${rej}`);
+  setText($("#cond-status"), `${j.trips} trip(s) of shaft ${j.shaft ? `'${j.shaft}'` : "(default)"} in ${j.db}${rej}`);
   $("#cond-status").className = j.rejected > 0 ? "cond-status warn" : "cond-status";
   renderAlarms(j, last);
   drawTrend($("#cond-trend"), trend, j.thresholds || {});
@@ -240,7 +240,12 @@ function drawHeat(cv, hm) {
   ctx.textAlign = "left";
   ctx.fillText(fix(hi, 3), bx + 14, m.t + 8);
   ctx.fillText(fix(lo, 3), bx + 14, m.t + bh);
-  ctx.fillText("m/s²", bx + 14, m.t + bh / 2);
+  ctx.save();
+  ctx.translate(bx + 26, m.t + bh / 2);
+  ctx.rotate(-Math.PI / 2);
+  ctx.textAlign = "center";
+  ctx.fillText("residual RMS [m/s²]", 0, 0);
+  ctx.restore();
 }
 
 // ---- the last trip's record ---------------------------------------------------------

@@ -97,8 +97,7 @@ check(nb === 40, `its depth-bin table has 40 rows (${nb})`);
 await fill(13, 13);
 await page.waitForSelector('#condition[data-trips="13"][data-last-trip="13"]', { timeout: 10000 });
 check(true, "trip 13 appeared without a reload");
-await page.$eval("#condition", (e) => e.scrollIntoView());
-await page.screenshot({ path: shot, fullPage: true });
+await (await page.$("#condition")).screenshot({ path: shot });  // the view itself
 console.log(`screenshot ${shot}`);
 
 // 5. The log: the missing file, then the database read-only.
