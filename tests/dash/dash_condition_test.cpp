@@ -59,7 +59,7 @@ TEST(DashCondition, SnapshotShowsTheStoredTrips) {
   EXPECT_TRUE(j["ok"].get<bool>());
   EXPECT_EQ(j["trips"], 8);
   EXPECT_EQ(j["rejected"], 1);
-  EXPECT_NE(j["rejected_notes"][0].get<std::string>().find("trip 9: preload_scale"), std::string::npos);
+  EXPECT_NE(j["rejected_notes"][0].get<std::string>().find("trip 9: id_scale"), std::string::npos);
   ASSERT_EQ(j["trend"].size(), 8u);
   EXPECT_EQ(j["trend"][6]["trip"], 7);
   EXPECT_DOUBLE_EQ(j["trend"][6]["s"].get<double>(), 0.6);

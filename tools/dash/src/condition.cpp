@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "hoist/history/condition_config.hpp"
+#include "hoist/history/plausible.hpp"
 #include "hoist/history/record_json.hpp"
 #include "hoist/history/schema.hpp"
 #include "hoist/io/config.hpp"
@@ -39,17 +40,6 @@ const char* levelName(ConditionLevel l) {
 }
 
 const char* dirName(TripDirection d) { return d == TripDirection::Down ? "down" : "up"; }
-
-/// Why a record read from the database is not shown ("" = it is).
-std::string implausible(const TripRecord& r) {
-  if (auto why = history::recordError(r); !why.empty()) return why;
-  if (r.trip <= 0) return "trip number " + std::to_string(r.trip);
-  if (r.id.attempted && r.id.sigma_scale >= 0.0 && !(r.id.scale > 0.0 && r.id.scale <= 5.0))
-    return "preload_scale " + std::to_string(r.id.scale) + " outside (0, 5]";
-  if (r.id.attempted && r.id.sigma_scale > 5.0) return "sigma_preload_scale " + std::to_string(r.id.sigma_scale) + " above 5";
-  if (!(r.depth_bin > 0.0)) return "depth_bin " + std::to_string(r.depth_bin);
-  return {};
-}
 
 /// A number for the page: null when not finite (JSON has no NaN).
 Json num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
@@ -97,7 +87,7 @@ Json ConditionView::build(history::Store& store, const std::string& shaft, const
   Json notes = Json::array();
   std::size_t rejected = 0;
   for (auto& r : all) {
-    if (auto why = implausible(r); !why.empty()) {
+    if (auto why = history::implausible(r); !why.empty()) {
       ++rejected;
       if (notes.size() < 10) notes.push_back("trip " + std::to_string(r.trip) + ": " + why);
       continue;
