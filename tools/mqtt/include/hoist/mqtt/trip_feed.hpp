@@ -29,20 +29,13 @@
 #include <nlohmann/json.hpp>
 
 #include "hoist/history/store.hpp"
+#include "hoist/mqtt/sparkplug_metrics.hpp"
 #include "hoist/trip_pipeline.hpp"
 
 namespace hoist::mqtt {
 
-/// The Sparkplug Condition/... values of a shaft.
-struct ConditionMetrics {
-  bool valid = false;          ///< an informative trip was seen (else scale/sigma are not meaningful)
-  double preload_scale = 1.0;  ///< the combined estimate of s
-  double preload_sigma = -1.0; ///< its sigma
-  bool last_informative = false;  ///< the last trip's identification entered the trend
-  std::int64_t trips_in_trend = 0;  ///< informative trips the trend used
-  int guide_preload_low = 0;   ///< 0 none, 1 WARNING, 2 CRITICAL
-  std::int64_t last_trip = 0;
-};
+/// The Sparkplug Condition/... values of a shaft (sparkplug_metrics.hpp).
+using ConditionMetrics = sparkplug::ConditionValues;
 
 struct TripUpdate {
   std::string shaft;       ///< the MQTT shaft name it was watched under
