@@ -128,6 +128,8 @@ install(FILES ${PROJECT_SOURCE_DIR}/service/config/demo.toml ${PROJECT_SOURCE_DI
         DESTINATION ${HOIST_DOC_SUBDIR}/examples COMPONENT runtime)
 install(FILES ${PROJECT_SOURCE_DIR}/tools/mqtt/config/example.toml DESTINATION ${HOIST_DOC_SUBDIR}/examples
         RENAME mqtt.toml COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/tools/mqtt/config/mosquitto.conf ${PROJECT_SOURCE_DIR}/tools/mqtt/config/mosquitto-acl.conf
+        DESTINATION ${HOIST_DOC_SUBDIR}/examples/mosquitto COMPONENT runtime)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/python/read_twin.py DESTINATION ${HOIST_DOC_SUBDIR}/examples
         COMPONENT runtime)
 

@@ -1,5 +1,7 @@
 #include "hoist/load_estimator.hpp"
 
+#include "load_estimator_detail.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -7,51 +9,9 @@
 
 namespace hoist {
 
+using namespace estimator_detail;
+
 namespace {
-
-/// Standard normal quantile (Acklam's rational approximation, |rel. error| < 1.2e-9).
-double normalQuantile(double p) {
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
-                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
-  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
-                             6.680131188771972e+01, -1.328068155288572e+01};
-  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
-                             3.754408661907416e+00};
-  const double lo = 0.02425, hi = 1.0 - lo;
-  if (p <= 0.0) return -INFINITY;
-  if (p >= 1.0) return INFINITY;
-  if (p < lo) {
-    const double q = std::sqrt(-2.0 * std::log(p));
-    return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  }
-  if (p > hi) {
-    const double q = std::sqrt(-2.0 * std::log(1.0 - p));
-    return -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  }
-  const double q = p - 0.5, r = q * q;
-  return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
-         (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
-}
-
-constexpr double kMaxSpecificForce = 100.0;  // |f_y| [m/s^2] a cage IMU can report
-constexpr double kMaxRate = 20.0;            // |omega| [rad/s]
-constexpr double kMaxRopeLoad = 1.0e8;       // |rope_load| [N]
-constexpr int kImuAccel = 0, kImuRate = 1, kRope = 2;
-// Time comparisons tolerate this much [s]: the same data timed by the CSV's t
-// (hoist-estimate) or by utime differences (the daemon) differ by an ulp.
-constexpr double kTimeEps = 1e-9;
-constexpr double kEnvelopeTime = 3.0;        // memory of the oscillation envelopes [s]
-constexpr double kStartTransientError = 0.1;  // rope-load model error after a start at a != 0, per N of m a
-constexpr double kJumpTransientError = 0.1;   // the same after a jump of a later on ...
-constexpr double kJumpTransientTime = 2.5;    // ... decaying faster (the shaft was steady before),
-constexpr double kRopeOscillationError = 0.07;  // the rope's oscillation, per N of m x_c'' (frequency error)
-constexpr double kJumpRefLength = 50.0;       // ... and less on a longer, softer rope (x 50 m / l)
-// (calibrated: n = 25 against n = 100 and 200, tests/model/load_estimator_test.cpp)
-constexpr double kStartTransientTime = 5.0;   // its decay time [s]
 
 void requirePositive(double v, const char* key) {
   if (!(std::isfinite(v) && v > 0.0)) throw std::invalid_argument(std::string(key) + ": must be > 0");
@@ -64,14 +24,6 @@ void requireNonNegative(double v, const char* key) {
 
 SensorValues sensorModel(const CageResponse& r, double g) {
   return {r.y_c_ddot + (g - r.kin.a) * r.theta, r.theta_dot, r.lambda[0]};
-}
-
-double chiSquareQuantile(double p, double dof) {
-  if (!(dof > 0.0)) return 0.0;
-  const double z = normalQuantile(p);
-  const double c = 2.0 / (9.0 * dof);
-  const double w = 1.0 - c + z * std::sqrt(c);
-  return w > 0.0 ? dof * w * w * w : 0.0;
 }
 
 void EstimatorSettings::validate() const {
@@ -97,6 +49,17 @@ void EstimatorSettings::validate() const {
   if (!(min_window_fill >= 0.0 && min_window_fill <= 1.0))
     throw std::invalid_argument("estimator.min_window_fill: must be in [0, 1]");
   requirePositive(sensor_timeout, "estimator.sensor_timeout");
+  requirePositive(model_band, "estimator.model_band");
+  requirePositive(noise_memory, "estimator.noise_memory");
+  if (!(quiet_ratio > 0.0 && quiet_ratio < 1.0)) throw std::invalid_argument("estimator.quiet_ratio: must be in (0, 1)");
+  requirePositive(quiet_memory, "estimator.quiet_memory");
+  requirePositive(stuck_time, "estimator.stuck_time");
+  if (!(noisy_factor > 1.0 && std::isfinite(noisy_factor)))
+    throw std::invalid_argument("estimator.noisy_factor: must be > 1");
+  if (!(band_block >= 0.0 && band_block <= 5.0)) throw std::invalid_argument("estimator.band_block: must be in [0, 5] s");
+  requireNonNegative(change_drift, "estimator.change_drift");
+  requirePositive(change_threshold, "estimator.change_threshold");
+  requireNonNegative(change_holdoff, "estimator.change_holdoff");
   if (max_rate < 1 || max_rate > 100000) throw std::invalid_argument("estimator.max_rate: must be in [1, 100000] Hz");
   if (nis_window * max_rate > 5.0e6)
     throw std::invalid_argument("estimator.nis_window: nis_window * max_rate must stay below 5e6 entries");
@@ -109,9 +72,12 @@ LoadEstimator::LoadEstimator(const ShaftParams& twin, const EstimatorSettings& s
   ShaftParams unit = twin_;
   unit.Fa = 1.0;
   unit.b = 1.0;
-  sens_ = std::make_unique<FastSolver>(std::make_shared<const ShaftModel>(unit), Forcing::LoadOnly);
+  auto unit_model = std::make_shared<const ShaftModel>(unit);
+  sens_ = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
+  step_ = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
   Fa_c_ = twin_.Fa;
   M_c_ = twin_.Fa * twin_.b;
+  bounds_ = plausibilityBounds(twin_, 1.0);
   const auto cap = static_cast<std::size_t>(std::ceil(set_.nis_window * set_.max_rate)) + 2;
   ring_t_.assign(cap, 0.0);
   ring_nis_.assign(cap, 0.0);
@@ -152,8 +118,31 @@ void LoadEstimator::initialize(double t0, const Kinematics& k0) {
   first_t_ = t0;
   have_update_ = false;
   was_moving_ = false;
+  trip_ref_warm_ = false;
   trip_drift_ = 0.0;
   nis_flag_ = drift_flag_ = false;
+  const double sig[3] = {set_.noise.imu_accel, set_.noise.imu_rate, set_.noise.rope_load};
+  for (int i = 0; i < 3; ++i) {
+    SensorMonitorSettings ms;
+    ms.sigma = sig[i];
+    ms.lp_time = set_.model_band;
+    ms.noise_memory = set_.noise_memory;
+    ms.quiet_memory = set_.quiet_memory;
+    ms.quiet_ratio = set_.quiet_ratio;
+    ms.stuck_time = set_.stuck_time;
+    ms.noisy_factor = set_.noisy_factor;
+    mon_[i].reset(ms);
+  }
+  for (BandInnovation& b : band_) b = BandInnovation(set_.band_block);
+  cusum_fa_ = ChangeDetector(set_.change_drift, set_.change_threshold);
+  cusum_m_ = cusum_fa_;
+  rest_since_ = t0;
+  change_t_ = -1.0;
+  change_Fa0_ = change_M0_ = 0.0;
+  stepping_ = false;
+  o_Fa_ = Fa_c_;
+  o_M_ = M_c_;
+  step_e_fy_ = step_e_om_ = step_e_rope_ = 0.0;
   counts_ = {};
   est_ = {};
   twin_resp_ = sens_->response();
@@ -169,7 +158,13 @@ void LoadEstimator::restart(double t0, const Kinematics& k0) {
     seen[i] = seen_[i];
   }
   const EstimatorCounters counts = counts_;
+  SensorMonitor mon[3] = {mon_[0], mon_[1], mon_[2]};
+  const double change_t = change_t_, change_Fa0 = change_Fa0_, change_M0 = change_M0_;
   initialize(t0, k0);
+  for (int i = 0; i < 3; ++i) mon_[i] = mon[i];
+  change_t_ = change_t;
+  change_Fa0_ = change_Fa0;
+  change_M0_ = change_M0;
   Fa_ = Fa;
   PFa_ = PFa;
   M_ = M;
@@ -199,8 +194,24 @@ void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
     sens_->step(t0 + u * h, interpolate(k0, k1, h, u));
   }
   sens_->step(t1, k1);
+  if (stepping_) {
+    for (int j = 1; j < n; ++j) {
+      const double u = static_cast<double>(j) / n;
+      step_->step(t0 + u * h, interpolate(k0, k1, h, u));
+    }
+    step_->step(t1, k1);
+    if (t1 - step_t_ > kStepFoldTime) foldStep();
+  }
+  if (h > 0.0) sub_h_ = h / n;
+  const bool was_moving = moving();
   t_ = t1;
   kin_ = k1;
+  if (moving()) {
+    cusum_fa_.reset();
+    cusum_m_.reset();
+  } else if (was_moving) {
+    rest_since_ = t1;
+  }
   // Random walk of the loads over the interval (slower while the cage moves).
   const double scale = moving() ? set_.moving_walk_scale : 1.0;
   const double qfa = set_.fa_walk * scale, qm = set_.moment_walk * scale;
@@ -217,30 +228,50 @@ void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
 void LoadEstimator::predict(const CageResponse& twin) {
   twin_resp_ = twin;
   const CageResponse& s = sens_->response();
-  const double dFa = Fa_ - Fa_c_, dM = M_ - M_c_;
+  const CageResponse& q = stepping_ ? step_->response() : s;
+  const double oFa = o_Fa_ - Fa_c_, oM = o_M_ - M_c_;  // 0 unless following a load change
+  const double dFa = Fa_ - o_Fa_, dM = M_ - o_M_;
   // The sensor model is linear: the sensitivities read through it (the
   // sensitivity solver's own a-term is the twin's: same kinematics).
   const SensorValues zt = sensorModel(twin, twin_.g), zs = sensorModel(s, twin_.g);
-  h_fy_ = zs.f_y;
-  h_om_ = zs.omega;
-  h_rope_ = zs.rope_load;
-  base_fy_ = zt.f_y;
-  base_om_ = zt.omega;
-  base_rope_ = zt.rope_load;
-  pred_fy_ = zt.f_y + dM * h_fy_;
-  pred_om_ = zt.omega + dM * h_om_;
-  pred_rope_ = zt.rope_load + dFa * h_rope_;
+  const SensorValues zq = stepping_ ? sensorModel(q, twin_.g) : zs;
+  h_fy_ = zq.f_y;
+  h_om_ = zq.omega;
+  h_rope_ = zq.rope_load;
+  base_fy_ = zt.f_y + oM * zs.f_y;
+  base_om_ = zt.omega + oM * zs.omega;
+  base_rope_ = zt.rope_load + oFa * zs.rope_load;
+  pred_fy_ = base_fy_ + dM * h_fy_;
+  pred_om_ = base_om_ + dM * h_om_;
+  pred_rope_ = base_rope_ + dFa * h_rope_;
+  // The step's onset is known to one sample: its response one sample early
+  // or late differs by about its change over one tick.  And the transient
+  // (the step's response less the steady one) rings the modes the n-mode
+  // model resolves least: kStepModelError of it.  Both allowed as model error.
+  if (stepping_) {
+    auto err = [](double d, double now, double prev, double steady) {
+      return std::hypot(d * (now - prev), kStepModelError * d * (now - steady));
+    };
+    if (step_fresh_) step_zq_ = zq;
+    step_fresh_ = false;
+    step_e_fy_ = err(dM, zq.f_y, step_zq_.f_y, zs.f_y);
+    step_e_om_ = err(dM, zq.omega, step_zq_.omega, zs.omega);
+    step_e_rope_ = err(dFa, zq.rope_load, step_zq_.rope_load, zs.rope_load);
+    step_zq_ = zq;
+  } else {
+    step_e_fy_ = step_e_om_ = step_e_rope_ = 0.0;
+  }
   // Envelopes (peak hold, decaying over kEnvelopeTime) of the predicted
   // oscillations: a model a few per cent off in frequency is off by up to
   // twice their amplitude a few cycles later, also at a zero crossing.
   const double dt = std::max(twin.t - env_t_, 0.0);
   env_t_ = twin.t;
   const double decay = std::exp(-dt / kEnvelopeTime);
-  const double yddot = twin.y_c_ddot + dM * s.y_c_ddot;
+  const double yddot = twin.y_c_ddot + oM * s.y_c_ddot + dM * q.y_c_ddot;
   env_fy_ = std::max(std::abs(yddot), env_fy_ * decay);
   env_om_ = std::max(std::abs(pred_om_), env_om_ * decay);
   // lambda_0 = Fa + m (g - a) - m x_c'': the rigid part is exact, m x_c'' oscillates.
-  const double xcdd = twin.x_c_ddot + dFa * s.x_c_ddot;
+  const double xcdd = twin.x_c_ddot + oFa * s.x_c_ddot + dFa * q.x_c_ddot;
   env_rope_ = std::max(twin_.m * std::abs(xcdd), env_rope_ * decay);
   // A later jump of the winder's acceleration does the same, less (the
   // shaft was in a steady state before it); a jerk-limited profile hardly.
@@ -264,8 +295,11 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
     ++counts_.implausible;
     return false;
   }
+  if (use_a) mon_[kImuAccel].sample(t_, f_y);
+  if (use_w) mon_[kImuRate].sample(t_, omega);
   const double eps = set_.model_error;
-  const double ea = eps * (std::abs(pred_fy_) + env_fy_), ew = eps * env_om_;
+  const double ea = std::hypot(eps * (std::abs(pred_fy_) + env_fy_), step_e_fy_);
+  const double ew = std::hypot(eps * env_om_, step_e_om_);
   const double ra = set_.noise.imu_accel * set_.noise.imu_accel + ea * ea;
   const double rw = set_.noise.imu_rate * set_.noise.imu_rate + ew * ew;
   // Innovation, its covariance S = H P H^T + R (1 or 2 rows), in closed form.
@@ -281,15 +315,19 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   Eigen::Matrix2d S = covariance(PM_);
   const bool gated = (use_a && std::abs(nu(0)) > set_.gate_sigma * std::sqrt(S(0, 0))) ||
                      (use_w && std::abs(nu(1)) > set_.gate_sigma * std::sqrt(S(1, 1)));
+  if (use_a) mon_[kImuAccel].gate(t_, gated);
+  if (use_w) mon_[kImuRate].gate(t_, gated);
   if (gated) {
+    if (run_m_ == 0) gate_t0_m_ = t_;
     if (++run_m_ < set_.gate_reset) {
       ++counts_.gated;
       return false;
     }
-    reopen(PM_, set_.moment_sigma0);
-    MF_ = M_;
-    PMF_ = PM_;
-    S = covariance(PM_);
+    // A load change: this sample was predicted without it; the next ones
+    // are predicted with the change's step (and the re-opened loads).
+    loadChange(gate_t0_m_);
+    ++counts_.gated;
+    return false;
   }
   run_m_ = 0;
   const Eigen::Matrix2d Si = S.inverse();
@@ -297,7 +335,7 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   M_ += K * nu;
   PM_ = std::max(PM_ - (K * S * K.transpose())(0, 0), 0.0);
   {  // the short-memory estimate, same measurement
-    const double dMF = MF_ - M_c_;
+    const double dMF = MF_ - o_M_;
     const Eigen::Vector2d nuF(use_a ? f_y - (base_fy_ + dMF * h_fy_) : 0.0,
                               use_w ? omega - (base_om_ + dMF * h_om_) : 0.0);
     const Eigen::Matrix2d SF = covariance(PMF_);
@@ -306,8 +344,15 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
     PMF_ = std::max(PMF_ - (KF * SF * KF.transpose())(0, 0), 0.0);
   }
   const int dof = (use_a ? 1 : 0) + (use_w ? 1 : 0);
-  tick_nis_ += nu.dot(Si * nu);
-  tick_dof_ += dof;
+  (void)dof;
+  if (use_a) {
+    mon_[kImuAccel].innovation(t_, nu(0));
+    band(kImuAccel, nu(0), S(0, 0), ea);
+  }
+  if (use_w) {
+    mon_[kImuRate].innovation(t_, nu(1));
+    band(kImuRate, nu(1), S(1, 1), ew);
+  }
   ++counts_.accepted;
   if (use_a) {
     last_upd_[kImuAccel] = t_;
@@ -324,8 +369,60 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   return true;
 }
 
-void LoadEstimator::reopen(double& P, double sigma0) {
-  P = std::max(P, sigma0 * sigma0);
+void LoadEstimator::band(int ch, double nu, double S, double e) {
+  if (!band_[ch].add(t_, nu, S, e)) return;
+  const double s = band_[ch].statistic();
+  tick_nis_ += s * s;
+  tick_dof_ += 1;
+  // f_y carries the moment's evidence at rest (the static tilt); omega only its transient.
+  ChangeDetector* c = ch == kRope ? &cusum_fa_ : ch == kImuAccel ? &cusum_m_ : nullptr;
+  if (c && changeAtRest(*c, s)) loadChange(std::max(c->onset() - set_.band_block, rest_since_));
+}
+
+bool LoadEstimator::changeAtRest(ChangeDetector& c, double z) {
+  if (moving() || t_ - rest_since_ + kTimeEps < set_.change_holdoff) return false;
+  return c.add(z, t_);
+}
+
+void LoadEstimator::foldStep() {
+  // The transient has decayed: the step's response is the steady one's.
+  stepping_ = false;
+  o_Fa_ = Fa_c_;
+  o_M_ = M_c_;
+}
+
+void LoadEstimator::loadChange(double onset) {
+  // One load changed: both its force and its moment re-open, whichever
+  // channel saw it (the rope load sees Fa at once, f_y the moment slowly).
+  if (!moving()) {
+    // At rest the change is a step at `onset`: the ropes ring, and the step
+    // solver carries it.  The shaft is time-invariant at rest, so starting
+    // it at rest and stepping it to now at the rest kinematics is the same
+    // as having started it at the onset.
+    const double t0 = std::max(onset, t_ - kMaxCatchUp);
+    if (stepping_) foldStep();  // a change during a change's transient: the first one's ringing is dropped
+    step_->initialize(t0, kin_, InitialState::Rest);
+    const int n = t_ > t0 ? std::max(1, static_cast<int>(std::ceil((t_ - t0) / sub_h_ - 1e-9))) : 0;
+    for (int j = 1; j <= n; ++j) step_->step(t0 + (t_ - t0) * j / n, kin_);
+    stepping_ = true;
+    step_fresh_ = true;
+    step_t_ = t0;
+    o_Fa_ = Fa_;
+    o_M_ = M_;
+  }
+  change_t_ = t_;
+  change_Fa0_ = Fa_;
+  change_M0_ = M_;
+  PFa_ = std::max(PFa_, set_.fa_sigma0 * set_.fa_sigma0);
+  PM_ = std::max(PM_, set_.moment_sigma0 * set_.moment_sigma0);
+  FaF_ = Fa_;
+  PFaF_ = PFa_;
+  MF_ = M_;
+  PMF_ = PM_;
+  run_fa_ = run_m_ = 0;
+  cusum_fa_.reset();
+  cusum_m_.reset();
+  rest_since_ = t_;  // the CUSUM waits change_holdoff again: the filters settle first
   ++counts_.load_changes;
   // A load cannot change while the cage moves: a change then is evidence of mismatch.
   if (moving()) trip_drift_ = std::max(trip_drift_, set_.drift_sigma + 1.0);
@@ -336,228 +433,45 @@ bool LoadEstimator::updateRopeLoad(double force) {
     ++counts_.implausible;
     return false;
   }
+  mon_[kRope].sample(t_, force);
   // The oscillating part of lambda_0 (m x_c''): the rope's modes beyond n,
   // and their frequency error, scale with it.
   // (both larger on a short, stiff rope, whose modes beyond n are the least resolved)
   const double er = kRopeOscillationError * env_rope_ * std::min(1.0, kJumpRefLength / kin_.l);
-  const double R = set_.noise.rope_load * set_.noise.rope_load + er * er +
-                   start_rope_ * start_rope_ + jump_rope_ * jump_rope_;
+  const double R = set_.noise.rope_load * set_.noise.rope_load + er * er + start_rope_ * start_rope_ +
+                   jump_rope_ * jump_rope_ + step_e_rope_ * step_e_rope_;
   const double nu = force - pred_rope_;
   double S = h_rope_ * h_rope_ * PFa_ + R;
-  if (std::abs(nu) > set_.gate_sigma * std::sqrt(S)) {
+  const bool gated = std::abs(nu) > set_.gate_sigma * std::sqrt(S);
+  mon_[kRope].gate(t_, gated);
+  if (gated) {
+    if (run_fa_ == 0) gate_t0_fa_ = t_;
     if (++run_fa_ < set_.gate_reset) {
       ++counts_.gated;
       return false;
     }
-    reopen(PFa_, set_.fa_sigma0);
-    FaF_ = Fa_;
-    PFaF_ = PFa_;
-    S = h_rope_ * h_rope_ * PFa_ + R;
+    loadChange(gate_t0_fa_);  // as in updateLateral: from the next sample on
+    ++counts_.gated;
+    return false;
   }
   run_fa_ = 0;
   const double K = PFa_ * h_rope_ / S;
   Fa_ += K * nu;
   PFa_ = std::max(PFa_ - K * K * S, 0.0);
   {  // the short-memory estimate, same measurement
-    const double nuF = force - (base_rope_ + (FaF_ - Fa_c_) * h_rope_);
+    const double nuF = force - (base_rope_ + (FaF_ - o_Fa_) * h_rope_);
     const double SF = h_rope_ * h_rope_ * PFaF_ + R;
     const double KF = PFaF_ * h_rope_ / SF;
     FaF_ += KF * nuF;
     PFaF_ = std::max(PFaF_ - KF * KF * SF, 0.0);
   }
-  tick_nis_ += nu * nu / S;
-  tick_dof_ += 1;
+  mon_[kRope].innovation(t_, nu);
+  band(kRope, nu, S, std::sqrt(std::max(R - set_.noise.rope_load * set_.noise.rope_load, 0.0)));
   ++counts_.accepted;
   last_upd_[kRope] = t_;
   seen_[kRope] = true;
   pred_rope_ += K * nu * h_rope_;
   return true;
-}
-
-void LoadEstimator::pushNis(double nis, int dof) {
-  const std::size_t cap = ring_t_.size();
-  if (count_ == cap) {  // full: the oldest entry leaves early (the window is shorter than asked)
-    const std::size_t tail = (head_ + cap - count_) % cap;
-    win_nis_ -= ring_nis_[tail];
-    win_dof_ -= ring_dof_[tail];
-    --count_;
-  }
-  ring_t_[head_] = t_;
-  ring_nis_[head_] = nis;
-  ring_dof_[head_] = dof;
-  head_ = (head_ + 1) % cap;
-  ++count_;
-  win_nis_ += nis;
-  win_dof_ += dof;
-}
-
-const LoadEstimate& LoadEstimator::finish() {
-  const bool skip = skip_nis_;
-  skip_nis_ = false;
-  if (tick_dof_ > 0 && !skip) {
-    if (!have_update_) {
-      have_update_ = true;
-      first_t_ = t_;
-    }
-    pushNis(tick_nis_, tick_dof_);
-  }
-  // Entries older than the window leave it.
-  const std::size_t cap = ring_t_.size();
-  while (count_ > 0) {
-    const std::size_t tail = (head_ + cap - count_) % cap;
-    if (ring_t_[tail] > t_ - set_.nis_window + kTimeEps) break;
-    win_nis_ -= ring_nis_[tail];
-    win_dof_ -= ring_dof_[tail];
-    --count_;
-  }
-  if (count_ == 0) {  // no round-off residue in an empty window
-    win_nis_ = 0.0;
-    win_dof_ = 0;
-  }
-
-  // Drift of the loads during a trip (the cage moving).
-  const bool mov = moving();
-  if (mov && !was_moving_) {
-    trip_Fa0_ = Fa_;
-    trip_PFa0_ = PFa_;
-    trip_M0_ = M_;
-    trip_PM0_ = PM_;
-    trip_QFa_ = trip_QM_ = 0.0;
-    trip_drift_ = 0.0;
-    drift_flag_ = false;
-  }
-  was_moving_ = mov;
-  if (mov) {
-    // With a right model, x - x0 has variance P0 - P (the information gained)
-    // plus the random walk's variance added since the trip began.
-    auto drift = [](double x, double x0, double P, double P0, double Q) {
-      const double var = std::max(P0 - P, 0.0) + Q + 1e-12 * (P0 + 1.0);
-      return std::abs(x - x0) / std::sqrt(var);
-    };
-    if (seen_[kRope]) trip_drift_ = std::max(trip_drift_, drift(Fa_, trip_Fa0_, PFa_, trip_PFa0_, trip_QFa_));
-    if (seen_[kImuAccel] || seen_[kImuRate])
-      trip_drift_ = std::max(trip_drift_, drift(M_, trip_M0_, PM_, trip_PM0_, trip_QM_));
-    if (trip_drift_ > set_.drift_sigma) drift_flag_ = true;
-  }
-  // Constancy: the short-memory estimate against the whole history's.  With
-  // a right model their difference has variance PF - P (nested estimates).
-  if (t_ - first_t_ + kTimeEps >= set_.constancy_memory && have_update_) {
-    auto gap = [](double xf, double x, double PF, double P) {
-      return std::abs(xf - x) / std::sqrt(std::max(PF - P, 1e-9 * (P + 1.0)));
-    };
-    double c = 0.0;
-    if (seen_[kRope]) c = std::max(c, gap(FaF_, Fa_, PFaF_, PFa_));
-    if (seen_[kImuAccel] || seen_[kImuRate]) c = std::max(c, gap(MF_, M_, PMF_, PM_));
-    const_drift_ = c;
-    if (c > set_.drift_sigma) drift_flag_ = true;
-  }
-
-  LoadEstimate& e = est_;
-  e.t = t_;
-  e.kin = kin_;
-  e.nis = tick_nis_;
-  e.nis_window = win_nis_;
-  e.nis_dof = win_dof_;
-  if (win_dof_ > 0) {
-    e.nis_lower = chiSquareQuantile(0.025, win_dof_);
-    e.nis_upper = chiSquareQuantile(0.975, win_dof_);
-    e.nis_bound = chiSquareQuantile(1.0 - set_.nis_alpha, win_dof_);
-  } else {
-    e.nis_lower = e.nis_upper = e.nis_bound = 0.0;
-  }
-  const bool filled = have_update_ && t_ - first_t_ + kTimeEps >= set_.min_window_fill * set_.nis_window;
-  // The alarm's bound: the chi-square quantile, and never below nis_margin
-  // times the expectation (a model right to about 1 % leaves a systematic
-  // residual that a test over thousands of samples resolves: significant,
-  // but not a shaft that behaves differently from its model).
-  e.nis_bound = std::max(e.nis_bound, set_.nis_margin * win_dof_);
-  if (filled && win_dof_ > 0 && win_nis_ > e.nis_bound) nis_flag_ = true;
-  else if (nis_flag_ && (win_dof_ == 0 || win_nis_ < e.nis_upper)) nis_flag_ = false;  // hysteresis
-  e.nis_exceeded = nis_flag_;
-  e.drift = std::max(trip_drift_, const_drift_);
-  e.drift_exceeded = drift_flag_;
-  e.mismatch = nis_flag_ || drift_flag_;
-
-  e.sensors = 0;
-  const unsigned bits[3] = {kSensorImuAccel, kSensorImuRate, kSensorRopeLoad};
-  for (int i = 0; i < 3; ++i)
-    if (t_ - last_upd_[i] <= set_.sensor_timeout + kTimeEps) e.sensors |= bits[i];
-  e.fa_observed = seen_[kRope];
-  e.moment_observed = seen_[kImuAccel] || seen_[kImuRate];
-
-  const double sFa = std::sqrt(PFa_), sM = std::sqrt(PM_);
-  e.Fa = Fa_;
-  e.sigma_Fa = sFa;
-  e.moment = M_;
-  e.sigma_moment = sM;
-  if (e.fa_observed && e.moment_observed && std::abs(Fa_) > 3.0 * sFa) {
-    e.b = M_ / Fa_;
-    e.sigma_b = std::sqrt(PM_ + e.b * e.b * PFa_) / std::abs(Fa_);
-  } else {
-    e.b = 0.0;
-    e.sigma_b = -1.0;
-  }
-
-  // The state the estimated load implies, and its sigma (load + model error).
-  const CageResponse& tw = twin_resp_;
-  const CageResponse& s = sens_->response();
-  const double dFa = Fa_ - Fa_c_, dM = M_ - M_c_, eps = set_.model_error;
-  auto lateral = [&](double open, double sens, double& value, double& sigma) {
-    value = open + dM * sens;
-    sigma = std::hypot(sens * sM, eps * value);
-  };
-  e.x_c = tw.x_c + dFa * s.x_c;
-  e.sigma_x_c = std::hypot(s.x_c * sFa, eps * e.x_c);
-  lateral(tw.y_c, s.y_c, e.y_c, e.sigma_y_c);
-  lateral(tw.theta, s.theta, e.theta, e.sigma_theta);
-  e.lambda[0] = tw.lambda[0] + dFa * s.lambda[0];
-  e.sigma_lambda[0] = std::hypot(s.lambda[0] * sFa, eps * (e.lambda[0] - (twin_.m * twin_.g + Fa_)));
-  for (int i = 1; i < 5; ++i) lateral(tw.lambda[i], s.lambda[i], e.lambda[i], e.sigma_lambda[i]);
-  e.theta_open = tw.theta;
-  return e;
-}
-
-}  // namespace hoist
-
-namespace hoist {
-
-void estimateRecorded(const ShaftParams& twin, const EstimatorSettings& settings, double max_step,
-                      const std::vector<MeasurementSample>& samples,
-                      const std::function<void(const LoadEstimate&, const EstimatorCounters&)>& sink,
-                      const std::function<void(double)>& progress) {
-  if (samples.empty()) return;
-  auto model = std::make_shared<const ShaftModel>(twin);
-  FastSolver solver(model);
-  LoadEstimator est(twin, settings);
-  auto apply = [&](const MeasurementSample& m) {
-    est.predict(solver.response());
-    const bool a = m.present & kSensorImuAccel, w = m.present & kSensorImuRate;
-    if (a && w) est.updateImu(m.z.f_y, m.z.omega);
-    else if (a) est.updateImuAccel(m.z.f_y);
-    else if (w) est.updateImuRate(m.z.omega);
-    if (m.present & kSensorRopeLoad) est.updateRopeLoad(m.z.rope_load);
-    sink(est.finish(), est.counters());
-  };
-  const MeasurementSample& first = samples.front();
-  solver.initialize(first.t, first.k, twin.initial);
-  est.initialize(first.t, first.k);
-  apply(first);
-  const std::size_t every = std::max<std::size_t>(1, samples.size() / 100);
-  for (std::size_t i = 1; i < samples.size(); ++i) {
-    const MeasurementSample& prev = samples[i - 1];
-    const MeasurementSample& m = samples[i];
-    const double h = m.t - prev.t;
-    const int n = h > 0.0 ? substepCount(h, max_step) : 1;
-    for (int j = 1; j < n; ++j) {
-      const double u = static_cast<double>(j) / n;
-      solver.step(prev.t + u * h, interpolate(prev.k, m.k, h, u));
-    }
-    solver.step(m.t, m.k);
-    est.advance(m.t, m.k, n);
-    apply(m);
-    if (progress && i % every == 0) progress(static_cast<double>(i) / samples.size());
-  }
-  if (progress) progress(1.0);
 }
 
 }  // namespace hoist

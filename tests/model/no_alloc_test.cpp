@@ -170,9 +170,9 @@ TEST(NoAlloc, LoadEstimatorTickAllocatesNothing) {
 }
 
 TEST(NoAlloc, LoadEstimatorLoadChangeAllocatesNothing) {
-  // A load change at rest (the rope load steps by 1500 N): the CUSUM/gate,
-  // the step solver's start and catch-up, the band blocks and the sensor
-  // monitors run in the tick, allocation-free.
+  // A load change at rest (the rope load steps by 1500 N): the gate, the
+  // step solver's start and catch-up, the band blocks, the CUSUM and the
+  // sensor monitors run in the tick, allocation-free.
   ShaftParams p;
   p.n = 25;
   auto model = std::make_shared<const ShaftModel>(p);
@@ -198,4 +198,5 @@ TEST(NoAlloc, LoadEstimatorLoadChangeAllocatesNothing) {
   Eigen::internal::set_is_malloc_allowed(true);
   EXPECT_EQ(allocationCount() - before, 0);
   EXPECT_GE(changes, 1) << "the test must reach the load-change path";
+  EXPECT_TRUE(est.followingLoadChange());
 }

@@ -8,6 +8,7 @@
 #include <mosquitto.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <mutex>
@@ -65,9 +66,10 @@ class Client {
     std::string topic, payload;
     bool retain = false;
   };
-  Client(int port, const std::string& id) {
+  Client(int port, const std::string& id, const std::string& user = "", const std::string& password = "") {
     mosquitto_lib_init();
     m_ = mosquitto_new(id.c_str(), true, this);
+    if (!user.empty()) mosquitto_username_pw_set(m_, user.c_str(), password.c_str());
     mosquitto_message_callback_set(m_, [](mosquitto*, void* obj, const mosquitto_message* msg) {
       auto* self = static_cast<Client*>(obj);
       std::lock_guard<std::mutex> lk(self->mu_);
@@ -713,7 +715,9 @@ TEST_F(MqttBridge, DiscoveryIsNotPoisoned) {
   EXPECT_EQ(lcm.count("north_HOIST_ALARM_ACK"), 0u);
   EXPECT_EQ(commandsOn("north/HOIST_ALARM_ACK", true), 1u);
 
-  // Another prefix claims "north" at the health rate: both reported, commands refused while it lasts.
+  // Another prefix claims "north" at the health rate: both reported, and the
+  // name stays with the daemon first heard (issue 33: the forged name costs
+  // the forger, never the real shaft): commands go on to north/.
   auto claim = [&](const std::vector<std::string>& prefixes, std::chrono::milliseconds d) {
     const auto end = std::chrono::steady_clock::now() + d;
     while (std::chrono::steady_clock::now() < end) {
@@ -731,10 +735,15 @@ TEST_F(MqttBridge, DiscoveryIsNotPoisoned) {
   EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["bridged_prefix"], "north/");
   EXPECT_EQ((*bh)["discovery"]["conflicts"][0]["prefixes"], json::array({"north/", "north_"}));
   c.publish("hoist/north/cmd/ack", R"({"kind":"*","level":0,"action":3,"user":"op"})");
+  EXPECT_TRUE(lcm.waitFor([&] { return commandsOn("north/HOIST_ALARM_ACK") == 2; }, 5s)) << readFile(log("bridge.log"));
+  EXPECT_EQ(lcm.count("north_HOIST_ALARM_ACK"), 0u);
   bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) {
-    return j["commands"]["rejected_by_reason"]["ambiguous_shaft"] == 1; }, 3s);
-  EXPECT_TRUE(bh);
+    return j["commands"]["forwarded"] == 2 && !j["discovery"]["conflicts"].empty(); }, 3s);
+  ASSERT_TRUE(bh) << readFile(log("bridge.log"));
+  EXPECT_EQ((*bh)["commands"]["rejected_by_reason"]["ambiguous_shaft"], 0);
   EXPECT_NE(readFile(log("bridge.log")).find("shaft name 'north' is already bridged from prefix 'north/'"),
+            std::string::npos) << readFile(log("bridge.log"));
+  EXPECT_NE(readFile(log("bridge.log")).find("prefix 'north_' (daemon instance 777) claims it too"),
             std::string::npos) << readFile(log("bridge.log"));
   lcm.pump(2500ms);  // the claim stops: it ages out
   bh = c.waitJson("hoist/_bridge/bridge-d/health", [](const json& j, bool) { return j["discovery"]["conflicts"].empty(); }, 3s);
@@ -1126,3 +1135,138 @@ TEST_F(MqttBridge, AnAlarmRaisedBeforeTheBridgeStartsAppearsAtOnce) {
   stopDaemonCleanly(*twind, log("twind.log"));
 }
 
+// Issue 33: operator commands carry an identity the broker vouches for.  The
+// shipped example mosquitto.conf and ACL (tools/mqtt/config), with this
+// test's port and files: an operator writes only hoist/<shaft>/cmd/ack/<its
+// user>; another user's flood on its own topic never takes the operator's
+// share; a forged topic never reaches the bridge; a payload naming somebody
+// else is refused; a 2 MiB payload is stopped by the broker (max_packet_size).
+TEST_F(MqttBridge, PerUserCommandTopicsWithTheExampleAcl) {
+  dir_ = testDir("mqtt_acl");
+  auto path = [&](const std::string& f) { return (dir_ / f).string(); };
+  const std::string url = urlFor(7976);
+  bool first = true;
+  for (const auto& [user, pw] : std::vector<std::pair<std::string, std::string>>{
+           {"hoist-bridge", "b-pw"}, {"op1", "op1-pw"}, {"mallory", "m-pw"}, {"scada", "s-pw"}}) {
+    std::vector<std::string> cmd{HOIST_MOSQUITTO_PASSWD, "-b"};
+    if (first) cmd.push_back("-c");
+    first = false;
+    for (const auto& a : {path("passwd"), user, pw}) cmd.push_back(a);
+    ASSERT_EQ(runProcess(cmd, path("pw.log"), 30s), 0) << readFile(path("pw.log"));
+  }
+  const int port = freeTcpPort();
+  std::string conf = readFile(HOIST_MQTT_CONFIG_DIR "/mosquitto.conf");
+  auto replace = [&](const std::string& from, const std::string& to) {  // every occurrence
+    ASSERT_NE(conf.find(from), std::string::npos) << from;
+    for (auto at = conf.find(from); at != std::string::npos; at = conf.find(from, at + to.size()))
+      conf.replace(at, from.size(), to);
+  };
+  replace("listener 8883", "listener " + std::to_string(port) + " 127.0.0.1");
+  replace("/etc/mosquitto/hoist.passwd", path("passwd"));
+  replace("/etc/mosquitto/hoist-acl.conf", HOIST_MQTT_CONFIG_DIR "/mosquitto-acl.conf");
+  std::ofstream(path("mosquitto.conf")) << conf << "persistence false\nlog_dest stdout\n";
+  Process broker({HOIST_MOSQUITTO, "-c", path("mosquitto.conf")}, path("mosquitto.log"));
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (!tcpOpen(port) && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
+  ASSERT_TRUE(tcpOpen(port)) << readFile(path("mosquitto.log"));
+
+  std::ofstream(path("bridge.pw")) << "b-pw\n";
+  ::chmod(path("bridge.pw").c_str(), 0600);
+  std::ofstream(path("bridge.toml")) << "[broker]\nurl = \"mqtt://127.0.0.1:" << port << "\"\nusername = \"hoist-bridge\"\n"
+                                     << "password_file = \"" << path("bridge.pw") << "\"\n"
+                                     << "[bridge]\nchannel_prefixes = [\"north/\"]\nhealth_period = 0.3\n"
+                                     << "command_rate = 0.2\ncommand_burst = 3\n";
+  Listener lcm(url);
+  lcm.subscribe("north/HOIST_ALARM_ACK");
+  Process bridge({HOIST_MQTT, "--config", path("bridge.toml"), "--lcm-url", url, "--client-id", "bridge-acl"},
+                 log("bridge.log"));
+  Client scada(port, "scada-c", "scada", "s-pw");
+  ASSERT_TRUE(scada.connected()) << readFile(path("mosquitto.log"));
+  scada.subscribe("hoist/#");
+  ASSERT_TRUE(scada.waitJson("hoist/_bridge/bridge-acl/health", [](const json& j, bool) {
+    return j["connection"]["state"] == "connected"; }, 10s)) << readFile(log("bridge.log"));
+  Client op1(port, "op1-c", "op1", "op1-pw"), mallory(port, "mallory-c", "mallory", "m-pw");
+  ASSERT_TRUE(op1.connected() && mallory.connected()) << readFile(path("mosquitto.log"));
+  op1.subscribe("hoist/north/cmd/result");
+  const std::string unshelve = R"({"kind":"*","level":0,"action":3})";
+  for (int i = 0; i < 40; ++i) mallory.publish("hoist/north/cmd/ack/mallory", unshelve);
+  for (int i = 0; i < 5; ++i) mallory.publish("hoist/north/cmd/ack/op1", unshelve);  // the ACL drops these
+  mallory.publish("hoist/north/cmd/ack/mallory", std::string(2u << 20, 'x'));  // over max_packet_size
+  std::this_thread::sleep_for(500ms);
+  for (int i = 0; i < 3; ++i) op1.publish("hoist/north/cmd/ack/op1", unshelve);
+  auto usersOn = [&](const std::string& user) {
+    std::size_t n = 0;
+    for (const auto& a : lcm.decoded<hoist::alarm_ack_t>("north/HOIST_ALARM_ACK"))
+      n += a.action == hoist::alarm_ack_t::ACTION_UNSHELVE && a.user == user;
+    return n;
+  };
+  EXPECT_TRUE(lcm.waitFor([&] { return usersOn("op1") == 3; }, 10s)) << readFile(log("bridge.log"));
+  lcm.pump(500ms);
+  EXPECT_EQ(usersOn("op1"), 3u) << "a forged cmd/ack/op1 reached the daemon";
+  EXPECT_LE(usersOn("mallory"), 3u) << "mallory got more than its own burst";
+  EXPECT_GE(usersOn("mallory"), 1u);
+  // A payload naming somebody else is refused (the topic's user is the identity).
+  op1.publish("hoist/north/cmd/ack/op1", R"({"kind":"*","level":0,"action":3,"user":"mallory"})");
+  auto refused = op1.waitJson("hoist/north/cmd/result", [](const json& j, bool) { return j["reason"] == "bad_user"; }, 5s);
+  EXPECT_TRUE(refused) << readFile(log("bridge.log"));
+  auto h = scada.waitJson("hoist/_bridge/bridge-acl/health", [](const json& j, bool) {
+    return j["commands"]["rejected_by_reason"]["bad_user"] == 1; }, 5s);
+  ASSERT_TRUE(h) << readFile(log("bridge.log"));
+  EXPECT_EQ((*h)["commands"]["rejected_by_reason"]["oversized"], 0) << "the 2 MiB payload reached the bridge";
+  EXPECT_GE((*h)["commands"]["rejected_by_reason"]["rate_limited"].get<int>(), 30);
+  EXPECT_TRUE(bridge.running());
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0) << readFile(log("bridge.log"));
+  broker.signal(SIGTERM);
+  broker.wait(5s);
+}
+
+// Issue 33: a dropped alarm transition is never silent -- counted, logged
+// (rate-limited) and the bridge's health is WARNING.  The broker is down at
+// start and the memory buffer holds one alarm transition; five arrive.
+TEST_F(MqttBridge, DroppedAlarmTransitionsAreLoggedAndWarn) {
+  dir_ = testDir("mqtt_alarm_drops");
+  const std::string url = urlFor(7977);
+  const int port = freeTcpPort();
+  Broker broker(dir_, port);
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[broker]\nreconnect_min = 0.2\nreconnect_max = 0.5\n[bridge]\nhealth_period = 0.3\n"
+                      << "channel_prefixes = [\"north/\"]\n[buffer]\nmax_alarm_events = 1\n";
+  Listener lcm(url);
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-w"},
+                 log("bridge.log"));
+  std::this_thread::sleep_for(500ms);
+  for (int i = 0; i < 5; ++i) {
+    hoist::alarm_t a{};
+    a.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                  std::chrono::system_clock::now().time_since_epoch()).count();
+    a.kind = "CAGE_POS_Y";
+    a.level = 1;
+    a.active = (i % 2) == 0;
+    a.event_type = a.active ? hoist::alarm_t::EVENT_RAISE : hoist::alarm_t::EVENT_CLEAR;
+    lcm.lcm().publish("north/HOIST_ALARM", &a);
+    lcm.pump(50ms);
+  }
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (readFile(log("bridge.log")).find("alarm transitions dropped") == std::string::npos &&
+         std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(50ms);
+  const std::string text = readFile(log("bridge.log"));
+  EXPECT_NE(text.find("alarm transitions dropped from the memory buffer ([buffer] max_alarm_events = 1"),
+            std::string::npos) << text;
+  broker.start();
+  Client c(port, "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/_bridge/#");
+  // (Health messages queued before the drops arrive first: wait for a later one.)
+  auto h = c.waitJson("hoist/_bridge/bridge-w/health", [](const json& j, bool) {
+    return j["buffer"]["dropped_alarm"] == 4; }, 10s);
+  ASSERT_TRUE(h) << readFile(log("bridge.log"));
+  EXPECT_EQ((*h)["level"], "WARNING") << h->dump();
+  EXPECT_EQ((*h)["buffer"]["dropped_alarm"], 4) << h->dump();
+  ASSERT_EQ((*h)["warnings"].size(), 1u) << h->dump();
+  EXPECT_NE((*h)["warnings"][0].get<std::string>().find("4 alarm transitions dropped"), std::string::npos);
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+  broker.stop();
+}

@@ -416,6 +416,73 @@ TEST_F(MqttJournal, RefusesWhatTheCheckedWriterRefuses) {
   }
 }
 
+// Issue 33: the journal's records are replayed with the bridge's
+// credentials, so its directory must be the bridge's own and its file 0600.
+TEST_F(MqttJournal, DirectoryMustBeOwnedAndNotGroupOrOtherWritable) {
+  auto refused = [&](const fs::path& d, const std::string& want) {
+    Journal j;
+    try {
+      j.open(d.string(), {});
+      ADD_FAILURE() << d << " was accepted";
+    } catch (const JournalError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(d.string()), std::string::npos) << what;
+      EXPECT_NE(what.find(want), std::string::npos) << what;
+    }
+    EXPECT_FALSE(fs::exists(d / "journal.bin")) << "nothing is created in a refused directory";
+  };
+  const auto open_dir = dir_ / "world";
+  fs::create_directory(open_dir);
+  ::chmod(open_dir.c_str(), 0777);
+  refused(open_dir, "mode 0777");
+  const auto group_dir = dir_ / "group";
+  fs::create_directory(group_dir);
+  ::chmod(group_dir.c_str(), 0770);
+  refused(group_dir, "mode 0770");
+  // A symlink to a good directory: refused (its target could be swapped).
+  const auto good = dir_ / "good";
+  fs::create_directory(good);
+  ::chmod(good.c_str(), 0700);
+  fs::create_directory_symlink(good, dir_ / "link");
+  refused(dir_ / "link", "symbolic link");
+  if (::geteuid() == 0) {  // another user's directory (only root can make one here)
+    const auto other = dir_ / "other";
+    fs::create_directory(other);
+    ::chmod(other.c_str(), 0755);
+    ASSERT_EQ(::chown(other.c_str(), 65534, 65534), 0);
+    refused(other, "owned by uid 65534");
+  }
+  // The bridge's own directory, 0700 or 0750: accepted.
+  Journal j;
+  EXPECT_NO_THROW(j.open(good.string(), {}));
+  j.close();
+  ::chmod(good.c_str(), 0750);
+  EXPECT_NO_THROW(j.open(good.string(), {}));
+  j.close();
+}
+
+TEST_F(MqttJournal, FileIsMode0600AfterCreationReopenAndCompaction) {
+  auto mode = [&] {
+    struct stat st{};
+    EXPECT_EQ(::stat(file().c_str(), &st), 0);
+    return st.st_mode & 07777;
+  };
+  ::chmod(dir_.c_str(), 0700);
+  const mode_t old_umask = ::umask(022);
+  Journal j;
+  j.open(dir_.string(), {});
+  EXPECT_EQ(mode(), 0600u);
+  j.close();
+  ::chmod(file().c_str(), 0644);  // a journal left by an older bridge
+  j.open(dir_.string(), {});
+  EXPECT_EQ(mode(), 0600u);
+  ASSERT_TRUE(j.append(msg(1)));
+  ASSERT_TRUE(j.prepend({msg(0)}));  // a compaction: a new file renamed over journal.bin
+  EXPECT_EQ(mode(), 0600u);
+  j.close();
+  ::umask(old_umask);
+}
+
 TEST(MqttJournalConfig, BufferKeys) {
   BridgeConfig c;
   applyBridgeToml("[buffer]\ndir = \"/var/lib/hoist-mqtt\"\nmax_bytes = 1048576\nfsync_interval = 0.5\n", "b.toml", c);

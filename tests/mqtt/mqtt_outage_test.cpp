@@ -50,7 +50,8 @@ namespace {
 /// The brokers' TCP ports: fixed, below the ephemeral range (a broker that
 /// restarts after minutes must find its port free; an ephemeral port may
 /// meanwhile be some client connection's source port).
-constexpr int kPortPlain = 18640, kPortRestart = 18641, kPortCentre = 18642, kPortSite = 18643, kPortCorrupt = 18644;
+constexpr int kPortPlain = 18640, kPortRestart = 18641, kPortCentre = 18642, kPortSite = 18643, kPortCorrupt = 18644,
+              kPortPlanted = 18645;
 
 double envSeconds(const char* name, double dflt) {
   const char* v = std::getenv(name);
@@ -577,6 +578,72 @@ TEST_F(MqttStoreAndForward, CorruptJournalIsReportedAndItsGoodPartReplayed) {
   EXPECT_NE(text.find("CRC mismatch"), std::string::npos) << text;
   EXPECT_NE(text.find("byte " + std::to_string(good_end)), std::string::npos) << text;
   EXPECT_TRUE(bridge->running()) << text;
+  bridge->signal(SIGTERM);
+  EXPECT_EQ(bridge->wait(15s), 0) << text;
+  broker.stop();
+}
+
+// Issue 33: a planted journal (valid CRCs) is replayed with the bridge's
+// credentials.  Only what the bridge would publish now goes out: its own
+// shafts' data topics with the retain flag it sets; never a command topic,
+// STATE, $SYS, another tree, nor a data topic with the wrong retain flag.
+TEST_F(MqttStoreAndForward, PlantedJournalReplaysOnlyWhatTheBridgeWouldPublish) {
+  dir_ = testDir("journal_planted");
+  auto rec = [](const std::string& topic, const std::string& payload, bool retain, hoist::mqtt::MsgClass cls) {
+    hoist::mqtt::OutMsg m;
+    m.topic = topic;
+    m.payload = payload;
+    m.qos = 1;
+    m.retain = retain;
+    m.cls = cls;
+    return m;
+  };
+  using hoist::mqtt::MsgClass;
+  {
+    hoist::mqtt::Journal j;
+    j.open((dir_ / "journal").string(), {});
+    ASSERT_TRUE(j.append(rec("hoist/bad/cage", "{\"utime\":1}", false, MsgClass::Cage)));
+    ASSERT_TRUE(j.append(rec("hoist/bad/cmd/ack",
+                             R"({"kind":"*","level":0,"action":2,"shelve_duration":3600,"user":"x"})", false,
+                             MsgClass::Health)));
+    ASSERT_TRUE(j.append(rec("spBv1.0/STATE/scada", R"({"online":false,"timestamp":1})", true, MsgClass::Alarm)));
+    ASSERT_TRUE(j.append(rec("$SYS/broker/forged", "x", true, MsgClass::Health)));
+    ASSERT_TRUE(j.append(rec("hoist/other/cage", "{\"utime\":7}", false, MsgClass::Cage)));
+    ASSERT_TRUE(j.append(rec("hoist/bad/cage", "{\"utime\":8}", true, MsgClass::Cage)));
+    ASSERT_TRUE(j.append(rec("hoist/bad/alarm/K", "{\"utime\":9}", false, MsgClass::Alarm)));
+    ASSERT_TRUE(j.append(rec("hoist/bad/alarm/K", "{\"utime\":2}", true, MsgClass::Alarm)));
+    ASSERT_TRUE(j.append(rec("hoist/bad/cage", "{\"utime\":3}", false, MsgClass::Cage)));
+  }
+  Broker broker(dir_, "broker", kPortPlanted);
+  ASSERT_NO_FATAL_FAILURE(broker.start());
+  Historian h(broker.port(), "historian-planted", "#", false);
+  ASSERT_TRUE(h.connected());
+  auto bridge = startBridge(bridgeConfig(dir_, broker.url(), urlFor(7975), "bad/"), "bridge-planted", "bridge.log");
+  std::optional<json> health;
+  ASSERT_TRUE(h.waitFor(
+      [&] {
+        for (const auto& m : h.messages())
+          if (m.topic == "hoist/_bridge/bridge-planted/health") {
+            const json j = json::parse(m.payload, nullptr, false);
+            if (j.is_object() && j.contains("journal") && j["journal"]["queued"] == 0) health = j;
+          }
+        return health.has_value() && h.live("hoist/bad/cage").size() >= 2;
+      },
+      20s))
+      << readFile(log("bridge.log"));
+  std::vector<std::string> topics;
+  for (const auto& m : h.messages())
+    if (m.topic.rfind("hoist/_bridge/", 0) != 0) topics.push_back(m.topic + (m.retain ? " (retained)" : ""));
+  EXPECT_EQ(utimes(h.live("hoist/bad/cage")), (std::vector<std::int64_t>{1, 3}));
+  for (const auto& t : topics) {
+    EXPECT_EQ(t.find("cmd/ack"), std::string::npos) << t;
+    EXPECT_EQ(t.find("STATE"), std::string::npos) << t;
+    EXPECT_EQ(t.find("hoist/other"), std::string::npos) << t;
+  }
+  EXPECT_EQ((*health)["journal"]["replay_refused"], 6) << health->dump();
+  EXPECT_GE((*health)["journal"]["replayed"].get<int>(), 3) << health->dump();  // + the bridge's own health
+  const std::string text = readFile(log("bridge.log"));
+  EXPECT_NE(text.find("hoist/bad/cmd/ack (retain false) not replayed"), std::string::npos) << text;
   bridge->signal(SIGTERM);
   EXPECT_EQ(bridge->wait(15s), 0) << text;
   broker.stop();

@@ -62,7 +62,9 @@ constexpr const char* kOutputHeader =
     "lambda_0,lambda_1,lambda_2,lambda_3,lambda_4,nis,nis_window,mismatch,"
     "sigma_b,x_c,sigma_x_c,sigma_lambda_0,sigma_lambda_1,sigma_lambda_2,sigma_lambda_3,sigma_lambda_4,"
     "theta_open,nis_dof,nis_lower,nis_upper,nis_bound,drift,nis_exceeded,drift_exceeded,sensors,"
-    "fa_observed,moment_observed,accepted,gated,load_changes,implausible";
+    "fa_observed,moment_observed,accepted,gated,load_changes,implausible,"
+    "plausible,fault_imu_accel,fault_imu_rate,fault_rope_load,noise_imu_accel,noise_imu_rate,noise_rope_load,"
+    "change_t,change_Fa,change_moment";
 
 void num(std::string& s, double v) {
   if (std::isnan(v)) s += "nan";
@@ -121,6 +123,16 @@ void appendRow(std::string& s, const hoist::LoadEstimate& e, const hoist::Estima
   integer(s, c.gated);
   integer(s, c.load_changes);
   integer(s, c.implausible);
+  integer(s, e.plausible ? 1 : 0);
+  integer(s, e.fault_imu_accel);
+  integer(s, e.fault_imu_rate);
+  integer(s, e.fault_rope_load);
+  num(s, e.noise_imu_accel);
+  num(s, e.noise_imu_rate);
+  num(s, e.noise_rope_load);
+  num(s, e.change_t);
+  num(s, e.change_Fa);
+  num(s, e.change_moment);
   s.back() = '\n';
 }
 
@@ -197,7 +209,10 @@ int run(const Options& o) {
   line.reserve(1024);
   hoist::LoadEstimate last;
   hoist::EstimatorCounters counts;
-  long rows = 0, mismatch_rows = 0;
+  long rows = 0, mismatch_rows = 0, implausible_rows = 0;
+  unsigned faults[3] = {0, 0, 0};  // every fault bit seen, per channel
+  std::string first_implausible, changes;
+  double last_change = -1.0;
   double first_mismatch = std::nan("");
   std::string first_why;  // what raised it first: the NIS window against its bound, or a drifting load
   int last_decile = 0;
@@ -221,6 +236,16 @@ int run(const Options& o) {
                 first_why += (first_why.empty() ? "" : "; ") + std::string("load drift ") + fmt("%.1f", e.drift) +
                              " sigma during the trip";
             }
+          }
+          if (!e.plausible && implausible_rows++ == 0)
+            first_implausible = "at t = " + fmt("%.2f", e.t) + " s (" + e.implausible + ")";
+          faults[0] |= e.fault_imu_accel;
+          faults[1] |= e.fault_imu_rate;
+          faults[2] |= e.fault_rope_load;
+          if (e.change_t >= 0.0 && e.change_t != last_change) {
+            if (last_change >= 0.0 || !changes.empty()) changes += "; ";
+            changes += "t = " + fmt("%.2f", e.change_t) + " s";
+            last_change = e.change_t;
           }
           last = e;
           counts = c;
@@ -257,7 +282,15 @@ int run(const Options& o) {
       << "; MODEL_MISMATCH in " << mismatch_rows << " rows, first "
       << (std::isnan(first_mismatch) ? std::string("none")
                                      : "at t = " + fmt("%.2f", first_mismatch) + " s (" + first_why + ")")
-      << ".\n";
+      << ". Not plausible in " << implausible_rows << " rows"
+      << (first_implausible.empty() ? std::string("") : ", first " + first_implausible) << ".";
+    const char* names[3] = {"f_y", "omega", "rope_load"};
+    for (int i = 0; i < 3; ++i)
+      if (faults[i]) s << " Sensor fault: " << names[i] << " " << hoist::sensorFaultReason(faults[i]) << ".";
+    if (!changes.empty())
+      s << " Load changes at " << changes << "; the last by " << fmt("%.1f", last.change_Fa) << " N and "
+        << fmt("%.1f", last.change_moment) << " N m.";
+    s << "\n";
     std::cout << s.str();
   }
   return 0;

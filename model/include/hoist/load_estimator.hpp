@@ -46,11 +46,14 @@
 // that is right to about model_error (the n-mode twin against the continuum is
 // within 1 %) is not reported as wrong.
 //
-// Model check.  NIS_k = nu^T S^-1 nu of every accepted update, summed over a
-// sliding window of nis_window seconds, is chi-square with dof = the number
-// of scalar measurements in the window when the model is right.  MODEL_MISMATCH
-// (WARNING) is evidence of a shaft that does not behave like its model:
-//   * the window's NIS above its chi-square (1 - nis_alpha) quantile, or
+// Model check (docs/estimation.md, "The model check").  Each channel's
+// innovations are summed over blocks of band_block seconds
+// (hoist/band_innovation.hpp): vibration above the model's band cancels,
+// what the model carries adds; s^2 of each block is one dof of the windowed
+// NIS over nis_window seconds.  MODEL_MISMATCH (WARNING) is evidence of a
+// shaft that does not behave like its model:
+//   * the window's NIS above its chi-square (1 - nis_alpha) quantile and
+//     nis_margin dof, or
 //   * a load estimate that drifts during a trip (the cage moving) by more than
 //     drift_sigma times the spread the filter itself expects, or
 //   * (constancy) the estimate over the last constancy_memory seconds (a
@@ -58,17 +61,27 @@
 //     from the whole history's by more than drift_sigma times the sigma of
 //     their difference (PF - P for nested estimates): a load that seems to
 //     change with depth is a model that is wrong with depth (weak preloads).
-// Per-sample gating rejects (and counts) an innovation beyond gate_sigma;
-// gate_reset consecutive rejections are a load change, not spikes: the
-// load's covariance is re-opened to its initial value.
-//
+// The tests start after a warm-up of min_window_fill x nis_window.
+// The other side -- a sensor quieter than its own noise (zeroed, stuck,
+// held), or one whose samples the gate mostly rejects -- is judged per
+// channel by hoist/sensor_monitor.hpp: LoadEstimate::fault_*, imu_quiet,
+// rope_quiet (SENSOR_FAULT in the daemon), not by MODEL_MISMATCH.
+// Per-sample gating rejects (and counts) an innovation beyond gate_sigma.
+// Load changes: gate_reset rejections in a row, or a CUSUM on the blocks at
+// rest (hoist/change_detector.hpp), on either channel, re-open both Fa and
+// M (one load changed).  At rest the change is a step: a third solver
+// (the unit load from rest at the change's onset) carries its transient for
+// kStepFoldTime (60 s); followingLoadChange() says so.
+// Physical bounds: LoadEstimate::plausible ([load] max_payload, max_offset
+// and hoist/plausibility.hpp).
 // Observability: the rope load alone gives Fa but not b; the IMU alone gives M
 // (and so y_c, theta, lambda_1..4) but not Fa or b; both give Fa and b = M/Fa.
 // Without a sensor the estimates stay at the configured load, their sigma
 // grows with the random walk, and observed()/sensorsInUse() say so.
 //
-// Real time: every buffer is sized in the constructor; initialize(),
-// advance(), update*() and finish() allocate nothing (tested).
+// Real time: every buffer and the three solvers are sized in the
+// constructor; initialize(), advance(), update*() and finish() allocate
+// nothing, a load change included (tests/model/no_alloc_test.cpp).
 #pragma once
 
 #include <array>
@@ -78,7 +91,11 @@
 #include <string>
 #include <vector>
 
+#include "hoist/band_innovation.hpp"
+#include "hoist/change_detector.hpp"
 #include "hoist/fast_solver.hpp"
+#include "hoist/plausibility.hpp"
+#include "hoist/sensor_monitor.hpp"
 
 namespace hoist {
 
@@ -109,6 +126,18 @@ struct EstimatorSettings {
   double min_window_fill = 0.5; ///< the NIS test needs the window at least this full (fraction of nis_window)
   int max_rate = 1000;          ///< largest update rate the NIS window is sized for [Hz]
   double sensor_timeout = 0.5;  ///< a sensor not updated for this long is not "in use" [s]
+  // Sensor health and the learned noise (hoist/sensor_monitor.hpp).
+  double model_band = 0.05;     ///< low-pass time constant splitting the model's band from the noise [s]
+  double noise_memory = 2.0;    ///< memory of the learned high-frequency noise variance [s]
+  double quiet_ratio = 0.25;    ///< a channel whose high-pass sigma is below quiet_ratio x its noise is quiet
+  double quiet_memory = 1.0;    ///< memory of the quiet test [s]
+  double stuck_time = 1.0;      ///< the same value for this long is a stuck channel [s]
+  double noisy_factor = 5.0;    ///< a learned noise above noisy_factor x the datasheet's is a fault
+  double band_block = 0.2;      ///< block of the band-limited innovations (NIS test, CUSUM) [s]
+  // Load changes at rest (hoist/change_detector.hpp): CUSUM on the band-limited innovations.
+  double change_drift = 1.0;    ///< CUSUM reference k [sigma per block]
+  double change_threshold = 6.0;  ///< CUSUM decision level h [sigma]
+  double change_holdoff = 2.0;  ///< the CUSUM runs once the cage has been at rest this long [s]
 
   /// Throws std::invalid_argument naming the first bad value (its [estimator]/[sensors] key).
   void validate() const;
@@ -132,9 +161,9 @@ struct LoadEstimate {
   double theta = 0.0, sigma_theta = 0.0;
   std::array<double, 5> lambda{}, sigma_lambda{};
   double theta_open = 0.0;                 ///< the open-loop twin's theta (configured load)
-  double nis = 0.0;          ///< NIS of this tick's updates (0 if none)
+  double nis = 0.0;          ///< NIS of the band blocks that closed this tick (0 if none)
   double nis_window = 0.0;   ///< sum over the window
-  int nis_dof = 0;           ///< scalar measurements in the window
+  int nis_dof = 0;           ///< blocks (one per channel and band_block) in the window
   double nis_lower = 0.0, nis_upper = 0.0;  ///< the window's 95 % two-sided chi-square bounds
   double nis_bound = 0.0;    ///< the MODEL_MISMATCH bound: max(1 - nis_alpha quantile, nis_margin dof)
   double drift = 0.0;        ///< largest load drift this trip [its sigma]
@@ -143,13 +172,41 @@ struct LoadEstimate {
   bool drift_exceeded = false;  ///< ... because of a drifting load
   unsigned sensors = 0;      ///< SensorBits updated within their timeout
   bool fa_observed = false, moment_observed = false;
+  // Sensor health (hoist/sensor_monitor.hpp): SensorFaultBits per channel;
+  // sensorFaultReason() names them.  A faulty channel's samples are still
+  // applied (the daemon decides what to do: SENSOR_FAULT).
+  unsigned fault_imu_accel = 0, fault_imu_rate = 0, fault_rope_load = 0;
+  unsigned faulty = 0;       ///< SensorBits of the channels with any fault
+  bool imu_quiet = false;    ///< f_y or omega quiet or stuck: quieter than its own noise (the NIS's lower side)
+  bool rope_quiet = false;   ///< rope_load quiet or stuck
+  /// The noise sigma each channel is weighted with: max(datasheet, learned
+  /// from the high-frequency part of its innovations) [m/s^2, rad/s, N].
+  double noise_imu_accel = 0.0, noise_imu_rate = 0.0, noise_rope_load = 0.0;
+  // Load changes (one event for Fa and M, whichever channel saw it).
+  double change_t = -1.0;    ///< time of the last load change (-1: none since initialize())
+  double change_Fa = 0.0;    ///< its size so far: Fa now - Fa before it [N]
+  double change_moment = 0.0;  ///< M now - M before it [N m]
+  double change_level = 0.0; ///< the larger CUSUM statistic / its threshold (1 = a change)
+  /// Physical bounds ([load] max_payload, max_offset: ShaftParams::payloadLimit(),
+  /// offsetLimit()) and the twin's plausibility bounds (hoist/plausibility.hpp,
+  /// lateral limit 1 m) on the estimate and the state it implies.  false:
+  /// the estimate must not be used (a forged or failed sensor, or a model far
+  /// off), whatever its sigma says.  An observed load is judged 3 sigma
+  /// generously: 0 <= Fa + 3 sigma_Fa (and Fa >= 0 unless sigma_Fa < 5 % of
+  /// max_payload: an empty conveyance), Fa - 3 sigma_Fa <= max_payload,
+  /// |M| - 3 sigma_M <= max_payload max_offset, |b| - 3 sigma_b <= max_offset.
+  bool plausible = true;
+  /// Why not plausible: "Fa < 0", "Fa > max_payload", "|M| > max_payload * max_offset",
+  /// "|b| > max_offset", or the state's quantity ("y_c", "theta", "x_c",
+  /// "lambda_k", "non-finite"); "" when plausible.  A static string.
+  const char* implausible = "";
 };
 
 /// Counts since initialize().
 struct EstimatorCounters {
   std::int64_t accepted = 0;   ///< updates applied (per sensor message)
   std::int64_t gated = 0;      ///< samples rejected by the innovation gate
-  std::int64_t load_changes = 0;  ///< covariance re-opened after gate_reset rejections
+  std::int64_t load_changes = 0;  ///< load changes: CUSUM at rest, or gate_reset rejections in a row
   std::int64_t implausible = 0;   ///< non-finite or out-of-range samples refused
 };
 
@@ -220,16 +277,43 @@ class LoadEstimator {
   /// stepped exactly as the twin: its saved state turns the twin's state into
   /// the estimate's with hoist::addLoadResponse (forecasts from the estimate).
   const FastSolver& sensitivitySolver() const { return *sens_; }
+  /// True while a load change's transient is followed (for kStepFoldTime =
+  /// 60 s after a change at rest): the state the estimate implies is then
+  /// the steady superposition plus the step's transient, and a forecast
+  /// built from sensitivitySolver() alone omits the transient.
+  bool followingLoadChange() const { return stepping_; }
 
  private:
   bool updateLateral(double f_y, double omega, unsigned which);
-  void reopen(double& P, double sigma0);
+  /// A load change (CUSUM or gate_reset, either channel) that began at
+  /// `onset`: re-opens Fa and M; at rest the step solver starts.
+  void loadChange(double onset);
+  /// The CUSUM of a channel at rest; true: a change.
+  bool changeAtRest(ChangeDetector& c, double z);
+  /// An accepted innovation of channel `ch` into its band block (NIS window, CUSUM).
+  void band(int ch, double nu, double S, double e);
+  /// Stop following a load change's transient (decayed, or a restart).
+  void foldStep();
   void pushNis(double nis, int dof);
   bool moving() const;
 
   ShaftParams twin_;
   EstimatorSettings set_;
   std::unique_ptr<FastSolver> sens_;       // unit load (Fa = 1 N, M = 1 N m) since initialize(): dz/dFa, dz/dM
+  // A load change at rest is a step: the ropes ring.  step_ is the unit load
+  // applied as a step at the change's onset (started at rest), so the
+  // prediction after it is exact superposition:
+  //   z = z_twin + (o - c) dz/d(steady) + (x - o) dz/d(step),  o = the load before the change,
+  // until the transient has decayed (kStepFoldTime), then folded back.
+  std::unique_ptr<FastSolver> step_;
+  bool stepping_ = false;
+  double step_t_ = 0.0;                    // the step's onset
+  double o_Fa_ = 0.0, o_M_ = 0.0;          // origin of the step part (= the configured load when not stepping)
+  double sub_h_ = 0.0025;                  // the last advance()'s substep [s]
+  bool step_fresh_ = false;                // no step sensitivity of the previous tick yet
+  SensorValues step_zq_;                   // the step's sensitivities at the previous tick
+  double step_e_fy_ = 0.0, step_e_om_ = 0.0, step_e_rope_ = 0.0;  // model error of the onset's one-sample uncertainty
+  double gate_t0_fa_ = 0.0, gate_t0_m_ = 0.0;  // first gated sample of the current run
   double t_ = 0.0;
   Kinematics kin_;
   double Fa_c_ = 0.0, M_c_ = 0.0;          // the configured load (prior)
@@ -260,11 +344,20 @@ class LoadEstimator {
   bool have_update_ = false;
   // drift during a trip
   bool was_moving_ = false;
+  bool trip_ref_warm_ = false;             // the trip's reference was taken after the warm-up
   double trip_Fa0_ = 0.0, trip_PFa0_ = 0.0, trip_M0_ = 0.0, trip_PM0_ = 0.0, trip_QFa_ = 0.0, trip_QM_ = 0.0;
   double trip_drift_ = 0.0;
   bool nis_flag_ = false, drift_flag_ = false;  // the two MODEL_MISMATCH conditions
+  SensorMonitor mon_[3];                   // per channel (kImuAccel, kImuRate, kRope)
+  BandInnovation band_[3];                 // per channel: innovations summed over band_block
+  ChangeDetector cusum_fa_, cusum_m_;      // load changes at rest
+  double rest_since_ = 0.0;                // time the cage came to rest
+  double change_t_ = -1.0, change_Fa0_ = 0.0, change_M0_ = 0.0;  // the last load change and the loads before it
+  PlausibilityBounds bounds_;              // the twin's, lateral limit 1 m
   LoadEstimate est_;
   EstimatorCounters counts_;
+  /// Sets est_.plausible / implausible from est_ (after the state is filled).
+  void judgePlausibility();
 };
 
 /// The offline estimator (hoist-estimate), the same sequence the daemon runs

@@ -27,7 +27,9 @@
 // list in README.md (checked by a test) all follow it.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -76,6 +78,12 @@ struct ShaftParams {
   // [load]
   double Fa = 1000.0;  ///< load.eccentric_force
   double b = 1.0;      ///< load.offset
+  /// load.max_payload: the conveyance's rating [N]; the load estimate is
+  /// plausible only with 0 <= Fa <= this.  0 = derived: max(5 |Fa|, 2 m g).
+  double max_payload = 0.0;
+  /// load.max_offset: the largest |b| a load can sit at (the conveyance's
+  /// half-width) [m].  0 = derived: max(2 |b|, h / 4).
+  double max_offset = 0.0;
   // [model]
   int n = 50;          ///< model.modes
   double g = 9.81;     ///< model.gravity
@@ -102,6 +110,10 @@ struct ShaftParams {
   /// Largest admissible hoisting-rope length: the bottom sleeves must stay
   /// inside the guide ropes, 0 < l < L - 2h.
   double maxRopeLength() const { return L - 2.0 * h; }
+  /// max_payload, or its derived default when 0.
+  double payloadLimit() const { return max_payload > 0.0 ? max_payload : std::max(5.0 * std::abs(Fa), 2.0 * m * g); }
+  /// max_offset, or its derived default when 0.
+  double offsetLimit() const { return max_offset > 0.0 ? max_offset : std::max(2.0 * std::abs(b), 0.25 * h); }
 };
 
 /// The paper's Section 3 baseline (also the default-constructed value).
@@ -162,7 +174,7 @@ constexpr ParamField real(std::string_view sec, std::string_view name, double Sh
 
 /// Every value of ShaftParams, in the order of the TOML file (sections
 /// hoisting_rope, guide_ropes, cage, load, model).
-inline constexpr std::array<ParamField, 19> kParamFields = {{
+inline constexpr std::array<ParamField, 21> kParamFields = {{
     detail::real("hoisting_rope", "mass_per_length", &ShaftParams::rho1, "kg/m", "rho1", ParamBound::Positive,
                  "hoisting-rope mass per length"),
     detail::real("hoisting_rope", "axial_stiffness", &ShaftParams::EA, "N", "EA", ParamBound::Positive,
@@ -189,6 +201,10 @@ inline constexpr std::array<ParamField, 19> kParamFields = {{
     detail::real("load", "eccentric_force", &ShaftParams::Fa, "N", "Fa", ParamBound::Finite, "eccentric load"),
     detail::real("load", "offset", &ShaftParams::b, "m", "b", ParamBound::Finite,
                  "offset of the eccentric load from the cage axis"),
+    detail::real("load", "max_payload", &ShaftParams::max_payload, "N", "Fa_max", ParamBound::NonNegative,
+                 "the conveyance's rating: a load estimate above it is not plausible (0: max(5 |Fa|, 2 m g))"),
+    detail::real("load", "max_offset", &ShaftParams::max_offset, "m", "b_max", ParamBound::NonNegative,
+                 "the largest |b| a load can sit at, the conveyance's half-width (0: max(2 |b|, h / 4))"),
     ParamField{"model", "modes", -1, ParamType::Integer, nullptr, &ShaftParams::n, nullptr, nullptr, "", "n",
                ParamBound::Closed, 1.0, double(kMaxModes), true, "assumed modes per rope (integer)"},
     detail::real("model", "gravity", &ShaftParams::g, "m/s^2", "g", ParamBound::NonNegative,

@@ -103,6 +103,17 @@ class InputClock final : public ClockPolicy {
 
   TickResult tick(TwinCore&, double, double) override { return {}; }
   double staleTimeout(const TwinCore& c) const override { return c.cfg_.service.stale_timeout; }
+  double sensorTime(const TwinCore& c, std::int64_t utime, double, std::int64_t, double& offset) const override {
+    // The daemon's clock is the winder stream's: the sample's time on it.
+    // Before the first winder input there is none: the sample is applied at
+    // the first step (as hoist-estimate applies the first row's sensors).
+    if (!c.started_ || !c.have_input_) {
+      offset = 0.0;
+      return -std::numeric_limits<double>::infinity();
+    }
+    offset = static_cast<double>(utime - c.last_.utime) * 1e-6;
+    return t_base_ + static_cast<double>(utime - utime_base_) * 1e-6;
+  }
 
  private:
   static InputResult reject(TwinCore& c, InputResult& res, RejectReason r) {
@@ -205,6 +216,12 @@ class WallClock final : public ClockPolicy {
   }
 
   double staleTimeout(const TwinCore& c) const override { return c.periodStaleTimeout(); }
+  double sensorTime(const TwinCore&, std::int64_t utime, double wall_now, std::int64_t wall_utime,
+                    double& offset) const override {
+    // Model time is the daemon's wall clock: the sample is `offset` from now.
+    offset = static_cast<double>(utime - wall_utime) * 1e-6;
+    return wall_now + offset;
+  }
 };
 
 std::unique_ptr<ClockPolicy> makeClock(ClockMode mode) {
@@ -224,8 +241,14 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
       range_(validLengthRange(cfg.shaft)),
-      bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))) {
+      bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))),
+      // The predictions kept cover max_clock_offset at the step rate, and more.
+      timing_(cfg.estimator.max_clock_offset,
+              std::max<std::size_t>(64, static_cast<std::size_t>(std::ceil(1.5 * cfg.estimator.max_clock_offset *
+                                                                             cfg.service.rate)) + 16)),
+      gate_(cfg.alarms, cfg.estimator.clear_hold) {
   cfg_.service.validate();
+  cfg_.estimator.validate();
   // Envelope evaluations may be deferred below the GUIDE_ROPE WARNING
   // alarm's clear level: taken from that alarm's own settings.
   const AlarmSettings& gw = alarms_.find(AlarmKind::GuideRope, AlarmLevel::Warning)->settings();
@@ -261,40 +284,6 @@ void TwinCore::acceptSample(const WinderSample& s, double wall_now) {
   if (stale_) setStale(false);
 }
 
-void TwinCore::onCageImu(double f_y, double omega) {
-  if (!est_) return;
-  if (std::isfinite(f_y)) {
-    imu_.f_y = f_y;
-    imu_.has_accel = true;
-  }
-  if (std::isfinite(omega)) {
-    imu_.omega = omega;
-    imu_.has_rate = true;
-  }
-}
-
-void TwinCore::onRopeLoad(double force) {
-  if (!est_ || !std::isfinite(force)) return;
-  rope_force_ = force;
-  rope_pending_ = true;
-}
-
-void TwinCore::estimatorStep(const CageResponse& r) {
-  // The same sequence as hoist::estimateRecorded (hoist-estimate): predict,
-  // the IMU, the rope load, finish.
-  est_->predict(r);
-  if (imu_.has_accel && imu_.has_rate) est_->updateImu(imu_.f_y, imu_.omega);
-  else if (imu_.has_accel) est_->updateImuAccel(imu_.f_y);
-  else if (imu_.has_rate) est_->updateImuRate(imu_.omega);
-  if (rope_pending_) est_->updateRopeLoad(rope_force_);
-  imu_ = {};
-  rope_pending_ = false;
-  // A tick we flag degraded (fell behind, stale, fault hold, ...) is no
-  // evidence against the model: its NIS stays out of MODEL_MISMATCH's window.
-  if (degradedNow()) est_->excludeTickFromModelCheck();
-  est_->finish();
-}
-
 void TwinCore::initializeAt(double t, const Kinematics& k) {
   if (started_) ++resets_;
   solver_->initialize(t, k);
@@ -304,6 +293,8 @@ void TwinCore::initializeAt(double t, const Kinematics& k) {
     if (started_) est_->restart(t, k);
     else est_->initialize(t, k);
     est_synced_ = true;
+    timing_.reset(started_);  // a restart: the queued samples are of the old stream
+    gate_.reset();
   }
   t_ = t;
   kin_ = k;
@@ -431,25 +422,32 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
       alarms_.setModelFault(t, false, events_);
       // With the load estimator healthy, the clearance and rope-force alarms
       // judge the state the estimated load implies (the guide-rope envelope
-      // stays the twin's); HOIST_CAGE keeps the open-loop state.
-      double lambda0 = out_.lambda[0];
+      // stays the twin's); HOIST_CAGE keeps the open-loop state.  Which one,
+      // and the hold after a switch or a load change: EstimateGate.
+      const Judgement open{out_.clearance, out_.lambda[0], out_.lambda[0]};
+      const Judgement* judged = &open;
       est_in_use_ = false;
       if (est_ && est_synced_) {
         estimatorStep(solver_->response());
         const LoadEstimate& e = est_->estimate();
-        est_in_use_ = e.sensors != 0 && !e.mismatch && std::isfinite(e.y_c) && std::isfinite(e.theta) &&
-                      std::isfinite(e.lambda[0]);
-        if (est_in_use_) {
-          out_.clearance = computeClearance(e.y_c, e.theta, h, out_.clearance.guide_deflection, cfg_.alarms);
-          lambda0 = e.lambda[0];
+        const unsigned not_used = estimateNotUsed(e);
+        Judgement est = open;
+        if (!(not_used & (kNotUsedNonFinite | kNotUsedImplausible))) {
+          est.clearance = computeClearance(e.y_c, e.theta, h, out_.clearance.guide_deflection, cfg_.alarms);
+          est.lambda0_slack = est.lambda0_overload = e.lambda[0];
         }
+        judged = &gate_.step(t, not_used == 0, not_used, est, open, est_->counters().load_changes, e.Fa, e.moment);
+        est_in_use_ = gate_.inUse();
         alarms_.setModelMismatch(t, e.mismatch, e.nis_exceeded ? e.nis_window : e.drift,
                                  e.nis_exceeded ? e.nis_bound : est_->settings().drift_sigma, events_);
       }
+      alarms_.setSensorFault(t, t < sensor_fault_until_, sensor_fault_.value, sensor_fault_.limit, events_);
+      out_.clearance = judged->clearance;
       const std::size_t first = events_.size();
       alarms_.updateClearance(t, out_.clearance, events_);
       // Rope force against the static force at this length.
-      alarms_.updateRopeForce(t, lambda0, solver_->model().staticRopeForce(out_.kin.l), events_);
+      alarms_.updateRopeForce(t, judged->lambda0_slack, judged->lambda0_overload,
+                              solver_->model().staticRopeForce(out_.kin.l), events_);
       if (est_in_use_) events_.markFromEstimate(first);
       out_.rope_slack_threshold = alarms_.ropeSlackThreshold();
       out_.rope_overload_threshold = alarms_.ropeOverloadThreshold();
@@ -588,6 +586,7 @@ void TwinCore::housekeeping(double wall_now) {
   else
     stale_now = clock_->mode() == ClockMode::Wall && wall_now - start_wall_ > cfg_.service.stale_timeout;
   if (stale_now && !stale_) setStale(true);
+  if (est_) alarms_.setSensorFault(t_, t_ < sensor_fault_until_, sensor_fault_.value, sensor_fault_.limit, events_);
   alarms_.poll(t_, events_);
   out_.alarm_level = alarms_.highestActive();
   out_.degraded = degradedNow();
@@ -601,6 +600,7 @@ int TwinCore::command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLe
     case AlarmAction::Shelve: n = alarms_.shelve(t_, kind, level, shelve_duration, events_); break;
     case AlarmAction::Unshelve: n = alarms_.unshelve(t_, kind, level, events_); break;
     case AlarmAction::Reannounce: n = alarms_.reannounce(t_, kind, level, events_); break;
+    case AlarmAction::Calibrate: break;  // not an alarm command: calibrate()
   }
   out_.alarm_level = alarms_.highestActive();
   out_.degraded = degradedNow();

@@ -102,7 +102,7 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
     const bool client_utime = j.contains("utime");
     if (!client_utime) j["utime"] = now_utime;
     if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
-    if (!j.contains("user")) j["user"] = "mqtt";
+    if (!j.contains("user")) j["user"] = kDefaultCommandUser;
     std::string error;
     if (!hoist::msg::fromJson(j, r.ack, error)) {
       r.reject = CommandReject::BadFields;

@@ -134,9 +134,10 @@ void BridgeConfig::validate() const {
     if (!validChannelPrefix(p, &why)) bad("bridge.channel_prefixes", "'" + p + "': " + why);
   for (std::size_t i = 0; i < channel_prefixes.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
-      if (shaftName(channel_prefixes[i]) == shaftName(channel_prefixes[j]))
-        bad("bridge.channel_prefixes", "'" + channel_prefixes[j] + "' and '" + channel_prefixes[i] +
-                                           "' give the same shaft name '" + shaftName(channel_prefixes[i]) + "'");
+      if (const std::string clash = shaftNameClash(shaftName(channel_prefixes[j]), shaftName(channel_prefixes[i]),
+                                                   sparkplug);
+          !clash.empty())
+        bad("bridge.channel_prefixes", "'" + channel_prefixes[j] + "' and '" + channel_prefixes[i] + "' " + clash);
   range("bridge.cage_rate", cage_rate, 0.0, 1000.0, true);
   range("bridge.health_period", health_period, 0.1, 3600.0);
   range("bridge.max_shafts", max_shafts, 1, 10000);
@@ -362,6 +363,21 @@ std::string shaftName(const std::string& prefix) {
   std::string s = prefix;
   if (!s.empty() && (s.back() == '/' || s.back() == '_' || s.back() == '-' || s.back() == '.')) s.pop_back();
   return s.empty() ? std::string("default") : s;
+}
+
+std::string shaftNameClash(const std::string& a, const std::string& b, bool sparkplug) {
+  if (a == b) return "give the same shaft name '" + a + "'";
+  const std::string ta = a + "/", tb = b + "/";
+  if (tb.compare(0, ta.size(), ta) == 0 || ta.compare(0, tb.size(), tb) == 0) {
+    const std::string& inner = ta.size() > tb.size() ? a : b;
+    const std::string& outer = ta.size() > tb.size() ? b : a;
+    return "give shaft names whose topics overlap: 'hoist/" + inner + "/' lies inside shaft '" + outer +
+           "''s tree 'hoist/" + outer + "/'";
+  }
+  if (sparkplug && sparkplug::deviceId(a) == sparkplug::deviceId(b))
+    return "give shafts '" + a + "' and '" + b + "' the same Sparkplug device id '" + sparkplug::deviceId(a) +
+           "' ('/', '+' and '#' become '_')";
+  return "";
 }
 
 bool validChannelPrefix(const std::string& prefix, std::string* why) {

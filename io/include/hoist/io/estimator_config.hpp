@@ -63,7 +63,7 @@ int* intOf(EstimatorSettings& s) { return &(s.*M); }
 }  // namespace detail
 
 /// Every key of [sensors] and [estimator] but `enabled`, in file order.
-inline constexpr std::array<EstimatorField, 20> kEstimatorFields = {{
+inline constexpr std::array<EstimatorField, 30> kEstimatorFields = {{
     {"sensors", "imu_accel_noise", &detail::noiseOf<&SensorNoise::imu_accel>, nullptr, "m/s^2",
      "IMU lateral specific force f_y: noise standard deviation per sample"},
     {"sensors", "imu_rate_noise", &detail::noiseOf<&SensorNoise::imu_rate>, nullptr, "rad/s",
@@ -103,6 +103,26 @@ inline constexpr std::array<EstimatorField, 20> kEstimatorFields = {{
      "largest sensor update rate the NIS window is sized for (integer)"},
     {"estimator", "sensor_timeout", &detail::realOf<&EstimatorSettings::sensor_timeout>, nullptr, "s",
      "a sensor not updated for this long is not in use"},
+    {"estimator", "model_band", &detail::realOf<&EstimatorSettings::model_band>, nullptr, "s",
+     "sensor health: low-pass time constant splitting the model's band from the noise"},
+    {"estimator", "noise_memory", &detail::realOf<&EstimatorSettings::noise_memory>, nullptr, "s",
+     "sensor health: memory of the learned high-frequency noise"},
+    {"estimator", "quiet_ratio", &detail::realOf<&EstimatorSettings::quiet_ratio>, nullptr, "",
+     "a channel whose high-pass sigma is below quiet_ratio x its datasheet noise is quiet (a fault)"},
+    {"estimator", "quiet_memory", &detail::realOf<&EstimatorSettings::quiet_memory>, nullptr, "s",
+     "memory of the quiet and rejected tests"},
+    {"estimator", "stuck_time", &detail::realOf<&EstimatorSettings::stuck_time>, nullptr, "s",
+     "the very same value for this long is a stuck channel"},
+    {"estimator", "noisy_factor", &detail::realOf<&EstimatorSettings::noisy_factor>, nullptr, "",
+     "a learned noise above noisy_factor x the datasheet's is a fault"},
+    {"estimator", "band_block", &detail::realOf<&EstimatorSettings::band_block>, nullptr, "s",
+     "innovations are summed over blocks this long for the NIS test and the CUSUM (0: per sample)"},
+    {"estimator", "change_drift", &detail::realOf<&EstimatorSettings::change_drift>, nullptr, "sigma",
+     "load-change CUSUM reference k per block"},
+    {"estimator", "change_threshold", &detail::realOf<&EstimatorSettings::change_threshold>, nullptr, "sigma",
+     "load-change CUSUM decision level h"},
+    {"estimator", "change_holdoff", &detail::realOf<&EstimatorSettings::change_holdoff>, nullptr, "s",
+     "the CUSUM runs once the cage has been at rest (or the last change) this long"},
 }};
 
 /// The top-level sections of a daemon configuration besides the shaft's:

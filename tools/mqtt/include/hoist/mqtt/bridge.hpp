@@ -11,7 +11,9 @@
 //   <prefix>HOIST_FORECAST -> hoist/<shaft>/forecast    QoS 0, every message
 //   <prefix>HOIST_ESTIMATE -> hoist/<shaft>/estimate    QoS 0, latest estimate at [bridge] cage_rate
 // MQTT -> LCM (unless --no-commands):
-//   hoist/<shaft>/cmd/ack -> <prefix>HOIST_ALARM_ACK    (hoist/mqtt/command.hpp)
+//   hoist/<shaft>/cmd/ack/<user> -> <prefix>HOIST_ALARM_ACK  (one identity per topic, vouched for by the
+//                                   broker's ACL; its own budget; hoist/mqtt/command.hpp)
+//   hoist/<shaft>/cmd/ack        -> <prefix>HOIST_ALARM_ACK  (the legacy shared topic, one small shared budget)
 // The bridge itself:
 //   hoist/_bridge/<client_id>/status  QoS 1, RETAINED: {"online": true|false}; the LWT sets false
 //   hoist/_bridge/<client_id>/health  QoS 0, every [bridge] health_period: connection state, counters
@@ -26,6 +28,10 @@
 // replayed in order before live data (hoist/mqtt/journal.hpp; every message
 // then goes through one send function, sendOne(msg, historical)) -- and on
 // every (re)connection re-subscribes and republishes every alarm's current state.
+//
+// Inside, the bridge is in rooms (tools/mqtt/src; the map is at the top of
+// bridge.cpp): the LCM side, the shaft directory, the data path, the MQTT
+// link, the Sparkplug session, the command gate and the bridge's health.
 #pragma once
 
 #include <csignal>

@@ -44,7 +44,7 @@ enum class CommandReject : std::uint8_t {
   Retained,       ///< a retained MQTT message (never executed: it would replay on every resubscription)
   RateLimited,    ///< over the per-user, per-shaft rate ([bridge] command_rate, command_burst)
   NoMatchingAlarm,  ///< an acknowledge that matches no unacknowledged alarm the bridge knows of
-  AmbiguousShaft,   ///< two live prefixes claim the shaft's name (discovery): refused until one stops
+  AmbiguousShaft,   ///< no longer used (issue 33: the name stays with the daemon first heard); kept so the health keys do not change
   // Sparkplug B mode (DCMD/NCMD; hoist/mqtt/sparkplug_node.hpp):
   BadPayload,       ///< not a Sparkplug B payload (malformed protobuf, too many metrics, strings too long)
   UnknownMetric,    ///< a name or alias that is not a metric of the device (or node), or an unknown device
@@ -54,6 +54,9 @@ enum class CommandReject : std::uint8_t {
 };
 inline constexpr int kCommandRejects = 21;
 const char* toString(CommandReject r);  ///< "ok", "oversized", "not_json", ...
+
+/// The `user` of a payload that names none.
+inline constexpr const char* kDefaultCommandUser = "mqtt";
 
 struct CommandResult {
   CommandReject reject = CommandReject::None;

@@ -125,4 +125,12 @@ std::string shaftName(const std::string& prefix);
 /// digits, _ - . /; at most 64 characters) whose shaft name is usable in a topic.
 bool validChannelPrefix(const std::string& prefix, std::string* why = nullptr);
 
+/// "" if shafts named `a` and `b` can be bridged side by side, else why not
+/// (completing "'<prefix a>' and '<prefix b>' ..."): the same name; one's
+/// topic tree inside the other's (hoist/x/ and hoist/x/alarm/: the bridge
+/// never publishes inside another shaft's tree); or, with `sparkplug`, the
+/// same Sparkplug device id (a/1 and a_1).  Used by validate() for the
+/// configured prefixes and by discovery.
+std::string shaftNameClash(const std::string& a, const std::string& b, bool sparkplug);
+
 }  // namespace hoist::mqtt

@@ -85,9 +85,12 @@ class Journal {
   Journal& operator=(const Journal&) = delete;
 
   /// Opens (or creates) <dir>/journal.bin: `dir` is created if missing (one
-  /// level, mode 0750); it must be a writable directory and journal.bin, if
-  /// present, a regular file.  Throws JournalError naming the path otherwise.
-  /// A corrupt or truncated file is not an error: see the report.
+  /// level, mode 0750); it must be a writable directory owned by this
+  /// process's user, not a symbolic link and not writable by group or others
+  /// (ownDirectoryError), and journal.bin, if present, a regular file; the
+  /// file is kept mode 0600.  Throws JournalError naming the path (and the
+  /// directory's mode) otherwise.  A corrupt or truncated file is not an
+  /// error: see the report.
   JournalReport open(const std::string& dir, const JournalLimits& limits);
   bool isOpen() const { return fd_ >= 0; }
   /// Syncs (consumed marker, fdatasync) and closes.
@@ -131,6 +134,12 @@ class Journal {
   const std::string& lastError() const { return last_error_; }
   const std::string& path() const { return path_; }
   const JournalLimits& limits() const { return limits_; }
+
+  /// "" if `dir` is a directory of this process's user that group and
+  /// others cannot write (and not a symbolic link); else why not, naming
+  /// `dir` and its mode.
+  static std::string ownDirectoryError(const std::string& dir);
+  static constexpr unsigned kFileMode = 0600;  ///< journal.bin's mode
 
   /// Encodes one message record (prefix included); exposed for the tests.
   static std::string encodeMessage(const OutMsg& m, std::uint64_t seq, std::int64_t queued_utime);

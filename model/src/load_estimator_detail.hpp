@@ -1,0 +1,27 @@
+// The load estimator's internal constants, shared by load_estimator.cpp (the
+// filter) and load_estimator_finish.cpp (the tests and the estimate).  Not
+// installed: model/src only.
+#pragma once
+
+namespace hoist::estimator_detail {
+
+inline constexpr double kMaxSpecificForce = 100.0;  // |f_y| [m/s^2] a cage IMU can report
+inline constexpr double kMaxRate = 20.0;            // |omega| [rad/s]
+inline constexpr double kMaxRopeLoad = 1.0e8;       // |rope_load| [N]
+inline constexpr int kImuAccel = 0, kImuRate = 1, kRope = 2;
+// Time comparisons tolerate this much [s]: the same data timed by the CSV's t
+// (hoist-estimate) or by utime differences (the daemon) differ by an ulp.
+inline constexpr double kTimeEps = 1e-9;
+inline constexpr double kEnvelopeTime = 3.0;        // memory of the oscillation envelopes [s]
+inline constexpr double kStartTransientError = 0.1;  // rope-load model error after a start at a != 0, per N of m a
+inline constexpr double kJumpTransientError = 0.1;   // the same after a jump of a later on ...
+inline constexpr double kStepFoldTime = 60.0;      // a load change's step transient is followed this long [s]
+inline constexpr double kStepModelError = 0.2;     // relative model error of a step's transient (n = 25 against n = 100)
+inline constexpr double kMaxCatchUp = 2.0;         // the step solver catches up at most this much of the past [s]
+inline constexpr double kJumpTransientTime = 2.5;    // ... decaying faster (the shaft was steady before),
+inline constexpr double kRopeOscillationError = 0.07;  // the rope's oscillation, per N of m x_c'' (frequency error)
+inline constexpr double kJumpRefLength = 50.0;       // ... and less on a longer, softer rope (x 50 m / l)
+// (calibrated: n = 25 against n = 100 and 200, tests/model/load_estimator_test.cpp)
+inline constexpr double kStartTransientTime = 5.0;   // its decay time [s]
+
+}  // namespace hoist::estimator_detail
