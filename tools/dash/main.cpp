@@ -24,6 +24,7 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/bus/subscriber.hpp"
 #include "hoist/msg/codec.hpp"
+#include "src/condition.hpp"
 #include "src/credential.hpp"
 #include "src/hub.hpp"
 #include "src/server.hpp"
@@ -85,6 +86,8 @@ int main(int argc, char** argv) {
   double max_peer_rate = 30.0;
   std::string token_credential = "hoist-dash-token";
   std::size_t reserved = 4;
+  std::string history_url, history_config, history_shaft;
+  double history_poll = 2.0;
   app.add_option("--bind", bind, "address to listen on (default 127.0.0.1: this machine only)");
   app.add_option("--port", port, "TCP port (default 8080; 0 = any free port, printed at start-up)")
       ->check(CLI::Range(0, 65535));
@@ -133,6 +136,16 @@ int main(int argc, char** argv) {
                  "bound to loopback or to all addresses. Any other Host gets 403 (DNS rebinding)");
   app.add_option("--duration", duration, "stop after this many seconds (default: until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
+  // The "Shaft condition" view (src/condition.hpp, docs/dashboard.md).
+  app.add_option("--history", history_url,
+                 "trip history database, read only: a SQLite file (sqlite:///path or a path) or postgresql://...; "
+                 "enables the Shaft condition view (default: none, or --config's [history] url)");
+  app.add_option("--config", history_config,
+                 "hoist-twind's configuration: its [history] url (unless --history) and password, and its "
+                 "[condition] thresholds for the Shaft condition view");
+  app.add_option("--history-shaft", history_shaft, "the shaft's name in the history database (default: the default shaft, \"\")");
+  app.add_option("--history-poll", history_poll, "seconds between checks of the history database for new trips (default 2)")
+      ->check(CLI::Range(0.1, 3600.0));
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   try {
@@ -203,6 +216,20 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  std::unique_ptr<hoist::dash::ConditionView> condition;
+  if (!history_url.empty() || !history_config.empty()) {
+    hoist::dash::ConditionOptions co;
+    try {
+      co = hoist::dash::conditionOptions(history_url, history_config, history_shaft);
+    } catch (const std::exception& e) {  // std::invalid_argument, io::ConfigError: both name the option / key
+      std::fprintf(stderr, "hoist-dash: %s\n", e.what());
+      return 2;
+    }
+    co.poll_s = history_poll;
+    // A missing or bad database is not fatal: the view says why and the worker retries.
+    condition = std::make_unique<hoist::dash::ConditionView>(std::move(co));
+  }
+
   if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-dash", app.count("--lcm-url") > 0, url, hoist::bus::resolveLcmUrl(url)); !bad.empty()) { std::fprintf(stderr, "%s\n", bad.c_str()); return 2; }
   url = hoist::bus::resolveLcmUrl(url);
   lcm::LCM lcm(url);
@@ -258,6 +285,7 @@ int main(int argc, char** argv) {
                    token_credential, reserved);
   }
   hoist::dash::Server server(io, hub, *files, lim);
+  if (condition) server.setConditionProvider([&condition] { return condition->snapshot(); });
   try {
     server.listen({addr, static_cast<unsigned short>(port)});
   } catch (const boost::system::system_error& e) {

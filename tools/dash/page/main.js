@@ -20,6 +20,7 @@ import { chartSize, makeCharts, onHistory, onCage } from "./trends.js";
 import { onAlarm, onInstance, renderAlarms } from "./alarms.js";
 import { makeEstimateCard, onEstimate, drawEstimate } from "./estimate.js";
 import { renderHealth, renderForecast, drawShaft } from "./panels.js";
+import "./condition.js";  // the Shaft condition view (its own polling of /api/condition)
 
 // Subscribe the next queued history once the previous one has arrived.
 export function nextHistory() {

@@ -358,6 +358,16 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
       respond(http::status::ok, s.dump(), "application/json", req.keep_alive(), req.method() == http::verb::head);
       return;
     }
+    if (target == "/api/condition") {  // the "Shaft condition" view (condition.hpp)
+      if (!server_.conditionProvider()) {
+        hub.count("http_not_found");
+        respondError(http::status::not_found, "no history database (hoist-dash --history URL)", req.keep_alive());
+        return;
+      }
+      respond(http::status::ok, server_.conditionProvider()(), "application/json", req.keep_alive(),
+              req.method() == http::verb::head);
+      return;
+    }
     const StaticFile* f = nullptr;
     switch (server_.files().lookup(target, &f)) {
       case StaticFiles::Verdict::Found:

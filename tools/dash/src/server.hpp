@@ -1,7 +1,8 @@
 // hoist/dash server.hpp -- HTTP and WebSocket on one port with Boost.Beast.
 //
-// GET serves the page's files (StaticFiles) and /api/stats (the Hub's
-// counters as JSON); a WebSocket upgrade that offers the subprotocol
+// GET serves the page's files (StaticFiles), /api/stats (the Hub's
+// counters as JSON) and /api/condition (the Shaft condition view's snapshot,
+// setConditionProvider); a WebSocket upgrade that offers the subprotocol
 // foxglove.websocket.v1 becomes a protocol client of the Hub.  Everything runs
 // on the one io_context thread.  Limits: request header 8 KiB and no request
 // body, 30 s to send a request, at most `max_connections` WebSockets and twice
@@ -22,6 +23,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -83,6 +85,11 @@ class Server {
   void listen(const boost::asio::ip::tcp::endpoint& ep);
   unsigned short port() const;
   void stop();  ///< closes the acceptor and every connection
+  /// GET /api/condition answers with what `provider` returns (JSON text; it
+  /// runs on the I/O thread: it must not block, e.g. ConditionView::snapshot).
+  /// Unset: 404 naming --history.
+  void setConditionProvider(std::function<std::string()> provider) { condition_ = std::move(provider); }
+  const std::function<std::string()>& conditionProvider() const { return condition_; }
 
   // Used by the sessions.
   struct Conn {
@@ -142,6 +149,7 @@ class Server {
   Limits limits_;
   boost::asio::ip::tcp::acceptor acceptor_;
   std::set<Conn*> conns_;
+  std::function<std::string()> condition_;
   bool stopped_ = false;
   std::chrono::steady_clock::time_point log_window_{};
   std::size_t log_lines_ = 0, log_suppressed_ = 0;

@@ -9,6 +9,7 @@
 //   SparkplugSession sparkplug_session.hpp the edge node, STATE, births, DCMD/NCMD
 //   CommandGate     command_gate.hpp      operator commands: check, rate limit, forward, answer
 //   BridgeHealth    bridge_health.hpp     hoist/_bridge/<client_id>/health
+//   TripFeed        hoist/mqtt/trip_feed.hpp  [history]: hoist/<shaft>/trip/last, Condition/... metrics
 // (replay_check.hpp: what the bridge would publish now, for the journal's replay.)
 #include "hoist/mqtt/bridge.hpp"
 
@@ -26,6 +27,8 @@
 #include "bridge_health.hpp"
 #include "command_gate.hpp"
 #include "hoist/bus/channels.hpp"
+#include "hoist/history/config.hpp"
+#include "hoist/mqtt/trip_feed.hpp"
 #include "lcm_side.hpp"
 #include "mqtt_link.hpp"
 #include "replay_check.hpp"
@@ -67,6 +70,8 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
   ShaftData data{cfg, link, log};
   CommandGate gate{cfg, cfg.sparkplug, dir, data, lcm, link, log};
   std::unique_ptr<BridgeHealth> health;
+  std::unique_ptr<TripFeed> trips;               // [history] url set
+  std::map<std::string, std::string> trip_last;  // JSON mode: topic -> retained payload (republished on connect)
 
   Impl(const BridgeConfig& c, const std::string& password)
       : cfg(c),
@@ -91,6 +96,12 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
                                  [this](const Shaft& s, const hoist::forecast_t& m) { data.onForecast(s, m); });
     lcm.route<hoist::estimate_t>(hoist::bus::kChannelEstimate,
                                  [this](const Shaft& s, const hoist::estimate_t& m) { data.onEstimate(s, m); });
+    if (!cfg.history_url.empty()) {
+      history::HistoryConfig hc;
+      hc.url = cfg.history_url;  // absolute (config.cpp)
+      trips = std::make_unique<TripFeed>(history::resolveStoreOptions(hc, "", "history.url"), ConditionSettings{},
+                                         cfg.history_poll);
+    }
     dir.addConfigured();
     lcm.listen([this](const std::string& prefix) { return dir.resolve(prefix); });
   }
@@ -120,6 +131,7 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
                    s.name, s.prefix, cfg.sp_group_id, cfg.sp_edge_node_id, sparkplug::deviceId(s.name), origin);
       data.bound(s);
       sp->deviceBound(s.name);
+      if (trips) trips->watch(s.name);
       return;
     }
     spdlog::info("shaft '{}': LCM {}HOIST_{{CAGE,HEALTH,ALARM,FORECAST,ESTIMATE}} -> "
@@ -130,6 +142,7 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
                  origin);
     if (link.connected()) subscribeCommands(s);
     data.bound(s);
+    if (trips) trips->watch(s.name);
     // Discovered: bound on its daemon's health, which it has heard.
     if (!s.configured) requestAlarmStates(s, s.streak_instance);
   }
@@ -173,6 +186,22 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
     if (!lcm.publishAck(channel, m)) spdlog::warn("shaft '{}': cannot ask for its alarm states on {}", s.name, channel);
   }
 
+  /// A new last trip of a bound shaft (the trip feed): retained
+  /// hoist/<shaft>/trip/last (QoS 1), or the device's Condition/... metrics.
+  void publishTrip(const TripUpdate& u) {
+    bool bound = false;
+    for (const auto& [p, s] : dir.all()) bound = bound || (s.bound && s.name == u.shaft);
+    if (!bound) return;
+    if (sp) {
+      sp->metrics(u.shaft).onCondition(u.cond, hoist::bus::wallUtime());
+      sp->sendData(u.shaft, sparkplug::Source::Condition, MsgClass::Health);
+      return;
+    }
+    const std::string topic = "hoist/" + u.shaft + "/trip/last";
+    trip_last[topic] = u.last.dump();
+    link.publish({topic, trip_last[topic], 1, true, MsgClass::Health});
+  }
+
   // ---- the link's events ----
 
   void connected() override {
@@ -197,6 +226,7 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
     // twice (unless the journal had to drop alarm transitions).
     data.republishAlarms(dir, link.takeJournalAlarmLoss());
     link.clearJournaledAlarms();
+    for (const auto& [topic, payload] : trip_last) link.publish({topic, payload, 1, true, MsgClass::Health});
     publishHealth();
   }
 
@@ -258,6 +288,8 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
         next_cage += cage_period;
         if (next_cage < now) next_cage = now + cage_period;
       }
+      if (trips)
+        for (const auto& u : trips->take()) publishTrip(u);
       if (now >= next_health) {
         if (sp) {
           sp->healthTick();

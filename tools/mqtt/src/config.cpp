@@ -1,6 +1,10 @@
 // hoist-mqtt configuration: see hoist/mqtt/config.hpp.
 #include "hoist/mqtt/config.hpp"
 
+#include <filesystem>
+
+#include "hoist/history/config.hpp"
+
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -209,7 +213,7 @@ using hoist::io::SectionReader;
 
 /// The sections hoist-mqtt takes, in the order they are listed in errors.
 const std::vector<std::string>& sectionNames() {
-  static const std::vector<std::string> names{"broker", "tls", "bridge", "buffer", "sparkplug"};
+  static const std::vector<std::string> names{"broker", "tls", "bridge", "buffer", "sparkplug", "history"};
   return names;
 }
 
@@ -227,7 +231,7 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
   }
   auto str = [](std::string& out) { return [&out](const toml::node&, const std::string& v) { out = v; }; };
   SectionReader broker(root, "broker", source), tls(root, "tls", source), bridge(root, "bridge", source),
-      buffer(root, "buffer", source), sp(root, "sparkplug", source);
+      buffer(root, "buffer", source), sp(root, "sparkplug", source), history(root, "history", source);
   broker.string("url", str(c.url));
   broker.string("client_id", str(c.client_id));
   broker.integer("keepalive", c.keepalive);
@@ -295,8 +299,27 @@ void apply(const toml::table& root, const std::string& source, BridgeConfig& c) 
       c.sp_deadbands[std::string(k.str())] = d;
     }
   });
-  for (SectionReader* r : {&broker, &tls, &bridge, &buffer, &sp}) r->run();
-  const std::vector<const SectionReader*> readers{&broker, &tls, &bridge, &buffer, &sp};
+  history.on("url", [&history, &c, &source](const toml::node& n) {
+    const auto* v = n.as_string();
+    if (!v) history.fail(n, "url", "must be a string: a SQLite path or postgresql://...");
+    try {  // checked now (a password in it is refused); relative to the configuration's folder
+      const auto u = hoist::history::parseDatabaseUrl(v->get(), "history.url",
+                                                      std::filesystem::path(source).parent_path().string());
+      c.history_url = u.backend == hoist::history::Backend::Sqlite ? "sqlite://" + std::filesystem::absolute(u.target).string()
+                                                                   : v->get();
+    } catch (const std::invalid_argument& e) {
+      history.fail(n, "url", e.what());
+    }
+  });
+  history.on("poll_seconds", [&history, &c](const toml::node& n) {
+    const auto* f = n.as_floating_point();
+    const auto* i = n.as_integer();
+    const double v = f ? f->get() : i ? static_cast<double>(i->get()) : -1.0;
+    if (!(v >= 0.1 && v <= 3600.0)) history.fail(n, "poll_seconds", "must be a number of seconds in 0.1..3600");
+    c.history_poll = v;
+  });
+  for (SectionReader* r : {&broker, &tls, &bridge, &buffer, &sp, &history}) r->run();
+  const std::vector<const SectionReader*> readers{&broker, &tls, &bridge, &buffer, &sp, &history};
   applyCredentials(c);  // before the files are checked: a credential replaces an unreadable file
   try {
     c.validate();

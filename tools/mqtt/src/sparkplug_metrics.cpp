@@ -107,6 +107,15 @@ std::vector<MetricDef> makeDeviceMetrics() {
   add("Estimate/In Use", D::Boolean, "", E);
   add("Estimate/Mismatch", D::Boolean, "", E);
   add("Estimate/Sensors", D::Int32, "", E);
+  // From the history database's trips (hoist/mqtt/trip_feed.hpp), when
+  // [history] url is set; null until the first trip record.
+  const Source T = Source::Condition;
+  add("Condition/Last Trip", D::Int64, "", T);
+  add("Condition/Preload Scale", D::Double, "", T);
+  add("Condition/Preload Scale Sigma", D::Double, "", T);
+  add("Condition/Last Trip Informative", D::Boolean, "", T);
+  add("Condition/Trips In Trend", D::Int64, "", T);
+  add("Condition/Guide Preload Low", D::Int32, "", T);
   return m;
 }
 
@@ -360,6 +369,17 @@ void DeviceMetrics::onEstimate(const hoist::estimate_t& m) {
   setB("Estimate/In Use", m.in_use, u);
   setB("Estimate/Mismatch", m.mismatch, u);
   setI("Estimate/Sensors", m.sensors, u);
+}
+
+void DeviceMetrics::onCondition(const ConditionValues& c, std::int64_t utime) {
+  setI("Condition/Last Trip", c.last_trip, utime);
+  std::size_t i = 0;
+  // Before an informative trip the combined estimate means nothing: null.
+  if (byName("Condition/Preload Scale", &i)) set(i, c.valid ? valD(c.preload_scale) : Value{}, utime);
+  if (byName("Condition/Preload Scale Sigma", &i)) set(i, c.valid ? valD(c.preload_sigma) : Value{}, utime);
+  setB("Condition/Last Trip Informative", c.last_informative, utime);
+  setI("Condition/Trips In Trend", c.trips_in_trend, utime);
+  setI("Condition/Guide Preload Low", c.guide_preload_low, utime);
 }
 
 bool DeviceMetrics::setAlarm(const std::string& kind, int level, bool active, bool acked, bool shelved,

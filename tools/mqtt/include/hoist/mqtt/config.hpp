@@ -88,7 +88,11 @@ struct BridgeConfig {
   std::string sp_edge_node_id;         ///< edge node id (required when enabled)
   std::string sp_primary_host_id;      ///< "" = no primary host; else wait for its STATE online before births
   double sp_deadband = 0.0;            ///< default deadband of every numeric device metric (in its units)
-  std::map<std::string, double> sp_deadbands;  ///< per metric name (hoist/mqtt/sparkplug_metrics.hpp)
+  std::map<std::string, double> sp_deadbands;
+  // [history]: the trip records' database, read-only (hoist/mqtt/trip_feed.hpp):
+  // retained hoist/<shaft>/trip/last and the Sparkplug Condition/... metrics.
+  std::string history_url;    ///< "" = no trip feed; SQLite path (relative to the config) or postgresql://
+  double history_poll = 5.0;  ///< seconds between checks for a new trip, 0.1..3600  ///< per metric name (hoist/mqtt/sparkplug_metrics.hpp)
 
   bool wantsTls() const;
   /// Throws std::invalid_argument("section.key: reason").

@@ -12,6 +12,12 @@
 //   Alarms/<KIND>/{Ack,Shelve,Unshelve}  writable by DCMD (the only writable ones)
 //   Forecast/...  from <prefix>HOIST_FORECAST (the summary over its scenarios)
 //   Estimate/...  from <prefix>HOIST_ESTIMATE (null until the first estimate)
+//   Condition/... from the history database's trip records ([history] url,
+//                 hoist/mqtt/trip_feed.hpp): Last Trip, Preload Scale and its
+//                 Sigma (the trend's combined estimate; null before an
+//                 informative trip), Last Trip Informative, Trips In Trend,
+//                 Guide Preload Low (0 none, 1 WARNING, 2 CRITICAL); null
+//                 until the first trip record
 // A metric with no value yet is born with is_null.  DDATA carries the metrics
 // of one source whose value changed by more than their deadband
 // ([sparkplug] deadband, [sparkplug.deadbands]; 0 = any change) since it was
@@ -39,7 +45,7 @@ enum class DataType : std::uint32_t {
 bool isNumeric(DataType t);
 const char* typeName(DataType t);  ///< "Int64", "Double", ...
 
-enum class Source : std::uint8_t { Node, Cage, Health, Alarm, Forecast, Estimate, Command };
+enum class Source : std::uint8_t { Node, Cage, Health, Alarm, Forecast, Estimate, Command, Condition };
 
 struct MetricDef {
   std::string name;
@@ -53,6 +59,16 @@ struct MetricDef {
 const std::vector<MetricDef>& deviceMetrics();
 const MetricDef* findDeviceMetric(std::string_view name);
 std::vector<std::string> deviceMetricNames();
+
+/// The Condition/... metrics' values (hoist::mqtt::ConditionMetrics as the
+/// trip feed reads them; no dependency on the history library here).
+struct ConditionValues {
+  bool valid = false;
+  double preload_scale = 1.0, preload_sigma = -1.0;
+  bool last_informative = false;
+  std::int64_t trips_in_trend = 0, last_trip = 0;
+  int guide_preload_low = 0;
+};
 
 /// A metric value.  Integers of every width in `i`, Float/Double in `d`.
 struct Value {
@@ -107,6 +123,8 @@ class DeviceMetrics {
   void onHealth(const hoist::health_t& m);
   void onForecast(const hoist::forecast_t& m);
   void onEstimate(const hoist::estimate_t& m);
+  /// A new trip record of this shaft (the trip feed); utime = its arrival.
+  void onCondition(const ConditionValues& c, std::int64_t utime);
   /// The state of alarm `kind` (an alarm_t kind name; other kinds are ignored:
   /// false).  level 0..2 = the highest active, unshelved level.
   bool setAlarm(const std::string& kind, int level, bool active, bool acked, bool shelved, std::int64_t utime);
