@@ -64,7 +64,7 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 struct Options {
   std::string config, profile = "paper", out, shape_out, shape_times = "18,36,60", write_profile;
-  double dt = 0.01, max_step = 0.0025, t_end = -1.0, rho_inf = -1.0;
+  double dt = 0.01, max_step = hoist::kDefaultMaxStep, t_end = -1.0, rho_inf = -1.0;
   double estop_at = std::nan(""), estop_decel = 3.0, estop_jerk = 10.0;
   int modes = 0, shape_points = 401;
   std::string initial, method = "fast", static_correction;
