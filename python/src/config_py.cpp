@@ -9,6 +9,7 @@
 #include "hoist/history/config.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/io/error.hpp"
+#include "hoist/profile.hpp"
 
 namespace py = pybind11;
 
@@ -120,7 +121,7 @@ Config makeConfig(toml::table tbl, std::string source) {
   io::estimatorConfigFromToml(tbl, source);  // [sensors]/[estimator] errors now, not at estimate()
   history::conditionSettingsFromToml(tbl, source);  // [condition]: now, not at record_trips()
   history::historyConfigFromToml(tbl, source);
-  io::serviceMaxStep(tbl, source, 0.0025);
+  io::serviceMaxStep(tbl, source, kDefaultMaxStep);
   c.tbl = std::move(tbl);
   c.source = std::move(source);
   return c;
@@ -217,7 +218,7 @@ std::string toTomlText(const Config& c) {
 }  // namespace
 
 io::EstimatorConfig Config::estimator() const { return io::estimatorConfigFromToml(tbl, source); }
-double Config::serviceMaxStep() const { return io::serviceMaxStep(tbl, source, 0.0025); }
+double Config::serviceMaxStep() const { return io::serviceMaxStep(tbl, source, kDefaultMaxStep); }
 
 void bindConfig(py::module_& m) {
   py::class_<Config>(m, "Config", "A shaft configuration (the TOML of hoist-sim, hoist-estimate and hoist-twind).")

@@ -26,7 +26,7 @@ struct Config {
 
   /// The [sensors]/[estimator] settings (validated at load and on set()).
   io::EstimatorConfig estimator() const;
-  /// hoist-estimate's default substep: [service] max_step, else 0.0025 s.
+  /// hoist-estimate's default substep: [service] max_step, else kDefaultMaxStep (0.0025 s).
   double serviceMaxStep() const;
 };
 

@@ -1,5 +1,5 @@
-// ShaftContext: what every room of one hosted shaft shares (shaft_twin.hpp
-// draws the rooms): the configuration, the names, the log, the model
+// ShaftContext: what every room of one hosted shaft shares (the rooms:
+// docs/architecture.md): the configuration, the names, the log, the model
 // (TwinCore), the statistics and the shaft's wall clock.  Plain data plus
 // two clock helpers; the rooms hold a reference to it.
 #pragma once

@@ -1,34 +1,8 @@
 // ShaftTwin: one shaft hosted by hoist-twind.  A small class that wires the
-// shaft's rooms together; each room does one job:
-//
-//   ShaftContext       shaft_context.hpp       what the rooms share: config, channel names, log,
-//                                              the model (TwinCore), the statistics, the wall clock
-//   ShaftInputs        shaft_inputs.hpp        subscribe, decode, validate; winder samples, operator
-//                                              alarm commands, trip plans, our own health from others
-//   ShaftOutputs       shaft_outputs.hpp       preallocated messages, all-finite check, encode, publish
-//   ShaftHealth        shaft_health.hpp        statistics into HOIST_HEALTH, final log lines, run
-//                                              figures, resident memory
-//   ForecastScheduler  forecast_scheduler.hpp  look-ahead forecasts: plan in force, snapshots, results
-//
-// Arrows run one way: ShaftInputs -> ForecastScheduler -> ShaftOutputs, and
-// every room -> ShaftContext; ShaftHealth reads the context only.
-//
-// Where new things go:
-//   * a new INPUT channel (e.g. HOIST_CAGE_IMU, HOIST_ROPE_LOAD): its name in
-//     msgs/include/hoist/bus/channels.hpp, one row in ShaftInputs::routes_
-//     and one handle*() there that decodes and validates it and hands the
-//     sample to the room that uses it (never math in ShaftInputs);
-//   * a new OUTPUT message (e.g. HOIST_ESTIMATE): its preallocated message,
-//     buffer and one publish*() in ShaftOutputs (hoist::msg::allFinite covers it);
-//   * a new job (e.g. an estimator): its own room (class, files, one-line
-//     comment per field) owned here beside the others, constructed after
-//     ShaftOutputs, called from tick() or from its input handler; its
-//     counters go into ShaftStats (shaft_stats.hpp);
-//   * a new ALARM: its kind in the contract (msgs/contract, the alarm
-//     vocabulary), one row in the slot table of AlarmEngine
-//     (service/src/alarms.cpp), its setter there, its text in
-//     describeAlarm (service/src/messages.cpp); the room that detects the
-//     condition calls the setter through TwinCore.
+// shaft's rooms together (ShaftContext, ShaftInputs, ShaftOutputs,
+// ShaftHealth, ForecastScheduler); each room does one job.  The rooms, the
+// arrows between them and where a new channel, message, job or alarm goes
+// are in the one map, docs/architecture.md ("The daemon's rooms").
 //
 // The Daemon owns the io_context, the LCM instance and the schedule; it
 // calls the input handlers from its receive path (subscribed in

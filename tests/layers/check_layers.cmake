@@ -1,5 +1,5 @@
-# check_layers.cmake -- the two main layer rules of the README's Development
-# section, run as a CTest test (tests/layers/CMakeLists.txt):
+# check_layers.cmake -- the layer rules of docs/architecture.md ("The rules,
+# and which are checked"), run as a CTest test (tests/layers/CMakeLists.txt):
 #   1. hoist_model links nothing but Eigen (MODEL_LINKS: its LINK_LIBRARIES and
 #      INTERFACE_LINK_LIBRARIES, '|'-separated, read at configure time);
 #   2. nothing under service/ or io/ includes a header from tools/: no include

@@ -12,7 +12,7 @@
 // --config: a shaft TOML or hoist-twind's configuration ([service],
 // [alarms], [forecast], [sensors], [estimator] are accepted; [estimator]
 // enabled is not needed here).  The substep length is --max-step, else the
-// file's [service] max_step, else 0.0025 s (the daemon's default), so that
+// file's [service] max_step, else hoist::kDefaultMaxStep (0.0025 s, the daemon's default), so that
 // the live and offline estimators agree.  The NIS window is sized for the
 // file's rate: [estimator] max_rate is raised to the fastest row rate when
 // that is higher (the daemon sizes it for its own rate).
@@ -42,6 +42,7 @@
 #include "hoist/io/profile.hpp"
 #include "hoist/io/results.hpp"
 #include "hoist/load_estimator.hpp"
+#include "hoist/profile.hpp"
 
 namespace {
 
@@ -162,7 +163,7 @@ int run(const Options& o) {
   const toml::table tbl = hoist::io::loadTomlFile(o.config);
   hoist::ShaftParams p = hoist::io::shaftParamsFromToml(tbl, o.config, hoist::io::daemonSections());
   const hoist::io::EstimatorConfig ec = hoist::io::estimatorConfigFromToml(tbl, o.config);
-  const double max_step = o.max_step >= 0.0 ? o.max_step : hoist::io::serviceMaxStep(tbl, o.config, 0.0025);
+  const double max_step = o.max_step >= 0.0 ? o.max_step : hoist::io::serviceMaxStep(tbl, o.config, hoist::kDefaultMaxStep);
   if (o.modes != 0) p.n = o.modes;
   try {
     p.validate();

@@ -45,6 +45,7 @@
 // unless --lenient -- the log had corrupt regions (bytes skipped, events
 // lost) or events that carry a hoist fingerprint but fail the checked decode;
 // 2 for a bad command line.
+#include "hoist/cli/app.hpp"
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <cstdint>
@@ -374,9 +375,7 @@ int main(int argc, char** argv) {
       "(as hoist-sim writes them).  Corrupted events are skipped (resynchronising on\n"
       "the next event) and reported; the exit status is then 1 unless --lenient.\n"
       "Exit status: 0 ok, 1 unreadable log / unwritable file / data lost, 2 bad usage."};
-  app.name("hoist-log2csv");  // usage lines name the program, not the path it was run by
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-log2csv ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-log2csv");
   std::string log_path, out_dir;
   bool lenient = false;
   // Required, but checked after parsing: CLI11 reports a missing LOGFILE
@@ -385,12 +384,7 @@ int main(int argc, char** argv) {
   app.add_option("--out-dir", out_dir, "output directory (created if missing; required)");
   app.add_flag("--lenient", lenient,
                "exit 0 even when corrupt events were skipped or events failed to decode");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   for (const auto& [given, what] : {std::pair{!log_path.empty(), "LOGFILE"}, std::pair{!out_dir.empty(), "--out-dir"}})
     if (!given) {
       std::cerr << "hoist-log2csv: " << what << " is required\nRun with --help for more information.\n";

@@ -39,6 +39,7 @@
 // are network strings too (terminalSafe, at most 24 bytes shown), and at
 // most forecast_t.MAX_SCENARIOS scenarios are shown (the checked decoder
 // rejects more).
+#include "hoist/cli/app.hpp"
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <unistd.h>
@@ -299,9 +300,7 @@ int main(int argc, char** argv) {
       "with HOIST_FORECAST, per scenario the worst forecast clearance and the time to violation\n"
       "(seconds to the first CRITICAL / WARNING crossing); with HOIST_ESTIMATE, the estimated\n"
       "load (Fa, b with their sigmas), theta estimated and open loop, the NIS and MODEL_MISMATCH."};
-  app.name("hoist-monitor");  // usage lines name the program, not the path it was run by
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-monitor ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-monitor");
   std::string url, prefix;
   double period = 1.0, duration = 0.0;
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
@@ -315,12 +314,7 @@ int main(int argc, char** argv) {
   bool no_forecast = false;
   app.add_flag("--no-forecast", no_forecast,
                "no forecast line under each line (the look-ahead's scenarios; scripts/demo.sh shows none)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-monitor", app.count("--lcm-url") > 0, url,
                                                             hoist::bus::resolveLcmUrl(url));
       !bad.empty()) {

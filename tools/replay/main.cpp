@@ -45,6 +45,7 @@
 //
 // --timing-test: an alias of hoist-timing-test (timing_cli.hpp), the
 // soft-real-time check of a running hoist-twind.
+#include "hoist/cli/app.hpp"
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <time.h>
@@ -145,9 +146,7 @@ int main(int argc, char** argv) {
       "a synthetic hoist profile, a profile CSV or an LCM log, in real time or at --speed X.\n"
       "With no source it plays the paper's trapezoid (Fig. 2: 50 m -> 300 m, 60 s).\n"
       "--timing-test ... runs hoist-timing-test (the real-time check of a running hoist-twind)."};
-  app.name("hoist-replay");  // usage lines name the program, not the path it was run by
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-replay ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-replay");
   std::string profile_arg, log_path, url, config_path;
   std::vector<std::string> prefixes;
   double speed = 1.0, rate = 100.0;
@@ -189,7 +188,7 @@ int main(int argc, char** argv) {
                  "played as S seconds (default 10)")
       ->check(numberIn(0.0, 1e6, false, "in [0, 1e6] s"));
   app.add_flag("-q,--quiet", quiet, "no progress display");
-  if (const auto rc = hoist::replay::parseCommandLine(app, argc, argv)) return *rc;
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
 
   if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-replay", app.count("--lcm-url") > 0, url,
                                                             hoist::bus::resolveLcmUrl(url));

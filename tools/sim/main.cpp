@@ -25,6 +25,7 @@
 // Exit status: 0 done, 2 bad input (config, profile, options), 1 the run
 // failed (non-finite or implausible state -- the message names the time, the
 // quantity and its value --, write error, out of memory).
+#include "hoist/cli/app.hpp"
 #include "hoist/version.hpp"
 #include <unistd.h>
 
@@ -64,7 +65,7 @@ double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>
 
 struct Options {
   std::string config, profile = "paper", out, shape_out, shape_times = "18,36,60", write_profile;
-  double dt = 0.01, max_step = 0.0025, t_end = -1.0, rho_inf = -1.0;
+  double dt = 0.01, max_step = hoist::kDefaultMaxStep, t_end = -1.0, rho_inf = -1.0;
   double estop_at = std::nan(""), estop_decel = 3.0, estop_jerk = 10.0;
   int modes = 0, shape_points = 401;
   std::string initial, method = "fast", static_correction;
@@ -518,9 +519,7 @@ int main(int argc, char** argv) {
       "Writes t,l,v,a,x_c,y_c,theta,lambda_0..lambda_4 per output step.\n"
       "Also: 'hoist-sim study NAME ...' runs the paper's parameter studies (hoist-study --help).",
       "hoist-sim"};
-  app.name("hoist-sim");  // usage lines name the program, not the path it was run by
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-sim ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-sim");
   app.add_option("--config", o.config, "shaft TOML; missing keys take the paper's values (--print-config lists every key)")
       ->check(CLI::ExistingFile);
   app.add_option("--profile", o.profile, std::string("hoist profile CSV or SPEC (default: paper)\n") +
@@ -582,12 +581,7 @@ int main(int argc, char** argv) {
                "minutes: add --progress)");
   app.add_flag("--progress", o.progress,
                "show progress on stderr even with -q or without a terminal (then one line per 10 %)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   for (int i = 0; i < argc; ++i) {
     if (i) g_command_line += ' ';
     g_command_line += i == 0 ? std::string("hoist-sim") : std::string(argv[i]);

@@ -25,7 +25,7 @@ struct Common {
   std::string profile;
   int modes = 0;
   double dt = 0.01;
-  double max_step = 0.0025;
+  double max_step = kDefaultMaxStep;
   std::string initial = "config";  // as hoist-sim: model.initial unless given
   std::string static_correction;  // "" -> off for the paper's studies, config (default on) for sweep/advise
   int jobs = 0;

@@ -10,6 +10,7 @@
 //
 // Exit status: 0 success, 1 a run failed or a file could not be written,
 // 2 usage or configuration error, 3 (advise) target infeasible in the range.
+#include "hoist/cli/app.hpp"
 #include "hoist/version.hpp"
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -38,9 +39,7 @@ int main(int argc, char** argv) {
       "frequencies of y_c/theta/lambda_1 in the uniform-velocity and deceleration/rest stages) and\n"
       "PNG figures rendered by gnuplot (with the .gp script next to each PNG).\n"
       "Exit status: 0 ok, 1 run or file failure, 2 usage/config error, 3 advise: infeasible."};
-  app.name("hoist-study");  // usage lines name the program, not the path it was run by
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-study ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-study");
   app.require_subcommand(1, 1);
   app.fallthrough(false);
   Common c;
@@ -101,12 +100,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
 
   // The paper's studies reproduce its figures: the paper's truncation unless asked otherwise.
   if (c.static_correction.empty() && !advise->parsed() && !sweep->parsed()) c.static_correction = "off";

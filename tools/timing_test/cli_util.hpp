@@ -1,10 +1,9 @@
 // cli_util.hpp -- small command-line helpers shared by hoist-replay and
-// hoist-timing-test.
+// hoist-timing-test (the parse itself: hoist/cli/app.hpp, every program's).
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <cmath>
-#include <optional>
 #include <string>
 
 namespace hoist::replay {
@@ -48,18 +47,6 @@ inline CLI::Validator numberIn(double lo, double hi, bool lo_open, const std::st
         return std::string();
       },
       "NUMBER");
-}
-
-/// Parse the command line; on --help or an error, the exit status to return
-/// (0 for --help, 2 for a usage error, after CLI11 printed the message).
-inline std::optional<int> parseCommandLine(CLI::App& app, int argc, char** argv) {
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
-  return std::nullopt;
 }
 
 }  // namespace hoist::replay

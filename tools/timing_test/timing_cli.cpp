@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "cli_util.hpp"
+#include "hoist/cli/app.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/io/daemon_shaft.hpp"
 #include "hoist/bus/channels.hpp"
@@ -60,9 +61,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
                "for --duration, listens to its HOIST_HEALTH and HOIST_CAGE, and judges deadline misses, tick\n"
                "lateness, step time, end-to-end latency and rejected inputs against budgets (see the end)."};
   app.footer(kTimingHelp);
-  app.name(program);
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", program + " " + hoist::kVersionString);
+  hoist::cli::nameProgram(app, program);
   std::string url, config_path, report_path;
   std::vector<std::string> prefixes;
   double rate = 100.0, duration = 60.0, health_timeout = 5.0;
@@ -103,7 +102,7 @@ int timingTestMain(int argc, char** argv, const std::string& program) {
   budget("--max-e2e-p99-us", b_e2e_p99, "budget: end-to-end latency p99, input publish -> cage output received [us]");
   budget("--max-rejected", budgets.max_rejected, "budget: inputs rejected by the daemon (default 0)");
   app.add_option("--report", report_path, "also write the Markdown report to FILE");
-  if (const auto rc = parseCommandLine(app, argc, argv)) return *rc;
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   for (const auto& [opt, given, value, resolved] :
        {std::tuple{"--lcm-url", app.count("--lcm-url") > 0, url, hoist::bus::resolveLcmUrl(url)},
         std::tuple{"--lcm-url-out", app.count("--lcm-url-out") > 0, url_out, url_out}})

@@ -9,7 +9,7 @@
 // against budgets (evaluate) and written as Markdown (formatReport).
 //
 // evaluate() and formatReport() are pure (timing_report.cpp, unit-tested);
-// runTimingTest() does the LCM work (timing_test.cpp).
+// runTimingTest() does the LCM work (timing_run.cpp).
 #pragma once
 
 #include <cstdint>

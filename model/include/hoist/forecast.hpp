@@ -29,6 +29,7 @@
 #include "hoist/clearance.hpp"
 #include "hoist/fast_solver.hpp"
 #include "hoist/guide_rope_envelope.hpp"
+#include "hoist/profile.hpp"
 #include "hoist/scenario.hpp"
 
 namespace hoist {
@@ -36,7 +37,7 @@ namespace hoist {
 struct ForecastOptions {
   double horizon = 20.0;     ///< [s] ([forecast] horizon)
   double dt = 0.01;          ///< output step [s]: the daemon's tick, 1 / [service] rate
-  double max_step = 0.0025;  ///< largest integration substep [s] ([service] max_step; 0: dt itself)
+  double max_step = kDefaultMaxStep;  ///< largest integration substep [s] ([service] max_step; 0: dt itself)
   int envelope_points = 401; ///< guide-rope depth samples ([service] envelope_points)
   int series_points = 50;    ///< decimated series length, 1..ForecastSummary::kMaxSeries
   /// Modes per rope of the forecast's own model (0: the model's n, the exact

@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "hoist/load_estimator.hpp"
+#include "hoist/profile.hpp"
 #include "hoist/trip_record.hpp"
 
 namespace hoist {
@@ -53,7 +54,7 @@ namespace hoist {
 struct PreloadFitOptions {
   double max_sigma = 0.1;           ///< [condition] max_sigma: informative when sigma(s) <= this
   double accel_offset_sigma = 0.0;  ///< prior sigma of the IMU's offset [m/s^2]; 0: calibrated, not fitted
-  double max_step = 0.0025;         ///< largest solver step [s] (the twin's)
+  double max_step = kDefaultMaxStep;  ///< largest solver step [s] (the twin's)
   int max_iterations = 4;           ///< local parabolas at most (up to three solver runs each)
 };
 

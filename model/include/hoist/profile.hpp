@@ -41,6 +41,12 @@ double integrateLength(double l0, double v0, double a0, double v1, double a1, do
 /// than `limit` substeps would be needed (never clamps in silence).
 int substepCount(double interval, double max_step, int limit = 1000000);
 
+/// The default largest integration substep [s] of every program: hoist-sim's
+/// --max-step, hoist-twind's [service] max_step (both clock modes),
+/// hoist-estimate's and hoist-study's, the forecast's and the preload
+/// identification's: 4 substeps per 10-ms output step.  The one place it is written.
+inline constexpr double kDefaultMaxStep = 0.0025;
+
 struct ProfileSample {
   double t = 0.0;
   Kinematics k;

@@ -20,7 +20,7 @@ namespace hoist::io {
 /// and negative/zero sentinels mean "as the configuration says".
 struct SimRunOptions {
   double dt = 0.01;             ///< --dt, output step [s]
-  double max_step = 0.0025;     ///< --max-step [s], 0: integrate with dt
+  double max_step = kDefaultMaxStep;  ///< --max-step [s], 0: integrate with dt
   double t_end = -1.0;          ///< --t-end [s], < 0: the profile's end
   double rho_inf = -1.0;        ///< --rho-inf, < 0: model.rho_inf
   int modes = 0;                ///< --modes, 0: model.modes

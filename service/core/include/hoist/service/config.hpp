@@ -12,6 +12,7 @@
 
 #include "hoist/load_estimator.hpp"
 #include "hoist/params.hpp"
+#include "hoist/profile.hpp"
 #include "hoist/service/alarms.hpp"
 
 namespace hoist::svc {
@@ -45,7 +46,7 @@ struct ServiceConfig {
   /// 0 = off (stale_timeout only).  --clock input always uses stale_timeout.
   double stale_periods = 3.0;
   double stale_min = 0.02;      ///< floor of the period-relative timeout [s]
-  double max_step = 0.0025;     ///< largest integration step: longer ticks/input intervals are substepped [s]; 0 = off (same default as hoist-sim)
+  double max_step = kDefaultMaxStep;  ///< largest integration step: longer ticks/input intervals are substepped [s]; 0 = off (same default as hoist-sim)
   int shape_points = 101;       ///< depth samples in HOIST_GUIDE_SHAPE, [2, 2001]
   int envelope_points = 401;    ///< depth samples for the guide-rope deflection alarm, [2, 20001]
   /// The deflection alarm's envelope may be a conservative bound at most
