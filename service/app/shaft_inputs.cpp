@@ -385,19 +385,26 @@ void ShaftInputs::handleOwnAlarm(const lcm::ReceiveBuffer* rbuf) {
   if (at > n || !skipString() || !skipString()) return;
   at += 1;
   if (at + 8 > n) return;
-  otherPublisher(static_cast<std::int64_t>(readBe(b + at, 8)), ut, ctx_.ch.alarm);
+  // Our own events come back with an event id we have used; one with our
+  // instance id and an event id we have not used yet is a forger's copy.
+  const auto event_id = static_cast<std::int64_t>(readBe(b + 16, 8));
+  const auto id = static_cast<std::int64_t>(readBe(b + at, 8));
+  otherPublisher(id, ut, ctx_.ch.alarm, id == ctx_.instance_id && event_id >= out_.nextAlarmId());
 }
 
-void ShaftInputs::otherPublisher(std::int64_t id, std::uint64_t ut, const std::string& channel) {
+void ShaftInputs::otherPublisher(std::int64_t id, std::uint64_t ut, const std::string& channel, bool unpublished) {
   // Our own instance id with a utime far from our clock is not us: a
   // recording of this twin played back (lcm-logplayer) beside it, which
   // would mix old and new states in every client.
   const double skew = static_cast<double>(static_cast<std::int64_t>(ut) - bus::wallUtime()) * 1e-6;
   const bool replayed = id == ctx_.instance_id && std::abs(skew) > kReplaySkew;
-  if (id == ctx_.instance_id && !replayed) return;
+  if (id == ctx_.instance_id && !replayed && !unpublished) return;
   const double wall = ctx_.wallNow();
   if (!(other_seen_wall_ >= 0.0) || id != other_id_) {
-    if (replayed)
+    if (unpublished && !replayed)
+      ctx_.log.error("{}an alarm event with this twin's instance id {} that it never published on {} (event id "
+                     "beyond its last): somebody copies the instance id", ctx_.tag, id, channel);
+    else if (replayed)
       ctx_.log.error("{}a recording of this twin is being played on {} (our instance {}, utime {:.0f} s from our "
                      "clock): replay beside a live twin on another LCM URL or channel prefix", ctx_.tag,
                      channel, id, skew);

@@ -398,6 +398,7 @@ class HubClockTest : public HubTest {
              std::int64_t instance = 7) {
     alarm_t a{};
     a.instance_id = instance;  // the daemon whose health the hub follows (issue 33)
+    a.id = ++alarm_seq;        // its event number (+1 per event)
     a.utime = utime;
     a.kind = kind;
     a.level = 1;
@@ -409,6 +410,7 @@ class HubClockTest : public HubTest {
   }
   void advance(double s) { now_ns += static_cast<std::uint64_t>(s * 1e9); }
   std::uint64_t now_ns = 1'700'000'000'000'000'000ULL;
+  std::int64_t alarm_seq = 0;
 };
 
 TEST_F(HubClockTest, OneShotPrefixesAgeOutAndARealDaemonTakesTheirSlot) {
@@ -612,9 +614,10 @@ TEST_F(HubClockTest, ForgedAlarmClearAndImpostorHealthNeitherClearTheRowNorGoUnl
   hub.onClientText(c, Json{{"op", "subscribe"},
                            {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "north/HOIST_ALARM")}}}}}.dump());
   health(hub, "north/", 7);
-  auto alarmOn = [&](int event, bool active, bool acked, std::int64_t instance) {
+  auto alarmOn = [&](int event, bool active, bool acked, std::int64_t instance, std::int64_t id) {
     alarm_t a{};
     a.utime = 1000;
+    a.id = id;
     a.instance_id = instance;
     a.kind = "CAGE_POS_Y";
     a.level = 1;
@@ -624,12 +627,15 @@ TEST_F(HubClockTest, ForgedAlarmClearAndImpostorHealthNeitherClearTheRowNorGoUnl
     const auto b = encode(a);
     hub.onLcm("north/HOIST_ALARM", b.data(), b.size());
   };
-  alarmOn(alarm_t::EVENT_RAISE, true, false, 7);
-  ASSERT_EQ(c.data.size(), 1u);
-  alarmOn(alarm_t::EVENT_CLEAR, false, true, 8);  // forged: another instance
-  alarmOn(alarm_t::EVENT_CLEAR, false, true, 0);  // forged: no instance
-  EXPECT_EQ(c.data.size(), 1u) << "a forged CLEAR reached the clients";
+  alarmOn(alarm_t::EVENT_CLEAR, false, true, 7, 4);  // the daemon's event 4 (an earlier CLEAR)
+  alarmOn(alarm_t::EVENT_RAISE, true, false, 7, 5);
+  ASSERT_EQ(c.data.size(), 2u);
+  alarmOn(alarm_t::EVENT_CLEAR, false, true, 8, 6);  // forged: another instance
+  alarmOn(alarm_t::EVENT_CLEAR, false, true, 0, 6);  // forged: no instance
+  alarmOn(alarm_t::EVENT_CLEAR, false, true, 7, 4);  // the old CLEAR played back
+  EXPECT_EQ(c.data.size(), 2u) << "a forged CLEAR reached the clients";
   EXPECT_EQ(hub.counter("HOIST_ALARM_foreign_instance"), 2u);
+  EXPECT_EQ(hub.counter("HOIST_ALARM_old_event_id"), 1u);
   // An impostor's health under the same prefix while instance 7 talks: no
   // restart, no row cleared, its cage states dropped.
   advance(1.0);
@@ -641,7 +647,7 @@ TEST_F(HubClockTest, ForgedAlarmClearAndImpostorHealthNeitherClearTheRowNorGoUnl
   EXPECT_EQ(hub.counter("health_impostor"), 1u);
   EXPECT_EQ(hub.counter("HOIST_CAGE_foreign_instance"), 1u);
   EXPECT_EQ(hub.counter("daemon_restarts"), 0u);
-  EXPECT_EQ(c.data.size(), 1u);
+  EXPECT_EQ(c.data.size(), 2u);
   RecClient late;
   hub.addClient(late);
   hub.onClientText(late, Json{{"op", "subscribe"},

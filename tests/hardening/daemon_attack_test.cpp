@@ -221,9 +221,22 @@ TEST_F(DaemonAttack, AlarmEventOfAnotherInstanceOnItsOwnChannelRaisesDuplicatePu
   forged.instance_id = h.instance_id + 1;
   listener_->lcm().publish("HOIST_ALARM", &forged);
   EXPECT_TRUE(listener_->waitFor(duplicateRaised, 5s)) << "a forged alarm event went unnoticed";
+  // A forger who copies the instance id cannot use an event id the daemon has
+  // not used yet without being noticed (and clients drop old event ids).
+  forged.instance_id = h.instance_id;
+  forged.id = 1'000'000;
+  listener_->lcm().publish("HOIST_ALARM", &forged);
+  const auto until = std::chrono::steady_clock::now() + 5s;
+  while (readFile((dir_ / "twind.log").string()).find("that it never published") == std::string::npos &&
+         std::chrono::steady_clock::now() < until)
+    listener_->pump(100ms);
   stopDaemonCleanly(*d, (dir_ / "twind.log").string());
   const std::string log = readFile((dir_ / "twind.log").string());
   EXPECT_NE(log.find("another publisher (instance " + std::to_string(h.instance_id + 1) + ") on HOIST_ALARM"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("an alarm event with this twin's instance id " + std::to_string(h.instance_id) +
+                     " that it never published on HOIST_ALARM"),
             std::string::npos)
       << log;
 }

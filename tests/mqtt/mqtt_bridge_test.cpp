@@ -802,6 +802,8 @@ hoist::alarm_t alarmEvent(const std::string& kind, int event, bool active) {
   hoist::alarm_t a{};
   a.utime = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   a.instance_id = 4244;  // forgedHealth(4244) is sent first: the instance the bridge follows
+  static std::int64_t next_id = 0;
+  a.id = ++next_id;      // the daemon numbers its events (+1 each)
   a.kind = kind;
   a.level = hoist::alarm_t::LEVEL_WARNING;
   a.event_type = static_cast<std::int8_t>(event);
@@ -1247,6 +1249,7 @@ TEST_F(MqttBridge, DroppedAlarmTransitionsAreLoggedAndWarn) {
   for (int i = 0; i < 5; ++i) {
     hoist::alarm_t a{};
     a.instance_id = 4245;
+    a.id = i + 1;
     a.utime = std::chrono::duration_cast<std::chrono::microseconds>(
                   std::chrono::system_clock::now().time_since_epoch()).count();
     a.kind = "CAGE_POS_Y";
@@ -1322,6 +1325,10 @@ TEST_F(MqttBridge, ForgedAlarmClearAndImpostorHealthCostOnlyTheForger) {
   forged.user = "";
   forged.instance_id = real + 1;
   lcm.lcm().publish("north/HOIST_ALARM", &forged);
+  // With the copied instance id, an old event id (a replay of an old CLEAR).
+  forged.instance_id = real;
+  forged.id = 0;
+  lcm.lcm().publish("north/HOIST_ALARM", &forged);
   // The impostor's health, at 10 Hz for a second, under the real prefix.
   for (int i = 0; i < 10; ++i) {
     const auto h = forgedHealth(real + 2);
@@ -1336,7 +1343,9 @@ TEST_F(MqttBridge, ForgedAlarmClearAndImpostorHealthCostOnlyTheForger) {
     return false;
   }, 5s)) << readFile(log("bridge.log"));
   auto health = c.waitJson("hoist/_bridge/bridge-f/health", [](const json& j, bool) {
-    return j["lcm"]["foreign_instance"].value("HOIST_ALARM", 0) >= 1 && j["lcm"].value("impostor_health", 0) >= 1;
+    return j["lcm"]["foreign_instance"].value("HOIST_ALARM", 0) >= 1 &&
+           j["lcm"]["foreign_instance"].value("HOIST_ALARM_old_event_id", 0) >= 1 &&
+           j["lcm"].value("impostor_health", 0) >= 1;
   }, 5s);
   EXPECT_TRUE(health) << readFile(log("bridge.log"));
   const auto states = c.on("hoist/north/alarm/CAGE_POS_Y");
