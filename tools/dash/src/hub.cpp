@@ -676,7 +676,6 @@ void Hub::removePrefix(const std::string& prefix) {
   states_asked_.erase(prefix);
   instance_.erase(prefix);
   instance_last_ns_.erase(prefix);
-  last_alarm_id_.erase(prefix);
   decimators_.erase(prefix);
   estimate_decimators_.erase(prefix);
   history_.erase(prefix);

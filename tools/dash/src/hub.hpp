@@ -199,7 +199,6 @@ class Hub {
   bool request_states_ = false;  // requestAlarmStates() was called
   std::map<std::string, std::int64_t> instance_;      // prefix -> daemon instance followed (its latest accepted health)
   std::map<std::string, std::uint64_t> instance_last_ns_;  // prefix -> when that instance's health was last heard
-  std::map<std::string, std::pair<std::int64_t, std::int64_t>> last_alarm_id_;  // prefix -> (instance, event id) last accepted
   std::map<std::string, std::int64_t> states_asked_;  // prefix -> daemon instance asked (bounded by the prefixes)
   Publisher publish_;
   Clock clock_;

@@ -37,22 +37,6 @@ bool Hub::fromFollowedInstance(const std::string& prefix, const std::string& suf
   if (!j.contains("instance_id")) return true;  // a type without a sender (trip plans, guide shape)
   const std::int64_t instance = j.value("instance_id", std::int64_t{0});
   const auto it = instance_.find(prefix);
-  if (it != instance_.end() && it->second == instance && suffix == "HOIST_ALARM") {
-    // The daemon numbers its events (+1 each): an id not above the last one
-    // of this instance is an old event played back (an old CLEAR would clear
-    // the row).
-    const std::int64_t event_id = j.value("id", std::int64_t{0});
-    auto [last, fresh] = last_alarm_id_.emplace(prefix, std::make_pair(instance, event_id));
-    if (fresh || last->second.first != instance || event_id > last->second.second) {
-      last->second = {instance, event_id};
-      return true;
-    }
-    count("HOIST_ALARM_old_event_id");
-    if (logAllowed())
-      spdlog::warn("shaft '{}': dropped an alarm event with an old event id {} (last {}): a replay",
-                   msg::terminalSafe(shaftName(prefix), 64), event_id, last->second.second);
-    return false;
-  }
   if (it != instance_.end() ? it->second == instance : suffix != "HOIST_ALARM") return true;
   count(suffix + "_foreign_instance");
   if (logAllowed())

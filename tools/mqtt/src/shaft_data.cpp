@@ -104,20 +104,6 @@ void ShaftData::onAlarm(const Shaft& s, const hoist::alarm_t& m) {
   // Only the daemon whose health this shaft follows changes what SCADA sees
   // (issue 33: one forged CLEAR turned the retained alarm inactive).
   if (!admit(s, m.instance_id, "HOIST_ALARM", true)) return;
-  // The daemon numbers its events (+1 each, re-announces included): an event
-  // id not above the last one of that instance is a replay of an old event
-  // (an old CLEAR played back would clear the alarm): dropped, counted, logged.
-  Feed& fe = feed(s);
-  if (fe.alarm_instance == m.instance_id && m.id <= fe.last_alarm_id) {
-    const std::uint64_t n = ++foreign_["HOIST_ALARM_old_event_id"];
-    std::int64_t suppressed = 0;
-    if (log_.allow(LogBudget::kLcm, Clock::now(), suppressed))
-      spdlog::warn("shaft '{}': dropped an alarm event with an old event id {} (last {}): a replay ({} so far) "
-                   "[{} similar suppressed]", printable(s.name, 64), m.id, fe.last_alarm_id, n, suppressed);
-    return;
-  }
-  fe.alarm_instance = m.instance_id;
-  fe.last_alarm_id = m.id;
   if (!validKind(m.kind) || m.level < 1 || m.level > 2) {
     ++alarm_rejected_;
     std::int64_t suppressed = 0;

@@ -50,7 +50,6 @@ class ShaftData {
     bool estimate_new = false;
     bool alarms_settled = false;  // Sparkplug: alarm kinds never heard of are known inactive
     std::map<std::string, AlarmState> alarms;  // by kind
-    std::int64_t alarm_instance = 0, last_alarm_id = -1;  // the latest accepted event's instance and id
     std::uint64_t cage_in = 0, cage_out = 0, alarms_in = 0, forecasts_in = 0, estimates_in = 0, estimates_out = 0;
   };
 
