@@ -608,40 +608,27 @@ TEST_F(HubClockTest, ForgedAlarmClearAndImpostorHealthNeitherClearTheRowNorGoUnl
   auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log_text);
   auto old_logger = spdlog::default_logger();
   spdlog::set_default_logger(std::make_shared<spdlog::logger>("t", sink));
-  Hub hub = makeTimed({"north/"});
+  Hub hub = makeTimed({""});
   RecClient c;
   hub.addClient(c);
   hub.onClientText(c, Json{{"op", "subscribe"},
-                           {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "north/HOIST_ALARM")}}}}}.dump());
-  health(hub, "north/", 7);
-  auto alarmOn = [&](int event, bool active, bool acked, std::int64_t instance, std::int64_t id) {
-    alarm_t a{};
-    a.utime = 1000;
-    a.id = id;
-    a.instance_id = instance;
-    a.kind = "CAGE_POS_Y";
-    a.level = 1;
-    a.event_type = static_cast<std::int8_t>(event);
-    a.active = active;
-    a.acked = acked;
-    const auto b = encode(a);
-    hub.onLcm("north/HOIST_ALARM", b.data(), b.size());
-  };
-  alarmOn(alarm_t::EVENT_CLEAR, false, true, 7, 4);  // the daemon's event 4 (an earlier CLEAR)
-  alarmOn(alarm_t::EVENT_RAISE, true, false, 7, 5);
+                           {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "HOIST_ALARM")}}}}}.dump());
+  health(hub, "", 7);
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_CLEAR, 500, false, true, 7);  // an earlier CLEAR
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_RAISE, 1000, true, false, 7);
   ASSERT_EQ(c.data.size(), 2u);
-  alarmOn(alarm_t::EVENT_CLEAR, false, true, 8, 6);  // forged: another instance
-  alarmOn(alarm_t::EVENT_CLEAR, false, true, 0, 6);  // forged: no instance
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_CLEAR, 2000, false, true, 8);  // forged: another instance
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_CLEAR, 2000, false, true, 0);  // forged: no instance
   EXPECT_EQ(c.data.size(), 2u) << "a forged CLEAR reached the clients";
   EXPECT_EQ(hub.counter("HOIST_ALARM_foreign_instance"), 2u);
   // An impostor's health under the same prefix while instance 7 talks: no
   // restart, no row cleared, its cage states dropped.
   advance(1.0);
-  health(hub, "north/", 8);
+  health(hub, "", 8);
   cage_state_t cs{};
   cs.instance_id = 8;
   const auto cb = encode(cs);
-  hub.onLcm("north/HOIST_CAGE", cb.data(), cb.size());
+  hub.onLcm("HOIST_CAGE", cb.data(), cb.size());
   EXPECT_EQ(hub.counter("health_impostor"), 1u);
   EXPECT_EQ(hub.counter("HOIST_CAGE_foreign_instance"), 1u);
   EXPECT_EQ(hub.counter("daemon_restarts"), 0u);
@@ -649,7 +636,7 @@ TEST_F(HubClockTest, ForgedAlarmClearAndImpostorHealthNeitherClearTheRowNorGoUnl
   RecClient late;
   hub.addClient(late);
   hub.onClientText(late, Json{{"op", "subscribe"},
-                              {"subscriptions", {{{"id", 4}, {"channelId", channelId(late, "north/HOIST_ALARM")}}}}}.dump());
+                              {"subscriptions", {{{"id", 4}, {"channelId", channelId(late, "HOIST_ALARM")}}}}}.dump());
   ASSERT_EQ(late.data.size(), 1u);
   EXPECT_TRUE(Json::parse(late.data[0].substr(13))["active"].get<bool>()) << "the row is still active";
   spdlog::set_default_logger(old_logger);
