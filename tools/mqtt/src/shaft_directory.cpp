@@ -231,6 +231,10 @@ ShaftDirectory::HealthSeen ShaftDirectory::onHealth(const Shaft& cs, std::int64_
   s.last_health = now;
   if (!s.bound) {
     tryConfirm(s, now);
+    if (s.bound) {  // bound to the instance that confirmed it: its alarm states (asked for now) pass
+      s.instance_id = instance_id;
+      s.instance_last = now;
+    }
     return out;
   }
   out.bound = true;
