@@ -190,7 +190,7 @@ TEST_F(DaemonAttack, AlarmEventOfAnotherInstanceOnItsOwnChannelRaisesDuplicatePu
   // Issue 33: one forged alarm_t on HOIST_ALARM (a CLEAR from another
   // instance) is a second publisher of the daemon's outputs, as forged health
   // is.  Before: nothing noticed it.  The daemon's own alarm events (a shelve
-  // of every alarm: one event per slot) raise nothing.
+  // of CAGE_POS_Y: one event per level) raise nothing.
   start(7980, "forged_alarm");
   auto d = startDaemon({}, "twind.log");
   const hoist::health_t h = lastHealth();
@@ -201,7 +201,7 @@ TEST_F(DaemonAttack, AlarmEventOfAnotherInstanceOnItsOwnChannelRaisesDuplicatePu
     return false;
   };
   hoist::alarm_ack_t ack{};
-  ack.kind = "*";
+  ack.kind = "CAGE_POS_Y";
   ack.action = hoist::alarm_ack_t::ACTION_SHELVE;
   ack.shelve_duration = 60.0;
   ack.user = "op";
@@ -225,6 +225,7 @@ TEST_F(DaemonAttack, AlarmEventOfAnotherInstanceOnItsOwnChannelRaisesDuplicatePu
   // not used yet without being noticed (and clients drop old event ids).
   forged.instance_id = h.instance_id;
   forged.id = 1'000'000;
+  forged.utime = nowUs();
   listener_->lcm().publish("HOIST_ALARM", &forged);
   const auto until = std::chrono::steady_clock::now() + 5s;
   while (readFile((dir_ / "twind.log").string()).find("that it never published") == std::string::npos &&
