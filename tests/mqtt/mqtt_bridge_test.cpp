@@ -854,7 +854,11 @@ TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
   EXPECT_EQ((*r)["result"], "accepted");
   EXPECT_EQ((*r)["reason"], "forwarded");
   EXPECT_EQ((*r)["command"]["kind"], "CAGE_POS_Y");
-  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("west/HOIST_ALARM_ACK") == 1; }, 5s));
+  ASSERT_TRUE(lcm.waitFor([&] {
+    for (const auto& a : lcm.decoded<hoist::alarm_ack_t>("west/HOIST_ALARM_ACK"))
+      if (a.user == "op-ok") return true;
+    return false;
+  }, 5s));
 
   c.publish("hoist/west/cmd/ack", R"({"kind":"GUIDE_ROPE","level":0,"action":1,"user":"op-none"})");
   r = result("op-none");
