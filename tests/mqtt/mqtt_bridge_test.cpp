@@ -233,6 +233,8 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
     hoist::forecast_t f{};
     f.utime = 1;
     f.seq = 5;
+    // As the daemon (the bridge drops data of any other instance than the shaft's).
+    f.instance_id = lcm.decoded<hoist::health_t>("north/HOIST_HEALTH").back().instance_id;
     f.t_start = 20.0;
     f.plan_seq = -1;
     f.num_scenarios = 1;
