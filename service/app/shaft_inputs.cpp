@@ -8,6 +8,7 @@
 
 #include "forecast_scheduler.hpp"
 #include "hoist/alarm_ack_t.hpp"
+#include "hoist/alarm_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/contract/alarm_command.hpp"
 #include "hoist/service/messages.hpp"
@@ -25,6 +26,7 @@ ShaftInputs::ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, For
   routes_[kAck] = {this, &ctx_.ch.ack, &ShaftInputs::handleAck, "HOIST_ALARM_ACK"};
   routes_[kTripPlan] = {this, &ctx_.ch.trip_plan, &ShaftInputs::handleTripPlan, "HOIST_TRIP_PLAN"};
   routes_[kOwnHealth] = {this, &ctx_.ch.health, &ShaftInputs::handleOwnHealth, "HOIST_HEALTH"};
+  routes_[kOwnAlarm] = {this, &ctx_.ch.alarm, &ShaftInputs::handleOwnAlarm, "HOIST_ALARM"};
   routes_[kCageImu] = {this, &ctx_.ch.cage_imu, &ShaftInputs::handleCageImu, "HOIST_CAGE_IMU"};
   routes_[kRopeLoad] = {this, &ctx_.ch.rope_load, &ShaftInputs::handleRopeLoad, "HOIST_ROPE_LOAD"};
   text_[0] = '\0';
@@ -57,14 +59,20 @@ void ShaftInputs::subscribe(bus::InputRouter* router, bool own_health) {
   add(router, routes_[kWinder]);
   add(router, routes_[kAck]);
   if (forecast_) add(router, routes_[kTripPlan]);
-  if (own_health) add(router, routes_[kOwnHealth]);
+  if (own_health) {
+    add(router, routes_[kOwnHealth]);
+    add(router, routes_[kOwnAlarm]);
+  }
   if (ctx_.core.estimatorEnabled()) {
     add(router, routes_[kCageImu]);
     add(router, routes_[kRopeLoad]);
   }
 }
 
-void ShaftInputs::watchOwnOutputs(bus::InputRouter* router) { add(router, routes_[kOwnHealth]); }
+void ShaftInputs::watchOwnOutputs(bus::InputRouter* router) {
+  add(router, routes_[kOwnHealth]);
+  add(router, routes_[kOwnAlarm]);
+}
 
 void ShaftInputs::forgetSilentPublisher(double wall) {
   if (other_seen_wall_ >= 0.0 && wall - other_seen_wall_ > 3.0 / ctx_.cfg.service.health_rate) {
@@ -357,21 +365,68 @@ void ShaftInputs::handleOwnHealth(const lcm::ReceiveBuffer* rbuf) {
   for (int i = 8; i < 16; ++i) ut = (ut << 8) | b[i];
   for (int i = 16; i < 24; ++i) id = static_cast<std::int64_t>((static_cast<std::uint64_t>(id) << 8) | b[i]);
   if (fp != static_cast<std::int64_t>(hoist::health_t::getHash())) return;
+  otherPublisher(id, ut, ctx_.ch.health);
+}
+
+namespace {
+/// Big-endian integer of `n` bytes at `p`.
+std::uint64_t readBe(const std::uint8_t* p, int n) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < n; ++i) v = (v << 8) | p[i];
+  return v;
+}
+}  // namespace
+
+void ShaftInputs::handleOwnAlarm(const lcm::ReceiveBuffer* rbuf) {
+  // alarm_t's instance_id follows its strings: walk the encoding (no decode,
+  // no allocation) -- fingerprint, utime, id, t (4 x 8), kind (int32 length
+  // + bytes), level, event_type, active, acked, shelved, latched (6 x 1),
+  // value, threshold, shelved_for (3 x 8), message, user (strings),
+  // from_estimate (1), instance_id (8).  A message too short for that is not
+  // a daemon's alarm event: ignored (clients refuse it as undecodable).
+  const auto* b = static_cast<const std::uint8_t*>(rbuf->data);
+  const std::size_t n = rbuf->data_size;
+  if (n < 32 || readBe(b, 8) != static_cast<std::uint64_t>(hoist::alarm_t::getHash())) return;
+  const std::uint64_t ut = readBe(b + 8, 8);
+  std::size_t at = 32;
+  const auto skipString = [&]() {
+    if (at + 4 > n) return false;
+    const std::uint64_t len = readBe(b + at, 4);
+    if (len > n - at - 4) return false;
+    at += 4 + static_cast<std::size_t>(len);
+    return true;
+  };
+  if (!skipString()) return;
+  at += 6 + 24;
+  if (at > n || !skipString() || !skipString()) return;
+  at += 1;
+  if (at + 8 > n) return;
+  // Our own events come back with an event id we have used; one with our
+  // instance id and an event id we have not used yet is a forger's copy.
+  const auto event_id = static_cast<std::int64_t>(readBe(b + 16, 8));
+  const auto id = static_cast<std::int64_t>(readBe(b + at, 8));
+  otherPublisher(id, ut, ctx_.ch.alarm, id == ctx_.instance_id && event_id >= out_.nextAlarmId());
+}
+
+void ShaftInputs::otherPublisher(std::int64_t id, std::uint64_t ut, const std::string& channel, bool unpublished) {
   // Our own instance id with a utime far from our clock is not us: a
   // recording of this twin played back (lcm-logplayer) beside it, which
   // would mix old and new states in every client.
   const double skew = static_cast<double>(static_cast<std::int64_t>(ut) - bus::wallUtime()) * 1e-6;
   const bool replayed = id == ctx_.instance_id && std::abs(skew) > kReplaySkew;
-  if (id == ctx_.instance_id && !replayed) return;
+  if (id == ctx_.instance_id && !replayed && !unpublished) return;
   const double wall = ctx_.wallNow();
   if (!(other_seen_wall_ >= 0.0) || id != other_id_) {
-    if (replayed)
+    if (unpublished && !replayed)
+      ctx_.log.error("{}an alarm event with this twin's instance id {} that it never published on {} (event id "
+                     "beyond its last): somebody copies the instance id", ctx_.tag, id, channel);
+    else if (replayed)
       ctx_.log.error("{}a recording of this twin is being played on {} (our instance {}, utime {:.0f} s from our "
                      "clock): replay beside a live twin on another LCM URL or channel prefix", ctx_.tag,
-                     ctx_.ch.health, id, skew);
+                     channel, id, skew);
     else
-      ctx_.log.error("{}another publisher (instance {}) on {}: a second twin with the same channels? "
-                     "(this one is instance {})", ctx_.tag, id, ctx_.ch.health, ctx_.instance_id);
+      ctx_.log.error("{}another publisher (instance {}) on {}: a second twin with the same channels, or a forger? "
+                     "(this one is instance {})", ctx_.tag, id, channel, ctx_.instance_id);
   }
   other_id_ = id;
   other_seen_wall_ = wall;

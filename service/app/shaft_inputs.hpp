@@ -79,12 +79,18 @@ class ShaftInputs {
     /// The guarded entry point (LCM's callback signature).
     void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   };
-  enum RouteId { kWinder, kAck, kTripPlan, kOwnHealth, kCageImu, kRopeLoad, kRoutes };
+  enum RouteId { kWinder, kAck, kTripPlan, kOwnHealth, kOwnAlarm, kCageImu, kRopeLoad, kRoutes };
 
   void handleWinder(const lcm::ReceiveBuffer* rbuf);
   void handleAck(const lcm::ReceiveBuffer* rbuf);
   void handleTripPlan(const lcm::ReceiveBuffer* rbuf);
   void handleOwnHealth(const lcm::ReceiveBuffer* rbuf);
+  void handleOwnAlarm(const lcm::ReceiveBuffer* rbuf);  // alarm events of another instance on our HOIST_ALARM
+  /// Instance `id` (utime `ut` [us]) published on our output `channel`:
+  /// unless it is us, raise DUPLICATE_PUBLISHER and log the first message.
+  /// `unpublished`: an alarm event with our own id that we never published
+  /// (its event id not yet used): a forger who copied the id.
+  void otherPublisher(std::int64_t id, std::uint64_t ut, const std::string& channel, bool unpublished = false);
   void handleCageImu(const lcm::ReceiveBuffer* rbuf);   // the load estimator's sensors ([estimator] enabled)
   void handleRopeLoad(const lcm::ReceiveBuffer* rbuf);
   void rejectSensor(const char* channel, const char* detail);

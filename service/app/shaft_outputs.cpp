@@ -68,6 +68,7 @@ ShaftOutputs::ShaftOutputs(ShaftContext& ctx, lcm::LCM& out) : ctx_(ctx), out_(o
   estimate_msg_.instance_id = ctx_.instance_id;
   estimate_buf_.resize(static_cast<std::size_t>(estimate_msg_.getEncodedSize()) + 64);
   health_msg_.instance_id = ctx_.instance_id;
+  alarm_msg_.instance_id = ctx_.instance_id;  // clients accept alarm events only from this instance
   alarm_msg_.message.reserve(sizeof text_);
   cage_buf_.resize(static_cast<std::size_t>(cage_msg_.getEncodedSize()) + 64);
   shape_buf_.resize(static_cast<std::size_t>(shape_msg_.getEncodedSize()) + 64);

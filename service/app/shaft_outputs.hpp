@@ -30,6 +30,10 @@ using bus::UdpmSender;
 
 class ShaftOutputs {
  public:
+  /// HOIST_ALARM.id the next alarm event will carry (every event this
+  /// instance published has a smaller one: ShaftInputs tells forged events
+  /// with a copied instance id by it).
+  std::int64_t nextAlarmId() const { return alarm_id_; }
   /// Publishes through `out` unless setSender() gives the daemon's own publisher.
   ShaftOutputs(ShaftContext& ctx, lcm::LCM& out);
   ShaftOutputs(const ShaftOutputs&) = delete;

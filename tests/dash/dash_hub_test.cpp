@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -19,6 +20,8 @@
 #include "hoist/forecast_t.hpp"
 #include "hoist/health_t.hpp"
 #include "hoist/msg/names.hpp"
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 #include "attack_bytes.hpp"
 #include "hub.hpp"
 #include "static_files.hpp"
@@ -391,8 +394,11 @@ class HubClockTest : public HubTest {
     const auto b = encode(h);
     hub.onLcm(prefix + "HOIST_HEALTH", b.data(), b.size());
   }
-  void alarm(Hub& hub, const std::string& kind, int event, std::int64_t utime, bool active = true, bool acked = false) {
+  void alarm(Hub& hub, const std::string& kind, int event, std::int64_t utime, bool active = true, bool acked = false,
+             std::int64_t instance = 7) {
     alarm_t a{};
+    a.instance_id = instance;  // the daemon whose health the hub follows (issue 33)
+    a.id = ++alarm_seq;        // its event number (+1 per event)
     a.utime = utime;
     a.kind = kind;
     a.level = 1;
@@ -404,6 +410,7 @@ class HubClockTest : public HubTest {
   }
   void advance(double s) { now_ns += static_cast<std::uint64_t>(s * 1e9); }
   std::uint64_t now_ns = 1'700'000'000'000'000'000ULL;
+  std::int64_t alarm_seq = 0;
 };
 
 TEST_F(HubClockTest, OneShotPrefixesAgeOutAndARealDaemonTakesTheirSlot) {
@@ -476,6 +483,7 @@ TEST_F(HubClockTest, AlarmsOfPrefixesThatNeverSendHealthAreForgotten) {
     a.level = 1;
     a.event_type = 1;
     a.active = true;
+    a.instance_id = 9;
     const auto b = encode(a);
     hub.onLcm(prefix + "HOIST_ALARM", b.data(), b.size());
   };
@@ -496,6 +504,7 @@ TEST_F(HubClockTest, ActivationKeptAcrossReannouncesAndStaleCommandsRefused) {
   Hub hub = makeTimed({""});
   RecClient c;
   hub.addClient(c);
+  health(hub, "", 7);
   alarm(hub, "CAGE_POS_Y", 1, 1000);   // RAISE
   alarm(hub, "CAGE_POS_Y", 6, 31000);  // REANNOUNCE
   hub.onClientText(c, Json{{"op", "subscribe"}, {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "HOIST_ALARM")}}}}}.dump());
@@ -552,15 +561,20 @@ TEST_F(HubClockTest, ANewDaemonInstanceClearsTheAlarmsOfTheOneThatHasGone) {
   healthAt(7, 101'000'000, 101.0);
   const auto before = c.data.size();
   ASSERT_EQ(before, 2u);
-  // Killed at 102 s; instance 9 starts at 200 s and raises CAGE_POS_Y before its first health.
-  alarm(hub, "CAGE_POS_Y", 1, 200'500'000);
+  // Killed at 102 s; instance 9 starts at 200 s and raises CAGE_POS_Y before
+  // its first health: not the instance the hub follows yet, dropped (issue
+  // 33); the re-announce the new instance is asked for brings it back.
+  advance(100.0);
+  alarm(hub, "CAGE_POS_Y", 1, 200'500'000, true, false, 9);
+  EXPECT_EQ(hub.counter("HOIST_ALARM_foreign_instance"), 1u);
   const auto requests = pub.size();
   healthAt(9, 201'000'000, 1.0);
   EXPECT_EQ(hub.counter("daemon_restarts"), 1u);
   EXPECT_EQ(hub.counter("alarms_cleared_restart"), 2u);
-  ASSERT_EQ(c.data.size(), before + 1 + 2) << "CAGE_POS_Y, then one CLEAR per alarm of the old instance";
+  alarm(hub, "CAGE_POS_Y", 6, 201'100'000, true, false, 9);  // the re-announce
+  ASSERT_EQ(c.data.size(), before + 2 + 1) << "one CLEAR per alarm of the old instance, then CAGE_POS_Y";
   std::set<std::string> cleared;
-  for (std::size_t i = before + 1; i < c.data.size(); ++i) {
+  for (std::size_t i = before; i < before + 2; ++i) {
     const Json a = Json::parse(c.data[i].substr(13));
     EXPECT_FALSE(a["active"].get<bool>());
     EXPECT_TRUE(a["acked"].get<bool>()) << "acknowledged and inactive: normal, off every list";
@@ -577,9 +591,59 @@ TEST_F(HubClockTest, ANewDaemonInstanceClearsTheAlarmsOfTheOneThatHasGone) {
   ASSERT_EQ(late.data.size(), 1u);
   EXPECT_EQ(Json::parse(late.data[0].substr(13))["kind"], "CAGE_POS_Y");
   // The same instance again clears nothing.
+  advance(1.0);
   healthAt(9, 202'000'000, 2.0);
   EXPECT_EQ(hub.counter("daemon_restarts"), 1u);
   EXPECT_EQ(c.data.size(), before + 3);
+}
+
+// Issue 33: one forged alarm_t CLEAR of the active CAGE_POS_Y, from another
+// daemon instance than the one whose health the hub follows, cleared the
+// dashboard's row for every client with no trace.  Now it is dropped,
+// counted and logged; so is a forged health stream of another instance under
+// the same prefix while the real daemon talks (it would have cleared every
+// alarm as a "restart"), and its cage states.
+TEST_F(HubClockTest, ForgedAlarmClearAndImpostorHealthNeitherClearTheRowNorGoUnlogged) {
+  std::ostringstream log_text;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log_text);
+  auto old_logger = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("t", sink));
+  Hub hub = makeTimed({""});
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "subscribe"},
+                           {"subscriptions", {{{"id", 3}, {"channelId", channelId(c, "HOIST_ALARM")}}}}}.dump());
+  health(hub, "", 7);
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_CLEAR, 500, false, true, 7);  // an earlier CLEAR
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_RAISE, 1000, true, false, 7);
+  ASSERT_EQ(c.data.size(), 2u);
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_CLEAR, 2000, false, true, 8);  // forged: another instance
+  alarm(hub, "CAGE_POS_Y", alarm_t::EVENT_CLEAR, 2000, false, true, 0);  // forged: no instance
+  EXPECT_EQ(c.data.size(), 2u) << "a forged CLEAR reached the clients";
+  EXPECT_EQ(hub.counter("HOIST_ALARM_foreign_instance"), 2u);
+  // An impostor's health under the same prefix while instance 7 talks: no
+  // restart, no row cleared, its cage states dropped.
+  advance(1.0);
+  health(hub, "", 8);
+  cage_state_t cs{};
+  cs.instance_id = 8;
+  const auto cb = encode(cs);
+  hub.onLcm("HOIST_CAGE", cb.data(), cb.size());
+  EXPECT_EQ(hub.counter("health_impostor"), 1u);
+  EXPECT_EQ(hub.counter("HOIST_CAGE_foreign_instance"), 1u);
+  EXPECT_EQ(hub.counter("daemon_restarts"), 0u);
+  EXPECT_EQ(c.data.size(), 2u);
+  RecClient late;
+  hub.addClient(late);
+  hub.onClientText(late, Json{{"op", "subscribe"},
+                              {"subscriptions", {{{"id", 4}, {"channelId", channelId(late, "HOIST_ALARM")}}}}}.dump());
+  ASSERT_EQ(late.data.size(), 1u);
+  EXPECT_TRUE(Json::parse(late.data[0].substr(13))["active"].get<bool>()) << "the row is still active";
+  spdlog::set_default_logger(old_logger);
+  const std::string text = log_text.str();
+  EXPECT_NE(text.find("dropped HOIST_ALARM of daemon instance 8: the dashboard follows instance 7"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("health of another daemon instance 8 while instance 7 is alive"), std::string::npos) << text;
 }
 
 // hoist-dash asks each shaft's daemon for its alarms' current states
@@ -612,7 +676,8 @@ TEST_F(HubClockTest, AlarmStatesAreRequestedAtStartAndForEachDiscoveredShaft) {
     health(fixed, "a/", 7);
     health(fixed, "a/", 7);
     EXPECT_EQ(requests("a/HOIST_ALARM_ACK"), 1) << "once per daemon instance";
-    health(fixed, "a/", 8);  // the daemon restarted
+    advance(4.0);            // instance 7 silent for longer than health_gap_s ...
+    health(fixed, "a/", 8);  // ... the daemon restarted
     EXPECT_EQ(requests("a/HOIST_ALARM_ACK"), 2);
     EXPECT_EQ(requests("b/HOIST_ALARM_ACK"), 0);
     health(fixed, "b/", 9);
@@ -635,6 +700,7 @@ TEST_F(HubClockTest, AlarmStatesAreRequestedAtStartAndForEachDiscoveredShaft) {
   hub.addClient(c);
   alarm_t a{};
   a.utime = 5000;
+  a.instance_id = 7;
   a.kind = "CAGE_POS_Y";
   a.level = 1;
   a.event_type = alarm_t::EVENT_REANNOUNCE;

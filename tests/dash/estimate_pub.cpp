@@ -96,8 +96,10 @@ int main(int argc, char** argv) {
       e.mismatch = 1;
       e.nis_exceeded = 1;
       if (k == 0) {
-        const hoist::alarm_t a = raisedAlarm(e.utime, e.t, "MODEL_MISMATCH", hoist::alarm_t::LEVEL_WARNING, 450.0, 372.0,
-                                             "MODEL_MISMATCH WARNING raised: the shaft does not behave like its model");
+        DaemonVoice voice(lcm, prefix, 300);  // no daemon here: a health of instance 4242 first
+        const hoist::alarm_t a =
+            voice.sign(raisedAlarm(e.utime, e.t, "MODEL_MISMATCH", hoist::alarm_t::LEVEL_WARNING, 450.0, 372.0,
+                                   "MODEL_MISMATCH WARNING raised: the shaft does not behave like its model"));
         lcm.publish(prefix + "HOIST_ALARM", &a);
       }
     } else if (mode == "norope") {

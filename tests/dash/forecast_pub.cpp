@@ -68,13 +68,14 @@ int main(int argc, char** argv) {
   lcm::LCM lcm(argv[1]);
   if (!lcm.good()) return 1;
   const std::string ch = prefix + "HOIST_FORECAST";
+  DaemonVoice voice(lcm, prefix, 3000);  // the daemon's instance id, as hoist-twind's own forecasts carry
   for (int k = 0; k < count; ++k) {
     hoist::forecast_t f{};
     f.utime = std::chrono::duration_cast<std::chrono::microseconds>(
                   std::chrono::system_clock::now().time_since_epoch())
                   .count();
     f.seq = k;
-    f.instance_id = 4242;
+    f.instance_id = voice.instance;
     f.t_start = 20.0 + k;
     f.l = 150.0;
     f.v = 5.0;
@@ -95,10 +96,10 @@ int main(int argc, char** argv) {
     }
     lcm.publish(ch, b.data(), static_cast<unsigned>(b.size()));
     if (k == 0) {
-      const hoist::alarm_t a = raisedAlarm(
+      const hoist::alarm_t a = voice.sign(raisedAlarm(
           f.utime, f.t_start, "PREDICTED_CLEARANCE", hoist::alarm_t::LEVEL_WARNING, 19.39, 20.0,
           "PREDICTED_CLEARANCE WARNING raised: forecast scenario 'estop' crosses the CRITICAL clearance threshold "
-          "in 19.4 s (horizon 20 s) [unacknowledged]");
+          "in 19.4 s (horizon 20 s) [unacknowledged]"));
       lcm.publish(prefix + "HOIST_ALARM", &a);
     }
     std::printf("published %s seq %d (%zu bytes)\n", ch.c_str(), k, b.size());

@@ -186,6 +186,62 @@ TEST_F(DaemonAttack, SecondPublisherOnTheSameChannelsIsDetected) {
   EXPECT_NE(log.find("another publisher"), std::string::npos);
 }
 
+TEST_F(DaemonAttack, AlarmEventOfAnotherInstanceOnItsOwnChannelRaisesDuplicatePublisher) {
+  // Issue 33: one forged alarm_t on HOIST_ALARM (a CLEAR from another
+  // instance) is a second publisher of the daemon's outputs, as forged health
+  // is.  Before: nothing noticed it.  The daemon's own alarm events (a shelve
+  // of CAGE_POS_Y: one event per level) raise nothing.
+  start(7980, "forged_alarm");
+  auto d = startDaemon({}, "twind.log");
+  const hoist::health_t h = lastHealth();
+  ASSERT_NE(h.instance_id, 0);
+  auto duplicateRaised = [&] {
+    for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
+      if (a.kind == "DUPLICATE_PUBLISHER" && a.event_type == hoist::alarm_t::EVENT_RAISE) return true;
+    return false;
+  };
+  hoist::alarm_ack_t ack{};
+  ack.kind = "CAGE_POS_Y";
+  ack.action = hoist::alarm_ack_t::ACTION_SHELVE;
+  ack.shelve_duration = 60.0;
+  ack.user = "op";
+  listener_->lcm().publish("HOIST_ALARM_ACK", &ack);
+  ASSERT_TRUE(listener_->waitFor([&] { return listener_->count("HOIST_ALARM") > 0; }, 5s));
+  listener_->pump(1500ms);
+  for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM")) EXPECT_EQ(a.instance_id, h.instance_id);
+  EXPECT_FALSE(duplicateRaised()) << "the daemon took its own alarm events for another publisher";
+  hoist::alarm_t forged{};
+  forged.utime = nowUs();
+  forged.kind = "CAGE_POS_Y";
+  forged.level = hoist::alarm_t::LEVEL_WARNING;
+  forged.event_type = hoist::alarm_t::EVENT_CLEAR;
+  forged.acked = 1;
+  forged.message = "all clear";
+  forged.user = "";
+  forged.instance_id = h.instance_id + 1;
+  listener_->lcm().publish("HOIST_ALARM", &forged);
+  EXPECT_TRUE(listener_->waitFor(duplicateRaised, 5s)) << "a forged alarm event went unnoticed";
+  // A forger who copies the instance id cannot use an event id the daemon has
+  // not used yet without being noticed (and clients drop old event ids).
+  forged.instance_id = h.instance_id;
+  forged.id = 1'000'000;
+  forged.utime = nowUs();
+  listener_->lcm().publish("HOIST_ALARM", &forged);
+  const auto until = std::chrono::steady_clock::now() + 5s;
+  while (readFile((dir_ / "twind.log").string()).find("that it never published") == std::string::npos &&
+         std::chrono::steady_clock::now() < until)
+    listener_->pump(100ms);
+  stopDaemonCleanly(*d, (dir_ / "twind.log").string());
+  const std::string log = readFile((dir_ / "twind.log").string());
+  EXPECT_NE(log.find("another publisher (instance " + std::to_string(h.instance_id + 1) + ") on HOIST_ALARM"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("an alarm event with this twin's instance id " + std::to_string(h.instance_id) +
+                     " that it never published on HOIST_ALARM"),
+            std::string::npos)
+      << log;
+}
+
 TEST_F(DaemonAttack, SignalsAndADeadLogReaderDoNotKill) {
   // Before the fix: SIGHUP, SIGUSR1 and SIGPIPE killed the daemon at once.
   start(7854, "signals");

@@ -233,6 +233,8 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
     hoist::forecast_t f{};
     f.utime = 1;
     f.seq = 5;
+    // As the daemon (the bridge drops data of any other instance than the shaft's).
+    f.instance_id = lcm.decoded<hoist::health_t>("north/HOIST_HEALTH").back().instance_id;
     f.t_start = 20.0;
     f.plan_seq = -1;
     f.num_scenarios = 1;
@@ -801,6 +803,9 @@ namespace {
 hoist::alarm_t alarmEvent(const std::string& kind, int event, bool active) {
   hoist::alarm_t a{};
   a.utime = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  a.instance_id = 4244;  // forgedHealth(4244) is sent first: the instance the bridge follows
+  static std::int64_t next_id = 0;
+  a.id = ++next_id;      // the daemon numbers its events (+1 each)
   a.kind = kind;
   a.level = hoist::alarm_t::LEVEL_WARNING;
   a.event_type = static_cast<std::int8_t>(event);
@@ -833,6 +838,9 @@ TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
                   "west/", "--client-id", "bridge-r"},
                  log("bridge.log"));
   ASSERT_TRUE(c.waitJson("hoist/_bridge/bridge-r/status", [](const json& j, bool) { return j.value("online", false); }, 10s));
+  const auto west_health = forgedHealth(4244);
+  lcm.lcm().publish("west/HOIST_HEALTH", &west_health);
+  lcm.pump(200ms);
   auto raise = alarmEvent("CAGE_POS_Y", hoist::alarm_t::EVENT_RAISE, true);
   lcm.lcm().publish("west/HOIST_ALARM", &raise);
   ASSERT_TRUE(c.waitJson("hoist/west/alarm/CAGE_POS_Y", [](const json& j, bool) { return j["active"] == true; }, 5s));
@@ -848,7 +856,11 @@ TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
   EXPECT_EQ((*r)["result"], "accepted");
   EXPECT_EQ((*r)["reason"], "forwarded");
   EXPECT_EQ((*r)["command"]["kind"], "CAGE_POS_Y");
-  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("west/HOIST_ALARM_ACK") == 1; }, 5s));
+  ASSERT_TRUE(lcm.waitFor([&] {
+    for (const auto& a : lcm.decoded<hoist::alarm_ack_t>("west/HOIST_ALARM_ACK"))
+      if (a.user == "op-ok") return true;
+    return false;
+  }, 5s));
 
   c.publish("hoist/west/cmd/ack", R"({"kind":"GUIDE_ROPE","level":0,"action":1,"user":"op-none"})");
   r = result("op-none");
@@ -864,13 +876,17 @@ TEST_F(MqttBridge, CommandResultsAndStaleBacklog) {
   ASSERT_TRUE(dup);
   EXPECT_EQ((*dup)["result"], "refused");
   lcm.pump(300ms);
-  EXPECT_EQ(lcm.count("west/HOIST_ALARM_ACK"), 1u) << "a refused command was forwarded";
+  std::size_t forwarded = 0;  // not the bridge's own re-announce request (sent on west/'s first health)
+  for (const auto& a : lcm.decoded<hoist::alarm_ack_t>("west/HOIST_ALARM_ACK"))
+    forwarded += a.action != hoist::alarm_ack_t::ACTION_REANNOUNCE;
+  EXPECT_EQ(forwarded, 1u) << "a refused command was forwarded";
   EXPECT_NE(readFile(log("bridge.log")).find("matches no alarm"), std::string::npos) << readFile(log("bridge.log"));
   for (const auto& m : c.on("hoist/west/cmd/result")) EXPECT_FALSE(m.retain);
 
   // An outage: cage states and alarm transitions while the broker is down.
   broker.stop();
   hoist::cage_state_t cage{};
+  cage.instance_id = 4244;
   for (int i = 0; i < 30; ++i) {
     cage.seq = i;
     lcm.lcm().publish("west/HOIST_CAGE", &cage);
@@ -1236,8 +1252,13 @@ TEST_F(MqttBridge, DroppedAlarmTransitionsAreLoggedAndWarn) {
   Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--client-id", "bridge-w"},
                  log("bridge.log"));
   std::this_thread::sleep_for(500ms);
+  const auto north_health = forgedHealth(4245);
+  lcm.lcm().publish("north/HOIST_HEALTH", &north_health);
+  lcm.pump(200ms);
   for (int i = 0; i < 5; ++i) {
     hoist::alarm_t a{};
+    a.instance_id = 4245;
+    a.id = i + 1;
     a.utime = std::chrono::duration_cast<std::chrono::microseconds>(
                   std::chrono::system_clock::now().time_since_epoch()).count();
     a.kind = "CAGE_POS_Y";
@@ -1269,4 +1290,80 @@ TEST_F(MqttBridge, DroppedAlarmTransitionsAreLoggedAndWarn) {
   bridge.signal(SIGTERM);
   EXPECT_EQ(bridge.wait(5s), 0);
   broker.stop();
+}
+
+// Issue 33: one forged alarm_t CLEAR of the active CAGE_POS_Y on HOIST_ALARM,
+// from another daemon instance, turned the retained hoist/north/alarm/CAGE_POS_Y
+// inactive, and nothing logged it.  Now the bridge accepts alarm events only
+// from the instance whose health it follows: the retained state stays active,
+// the drop is counted (health lcm.foreign_instance) and logged.  A forged
+// health stream of another instance under the same prefix while the daemon
+// talks is an impostor: dropped and logged, never a "restart" that clears the
+// shaft's alarms, and commands still reach the daemon.
+TEST_F(MqttBridge, ForgedAlarmClearAndImpostorHealthCostOnlyTheForger) {
+  dir_ = testDir("mqtt_forged_alarm");
+  const std::string url = urlFor(7981);
+  Broker broker(dir_, freeTcpPort());
+  broker.start();
+  Client c(broker.port(), "c");
+  ASSERT_TRUE(c.connected());
+  c.subscribe("hoist/#");
+  Listener lcm(url);
+  lcm.subscribe("north/HOIST_(HEALTH|ALARM|ALARM_ACK)");
+  auto twind = startDaemonAndWait(lcm, {HOIST_TWIND, "--config", daemonConfig(dir_, "north/"), "--lcm-url", url},
+                                  log("twind.log"), "north/HOIST_HEALTH");
+  Process replay({HOIST_REPLAY, "--profile", "rest:t_end=60", "--lcm-url", url, "--channel-prefix", "north/"},
+                 log("replay.log"));
+  const auto bcfg = (dir_ / "bridge.toml").string();
+  std::ofstream(bcfg) << "[bridge]\nhealth_period = 0.3\n";
+  Process bridge({HOIST_MQTT, "--broker", broker.url(), "--config", bcfg, "--lcm-url", url, "--channel-prefix",
+                  "north/", "--client-id", "bridge-f"},
+                 log("bridge.log"));
+  ASSERT_TRUE(c.waitJson("hoist/north/alarm/CAGE_POS_Y", [](const json& j, bool) { return isWarningActive(j); }, 15s))
+      << readFile(log("bridge.log")) << readFile(log("twind.log"));
+  const auto real = lcm.decoded<hoist::health_t>("north/HOIST_HEALTH").back().instance_id;
+  const std::size_t before = c.on("hoist/north/alarm/CAGE_POS_Y").size();
+  hoist::alarm_t forged{};
+  forged.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                     std::chrono::system_clock::now().time_since_epoch()).count();
+  forged.kind = "CAGE_POS_Y";
+  forged.level = hoist::alarm_t::LEVEL_WARNING;
+  forged.event_type = hoist::alarm_t::EVENT_CLEAR;
+  forged.acked = 1;
+  forged.message = "all clear";
+  forged.user = "";
+  forged.instance_id = real + 1;
+  lcm.lcm().publish("north/HOIST_ALARM", &forged);
+  // The impostor's health, at 10 Hz for a second, under the real prefix.
+  for (int i = 0; i < 10; ++i) {
+    const auto h = forgedHealth(real + 2);
+    lcm.lcm().publish("north/HOIST_HEALTH", &h);
+    lcm.pump(100ms);
+  }
+  // Commands keep going to the real shaft.
+  c.publish("hoist/north/cmd/ack", R"({"kind":"CAGE_POS_Y","level":0,"action":1,"user":"scada-op"})");
+  EXPECT_TRUE(lcm.waitFor([&] {
+    for (const auto& a : lcm.decoded<hoist::alarm_ack_t>("north/HOIST_ALARM_ACK"))
+      if (a.user == "scada-op") return true;
+    return false;
+  }, 5s)) << readFile(log("bridge.log"));
+  auto health = c.waitJson("hoist/_bridge/bridge-f/health", [](const json& j, bool) {
+    return j["lcm"]["foreign_instance"].value("HOIST_ALARM", 0) >= 1 && j["lcm"].value("impostor_health", 0) >= 1;
+  }, 5s);
+  EXPECT_TRUE(health) << readFile(log("bridge.log"));
+  const auto states = c.on("hoist/north/alarm/CAGE_POS_Y");
+  for (std::size_t i = before; i < states.size(); ++i) {
+    const json j = json::parse(states[i].payload);
+    EXPECT_NE(j.value("last_event", ""), "CLEAR") << "the forged CLEAR was published: " << j.dump();
+    EXPECT_TRUE(j["active"].get<bool>()) << j.dump();
+  }
+  for (const auto& m : c.on("hoist/north/health"))
+    EXPECT_EQ(json::parse(m.payload)["instance_id"], real) << "an impostor's health was published as north's";
+  bridge.signal(SIGTERM);
+  EXPECT_EQ(bridge.wait(5s), 0);
+  const std::string text = readFile(log("bridge.log"));
+  EXPECT_NE(text.find("dropped HOIST_ALARM of daemon instance " + std::to_string(real + 1)), std::string::npos) << text;
+  EXPECT_NE(text.find("health of another daemon instance " + std::to_string(real + 2)), std::string::npos) << text;
+  EXPECT_EQ(text.find("new daemon instance"), std::string::npos) << "the impostor was taken for a restart:\n" << text;
+  stopDaemonCleanly(*twind, log("twind.log"));
 }

@@ -243,6 +243,7 @@ class Twin {
         hoist::alarm_t a{};
         a.utime = utime + 1;
         a.id = k;
+        a.instance_id = 4242;
         a.kind = "CAGE_POS_Y";
         a.level = hoist::alarm_t::LEVEL_WARNING;
         a.event_type = raise ? hoist::alarm_t::EVENT_RAISE : hoist::alarm_t::EVENT_CLEAR;

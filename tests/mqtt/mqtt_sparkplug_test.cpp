@@ -204,6 +204,7 @@ hoist::alarm_t raise(const std::string& kind) {
   hoist::alarm_t a{};
   a.utime = 1'700'000'001'000'000;
   a.id = 1;
+  a.instance_id = 77;  // the daemon whose health the bridge follows (issue 33)
   a.kind = kind;
   a.level = hoist::alarm_t::LEVEL_WARNING;
   a.event_type = hoist::alarm_t::EVENT_RAISE;
@@ -277,6 +278,11 @@ TEST_F(MqttSparkplug, IndependentHostChecksBirthsDataRebirthAckAndDeath) {
   h.clock = "wall";
   h.alarms_active = 1;
   ASSERT_EQ(pub.publish("north/HOIST_HEALTH", &h), 0);
+  hoist::health_t h77{};
+  h77.instance_id = 77;  // alarm events pass only from the instance whose health the bridge follows
+  h77.clock = "wall";
+  ASSERT_EQ(pub.publish("north/HOIST_HEALTH", &h77), 0);
+  std::this_thread::sleep_for(200ms);
   const hoist::alarm_t a = raise("CAGE_POS_Y");
   ASSERT_EQ(pub.publish("north/HOIST_ALARM", &a), 0);
   hoist::estimate_t e{};
@@ -389,6 +395,11 @@ TEST_F(MqttSparkplug, BadCommandsAreRefusedAndCountedNothingLost) {
   acks.subscribe("north/HOIST_ALARM_ACK");
   lcm::LCM pub(lcm_url_);
   ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 15s)) << tail(host_log_);
+  hoist::health_t h77{};
+  h77.instance_id = 77;  // alarm events pass only from the instance whose health the bridge follows
+  h77.clock = "wall";
+  ASSERT_EQ(pub.publish("north/HOIST_HEALTH", &h77), 0);
+  std::this_thread::sleep_for(200ms);
   const hoist::alarm_t a = raise("CAGE_POS_Y");
   ASSERT_EQ(pub.publish("north/HOIST_ALARM", &a), 0);
   ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DDATA"; }, 5s));
@@ -455,6 +466,11 @@ TEST_F(MqttSparkplug, NoCommandsRefusesAndCountsWrites) {
   acks.subscribe("north/HOIST_ALARM_ACK");
   lcm::LCM pub(lcm_url_);
   ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 15s)) << tail(host_log_);
+  hoist::health_t h77{};
+  h77.instance_id = 77;  // alarm events pass only from the instance whose health the bridge follows
+  h77.clock = "wall";
+  ASSERT_EQ(pub.publish("north/HOIST_HEALTH", &h77), 0);
+  std::this_thread::sleep_for(200ms);
   const hoist::alarm_t a = raise("CAGE_POS_Y");
   ASSERT_EQ(pub.publish("north/HOIST_ALARM", &a), 0);
   for (int i = 0; i < 3; ++i) command(std::string("dcmd north ") + kAck);

@@ -198,7 +198,18 @@ void Hub::addPrefix(const std::string& prefix) {
     ch.schema = schemaText(t.schema);
     auto& stored = channels_[ch.topic] = std::move(ch);
     by_id_[stored.id] = &stored;
-    if (suffix == "HOIST_ALARM" && !pending.empty()) stored.table = std::move(pending.mapped());
+    if (suffix == "HOIST_ALARM" && !pending.empty()) {
+      // Kept from before the shaft was confirmed: only the confirmed daemon
+      // instance's alarm events (issue 33).
+      const auto d = disc_.find(prefix);
+      for (auto& [key, a] : pending.mapped()) {
+        const Json j = Json::parse(*a, nullptr, false);
+        if (d == disc_.end() || (j.is_object() && j.value("instance_id", std::int64_t{0}) == d->second.instance))
+          stored.table[key] = a;
+        else
+          count("HOIST_ALARM_foreign_instance");
+      }
+    }
     added.push_back(&stored);
     // The decimated channels (cage state, load estimate): min/max of every
     // numeric field per interval, at the display rate.
@@ -348,9 +359,10 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
   if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
   if (suffix == "HOIST_HEALTH" && channelFor(channel) != nullptr) {
-    noteInstance(prefix, j);
+    if (!noteInstance(prefix, j)) return;
     maybeRequestAlarmStates(prefix, j);
   }
+  if (suffix != "HOIST_HEALTH" && channelFor(channel) != nullptr && !fromFollowedInstance(prefix, suffix, j)) return;
   if (suffix == "HOIST_ALARM" && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
@@ -663,6 +675,7 @@ void Hub::removePrefix(const std::string& prefix) {
   disc_.erase(prefix);
   states_asked_.erase(prefix);
   instance_.erase(prefix);
+  instance_last_ns_.erase(prefix);
   decimators_.erase(prefix);
   estimate_decimators_.erase(prefix);
   history_.erase(prefix);

@@ -168,7 +168,15 @@ class Hub {
   /// states older than the new instance's start are void -- removed from the
   /// table and sent to the clients as cleared ("the daemon restarted", as
   /// hoist-mqtt does); the new instance is asked to re-announce its own.
-  void noteInstance(const std::string& prefix, const Json& health);
+  /// Another instance while the followed one has been heard within
+  /// health_gap_s is an impostor under its prefix: false (the caller drops
+  /// its health), counted (health_impostor) and logged; the shaft is kept.
+  bool noteInstance(const std::string& prefix, const Json& health);
+  /// True if `j` (a message on `prefix` + `suffix`) comes from the daemon
+  /// instance whose health the hub follows; alarm events need that instance
+  /// known, other data passes before the first health.  Else counted
+  /// (<suffix>_foreign_instance) and logged (rate-limited), issue 33.
+  bool fromFollowedInstance(const std::string& prefix, const std::string& suffix, const Json& j);
   void removePrefix(const std::string& prefix);
   void onDiscoveryHealth(const std::string& prefix, const Json& health);
   void noteHealth(Evidence& e, std::int64_t instance, std::uint64_t now) const;
@@ -189,7 +197,8 @@ class Hub {
 
   Options opt_;
   bool request_states_ = false;  // requestAlarmStates() was called
-  std::map<std::string, std::int64_t> instance_;      // prefix -> daemon instance of its latest health
+  std::map<std::string, std::int64_t> instance_;      // prefix -> daemon instance followed (its latest accepted health)
+  std::map<std::string, std::uint64_t> instance_last_ns_;  // prefix -> when that instance's health was last heard
   std::map<std::string, std::int64_t> states_asked_;  // prefix -> daemon instance asked (bounded by the prefixes)
   Publisher publish_;
   Clock clock_;

@@ -33,11 +33,37 @@ void Hub::maybeRequestAlarmStates(const std::string& prefix, const Json& health)
   requestAlarmStates(prefix);
 }
 
-void Hub::noteInstance(const std::string& prefix, const Json& health) {
+bool Hub::fromFollowedInstance(const std::string& prefix, const std::string& suffix, const Json& j) {
+  if (!j.contains("instance_id")) return true;  // a type without a sender (trip plans, guide shape)
+  const std::int64_t instance = j.value("instance_id", std::int64_t{0});
+  const auto it = instance_.find(prefix);
+  if (it != instance_.end() ? it->second == instance : suffix != "HOIST_ALARM") return true;
+  count(suffix + "_foreign_instance");
+  if (logAllowed())
+    spdlog::warn("shaft '{}': dropped {} of daemon instance {}: the dashboard follows instance {}",
+                 msg::terminalSafe(shaftName(prefix), 64), suffix, instance,
+                 it == instance_.end() ? std::string("(none heard yet)") : std::to_string(it->second));
+  return false;
+}
+
+bool Hub::noteInstance(const std::string& prefix, const Json& health) {
   const std::int64_t instance = health.value("instance_id", std::int64_t{0});
-  if (instance == 0) return;
+  const std::uint64_t now = clock_();
+  const auto followed = instance_.find(prefix);
+  if (followed != instance_.end() && followed->second != instance &&
+      static_cast<double>(now - std::min(now, instance_last_ns_[prefix])) * 1e-9 <= opt_.health_gap_s) {
+    // The followed daemon still talks: a second instance under its prefix
+    // costs itself, never the shaft's alarms (issue 33).
+    count("health_impostor");
+    if (logAllowed())
+      spdlog::warn("shaft '{}': health of another daemon instance {} while instance {} is alive: an impostor, dropped",
+                   msg::terminalSafe(shaftName(prefix), 64), instance, followed->second);
+    return false;
+  }
+  if (instance == 0) return true;
+  instance_last_ns_[prefix] = now;
   auto [it, fresh] = instance_.emplace(prefix, instance);
-  if (fresh || it->second == instance) return;
+  if (fresh || it->second == instance) return true;
   const std::int64_t old = it->second;
   it->second = instance;
   // The new daemon's start on its own clock (the alarms' utimes are on it too).
@@ -72,6 +98,7 @@ void Hub::noteInstance(const std::string& prefix, const Json& health) {
   count("alarms_cleared_restart", cleared);
   spdlog::info("shaft '{}': new daemon instance {} (was {}): {} alarm state(s) from before its start cleared",
                shaftName(prefix), instance, old, cleared);
+  return true;
 }
 
 void Hub::requestAlarmStates(const std::string& prefix) {

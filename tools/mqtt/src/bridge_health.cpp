@@ -63,6 +63,8 @@ json BridgeHealth::build() const {
               {"decode_errors", lcm_.decodeErrorsTotal()},
               {"decode_errors_by_reason", dec},
               {"alarm_rejected", data_.alarmRejected()},
+              {"foreign_instance", data_.foreignInstance()},
+              {"impostor_health", dir_.impostors()},
               {"ignored_channels", lcm_.ignoredChannels()}};
   j["mqtt"] = {{"published", ln.published}, {"publish_errors", ln.publish_errors}};
   if (sp_) {

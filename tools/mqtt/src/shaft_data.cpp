@@ -87,7 +87,23 @@ void ShaftData::onHealth(const Shaft& s, const hoist::health_t& m, bool restarte
   link_.publish({s.t.health, hoist::msg::toJson(m).dump(), 0, false, MsgClass::Health});
 }
 
+bool ShaftData::admit(const Shaft& s, std::int64_t instance, const char* channel, bool strict) {
+  if (ShaftDirectory::fromBoundInstance(s, instance)) return true;
+  if (!strict && s.instance_id == 0) return true;  // no health yet: the daemon is the only one heard
+  const std::uint64_t n = ++foreign_[channel];
+  std::int64_t suppressed = 0;
+  if (log_.allow(LogBudget::kLcm, Clock::now(), suppressed))
+    spdlog::warn("shaft '{}': dropped {} of daemon instance {} on {}{}: the shaft follows instance {} ({} dropped "
+                 "on it so far) [{} similar suppressed]",
+                 printable(s.name, 64), channel, instance, printable(s.prefix, 64), channel,
+                 s.instance_id == 0 ? std::string("(none heard yet)") : std::to_string(s.instance_id), n, suppressed);
+  return false;
+}
+
 void ShaftData::onAlarm(const Shaft& s, const hoist::alarm_t& m) {
+  // Only the daemon whose health this shaft follows changes what SCADA sees
+  // (issue 33: one forged CLEAR turned the retained alarm inactive).
+  if (!admit(s, m.instance_id, "HOIST_ALARM", true)) return;
   if (!validKind(m.kind) || m.level < 1 || m.level > 2) {
     ++alarm_rejected_;
     std::int64_t suppressed = 0;

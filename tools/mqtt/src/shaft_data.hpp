@@ -63,6 +63,11 @@ class ShaftData {
   void useSparkplug(SparkplugSession* sp) { sp_ = sp; }
 
   // ---- from LCM (the shaft as the directory resolved it) ----
+  /// True if a message of daemon instance `instance` on `s`'s `channel` may
+  /// pass: from the instance the shaft is bound to (ShaftDirectory).  Alarm
+  /// events (`strict`) need that instance known; data before the first health
+  /// passes.  Others are counted by channel and logged (rate-limited).
+  bool admit(const Shaft& s, std::int64_t instance, const char* channel, bool strict);
   void onCage(const Shaft& s, const hoist::cage_state_t& m);
   void onEstimate(const Shaft& s, const hoist::estimate_t& m);
   void onForecast(const Shaft& s, const hoist::forecast_t& m);
@@ -91,6 +96,8 @@ class ShaftData {
   bool ackMatches(const std::string& prefix, const hoist::alarm_ack_t& ack) const;
   int activeAlarms(const std::string& prefix) const;
   std::uint64_t alarmRejected() const { return alarm_rejected_; }
+  /// Messages dropped by admit(), by channel suffix.
+  const std::map<std::string, std::uint64_t>& foreignInstance() const { return foreign_; }
 
  private:
   Feed& feed(const Shaft& s) { return feeds_[s.prefix]; }
@@ -105,6 +112,7 @@ class ShaftData {
   SparkplugSession* sp_ = nullptr;
   std::map<std::string, Feed> feeds_;  // by prefix
   std::uint64_t alarm_rejected_ = 0;
+  std::map<std::string, std::uint64_t> foreign_;  // admit()'s drops by channel suffix
 };
 
 }  // namespace hoist::mqtt

@@ -202,6 +202,20 @@ ShaftDirectory::HealthSeen ShaftDirectory::onHealth(const Shaft& cs, std::int64_
   if (it == shafts_.end()) return out;
   Shaft& s = it->second;
   const auto now = Clock::now();
+  if (s.bound && s.instance_id != 0 && instance_id != s.instance_id &&
+      seconds(now - s.instance_last) <= cfg_.discovery_timeout) {
+    // The shaft is bound to a daemon that still talks: a second instance under
+    // its prefix costs itself (dropped), never the real shaft (issue 33).
+    ++s.impostor_in;
+    ++impostors_;
+    out.impostor = true;
+    std::int64_t suppressed = 0;
+    if (log_.allow(LogBudget::kLcm, now, suppressed))
+      spdlog::warn("shaft '{}': health of another daemon instance {} on {}HOIST_HEALTH while instance {} is alive: "
+                   "an impostor, dropped ({} so far) [{} similar suppressed]",
+                   s.name, instance_id, printable(s.prefix, 64), s.instance_id, s.impostor_in, suppressed);
+    return out;
+  }
   const bool continues =
       s.streak > 0 && instance_id == s.streak_instance && seconds(now - s.last_health) <= cfg_.discovery_timeout;
   if (instance_id == 0) {
@@ -217,11 +231,16 @@ ShaftDirectory::HealthSeen ShaftDirectory::onHealth(const Shaft& cs, std::int64_
   s.last_health = now;
   if (!s.bound) {
     tryConfirm(s, now);
+    if (s.bound) {  // bound to the instance that confirmed it: its alarm states (asked for now) pass
+      s.instance_id = instance_id;
+      s.instance_last = now;
+    }
     return out;
   }
   out.bound = true;
   out.restarted = s.instance_id != 0 && instance_id != s.instance_id;
   s.instance_id = instance_id;
+  s.instance_last = now;
   return out;
 }
 

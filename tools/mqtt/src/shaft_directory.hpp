@@ -35,7 +35,9 @@ struct Shaft {
   std::int64_t streak_instance = 0;
   int streak = 0;                 ///< health messages of streak_instance, gaps <= discovery_timeout
   std::int64_t states_asked = 0;  ///< daemon instance asked for its alarm states
-  std::int64_t instance_id = 0;   ///< the daemon instance of the bound shaft's last health
+  std::int64_t instance_id = 0;   ///< the daemon instance the bound shaft is bound to (first heard, or its successor)
+  Clock::time_point instance_last{};  ///< last health of that instance
+  std::uint64_t impostor_in = 0;  ///< health messages of another instance while it lives (dropped)
   std::uint64_t health_in = 0;
 };
 
@@ -64,10 +66,16 @@ class ShaftDirectory {
   /// updated), else with discovery a new candidate; nullptr if not bridged.
   const Shaft* resolve(const std::string& prefix);
 
-  /// A health message of daemon instance `instance_id` on `s`.
+  /// A health message of daemon instance `instance_id` on `s`.  A bound
+  /// shaft stays bound to the instance it first heard: another instance id
+  /// (0 included) under the same prefix while that one has been heard within
+  /// discovery_timeout is an impostor (result `impostor`; its messages are
+  /// the caller's to drop); after that silence it is the daemon's successor
+  /// (a restart: `restarted`).
   struct HealthSeen {
     bool bound = false;      ///< the shaft is bound: its health is published
     bool restarted = false;  ///< a new daemon instance (alarm states from before it are void)
+    bool impostor = false;   ///< another instance while the bound one lives: dropped, counted, logged
   };
   HealthSeen onHealth(const Shaft& s, std::int64_t instance_id);
 
@@ -91,6 +99,12 @@ class ShaftDirectory {
   std::uint64_t refusedTotal() const { return refused_total_; }
   std::uint64_t evictedCandidates() const { return evicted_candidates_; }
   std::uint64_t agedOut() const { return aged_out_; }
+  std::uint64_t impostors() const { return impostors_; }
+  /// True if a message of daemon instance `instance_id` on `s` comes from the
+  /// instance `s` is bound to (never for an unbound shaft or instance 0).
+  static bool fromBoundInstance(const Shaft& s, std::int64_t instance_id) {
+    return s.bound && s.instance_id != 0 && instance_id == s.instance_id;
+  }
 
  private:
   Shaft* add(const std::string& prefix, bool configured);
@@ -107,7 +121,7 @@ class ShaftDirectory {
   std::map<std::string, std::string> cmd_topics_;  // command topic -> prefix bound to its shaft name
   std::map<std::string, std::string> bound_;       // shaft name -> the prefix published under it
   bool discover_ = false;
-  std::uint64_t refused_total_ = 0, evicted_candidates_ = 0, aged_out_ = 0;
+  std::uint64_t refused_total_ = 0, evicted_candidates_ = 0, aged_out_ = 0, impostors_ = 0;
   bool table_full_logged_ = false;
   Clock::time_point last_sweep_{};
 };
