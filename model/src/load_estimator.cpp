@@ -233,7 +233,7 @@ void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
   // The short-memory twins forget with time constant constancy_memory.
   const double forget = std::exp(h / set_.constancy_memory);
   PFaF_ = PFaF_ * forget + qfa * qfa * h;
-  PlF_ *= forget;
+  PlF_ *= forget;  // the offset's information too: nested estimates, PF - P >= 0
   PlF_(0, 0) += qm * qm * h;
   trip_QFa_ += qfa * qfa * h;
   trip_QM_ += qm * qm * h;
