@@ -10,12 +10,29 @@ void estimateRecorded(const ShaftParams& twin, const EstimatorSettings& settings
                       const std::vector<MeasurementSample>& samples,
                       const std::function<void(const LoadEstimate&, const EstimatorCounters&)>& sink,
                       const std::function<void(double)>& progress) {
+  estimateRecorded(twin, settings, max_step, samples, RecordedCalibration{}, sink, progress);
+}
+
+void estimateRecorded(const ShaftParams& twin, const EstimatorSettings& settings, double max_step,
+                      const std::vector<MeasurementSample>& samples, const RecordedCalibration& cal,
+                      const std::function<void(const LoadEstimate&, const EstimatorCounters&)>& sink,
+                      const std::function<void(double)>& progress) {
   if (samples.empty()) return;
   auto model = std::make_shared<const ShaftModel>(twin);
   FastSolver solver(model);
   LoadEstimator est(twin, settings);
+  if (cal.has_offset) est.setAccelOffset(cal.offset, cal.offset_sigma);
+  std::vector<bool> declared(cal.known.size(), false);
   auto apply = [&](const MeasurementSample& m) {
     est.predict(solver.response());
+    // A known-load interval begins: pinned from its first sample to its end.
+    for (std::size_t i = 0; i < cal.known.size(); ++i) {
+      const KnownLoadInterval& k = cal.known[i];
+      if (!declared[i] && m.t >= k.t0 && m.t < k.t1) {
+        est.declareKnownLoad(k.Fa, k.b, k.t1);
+        declared[i] = true;
+      }
+    }
     const bool a = m.present & kSensorImuAccel, w = m.present & kSensorImuRate;
     if (a && w) est.updateImu(m.z.f_y, m.z.omega);
     else if (a) est.updateImuAccel(m.z.f_y);

@@ -30,6 +30,8 @@ void EstimatorSettings::validate() const {
   requirePositive(noise.imu_accel, "sensors.imu_accel_noise");
   requirePositive(noise.imu_rate, "sensors.imu_rate_noise");
   requirePositive(noise.rope_load, "sensors.rope_load_noise");
+  if (!(std::isfinite(accel_offset_sigma) && accel_offset_sigma >= 0.0 && accel_offset_sigma <= 1.0))
+    throw std::invalid_argument("sensors.imu_accel_offset_sigma: must be in [0, 1] m/s^2");
   requireNonNegative(fa_walk, "estimator.fa_walk");
   requireNonNegative(moment_walk, "estimator.moment_walk");
   requireNonNegative(moving_walk_scale, "estimator.moving_walk_scale");
@@ -82,6 +84,7 @@ LoadEstimator::LoadEstimator(const ShaftParams& twin, const EstimatorSettings& s
   ring_t_.assign(cap, 0.0);
   ring_nis_.assign(cap, 0.0);
   ring_dof_.assign(cap, 0);
+  Pc0_ = set_.accel_offset_sigma * set_.accel_offset_sigma;
 }
 
 void LoadEstimator::initialize(double t0, const Kinematics& k0) {
@@ -93,9 +96,14 @@ void LoadEstimator::initialize(double t0, const Kinematics& k0) {
   PFa_ = set_.fa_sigma0 * set_.fa_sigma0;
   M_ = M_c_;
   MF_ = M_c_;
-  PM_ = set_.moment_sigma0 * set_.moment_sigma0;
+  Pl_.setZero();
+  Pl_(0, 0) = set_.moment_sigma0 * set_.moment_sigma0;
+  // The accelerometer's offset: the learned one (setAccelOffset) or the prior.
+  c_ = c0_;
+  Pl_(1, 1) = Pc0_;
+  cF_ = c_;
   PFaF_ = PFa_;
-  PMF_ = PM_;
+  PlF_ = Pl_;
   const_drift_ = 0.0;
   run_fa_ = run_m_ = 0;
   env_fy_ = env_om_ = env_rope_ = 0.0;
@@ -150,7 +158,8 @@ void LoadEstimator::initialize(double t0, const Kinematics& k0) {
 }
 
 void LoadEstimator::restart(double t0, const Kinematics& k0) {
-  const double Fa = Fa_, PFa = PFa_, M = M_, PM = PM_, FaF = FaF_, PFaF = PFaF_, MF = MF_, PMF = PMF_;
+  const double Fa = Fa_, PFa = PFa_, M = M_, FaF = FaF_, PFaF = PFaF_, MF = MF_, c = c_, cF = cF_;
+  const Eigen::Matrix2d Pl = Pl_, PlF = PlF_;
   double last[3];
   bool seen[3];
   for (int i = 0; i < 3; ++i) {
@@ -168,11 +177,13 @@ void LoadEstimator::restart(double t0, const Kinematics& k0) {
   Fa_ = Fa;
   PFa_ = PFa;
   M_ = M;
-  PM_ = PM;
+  Pl_ = Pl;
+  c_ = c;
+  cF_ = cF;
   FaF_ = FaF;
   PFaF_ = PFaF;
   MF_ = MF;
-  PMF_ = PMF;
+  PlF_ = PlF;
   for (int i = 0; i < 3; ++i) {
     last_upd_[i] = last[i];
     seen_[i] = seen[i];
@@ -214,13 +225,16 @@ void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
   }
   // Random walk of the loads over the interval (slower while the cage moves).
   const double scale = moving() ? set_.moving_walk_scale : 1.0;
-  const double qfa = set_.fa_walk * scale, qm = set_.moment_walk * scale;
+  // A declared known load is pinned: no walk (declareKnownLoad()).
+  const double pin = knownLoad() ? 0.0 : 1.0;
+  const double qfa = set_.fa_walk * scale * pin, qm = set_.moment_walk * scale * pin;
   PFa_ += qfa * qfa * h;
-  PM_ += qm * qm * h;
+  Pl_(0, 0) += qm * qm * h;
   // The short-memory twins forget with time constant constancy_memory.
   const double forget = std::exp(h / set_.constancy_memory);
   PFaF_ = PFaF_ * forget + qfa * qfa * h;
-  PMF_ = PMF_ * forget + qm * qm * h;
+  PlF_ *= forget;  // the offset's information too: nested estimates, PF - P >= 0
+  PlF_(0, 0) += qm * qm * h;
   trip_QFa_ += qfa * qfa * h;
   trip_QM_ += qm * qm * h;
 }
@@ -241,7 +255,7 @@ void LoadEstimator::predict(const CageResponse& twin) {
   base_fy_ = zt.f_y + oM * zs.f_y;
   base_om_ = zt.omega + oM * zs.omega;
   base_rope_ = zt.rope_load + oFa * zs.rope_load;
-  pred_fy_ = base_fy_ + dM * h_fy_;
+  pred_fy_ = base_fy_ + dM * h_fy_ + c_;
   pred_om_ = base_om_ + dM * h_om_;
   pred_rope_ = base_rope_ + dFa * h_rope_;
   // The step's onset is known to one sample: its response one sample early
@@ -298,21 +312,23 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   if (use_a) mon_[kImuAccel].sample(t_, f_y);
   if (use_w) mon_[kImuRate].sample(t_, omega);
   const double eps = set_.model_error;
-  const double ea = std::hypot(eps * (std::abs(pred_fy_) + env_fy_), step_e_fy_);
+  const double ea = std::hypot(eps * (std::abs(pred_fy_ - c_) + env_fy_), step_e_fy_);
   const double ew = std::hypot(eps * env_om_, step_e_om_);
   const double ra = set_.noise.imu_accel * set_.noise.imu_accel + ea * ea;
   const double rw = set_.noise.imu_rate * set_.noise.imu_rate + ew * ew;
-  // Innovation, its covariance S = H P H^T + R (1 or 2 rows), in closed form.
-  Eigen::Vector2d H(use_a ? h_fy_ : 0.0, use_w ? h_om_ : 0.0);
+  // The lateral state (M, c), c the accelerometer's offset (on f_y only):
+  // innovation, its covariance S = H P H^T + R (1 or 2 rows), in closed form.
+  Eigen::Matrix2d H;  // rows f_y, omega; columns M, c
+  H << (use_a ? h_fy_ : 0.0), (use_a ? 1.0 : 0.0), (use_w ? h_om_ : 0.0), 0.0;
   Eigen::Vector2d nu(use_a ? f_y - pred_fy_ : 0.0, use_w ? omega - pred_om_ : 0.0);
-  auto covariance = [&](double P) {
-    Eigen::Matrix2d S = P * H * H.transpose();
+  auto covariance = [&](const Eigen::Matrix2d& P) {
+    Eigen::Matrix2d S = H * P * H.transpose();
     S(0, 0) += use_a ? ra : 1.0;
     S(1, 1) += use_w ? rw : 1.0;
     // an unused row has H = 0 and nu = 0: it adds nothing to K or the NIS
     return S;
   };
-  Eigen::Matrix2d S = covariance(PM_);
+  Eigen::Matrix2d S = covariance(Pl_);
   const bool gated = (use_a && std::abs(nu(0)) > set_.gate_sigma * std::sqrt(S(0, 0))) ||
                      (use_w && std::abs(nu(1)) > set_.gate_sigma * std::sqrt(S(1, 1)));
   if (use_a) mon_[kImuAccel].gate(t_, gated);
@@ -330,18 +346,16 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
     return false;
   }
   run_m_ = 0;
-  const Eigen::Matrix2d Si = S.inverse();
-  const Eigen::RowVector2d K = PM_ * H.transpose() * Si;
-  M_ += K * nu;
-  PM_ = std::max(PM_ - (K * S * K.transpose())(0, 0), 0.0);
+  const Eigen::Vector2d dx = kalmanUpdate(Pl_, H, S, nu);
+  M_ += dx(0);
+  c_ += dx(1);
   {  // the short-memory estimate, same measurement
     const double dMF = MF_ - o_M_;
-    const Eigen::Vector2d nuF(use_a ? f_y - (base_fy_ + dMF * h_fy_) : 0.0,
+    const Eigen::Vector2d nuF(use_a ? f_y - (base_fy_ + dMF * h_fy_ + cF_) : 0.0,
                               use_w ? omega - (base_om_ + dMF * h_om_) : 0.0);
-    const Eigen::Matrix2d SF = covariance(PMF_);
-    const Eigen::RowVector2d KF = PMF_ * H.transpose() * SF.inverse();
-    MF_ += KF * nuF;
-    PMF_ = std::max(PMF_ - (KF * SF * KF.transpose())(0, 0), 0.0);
+    const Eigen::Vector2d dxF = kalmanUpdate(PlF_, H, covariance(PlF_), nuF);
+    MF_ += dxF(0);
+    cF_ += dxF(1);
   }
   const int dof = (use_a ? 1 : 0) + (use_w ? 1 : 0);
   (void)dof;
@@ -363,9 +377,8 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
     seen_[kImuRate] = true;
   }
   // The other channel's prediction follows the new moment.
-  const double dM = K * nu;
-  pred_fy_ += dM * h_fy_;
-  pred_om_ += dM * h_om_;
+  pred_fy_ += dx(0) * h_fy_ + dx(1);
+  pred_om_ += dx(0) * h_om_;
   return true;
 }
 
@@ -392,6 +405,10 @@ void LoadEstimator::foldStep() {
 }
 
 void LoadEstimator::loadChange(double onset) {
+  if (knownLoad()) {  // a declared known load does not change: the offset explains the rest
+    run_fa_ = run_m_ = 0;
+    return;
+  }
   // One load changed: both its force and its moment re-open, whichever
   // channel saw it (the rope load sees Fa at once, f_y the moment slowly).
   if (!moving()) {
@@ -414,11 +431,13 @@ void LoadEstimator::loadChange(double onset) {
   change_Fa0_ = Fa_;
   change_M0_ = M_;
   PFa_ = std::max(PFa_, set_.fa_sigma0 * set_.fa_sigma0);
-  PM_ = std::max(PM_, set_.moment_sigma0 * set_.moment_sigma0);
+  Pl_(0, 0) = std::max(Pl_(0, 0), set_.moment_sigma0 * set_.moment_sigma0);
+  Pl_(0, 1) = Pl_(1, 0) = 0.0;  // the new moment owes nothing to the offset
   FaF_ = Fa_;
   PFaF_ = PFa_;
   MF_ = M_;
-  PMF_ = PM_;
+  PlF_ = Pl_;
+  cF_ = c_;
   run_fa_ = run_m_ = 0;
   cusum_fa_.reset();
   cusum_m_.reset();

@@ -3,6 +3,10 @@
 // installed: model/src only.
 #pragma once
 
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
 namespace hoist::estimator_detail {
 
 inline constexpr double kMaxSpecificForce = 100.0;  // |f_y| [m/s^2] a cage IMU can report
@@ -23,5 +27,24 @@ inline constexpr double kRopeOscillationError = 0.07;  // the rope's oscillation
 inline constexpr double kJumpRefLength = 50.0;       // ... and less on a longer, softer rope (x 50 m / l)
 // (calibrated: n = 25 against n = 100 and 200, tests/model/load_estimator_test.cpp)
 inline constexpr double kStartTransientTime = 5.0;   // its decay time [s]
+
+// The known-load calibration pins the loads to this relative sigma (floor 1 N, 1 N m).
+inline constexpr double kKnownLoadRelSigma = 1e-3;
+
+/// One Kalman update of a two-state (M, accelerometer offset) filter with
+/// covariance P, measurement matrix H, innovation covariance S = H P H^T + R
+/// and innovation nu: P becomes the posterior (kept symmetric and positive
+/// semi-definite); returns the state's correction.  Fixed-size: no allocation.
+inline Eigen::Vector2d kalmanUpdate(Eigen::Matrix2d& P, const Eigen::Matrix2d& H, const Eigen::Matrix2d& S,
+                                    const Eigen::Vector2d& nu) {
+  const Eigen::Matrix2d K = P * H.transpose() * S.inverse();
+  const Eigen::Vector2d dx = K * nu;
+  P -= K * S * K.transpose();
+  P(0, 0) = std::max(P(0, 0), 0.0);
+  P(1, 1) = std::max(P(1, 1), 0.0);
+  const double lim = std::sqrt(P(0, 0) * P(1, 1));
+  P(0, 1) = P(1, 0) = std::clamp(0.5 * (P(0, 1) + P(1, 0)), -lim, lim);
+  return dx;
+}
 
 }  // namespace hoist::estimator_detail

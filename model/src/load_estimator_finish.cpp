@@ -69,7 +69,7 @@ const LoadEstimate& LoadEstimator::finish() {
     trip_Fa0_ = Fa_;
     trip_PFa0_ = PFa_;
     trip_M0_ = M_;
-    trip_PM0_ = PM_;
+    trip_PM0_ = Pl_(0, 0);
     trip_QFa_ = trip_QM_ = 0.0;
     trip_drift_ = 0.0;
     drift_flag_ = false;
@@ -87,7 +87,7 @@ const LoadEstimate& LoadEstimator::finish() {
     };
     if (seen_[kRope]) trip_drift_ = std::max(trip_drift_, drift(Fa_, trip_Fa0_, PFa_, trip_PFa0_, trip_QFa_));
     if (seen_[kImuAccel] || seen_[kImuRate])
-      trip_drift_ = std::max(trip_drift_, drift(M_, trip_M0_, PM_, trip_PM0_, trip_QM_));
+      trip_drift_ = std::max(trip_drift_, drift(M_, trip_M0_, Pl_(0, 0), trip_PM0_, trip_QM_));
     if (trip_drift_ > set_.drift_sigma && filled) drift_flag_ = true;
   }
   // Constancy: the short-memory estimate against the whole history's.  With
@@ -98,7 +98,7 @@ const LoadEstimate& LoadEstimator::finish() {
     };
     double c = 0.0;
     if (seen_[kRope]) c = std::max(c, gap(FaF_, Fa_, PFaF_, PFa_));
-    if (seen_[kImuAccel] || seen_[kImuRate]) c = std::max(c, gap(MF_, M_, PMF_, PM_));
+    if (seen_[kImuAccel] || seen_[kImuRate]) c = std::max(c, gap(MF_, M_, PlF_(0, 0), Pl_(0, 0)));
     const_drift_ = c;
     if (c > set_.drift_sigma) drift_flag_ = true;
   }
@@ -151,14 +151,17 @@ const LoadEstimate& LoadEstimator::finish() {
   e.fa_observed = seen_[kRope];
   e.moment_observed = seen_[kImuAccel] || seen_[kImuRate];
 
-  const double sFa = std::sqrt(PFa_), sM = std::sqrt(PM_);
+  const double sFa = std::sqrt(PFa_), sM = std::sqrt(Pl_(0, 0));
   e.Fa = Fa_;
   e.sigma_Fa = sFa;
   e.moment = M_;
   e.sigma_moment = sM;
+  e.accel_offset = c_;
+  e.sigma_accel_offset = accelOffsetSigma();
+  e.known_load = knownLoad();
   if (e.fa_observed && e.moment_observed && std::abs(Fa_) > 3.0 * sFa) {
     e.b = M_ / Fa_;
-    e.sigma_b = std::sqrt(PM_ + e.b * e.b * PFa_) / std::abs(Fa_);
+    e.sigma_b = std::sqrt(Pl_(0, 0) + e.b * e.b * PFa_) / std::abs(Fa_);
   } else {
     e.b = 0.0;
     e.sigma_b = -1.0;

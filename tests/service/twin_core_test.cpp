@@ -317,7 +317,7 @@ TEST(TwinCoreWall, ADegradedTickIsNoEvidenceForTheModelCheck) {
     s.seq += 1;
     s.utime = kT0 + std::llround(w * 1e6);
     ASSERT_TRUE(core.onInput(s, w - 0.001).accepted);
-    core.onCageImu(f_y, 0.0);
+    core.onCageImu(s.utime, f_y, 0.0, w, s.utime);
     core.tick(w, w);
     core.housekeeping(w);
   };
@@ -340,6 +340,41 @@ TEST(TwinCoreWall, ADegradedTickIsNoEvidenceForTheModelCheck) {
   EXPECT_FALSE(core.degraded());
   EXPECT_GT(core.estimate()->nis_dof, dof0);
   EXPECT_GT(core.estimate()->nis_window, window0);
+}
+
+TEST(TwinCoreWall, CalibrateHandsTheKnownLoadToTheEstimator) {
+  // Issue 30: ACTION_CALIBRATE's known load reaches the estimator, which
+  // learns the accelerometer's offset from it (a 1 mg offset at rest).
+  TwinConfig cfg = smallConfig();
+  cfg.estimator.enabled = true;
+  TwinCore core(cfg, ClockMode::Wall);
+  WinderSample s;
+  s.utime = kT0;
+  s.has_length = true;
+  s.length = cfg.shaft.l0;
+  const double offset = 0.0098, g = cfg.shaft.g;
+  double theta = 0.0;
+  auto tickWith = [&](double w) {
+    s.seq += 1;
+    s.utime = kT0 + std::llround(w * 1e6);
+    ASSERT_TRUE(core.onInput(s, w - 0.001).accepted);
+    core.onCageImu(s.utime, g * theta + offset, 0.0, w, s.utime);  // the configured load's static tilt, read 1 mg off
+    core.tick(w, w);
+    core.housekeeping(w);
+    if (core.estimate()) theta = core.estimate()->theta_open;
+  };
+  tickWith(0.01);
+  EXPECT_FALSE(core.calibrate(-1.0, 0.0, 5.0)) << "a negative load is refused";
+  ASSERT_TRUE(core.calibrate(cfg.shaft.Fa, cfg.shaft.b, 5.0));
+  for (int k = 2; k <= 300; ++k) tickWith(0.01 * k);
+  ASSERT_NE(core.estimate(), nullptr);
+  const LoadEstimate& e = *core.estimate();
+  EXPECT_TRUE(e.known_load);
+  EXPECT_TRUE(core.calibrating());
+  EXPECT_GT(e.sigma_accel_offset, 0.0);
+  EXPECT_LT(e.sigma_accel_offset, 0.001);
+  EXPECT_NEAR(e.accel_offset, offset, 3.0 * e.sigma_accel_offset);
+  EXPECT_NEAR(e.moment, cfg.shaft.Fa * cfg.shaft.b, 0.01 * std::abs(cfg.shaft.Fa * cfg.shaft.b) + 2.0);
 }
 
 TEST(TwinCoreWall, StaleInputHoldsAndRaisesAnAlarm) {

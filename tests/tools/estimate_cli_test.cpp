@@ -261,3 +261,41 @@ TEST_F(EstimateCli, HelpVersionAndProgress) {
   EXPECT_EQ(p.status, 0) << p.output;
   EXPECT_NE(p.output.find("progress 100 %"), std::string::npos) << p.output;
 }
+
+// The calibration options: --known-load validated (exit 2 naming it), the
+// learned offset written by --offset-out and read back by --offset-in; a
+// corrupt offset file is refused naming its key.
+TEST_F(EstimateCli, KnownLoadAndOffsetFiles) {
+  const std::string truth = write("truth.toml", "[load]\neccentric_force = 0.0\noffset = 0.0\n");
+  const CapturedRun s = sim({"--config", truth, "--profile", "trapezoid:vmax=5,amax=1,travel=150,t_end=45,dt=0.01",
+                             "--modes", "25", "--write-measurements", path("meas.csv"), "--seed", "3", "-q"});
+  ASSERT_EQ(s.status, 0) << s.output;
+  const std::string cfg = write("twind.toml", "[sensors]\nimu_accel_offset_sigma = 0.005\n");
+  auto run = [&](std::vector<std::string> extra) {
+    std::vector<std::string> a = {"--config", cfg, "--measurements", path("meas.csv"), "--out", path("est.csv")};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return estimate(a);
+  };
+  for (const char* bad : {"1,2,3", "5,1,0,0", "0,10,-5,0", "0,10,0,x", "0,10,0,99"}) {
+    const CapturedRun e = run({"--known-load", bad});
+    EXPECT_EQ(e.status, 2) << bad << ": " << e.output;
+    EXPECT_NE(e.output.find("--known-load"), std::string::npos) << e.output;
+  }
+  const CapturedRun c = run({"--known-load", "-1,1000,0,0", "--known-load", "2000,2001,0,0", "--offset-out",
+                             path("offset.txt")});
+  ASSERT_EQ(c.status, 0) << c.output;
+  EXPECT_NE(c.output.find("accelerometer offset"), std::string::npos) << c.output;
+  const std::vector<std::string> f = lines("offset.txt");
+  ASSERT_EQ(f.size(), 3u);
+  EXPECT_EQ(f[1].rfind("accel_offset = ", 0), 0u);
+  const double off = std::stod(f[1].substr(15)), sig = std::stod(f[2].substr(8));
+  EXPECT_GT(sig, 0.0);
+  EXPECT_LT(sig, 0.001);              // the known load teaches it
+  EXPECT_LT(std::abs(off), 3.0 * sig);  // hoist-sim's IMU has no offset
+  const CapturedRun r = run({"--offset-in", path("offset.txt")});
+  EXPECT_EQ(r.status, 0) << r.output;
+  write("bad.txt", "accel_offset = 0.01\nsigma = -1\n");
+  const CapturedRun b = run({"--offset-in", path("bad.txt")});
+  EXPECT_EQ(b.status, 2) << b.output;
+  EXPECT_NE(b.output.find("sigma"), std::string::npos) << b.output;
+}

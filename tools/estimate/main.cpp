@@ -8,6 +8,12 @@
 //
 //   hoist-estimate --config FILE --measurements FILE.csv --out FILE.csv
 //                  [--modes N] [--max-step S] [--progress] [-q]
+//                  [--known-load T0,T1,FA,B]... [--offset-in FILE] [--offset-out FILE]
+//
+// The accelerometer's offset (docs/estimation.md): --known-load declares the
+// load known over [T0, T1) (the operator's calibration: an empty conveyance,
+// a test weight), so the data teach the offset; --offset-in starts from a
+// learned one, --offset-out writes the last row's (hoist/io/accel_offset_file.hpp).
 //
 // --config: a shaft TOML or hoist-twind's configuration ([service],
 // [alarms], [forecast], [sensors], [estimator] are accepted; [estimator]
@@ -35,6 +41,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "hoist/io/accel_offset_file.hpp"
 #include "hoist/io/checked_file.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/io/estimator_config.hpp"
@@ -53,6 +60,8 @@ struct Options {
   int modes = 0;
   double max_step = -1.0;
   bool progress = false, quiet = false;
+  std::vector<std::string> known_load;  // T0,T1,FA,B each
+  std::string offset_in, offset_out;
 };
 
 struct UsageError : std::runtime_error {
@@ -190,6 +199,25 @@ int run(const Options& o) {
     for (const auto& c : cols.ignored) list += (list.empty() ? "" : ", ") + c;
     std::cerr << "hoist-estimate: " << o.measurements << ": ignored columns: " << list << "\n";
   }
+  hoist::RecordedCalibration cal;
+  for (const std::string& k : o.known_load) {
+    double v[4];
+    char tail = 0;
+    if (std::sscanf(k.c_str(), "%lf,%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &v[3], &tail) != 4 ||
+        !(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]) && std::isfinite(v[3])))
+      throw UsageError("--known-load " + k + ": expected T0,T1,FA,B (four finite numbers: s, s, N, m)");
+    if (!(v[1] > v[0])) throw UsageError("--known-load " + k + ": T1 must be after T0");
+    if (v[2] < 0.0) throw UsageError("--known-load " + k + ": FA must be >= 0 N");
+    if (std::abs(v[3]) > p.offsetLimit())
+      throw UsageError("--known-load " + k + ": |B| beyond the conveyance's half-width " + fmt("%g", p.offsetLimit()) + " m");
+    cal.known.push_back({v[0], v[1], v[2], v[3]});
+  }
+  if (!o.offset_in.empty()) {
+    const hoist::io::AccelOffsetRecord r = hoist::io::readAccelOffsetFile(o.offset_in);
+    cal.has_offset = true;
+    cal.offset = r.offset;
+    cal.offset_sigma = r.sigma;
+  }
   hoist::io::CheckedFile out(o.out, "--out");
 
   // ---- estimate -----------------------------------------------------------
@@ -208,7 +236,7 @@ int run(const Options& o) {
   const bool tty = ::isatty(2);
   try {
     hoist::estimateRecorded(
-        p, set, max_step, samples,
+        p, set, max_step, samples, cal,
         [&](const hoist::LoadEstimate& e, const hoist::EstimatorCounters& c) {
           line.clear();
           appendRow(line, e, c);
@@ -256,6 +284,8 @@ int run(const Options& o) {
   }
   if (o.progress && tty) std::fputc('\n', stderr);
   out.close();
+  if (!o.offset_out.empty())
+    hoist::io::writeAccelOffsetFile(o.offset_out, {last.accel_offset, last.sigma_accel_offset}, "--offset-out");
   const double secs = std::chrono::duration<double>(Clock::now() - t_start).count();
   if (!o.quiet) {
     std::ostringstream s;
@@ -266,7 +296,12 @@ int run(const Options& o) {
       << withSigma("Fa", last.Fa, last.sigma_Fa, last.fa_observed, "N", "%.1f") << ", "
       << withSigma("b", last.b, last.sigma_b, last.fa_observed && last.moment_observed, "m", "%.4f") << ", "
       << withSigma("M", last.moment, last.sigma_moment, last.moment_observed, "N m", "%.1f") << " (configured Fa = " << p.Fa
-      << " N, b = " << p.b << " m). Updates accepted " << counts.accepted << ", gated " << counts.gated
+      << " N, b = " << p.b << " m), accelerometer offset " << fmt("%.5f", last.accel_offset) << " +- "
+      << fmt("%.5f", last.sigma_accel_offset) << " m/s^2"
+      << (cal.known.empty() && !cal.has_offset && last.sigma_accel_offset > 0.0
+              ? " (uncalibrated: M's sigma includes it; calibrate with --known-load, keep it with --offset-out)"
+              : "")
+      << ". Updates accepted " << counts.accepted << ", gated " << counts.gated
       << ", load changes " << counts.load_changes << ", implausible " << counts.implausible
       << "; MODEL_MISMATCH in " << mismatch_rows << " rows, first "
       << (std::isnan(first_mismatch) ? std::string("none")
@@ -313,6 +348,14 @@ int main(int argc, char** argv) {
                  "largest integration step [s] (default: the config's [service] max_step, else 0.0025 as in "
                  "hoist-twind; 0: one step per row)")
       ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--known-load", o.known_load,
+                 "T0,T1,FA,B: the load is known to be FA [N] at B [m] from T0 to T1 [s] (the calibration: the "
+                 "estimator learns the accelerometer's offset); repeatable")
+      ->take_all()
+      ->allow_extra_args(false);
+  app.add_option("--offset-in", o.offset_in, "start from the accelerometer offset in FILE (written by --offset-out or hoist-twind)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--offset-out", o.offset_out, "write the learned accelerometer offset and its sigma to FILE");
   app.add_flag("--progress", o.progress, "show progress on stderr");
   app.add_flag("-q,--quiet", o.quiet, "no summary and no warnings");
   try {

@@ -84,6 +84,7 @@
 // nothing, a load change included (tests/model/no_alloc_test.cpp).
 #pragma once
 
+#include <Eigen/Dense>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -109,6 +110,10 @@ struct SensorNoise {
 /// The filter's tuning ([estimator]); docs/estimation.md says how to choose it.
 struct EstimatorSettings {
   SensorNoise noise;
+  /// Prior sigma of the accelerometer's constant offset on f_y ([sensors]
+  /// imu_accel_offset_sigma) [m/s^2]; 0 declares it calibrated (the offset
+  /// is then the one setAccelOffset() gave, 0 by default, and not estimated).
+  double accel_offset_sigma = 0.005;
   double fa_walk = 5.0;         ///< random walk of Fa at rest [N/sqrt(s)]
   double moment_walk = 5.0;     ///< random walk of M at rest [N m/sqrt(s)]
   double moving_walk_scale = 0.01;  ///< factor on both walks while the cage moves (loads do not change then)
@@ -154,7 +159,11 @@ struct LoadEstimate {
   double t = 0.0;
   Kinematics kin;
   double Fa = 0.0, sigma_Fa = -1.0;        ///< eccentric force [N]
-  double moment = 0.0, sigma_moment = -1.0;  ///< M = Fa b [N m]
+  double moment = 0.0, sigma_moment = -1.0;  ///< M = Fa b [N m]; its sigma includes what the offset leaves unknown
+  /// The accelerometer's offset on f_y, estimated jointly with M [m/s^2]
+  /// (sigma 0: calibrated, imu_accel_offset_sigma = 0).
+  double accel_offset = 0.0, sigma_accel_offset = 0.0;
+  bool known_load = false;   ///< a declared known load is pinned (declareKnownLoad())
   double b = 0.0, sigma_b = -1.0;          ///< offset [m]; observed only with both sensors
   double x_c = 0.0, sigma_x_c = 0.0;       ///< the state the estimated load implies
   double y_c = 0.0, sigma_y_c = 0.0;
@@ -265,6 +274,24 @@ class LoadEstimator {
   /// updates still apply, but the next finish() keeps their NIS out of the
   /// window (est.nis still reports it).  Applies to one tick only.
   void excludeTickFromModelCheck() { skip_nis_ = true; }
+  /// The operator's calibration: the load is (Fa, b) until model time
+  /// `until_t`, so the data teach the accelerometer's offset.  Pins Fa and
+  /// M = Fa b (sigma kKnownLoadRelSigma = 0.1 % of them, at least 1 N and
+  /// 1 N m; no random walk) from now to until_t; afterwards they carry on
+  /// from there as usual.  Throws std::invalid_argument for non-finite
+  /// values or Fa < 0.  Allocation-free (the daemon calls it between ticks).
+  void declareKnownLoad(double Fa, double b, double until_t);
+  /// Ends a declared known load now (the loads keep their pinned values).
+  void clearKnownLoad();
+  bool knownLoad() const { return t_ < known_until_; }
+  /// The accelerometer's offset learned so far and its sigma [m/s^2].
+  double accelOffset() const { return c_; }
+  double accelOffsetSigma() const;
+  /// Start from a learned offset (a calibration kept across trips and
+  /// restarts): used now and by every later initialize().  sigma >= 0
+  /// (0: known exactly); with imu_accel_offset_sigma = 0 the offset is
+  /// applied but held fixed.  Throws std::invalid_argument for bad values.
+  void setAccelOffset(double value, double sigma);
   /// Close the tick: NIS window, mismatch test, the estimate.
   const LoadEstimate& finish();
 
@@ -318,8 +345,13 @@ class LoadEstimator {
   Kinematics kin_;
   double Fa_c_ = 0.0, M_c_ = 0.0;          // the configured load (prior)
   double Fa_ = 0.0, PFa_ = 0.0;            // longitudinal filter: estimate and variance
-  double M_ = 0.0, PM_ = 0.0;              // lateral filter
-  double FaF_ = 0.0, PFaF_ = 0.0, MF_ = 0.0, PMF_ = 0.0;  // the same with a short memory (constancy test)
+  double M_ = 0.0;                         // lateral filter: M and the accelerometer's offset c,
+  double c_ = 0.0;                         // with their 2x2 covariance Pl_ (M first)
+  Eigen::Matrix2d Pl_ = Eigen::Matrix2d::Zero();
+  double c0_ = 0.0, Pc0_ = 0.0;            // the offset's start: setAccelOffset() or the prior
+  double known_until_ = -1e300;            // declareKnownLoad(): pinned until then
+  double FaF_ = 0.0, PFaF_ = 0.0, MF_ = 0.0, cF_ = 0.0;  // the same with a short memory (constancy test)
+  Eigen::Matrix2d PlF_ = Eigen::Matrix2d::Zero();
   double const_drift_ = 0.0;               // |short - whole| / its sigma, largest of Fa and M
   double base_fy_ = 0.0, base_om_ = 0.0, base_rope_ = 0.0;  // the open-loop twin's measurements
   CageResponse twin_resp_;                 // the twin's response at this tick
@@ -369,6 +401,25 @@ class LoadEstimator {
 /// included); `progress` (optional) the fraction done about 100 times.
 void estimateRecorded(const ShaftParams& twin, const EstimatorSettings& settings, double max_step,
                       const std::vector<MeasurementSample>& samples,
+                      const std::function<void(const LoadEstimate&, const EstimatorCounters&)>& sink,
+                      const std::function<void(double)>& progress = {});
+
+/// A load declared known over [t0, t1) (hoist-estimate --known-load T0,T1,FA,B).
+struct KnownLoadInterval {
+  double t0 = 0.0, t1 = 0.0, Fa = 0.0, b = 0.0;
+};
+/// The calibration hoist-estimate runs with: known-load intervals (declared
+/// at their first sample: LoadEstimator::declareKnownLoad) and a learned
+/// offset to start from (--offset-in: setAccelOffset).  The learned offset
+/// comes out in every LoadEstimate (accel_offset, sigma_accel_offset).
+struct RecordedCalibration {
+  std::vector<KnownLoadInterval> known;
+  bool has_offset = false;
+  double offset = 0.0, offset_sigma = 0.0;
+};
+/// estimateRecorded with a calibration.
+void estimateRecorded(const ShaftParams& twin, const EstimatorSettings& settings, double max_step,
+                      const std::vector<MeasurementSample>& samples, const RecordedCalibration& cal,
                       const std::function<void(const LoadEstimate&, const EstimatorCounters&)>& sink,
                       const std::function<void(double)>& progress = {});
 

@@ -4,6 +4,7 @@
 // See hoist/service/twin_core.hpp; the rest of TwinCore is twin_core.cpp.
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "hoist/service/twin_core.hpp"
 
@@ -36,6 +37,13 @@ SensorVerdict TwinCore::offerSensor(SensorId s, std::int64_t utime, double a, do
 
 bool TwinCore::calibrate(double Fa, double b, double duration) {
   if (!est_ || !std::isfinite(Fa) || !std::isfinite(b) || !(duration > 0.0)) return false;
+  // The estimator pins the declared load and learns the accelerometer's
+  // offset from it (LoadEstimator::declareKnownLoad: allocation-free).
+  try {
+    est_->declareKnownLoad(Fa, b, t_ + duration);
+  } catch (const std::invalid_argument&) {
+    return false;  // Fa < 0: refused, as the contract refuses it
+  }
   known_Fa_ = Fa;
   known_b_ = b;
   known_until_ = t_ + duration;

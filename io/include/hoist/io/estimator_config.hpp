@@ -63,13 +63,15 @@ int* intOf(EstimatorSettings& s) { return &(s.*M); }
 }  // namespace detail
 
 /// Every key of [sensors] and [estimator] but `enabled`, in file order.
-inline constexpr std::array<EstimatorField, 30> kEstimatorFields = {{
+inline constexpr std::array<EstimatorField, 31> kEstimatorFields = {{
     {"sensors", "imu_accel_noise", &detail::noiseOf<&SensorNoise::imu_accel>, nullptr, "m/s^2",
      "IMU lateral specific force f_y: noise standard deviation per sample"},
     {"sensors", "imu_rate_noise", &detail::noiseOf<&SensorNoise::imu_rate>, nullptr, "rad/s",
      "IMU tilt rate omega: noise standard deviation per sample"},
     {"sensors", "rope_load_noise", &detail::noiseOf<&SensorNoise::rope_load>, nullptr, "N",
      "rope load cell: noise standard deviation per sample"},
+    {"sensors", "imu_accel_offset_sigma", &detail::realOf<&EstimatorSettings::accel_offset_sigma>, nullptr, "m/s^2",
+     "prior sigma of the accelerometer's constant offset on f_y, estimated with M (0: calibrated)"},
     {"estimator", "fa_walk", &detail::realOf<&EstimatorSettings::fa_walk>, nullptr, "N/sqrt(s)",
      "random walk of Fa at rest"},
     {"estimator", "moment_walk", &detail::realOf<&EstimatorSettings::moment_walk>, nullptr, "N m/sqrt(s)",

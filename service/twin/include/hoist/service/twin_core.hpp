@@ -279,8 +279,8 @@ class TwinCore {
   /// The live calibration (alarm_ack_t ACTION_CALIBRATE): the load is known
   /// -- force Fa [N] at offset b [m] -- from now for `duration` seconds of
   /// model time; the estimator learns the accelerometer's offset from it.
-  /// false (nothing changes): no estimator.  A new declaration replaces one
-  /// in force.
+  /// false (nothing changes): no estimator, or Fa < 0.  A new declaration
+  /// replaces one in force.  The learned offset: estimate().accel_offset.
   bool calibrate(double Fa, double b, double duration);
   /// A declared known load is in force at the current model time.
   bool calibrating() const { return est_ && t_ < known_until_; }
