@@ -48,6 +48,11 @@ Band run(const CleanTruth& tr, const std::vector<MeasurementSample>& m, const Es
 
 }  // namespace
 
+// The prior the issue proposes as the default (about 0.5 mg); the shipped
+// default is 0 until the live daemon gives the same numbers with it
+// (docs/estimation.md, "The accelerometer's offset").
+constexpr double kOffsetPrior = 0.005;
+
 // Without the offset in the filter (imu_accel_offset_sigma = 0) a 1 mg offset
 // is the issue's confident error; with it the truth stays in the band.
 TEST(LoadEstimatorOffset, UncalibratedOneMgOffsetStaysInsideItsBand) {
@@ -55,6 +60,7 @@ TEST(LoadEstimatorOffset, UncalibratedOneMgOffsetStaysInsideItsBand) {
   for (double white : {0.002, 0.01}) {
     for (unsigned seed = 500; seed < 503; ++seed) {
       EstimatorSettings set;
+      set.accel_offset_sigma = kOffsetPrior;
       set.noise.imu_accel = white;
       const auto m = measure(tr, imu(white, kOneMg), seed);
       const Band b = run(tr, m, set);
@@ -88,6 +94,7 @@ TEST(LoadEstimatorOffset, CalibrationTripThenLoadedTripWithinFivePercent) {
   const CleanTruth loaded = simulate(config(), HoistProfile::trapezoid(), {1000.0, 1.0}, 100);
   for (double white : {0.002, 0.01}) {
     EstimatorSettings set;
+    set.accel_offset_sigma = kOffsetPrior;
     set.noise.imu_accel = white;
     RecordedCalibration c1;
     c1.known.push_back({-1e9, 1e9, 0.0, 0.0});
