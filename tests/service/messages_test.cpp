@@ -65,7 +65,8 @@ TEST(Messages, AnUnobservedLoadIsPublishedWithANegativeSigma) {
   e.fa_observed = false;
   e.moment_observed = true;
   hoist::estimate_t m{};
-  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, -1.0, true, m);
+  const EstimateGate gate(AlarmConfig{}, 2.0);
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, -1.0, gate, 0.0, false, m);
   EXPECT_EQ(m.Fa, 1000.0);
   EXPECT_LT(m.sigma_Fa, 0.0);
   EXPECT_FALSE(m.fa_observed);
@@ -74,12 +75,12 @@ TEST(Messages, AnUnobservedLoadIsPublishedWithANegativeSigma) {
   // Observed: the filter's sigma as it is; and M unobserved likewise.
   e.fa_observed = true;
   e.moment_observed = false;
-  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, true, m);
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, gate, 0.0, false, m);
   EXPECT_EQ(m.sigma_Fa, 5000.0);
   EXPECT_LT(m.sigma_moment, 0.0);
   EXPECT_LT(m.sigma_b, 0.0);
   e.moment_observed = true;
-  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, true, m);
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, gate, 0.0, false, m);
   EXPECT_EQ(m.sigma_b, 0.01);
 }
 
