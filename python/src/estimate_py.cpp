@@ -81,6 +81,16 @@ const std::vector<Cell>& cells() {
       {"gated", [](const E&, const C& c) { return static_cast<double>(c.gated); }},
       {"load_changes", [](const E&, const C& c) { return static_cast<double>(c.load_changes); }},
       {"implausible", [](const E&, const C& c) { return static_cast<double>(c.implausible); }},
+      {"plausible", [](const E& e, const C&) { return e.plausible ? 1.0 : 0.0; }},
+      {"fault_imu_accel", [](const E& e, const C&) { return static_cast<double>(e.fault_imu_accel); }},
+      {"fault_imu_rate", [](const E& e, const C&) { return static_cast<double>(e.fault_imu_rate); }},
+      {"fault_rope_load", [](const E& e, const C&) { return static_cast<double>(e.fault_rope_load); }},
+      {"noise_imu_accel", [](const E& e, const C&) { return e.noise_imu_accel; }},
+      {"noise_imu_rate", [](const E& e, const C&) { return e.noise_imu_rate; }},
+      {"noise_rope_load", [](const E& e, const C&) { return e.noise_rope_load; }},
+      {"change_t", [](const E& e, const C&) { return e.change_t; }},
+      {"change_Fa", [](const E& e, const C&) { return e.change_Fa; }},
+      {"change_moment", [](const E& e, const C&) { return e.change_moment; }},
   };
   return c;
 }

@@ -290,10 +290,12 @@ TEST_F(MqttSparkplug, IndependentHostChecksBirthsDataRebirthAckAndDeath) {
   e.seq = 9;
   e.Fa = 1234.5;
   e.in_use = true;
+  e.instance_id = 77;  // the daemon whose health the bridge follows (others' data is dropped)
   ASSERT_EQ(pub.publish("north/HOIST_ESTIMATE", &e), 0);
   hoist::forecast_t f{};
   f.utime = 1'700'000'004'000'000;
   f.seq = 3;
+  f.instance_id = 77;
   f.num_scenarios = 1;
   f.scenarios.resize(1);
   f.scenarios[0].name = "estop";

@@ -88,7 +88,7 @@ def test_the_gil_is_released_during_a_batch():
     t.start()
     try:
         t0 = time.perf_counter()
-        hoist.simulate_batch(preload_sweep(4), threads=1, t_end=6.0, modes=20)
+        hoist.simulate_batch(preload_sweep(4), threads=1, t_end=30.0, modes=40)  # about 0.5 s of work
         elapsed = time.perf_counter() - t0
         during = count
     finally:

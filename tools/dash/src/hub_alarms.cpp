@@ -178,6 +178,10 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
   // shelve_duration matters only for SHELVE (where validation requires it).
   if (!j.contains("utime")) j["utime"] = 0;
   if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
+  // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE, which the page
+  // does not send): absent in every alarm command.
+  for (const char* k : {"known_fa", "known_b", "calibrate_duration"})
+    if (!j.contains(k)) j[k] = 0.0;
   // The alarm the page drew (its activation): a command for an alarm that
   // was cleared and raised again since, or is gone, is refused.
   std::optional<std::int64_t> expect_activation;

@@ -102,6 +102,10 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
     const bool client_utime = j.contains("utime");
     if (!client_utime) j["utime"] = now_utime;
     if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
+    // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE, which this
+    // gate refuses): absent in every alarm command.
+    for (const char* k : {"known_fa", "known_b", "calibrate_duration"})
+      if (!j.contains(k)) j[k] = 0.0;
     if (!j.contains("user")) j["user"] = kDefaultCommandUser;
     std::string error;
     if (!hoist::msg::fromJson(j, r.ack, error)) {
