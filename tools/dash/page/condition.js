@@ -34,9 +34,10 @@ async function poll() {
     setTimeout(poll, POLL_MS);  // the server is gone: the live view says so; try again
     return;
   }
-  if (res.status === 404) return;  // no --history: no view (and no polling)
+  if (res.status === 404) return;  // an older hoist-dash without the view
   try {
     const j = await res.json();
+    if (j && j.enabled === false) return;  // no --history: no view (and no polling)
     if (j && typeof j === "object" && j.generation !== shownGeneration) render(j);
   } catch (e) {
     showError(`unreadable answer from the server (${e})`);

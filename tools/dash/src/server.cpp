@@ -360,8 +360,11 @@ class HttpSession : public std::enable_shared_from_this<HttpSession>, public Ser
     }
     if (target == "/api/condition") {  // the "Shaft condition" view (condition.hpp)
       if (!server_.conditionProvider()) {
-        hub.count("http_not_found");
-        respondError(http::status::not_found, "no history database (hoist-dash --history URL)", req.keep_alive());
+        // Not an error: the view is off.  (A 404 here was a console error
+        // on every page of a dashboard started without --history.)
+        respond(http::status::ok,
+                R"j({"enabled":false,"why":"no history database (hoist-dash --history URL)"})j",
+                "application/json", req.keep_alive(), req.method() == http::verb::head);
         return;
       }
       respond(http::status::ok, server_.conditionProvider()(), "application/json", req.keep_alive(),

@@ -59,9 +59,10 @@ process.on("uncaughtException", async (e) => {
   process.exit(1);
 });
 
-// 1. Without --history: /api/condition is 404 and the view stays hidden.
+// 1. Without --history: /api/condition says the view is off (naming --history) and the view stays hidden.
 const r404 = await fetch(new URL("/api/condition", plain.url));
-check(r404.status === 404 && /--history/.test(await r404.text()), "without --history, /api/condition answers 404 naming --history");
+const off = r404.status === 200 ? await r404.json() : {};
+check(off.enabled === false && /--history/.test(off.why || ""), "without --history, /api/condition says the view is off, naming --history");
 await page.goto(plain.url, { waitUntil: "load" });
 await page.waitForFunction(() => document.querySelector("#conn")?.dataset.state === "connected", { timeout: 10000 });
 check(await page.$eval("#condition", (e) => e.hidden), "without --history the Shaft condition view is hidden");

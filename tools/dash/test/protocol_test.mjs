@@ -84,8 +84,11 @@ for (const [topic, fields] of Object.entries(expect)) {
   const pub = start("forecast-pub", process.env.HOIST_FORECAST_PUB, [lcm, "", "3", "100"], dir);
   const res = await pub.exited;
   check(res.code === 0, `synthetic forecasts published (${pub.out.trim().split("\n").length} lines)`);
-  // (the test's daemon forecasts too -- on by default -- with its own instance id)
-  const synthetic = () => forecasts.filter((x) => x.instance_id === 4242);
+  // (the test's daemon forecasts too -- on by default; the synthetic ones carry
+  // its instance id as well, so they are told apart by their scenarios)
+  const synthetic = () => forecasts.filter((x) => x.num_scenarios === 2 && x.scenarios[0].name === "estop" &&
+                                                  x.scenarios[0].series_t.length === 50 && x.plan_seq === -1 &&
+                                                  x.compute_time === 0.02);
   await waitFor(() => synthetic().length >= 3, 5000, "3 HOIST_FORECAST messages");
   const f = synthetic()[0];
   const [e, o] = f.scenarios;
