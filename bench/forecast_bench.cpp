@@ -10,12 +10,13 @@
 //   build/bin/hoist-forecast-bench --benchmark_filter='/25/25/'   (exact vs economical at n = 25)
 #include <benchmark/benchmark.h>
 
+#include "bench_main.hpp"
+
 #include <memory>
 
 #include <cstdio>
 #include <string>
 
-#include "hoist/version.hpp"
 #include "hoist/forecast.hpp"
 #include "hoist/scenario.hpp"
 #include "hoist/simulator.hpp"
@@ -123,24 +124,7 @@ BENCHMARK(BM_ForecastPair)->Args({25, 0})->Args({25, 1})->Args({50, 1})->Args({2
 
 }  // namespace
 
-// BENCHMARK_MAIN() plus --version (from the one version header) and a
-// usage line naming the program.
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--version") {
-      std::printf("hoist-forecast-bench %s\n", hoist::kVersionString);
-      return 0;
-    }
-    if (a == "--help" || a == "-h") {
-      std::printf("usage: hoist-forecast-bench [Google Benchmark options]\n"
-                  "The look-ahead forecast's cost (docs/lookahead.md).  Options:\n");
-      std::fflush(stdout);
-    }
-  }
-  benchmark::Initialize(&argc, argv);  // --help: prints Google Benchmark's options, exits 0
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return hoist::bench::runMain(argc, argv, "hoist-forecast-bench",
+                               "The look-ahead forecast's cost (docs/lookahead.md).");
 }

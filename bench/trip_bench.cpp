@@ -3,12 +3,13 @@
 // the twin's max_step 0.0025 s.  Run: build/bin/hoist-trip-bench
 #include <benchmark/benchmark.h>
 
+#include "bench_main.hpp"
+
 #include <cstdio>
 #include <random>
 #include <string>
 
 #include "hoist/preload_identification.hpp"
-#include "hoist/version.hpp"
 
 using namespace hoist;
 
@@ -42,24 +43,7 @@ static void BM_IdentifyPreloadTrip(benchmark::State& state) {
 }
 BENCHMARK(BM_IdentifyPreloadTrip)->Arg(25)->Arg(50)->Unit(benchmark::kMillisecond)->Iterations(3);
 
-// BENCHMARK_MAIN() plus --version and a usage line naming the program.
 int main(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--version") {
-      std::printf("hoist-trip-bench %s\n", hoist::kVersionString);
-      return 0;
-    }
-    if (a == "--help" || a == "-h") {
-      std::printf("usage: hoist-trip-bench [Google Benchmark options]\n"
-                  "The guide-rope preload identification's cost per trip (docs/condition-identification.md).  "
-                  "Options:\n");
-      std::fflush(stdout);
-    }
-  }
-  benchmark::Initialize(&argc, argv);  // --help: prints Google Benchmark's options, exits 0
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return hoist::bench::runMain(argc, argv, "hoist-trip-bench",
+                               "The guide-rope preload identification's cost per trip (docs/condition-identification.md).");
 }
