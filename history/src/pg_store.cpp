@@ -243,6 +243,9 @@ class PgStore final : public Store {
     } catch (const Outage& o) {
       lost(o.why);
       return false;
+    } catch (...) {  // a schema we must not touch (StoreError): no connection kept, none leaked
+      lost("refused");
+      throw;
     }
     stats_.connected = true;
     stats_.last_error.clear();

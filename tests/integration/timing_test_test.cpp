@@ -68,8 +68,10 @@ TEST_F(TimingTest, GenerousBudgetsPass) {
   const auto report = (dir_ / "timing.md").string();
   std::string out;
   double secs = 0;
-  // Generous for a loaded 2-core CI machine; rejected inputs stay at 0.
-  const int rc = timingTest({"--rate", "100", "--duration", "4", "--max-misses", "1000", "--max-late-p99-us", "1e6",
+  // Generous for a loaded 2-core CI machine; rejected inputs stay at 0.  Fed
+  // at 25 Hz (a 40-ms period): a feeder woken 10-15 ms late by a busy machine
+  // (seen under ASan) is still on time, so the verdict can be PASS.
+  const int rc = timingTest({"--rate", "25", "--duration", "4", "--max-misses", "1000", "--max-late-p99-us", "1e6",
                              "--max-step-p99-us", "1e6", "--max-e2e-p99-us", "1e6", "--report", report},
                             out, secs);
   stopDaemon(*d, "twind.log");
@@ -85,7 +87,7 @@ TEST_F(TimingTest, GenerousBudgetsPass) {
   EXPECT_GT(std::stod(m[1].str()), 0.0);
   EXPECT_NE(r.find("| end-to-end latency p99.9 [us] | "), std::string::npos);
   EXPECT_NE(r.find("| host | "), std::string::npos);
-  EXPECT_NE(r.find("| rate | 100 Hz"), std::string::npos);
+  EXPECT_NE(r.find("| rate | 25 Hz"), std::string::npos) << r;
   EXPECT_NE(r.find("| duration | 4 s"), std::string::npos);
   EXPECT_NE(r.find("hoist-timing-test --lcm-url"), std::string::npos) << "the command is in the report";
   EXPECT_NE(r.find("## Violated budgets\n\nnone"), std::string::npos) << r;

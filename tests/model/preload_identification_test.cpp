@@ -84,7 +84,6 @@ TEST(PreloadIdentification, ScaleInsideItsBandIndustrialAndCheapImu) {
         if (id.sigma_scale > 0.0) EXPECT_LT(std::abs(id.scale - s), 3.0 * id.sigma_scale) << "imu " << accel << " s " << s;
         if (accel < 0.005) EXPECT_TRUE(id.informative);
         EXPECT_NEAR(id.moment, 1000.0, 3.0 * id.sigma_moment);
-        EXPECT_LT(id.cpu_seconds, 5.0);  // a sanity bound only: the cost is measured by hoist-trip-bench
         EXPECT_LT(id.sigma_imbalance, 0.0);
       }
     }
