@@ -60,6 +60,10 @@ struct DaemonOptions {
   double duration = 0.0;            ///< stop after this many seconds (0 = run until signalled)
   RealtimeRequest realtime;         ///< optional mlockall / SCHED_FIFO / affinity
   std::string report_path;          ///< write the run report (JSON) here at stop ("" = none)
+  /// The daemon's state directory (--state-dir, else systemd's
+  /// $STATE_DIRECTORY): each shaft's learned accelerometer offset is kept
+  /// there (offset_keeper.hpp; "" = not kept).
+  std::string state_dir;
   std::string command_line;         ///< for the report
   TestHooks hooks;                  ///< test-only fault injection
   double test_stall_at = -1.0;      ///< test only: at this many seconds the loop thread hangs for good

@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
   app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-twind ") + hoist::kVersionString);
   std::vector<std::string> config_paths;
-  std::string lcm_url, clock, prefix, log_level = "info", cpus, report;
+  std::string lcm_url, clock, prefix, log_level = "info", cpus, report, state_dir;
   double rate = 0.0, duration = 0.0;
   int rt_priority = 0;
   bool print_config = false, mlock = false, force = false;
@@ -103,6 +103,9 @@ int main(int argc, char** argv) {
   rt->add_option("--rt-priority", rt_priority, "run the loop thread SCHED_FIFO at this priority, 1..99")
       ->check(CLI::Range(1, 99));
   rt->add_option("--cpus", cpus, "pin the loop thread to these CPUs, e.g. 1 or 2-3");
+  app.add_option("--state-dir", state_dir,
+                 "keep state across restarts in DIR: each shaft's learned accelerometer offset (a calibration's "
+                 "result; [estimator] enabled). Default: $STATE_DIRECTORY (systemd's StateDirectory=), else none");
   app.add_option("--report", report,
                  "at stop, write a run report (JSON: step time and tick lateness histograms with "
                  "p50/p99/p99.9/max per shaft, deadline misses, counters, real-time settings) to FILE");
@@ -275,6 +278,21 @@ int main(int argc, char** argv) {
   opt.realtime.mlockall = mlock;
   opt.realtime.fifo_priority = rt_priority;
   opt.report_path = report;
+  if (state_dir.empty()) {
+    // systemd: StateDirectory= sets $STATE_DIRECTORY (colon-separated when several).
+    if (const char* env = std::getenv("STATE_DIRECTORY"); env && *env) {
+      state_dir = env;
+      state_dir = state_dir.substr(0, state_dir.find(':'));
+    }
+  }
+  if (!state_dir.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(state_dir, ec)) {
+      std::cerr << "hoist-twind: configuration error: --state-dir " << state_dir << ": not a directory\n";
+      return 2;
+    }
+  }
+  opt.state_dir = state_dir;
   if (const std::string bad = report.empty() ? "" : hoist::io::outputPathError(report, "--report"); !bad.empty()) { std::cerr << "hoist-twind: configuration error: " << bad << "\n"; return 2; }
   for (int i = 0; i < argc; ++i) opt.command_line += (i ? " " : "") + std::string(argv[i]);
 

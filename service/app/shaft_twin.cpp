@@ -67,8 +67,24 @@ void ShaftTwin::setForecastPool(ForecastPool* pool, double phase) {
   if (forecast_) forecast_->setPool(pool, phase);
 }
 
+void ShaftTwin::keepAccelOffset(const std::string& path, std::shared_ptr<spdlog::logger> log) {
+  if (!ctx_.cfg.estimator.enabled) return;
+  offsets_ = std::make_unique<OffsetKeeper>(path, ctx_.tag, std::move(log));
+  if (const auto r = offsets_->load()) {
+    if (!ctx_.core.setAccelOffset(r->offset, r->sigma))
+      ctx_.log.warn("{}accelerometer offset: {} holds a value the estimator refused ({} +- {} m/s^2): ignored",
+                    ctx_.tag, path, r->offset, r->sigma);
+  }
+  ctx_.offsets = offsets_.get();
+}
+
+void ShaftTwin::stopOffsetKeeper() {
+  if (offsets_) offsets_->stop();
+}
+
 void ShaftTwin::start(Clock::time_point start, double health_phase) {
   ctx_.start = start;
+  if (offsets_) offsets_->start();
   publishHealth();  // announce ourselves at once
   // Shafts of one daemon spread their later health messages over the period.
   health_.start(health_phase);
@@ -145,6 +161,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
         if (split) split->forecast += nanos(Clock::now() - p1);
       }
     }
+    if (r.stepped && ctx_.offsets) ctx_.offsets->afterTick(core);
   } else {
     core.housekeeping(wall);
   }

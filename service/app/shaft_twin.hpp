@@ -26,6 +26,7 @@
 #include "forecast_scheduler.hpp"
 #include "hoist/bus/udpm_receiver.hpp"
 #include "shaft_context.hpp"
+#include "offset_keeper.hpp"
 #include "shaft_health.hpp"
 #include "shaft_inputs.hpp"
 #include "shaft_outputs.hpp"
@@ -113,6 +114,13 @@ class ShaftTwin {
   void publishHealth(bool final_report = false);
   /// The final health line and per-reason rejection counts, in the log.
   void logFinal() const { health_.logFinal(); }
+  /// Keep the estimator's learned accelerometer offset in `path` across
+  /// restarts (offset_keeper.hpp): applies a kept one now; before start().
+  /// Nothing without [estimator] enabled.  `log`: the daemon's logger (the
+  /// keeper's writer thread logs through it, not through the loop's RtLog).
+  void keepAccelOffset(const std::string& path, std::shared_ptr<spdlog::logger> log);
+  /// Write a pending offset and join the keeper's writer.
+  void stopOffsetKeeper();
 
   const TwinConfig& config() const { return ctx_.cfg; }
   const bus::Channels& channels() const { return ctx_.ch; }
@@ -126,6 +134,7 @@ class ShaftTwin {
   lcm::LCM& in_;                                 ///< receives (LCM's path) and, without lcm_out, publishes
   ShaftOutputs outputs_;                         ///< every outgoing message
   std::unique_ptr<ForecastScheduler> forecast_;  ///< look-ahead forecasts (nullptr without [forecast] enabled)
+  std::unique_ptr<OffsetKeeper> offsets_;        ///< the kept accelerometer offset (nullptr: not kept)
   ShaftInputs inputs_;                           ///< every input channel
   ShaftHealth health_;                           ///< statistics into HOIST_HEALTH, the report's figures
   static constexpr int kLogCatchup = 0;          ///< log limiter key: limited catch-up

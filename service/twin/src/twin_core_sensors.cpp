@@ -50,6 +50,16 @@ bool TwinCore::calibrate(double Fa, double b, double duration) {
   return true;
 }
 
+bool TwinCore::setAccelOffset(double offset, double sigma) {
+  if (!est_) return false;
+  try {
+    est_->setAccelOffset(offset, sigma);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+  return true;
+}
+
 void TwinCore::noteSensorFault(SensorId s, SensorFaultReason r, double value, double limit) {
   sensor_fault_ = SensorFaultInfo{s, r, value, limit};
   sensor_fault_until_ = t_ + kSensorFaultHold;

@@ -282,6 +282,10 @@ class TwinCore {
   /// false (nothing changes): no estimator, or Fa < 0.  A new declaration
   /// replaces one in force.  The learned offset: estimate().accel_offset.
   bool calibrate(double Fa, double b, double duration);
+  /// Start the estimator from a learned accelerometer offset [m/s^2] and its
+  /// sigma (a calibration kept across restarts: LoadEstimator::setAccelOffset).
+  /// false (nothing changes): no estimator, or a value it refuses.
+  bool setAccelOffset(double offset, double sigma);
   /// A declared known load is in force at the current model time.
   bool calibrating() const { return est_ && t_ < known_until_; }
   /// The clock offset of the last offered sensor sample [s] (for the log).
