@@ -35,7 +35,7 @@ set(HOIST_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/hoist")
 
 # ---- programs -------------------------------------------------------------------
 set(_hoist_programs hoist-sim hoist-estimate hoist-study hoist-twind hoist-replay hoist-log2csv hoist-monitor
-                    hoist-alarm-ack hoist-wakeup-latency hoist-timing-test hoist-mqtt)
+                    hoist-alarm-ack hoist-wakeup-latency hoist-timing-test hoist-mqtt hoist-trips)
 foreach(p ${_hoist_programs})
   if(TARGET ${p})
     install(TARGETS ${p} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)

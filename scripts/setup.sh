@@ -37,6 +37,10 @@ required=(build-essential cmake pkg-config libeigen3-dev libboost-dev liblcm-dev
 dashboard=(nodejs npm chromium fonts-dejavu-core)
 # MQTT bridge (hoist-mqtt): the client library, and the broker, clients and openssl (TLS test) its tests and demo use.
 required+=(libmosquitto-dev mosquitto mosquitto-clients openssl)
+# The history database (history/, hoist-trips): SQLite embedded (the CLI checks
+# integrity in the tests), PostgreSQL through libpq; the server runs the PG tests;
+# zlib for the outage queue's CRC-32.
+required+=(libsqlite3-dev sqlite3 libpq-dev postgresql zlib1g-dev)
 # Its Sparkplug B mode: nanopb's generator (runs at build time; pulls protoc
 # and python3-protobuf) and its library.  Without them: no Sparkplug mode.
 required+=(nanopb libnanopb-dev)

@@ -11,7 +11,8 @@
 #      "hoist/service/alarms.hpp", from any library folder service/<lib>/include,
 #      or "shaft_twin.hpp").  What the tools share with the daemon is the
 #      contract in msgs/contract;
-#   4. msgs/ and rt/ include nothing from tools/ either (as rule 2);
+#   4. msgs/, rt/ and history/ include nothing from tools/ either (as rule 2),
+#      and history/ nothing from service/ (as rule 3);
 #   5. no tool includes "hoist/bus/udpm_receiver.hpp" itself: the choice
 #      between our udpm receive path and LCM's is made once, by
 #      hoist::bus::Subscriber ("hoist/bus/subscriber.hpp").
@@ -58,7 +59,7 @@ list(REMOVE_DUPLICATES _tool_names)
 # Include directories a service/ or io/ file may legitimately reach.
 file(GLOB _service_incs LIST_DIRECTORIES true "${ROOT}/service/*/include")  # one per library of service/
 file(GLOB _msgs_incs LIST_DIRECTORIES true "${ROOT}/msgs/*/include")  # msgs/contract, msgs/udpm
-set(_allowed_dirs "${ROOT}/model/include" "${ROOT}/io/include" "${ROOT}/msgs/include" ${_msgs_incs}
+set(_allowed_dirs "${ROOT}/model/include" "${ROOT}/io/include" "${ROOT}/history/include" "${ROOT}/msgs/include" ${_msgs_incs}
                   "${ROOT}/rt/include" "${ROOT}/service/include" ${_service_incs} "${ROOT}/service/app")
 
 function(_includes file out)
@@ -73,7 +74,7 @@ function(_includes file out)
 endfunction()
 
 # ---- rules 2 and 4: service/, io/, msgs/ and rt/ include nothing from tools/ --
-foreach(layer service io msgs rt)
+foreach(layer service io history msgs rt)
   file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/${layer}/*.hpp" "${ROOT}/${layer}/*.h"
        "${ROOT}/${layer}/*.cpp")
   foreach(f IN LISTS _files)
@@ -122,7 +123,8 @@ file(GLOB _tool_dirs LIST_DIRECTORIES true "${ROOT}/*/include" "${ROOT}/msgs/*/i
      "${ROOT}/tools/*/include" "${ROOT}/tools/*/src")
 list(FILTER _tool_dirs EXCLUDE REGEX "^${ROOT}/service/")
 file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/tools/*.hpp" "${ROOT}/tools/*.h" "${ROOT}/tools/*.cpp"
-     "${ROOT}/msgs/*.hpp" "${ROOT}/msgs/*.h" "${ROOT}/msgs/*.cpp" "${ROOT}/rt/*.hpp" "${ROOT}/rt/*.h" "${ROOT}/rt/*.cpp")
+     "${ROOT}/msgs/*.hpp" "${ROOT}/msgs/*.h" "${ROOT}/msgs/*.cpp" "${ROOT}/rt/*.hpp" "${ROOT}/rt/*.h" "${ROOT}/rt/*.cpp"
+     "${ROOT}/history/*.hpp" "${ROOT}/history/*.cpp")
 foreach(f IN LISTS _files)
   file(RELATIVE_PATH _rel "${ROOT}" "${f}")
   get_filename_component(_dir "${f}" DIRECTORY)
