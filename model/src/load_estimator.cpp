@@ -9,34 +9,6 @@ namespace hoist {
 
 namespace {
 
-/// Standard normal quantile (Acklam's rational approximation, |rel. error| < 1.2e-9).
-double normalQuantile(double p) {
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
-                             1.383577518672690e+02, -3.066479806614716e+01, 2.506628277459239e+00};
-  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
-                             6.680131188771972e+01, -1.328068155288572e+01};
-  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
-                             -2.549732539343734e+00, 4.374664141464968e+00, 2.938163982698783e+00};
-  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
-                             3.754408661907416e+00};
-  const double lo = 0.02425, hi = 1.0 - lo;
-  if (p <= 0.0) return -INFINITY;
-  if (p >= 1.0) return INFINITY;
-  if (p < lo) {
-    const double q = std::sqrt(-2.0 * std::log(p));
-    return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  }
-  if (p > hi) {
-    const double q = std::sqrt(-2.0 * std::log(1.0 - p));
-    return -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
-           ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
-  }
-  const double q = p - 0.5, r = q * q;
-  return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
-         (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
-}
-
 constexpr double kMaxSpecificForce = 100.0;  // |f_y| [m/s^2] a cage IMU can report
 constexpr double kMaxRate = 20.0;            // |omega| [rad/s]
 constexpr double kMaxRopeLoad = 1.0e8;       // |rope_load| [N]
@@ -66,14 +38,6 @@ SensorValues sensorModel(const CageResponse& r, double g) {
   return {r.y_c_ddot + (g - r.kin.a) * r.theta, r.theta_dot, r.lambda[0]};
 }
 
-double chiSquareQuantile(double p, double dof) {
-  if (!(dof > 0.0)) return 0.0;
-  const double z = normalQuantile(p);
-  const double c = 2.0 / (9.0 * dof);
-  const double w = 1.0 - c + z * std::sqrt(c);
-  return w > 0.0 ? dof * w * w * w : 0.0;
-}
-
 void EstimatorSettings::validate() const {
   requirePositive(noise.imu_accel, "sensors.imu_accel_noise");
   requirePositive(noise.imu_rate, "sensors.imu_rate_noise");
@@ -97,6 +61,17 @@ void EstimatorSettings::validate() const {
   if (!(min_window_fill >= 0.0 && min_window_fill <= 1.0))
     throw std::invalid_argument("estimator.min_window_fill: must be in [0, 1]");
   requirePositive(sensor_timeout, "estimator.sensor_timeout");
+  requirePositive(model_band, "estimator.model_band");
+  requirePositive(noise_memory, "estimator.noise_memory");
+  if (!(quiet_ratio > 0.0 && quiet_ratio < 1.0)) throw std::invalid_argument("estimator.quiet_ratio: must be in (0, 1)");
+  requirePositive(quiet_memory, "estimator.quiet_memory");
+  requirePositive(stuck_time, "estimator.stuck_time");
+  if (!(noisy_factor > 1.0 && std::isfinite(noisy_factor)))
+    throw std::invalid_argument("estimator.noisy_factor: must be > 1");
+  if (!(band_block >= 0.0 && band_block <= 5.0)) throw std::invalid_argument("estimator.band_block: must be in [0, 5] s");
+  requireNonNegative(change_drift, "estimator.change_drift");
+  requirePositive(change_threshold, "estimator.change_threshold");
+  requireNonNegative(change_holdoff, "estimator.change_holdoff");
   if (max_rate < 1 || max_rate > 100000) throw std::invalid_argument("estimator.max_rate: must be in [1, 100000] Hz");
   if (nis_window * max_rate > 5.0e6)
     throw std::invalid_argument("estimator.nis_window: nis_window * max_rate must stay below 5e6 entries");
@@ -152,8 +127,27 @@ void LoadEstimator::initialize(double t0, const Kinematics& k0) {
   first_t_ = t0;
   have_update_ = false;
   was_moving_ = false;
+  trip_ref_warm_ = false;
   trip_drift_ = 0.0;
   nis_flag_ = drift_flag_ = false;
+  const double sig[3] = {set_.noise.imu_accel, set_.noise.imu_rate, set_.noise.rope_load};
+  for (int i = 0; i < 3; ++i) {
+    SensorMonitorSettings ms;
+    ms.sigma = sig[i];
+    ms.lp_time = set_.model_band;
+    ms.noise_memory = set_.noise_memory;
+    ms.quiet_memory = set_.quiet_memory;
+    ms.quiet_ratio = set_.quiet_ratio;
+    ms.stuck_time = set_.stuck_time;
+    ms.noisy_factor = set_.noisy_factor;
+    mon_[i].reset(ms);
+  }
+  for (BandInnovation& b : band_) b = BandInnovation(set_.band_block);
+  cusum_fa_ = ChangeDetector(set_.change_drift, set_.change_threshold);
+  cusum_m_ = cusum_fa_;
+  rest_since_ = t0;
+  change_t_ = -1.0;
+  change_Fa0_ = change_M0_ = 0.0;
   counts_ = {};
   est_ = {};
   twin_resp_ = sens_->response();
@@ -169,7 +163,13 @@ void LoadEstimator::restart(double t0, const Kinematics& k0) {
     seen[i] = seen_[i];
   }
   const EstimatorCounters counts = counts_;
+  SensorMonitor mon[3] = {mon_[0], mon_[1], mon_[2]};
+  const double change_t = change_t_, change_Fa0 = change_Fa0_, change_M0 = change_M0_;
   initialize(t0, k0);
+  for (int i = 0; i < 3; ++i) mon_[i] = mon[i];
+  change_t_ = change_t;
+  change_Fa0_ = change_Fa0;
+  change_M0_ = change_M0;
   Fa_ = Fa;
   PFa_ = PFa;
   M_ = M;
@@ -199,8 +199,15 @@ void LoadEstimator::advance(double t1, const Kinematics& k1, int substeps) {
     sens_->step(t0 + u * h, interpolate(k0, k1, h, u));
   }
   sens_->step(t1, k1);
+  const bool was_moving = moving();
   t_ = t1;
   kin_ = k1;
+  if (moving()) {
+    cusum_fa_.reset();
+    cusum_m_.reset();
+  } else if (was_moving) {
+    rest_since_ = t1;
+  }
   // Random walk of the loads over the interval (slower while the cage moves).
   const double scale = moving() ? set_.moving_walk_scale : 1.0;
   const double qfa = set_.fa_walk * scale, qm = set_.moment_walk * scale;
@@ -264,6 +271,8 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
     ++counts_.implausible;
     return false;
   }
+  if (use_a) mon_[kImuAccel].sample(t_, f_y);
+  if (use_w) mon_[kImuRate].sample(t_, omega);
   const double eps = set_.model_error;
   const double ea = eps * (std::abs(pred_fy_) + env_fy_), ew = eps * env_om_;
   const double ra = set_.noise.imu_accel * set_.noise.imu_accel + ea * ea;
@@ -286,9 +295,7 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
       ++counts_.gated;
       return false;
     }
-    reopen(PM_, set_.moment_sigma0);
-    MF_ = M_;
-    PMF_ = PM_;
+    loadChange();
     S = covariance(PM_);
   }
   run_m_ = 0;
@@ -306,8 +313,15 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
     PMF_ = std::max(PMF_ - (KF * SF * KF.transpose())(0, 0), 0.0);
   }
   const int dof = (use_a ? 1 : 0) + (use_w ? 1 : 0);
-  tick_nis_ += nu.dot(Si * nu);
-  tick_dof_ += dof;
+  (void)dof;
+  if (use_a) {
+    mon_[kImuAccel].innovation(t_, nu(0));
+    band(kImuAccel, nu(0), S(0, 0), ea);
+  }
+  if (use_w) {
+    mon_[kImuRate].innovation(t_, nu(1));
+    band(kImuRate, nu(1), S(1, 1), ew);
+  }
   ++counts_.accepted;
   if (use_a) {
     last_upd_[kImuAccel] = t_;
@@ -324,8 +338,35 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   return true;
 }
 
-void LoadEstimator::reopen(double& P, double sigma0) {
-  P = std::max(P, sigma0 * sigma0);
+void LoadEstimator::band(int ch, double nu, double S, double e) {
+  if (!band_[ch].add(t_, nu, S, e)) return;
+  const double s = band_[ch].statistic();
+  tick_nis_ += s * s;
+  tick_dof_ += 1;
+  // f_y carries the moment's evidence at rest (the static tilt); omega only its transient.
+  if (ch == kRope ? changeAtRest(cusum_fa_, s) : ch == kImuAccel && changeAtRest(cusum_m_, s)) loadChange();
+}
+
+bool LoadEstimator::changeAtRest(ChangeDetector& c, double z) {
+  if (moving() || t_ - rest_since_ + kTimeEps < set_.change_holdoff) return false;
+  return c.add(z);
+}
+
+void LoadEstimator::loadChange() {
+  // One load changed: both its force and its moment re-open, whichever
+  // channel saw it (the rope load sees Fa at once, f_y the moment slowly).
+  change_t_ = t_;
+  change_Fa0_ = Fa_;
+  change_M0_ = M_;
+  PFa_ = std::max(PFa_, set_.fa_sigma0 * set_.fa_sigma0);
+  PM_ = std::max(PM_, set_.moment_sigma0 * set_.moment_sigma0);
+  FaF_ = Fa_;
+  PFaF_ = PFa_;
+  MF_ = M_;
+  PMF_ = PM_;
+  run_fa_ = run_m_ = 0;
+  cusum_fa_.reset();
+  cusum_m_.reset();
   ++counts_.load_changes;
   // A load cannot change while the cage moves: a change then is evidence of mismatch.
   if (moving()) trip_drift_ = std::max(trip_drift_, set_.drift_sigma + 1.0);
@@ -336,12 +377,13 @@ bool LoadEstimator::updateRopeLoad(double force) {
     ++counts_.implausible;
     return false;
   }
+  mon_[kRope].sample(t_, force);
   // The oscillating part of lambda_0 (m x_c''): the rope's modes beyond n,
   // and their frequency error, scale with it.
   // (both larger on a short, stiff rope, whose modes beyond n are the least resolved)
   const double er = kRopeOscillationError * env_rope_ * std::min(1.0, kJumpRefLength / kin_.l);
-  const double R = set_.noise.rope_load * set_.noise.rope_load + er * er +
-                   start_rope_ * start_rope_ + jump_rope_ * jump_rope_;
+  const double R = set_.noise.rope_load * set_.noise.rope_load + er * er + start_rope_ * start_rope_ +
+                   jump_rope_ * jump_rope_;
   const double nu = force - pred_rope_;
   double S = h_rope_ * h_rope_ * PFa_ + R;
   if (std::abs(nu) > set_.gate_sigma * std::sqrt(S)) {
@@ -349,9 +391,7 @@ bool LoadEstimator::updateRopeLoad(double force) {
       ++counts_.gated;
       return false;
     }
-    reopen(PFa_, set_.fa_sigma0);
-    FaF_ = Fa_;
-    PFaF_ = PFa_;
+    loadChange();
     S = h_rope_ * h_rope_ * PFa_ + R;
   }
   run_fa_ = 0;
@@ -365,8 +405,8 @@ bool LoadEstimator::updateRopeLoad(double force) {
     FaF_ += KF * nuF;
     PFaF_ = std::max(PFaF_ - KF * KF * SF, 0.0);
   }
-  tick_nis_ += nu * nu / S;
-  tick_dof_ += 1;
+  mon_[kRope].innovation(t_, nu);
+  band(kRope, nu, S, std::sqrt(std::max(R - set_.noise.rope_load * set_.noise.rope_load, 0.0)));
   ++counts_.accepted;
   last_upd_[kRope] = t_;
   seen_[kRope] = true;
@@ -392,12 +432,18 @@ void LoadEstimator::pushNis(double nis, int dof) {
 }
 
 const LoadEstimate& LoadEstimator::finish() {
+  // The tests wait until the filter has had warm = min_window_fill x
+  // nis_window of data: the first samples' gains are large (the prior's
+  // spread), and a gain that large chases even the vibration, whose
+  // echo then reaches the model's band.  The NIS window collects from then
+  // on and is tested once it is min_window_fill full again.
+  const double warm = set_.min_window_fill * set_.nis_window;
   if (tick_dof_ > 0) {
     if (!have_update_) {
       have_update_ = true;
       first_t_ = t_;
     }
-    pushNis(tick_nis_, tick_dof_);
+    if (t_ - first_t_ + kTimeEps >= warm) pushNis(tick_nis_, tick_dof_);
   }
   // Entries older than the window leave it.
   const std::size_t cap = ring_t_.size();
@@ -413,9 +459,12 @@ const LoadEstimate& LoadEstimator::finish() {
     win_dof_ = 0;
   }
 
+  const bool filled = have_update_ && t_ - first_t_ + kTimeEps >= warm;
   // Drift of the loads during a trip (the cage moving).
   const bool mov = moving();
-  if (mov && !was_moving_) {
+  // The trip's reference: its start, or the end of the warm-up if it began before.
+  if (mov && (!was_moving_ || (filled && !trip_ref_warm_))) {
+    trip_ref_warm_ = filled;
     trip_Fa0_ = Fa_;
     trip_PFa0_ = PFa_;
     trip_M0_ = M_;
@@ -427,15 +476,18 @@ const LoadEstimate& LoadEstimator::finish() {
   was_moving_ = mov;
   if (mov) {
     // With a right model, x - x0 has variance P0 - P (the information gained)
-    // plus the random walk's variance added since the trip began.
+    // plus the random walk's variance added since the trip began.  Floored at
+    // a quarter of P0: just after the reference P0 - P is one sample's worth,
+    // and the drift would be that sample's normalized innovation (any
+    // vibration the noise model leaves out would then raise the alarm).
     auto drift = [](double x, double x0, double P, double P0, double Q) {
-      const double var = std::max(P0 - P, 0.0) + Q + 1e-12 * (P0 + 1.0);
+      const double var = std::max(std::max(P0 - P, 0.0) + Q, 0.25 * P0) + 1e-12 * (P0 + 1.0);
       return std::abs(x - x0) / std::sqrt(var);
     };
     if (seen_[kRope]) trip_drift_ = std::max(trip_drift_, drift(Fa_, trip_Fa0_, PFa_, trip_PFa0_, trip_QFa_));
     if (seen_[kImuAccel] || seen_[kImuRate])
       trip_drift_ = std::max(trip_drift_, drift(M_, trip_M0_, PM_, trip_PM0_, trip_QM_));
-    if (trip_drift_ > set_.drift_sigma) drift_flag_ = true;
+    if (trip_drift_ > set_.drift_sigma && filled) drift_flag_ = true;
   }
   // Constancy: the short-memory estimate against the whole history's.  With
   // a right model their difference has variance PF - P (nested estimates).
@@ -463,13 +515,13 @@ const LoadEstimate& LoadEstimator::finish() {
   } else {
     e.nis_lower = e.nis_upper = e.nis_bound = 0.0;
   }
-  const bool filled = have_update_ && t_ - first_t_ + kTimeEps >= set_.min_window_fill * set_.nis_window;
   // The alarm's bound: the chi-square quantile, and never below nis_margin
   // times the expectation (a model right to about 1 % leaves a systematic
   // residual that a test over thousands of samples resolves: significant,
   // but not a shaft that behaves differently from its model).
   e.nis_bound = std::max(e.nis_bound, set_.nis_margin * win_dof_);
-  if (filled && win_dof_ > 0 && win_nis_ > e.nis_bound) nis_flag_ = true;
+  const bool nis_ready = have_update_ && t_ - first_t_ + kTimeEps >= 2.0 * warm;
+  if (nis_ready && win_dof_ > 0 && win_nis_ > e.nis_bound) nis_flag_ = true;
   else if (nis_flag_ && (win_dof_ == 0 || win_nis_ < e.nis_upper)) nis_flag_ = false;  // hysteresis
   e.nis_exceeded = nis_flag_;
   e.drift = std::max(trip_drift_, const_drift_);
@@ -480,6 +532,21 @@ const LoadEstimate& LoadEstimator::finish() {
   const unsigned bits[3] = {kSensorImuAccel, kSensorImuRate, kSensorRopeLoad};
   for (int i = 0; i < 3; ++i)
     if (t_ - last_upd_[i] <= set_.sensor_timeout + kTimeEps) e.sensors |= bits[i];
+  e.fault_imu_accel = mon_[kImuAccel].faults();
+  e.fault_imu_rate = mon_[kImuRate].faults();
+  e.fault_rope_load = mon_[kRope].faults();
+  e.faulty = (e.fault_imu_accel ? kSensorImuAccel : 0u) | (e.fault_imu_rate ? kSensorImuRate : 0u) |
+             (e.fault_rope_load ? kSensorRopeLoad : 0u);
+  constexpr unsigned kQuietBits = kFaultQuiet | kFaultStuck;
+  e.imu_quiet = ((e.fault_imu_accel | e.fault_imu_rate) & kQuietBits) != 0;
+  e.rope_quiet = (e.fault_rope_load & kQuietBits) != 0;
+  e.noise_imu_accel = std::sqrt(mon_[kImuAccel].noiseVariance());
+  e.noise_imu_rate = std::sqrt(mon_[kImuRate].noiseVariance());
+  e.noise_rope_load = std::sqrt(mon_[kRope].noiseVariance());
+  e.change_t = change_t_;
+  e.change_Fa = change_t_ >= 0.0 ? Fa_ - change_Fa0_ : 0.0;
+  e.change_moment = change_t_ >= 0.0 ? M_ - change_M0_ : 0.0;
+  e.change_level = std::max(cusum_fa_.level(), cusum_m_.level());
   e.fa_observed = seen_[kRope];
   e.moment_observed = seen_[kImuAccel] || seen_[kImuRate];
 
@@ -513,49 +580,6 @@ const LoadEstimate& LoadEstimator::finish() {
   for (int i = 1; i < 5; ++i) lateral(tw.lambda[i], s.lambda[i], e.lambda[i], e.sigma_lambda[i]);
   e.theta_open = tw.theta;
   return e;
-}
-
-}  // namespace hoist
-
-namespace hoist {
-
-void estimateRecorded(const ShaftParams& twin, const EstimatorSettings& settings, double max_step,
-                      const std::vector<MeasurementSample>& samples,
-                      const std::function<void(const LoadEstimate&, const EstimatorCounters&)>& sink,
-                      const std::function<void(double)>& progress) {
-  if (samples.empty()) return;
-  auto model = std::make_shared<const ShaftModel>(twin);
-  FastSolver solver(model);
-  LoadEstimator est(twin, settings);
-  auto apply = [&](const MeasurementSample& m) {
-    est.predict(solver.response());
-    const bool a = m.present & kSensorImuAccel, w = m.present & kSensorImuRate;
-    if (a && w) est.updateImu(m.z.f_y, m.z.omega);
-    else if (a) est.updateImuAccel(m.z.f_y);
-    else if (w) est.updateImuRate(m.z.omega);
-    if (m.present & kSensorRopeLoad) est.updateRopeLoad(m.z.rope_load);
-    sink(est.finish(), est.counters());
-  };
-  const MeasurementSample& first = samples.front();
-  solver.initialize(first.t, first.k, twin.initial);
-  est.initialize(first.t, first.k);
-  apply(first);
-  const std::size_t every = std::max<std::size_t>(1, samples.size() / 100);
-  for (std::size_t i = 1; i < samples.size(); ++i) {
-    const MeasurementSample& prev = samples[i - 1];
-    const MeasurementSample& m = samples[i];
-    const double h = m.t - prev.t;
-    const int n = h > 0.0 ? substepCount(h, max_step) : 1;
-    for (int j = 1; j < n; ++j) {
-      const double u = static_cast<double>(j) / n;
-      solver.step(prev.t + u * h, interpolate(prev.k, m.k, h, u));
-    }
-    solver.step(m.t, m.k);
-    est.advance(m.t, m.k, n);
-    apply(m);
-    if (progress && i % every == 0) progress(static_cast<double>(i) / samples.size());
-  }
-  if (progress) progress(1.0);
 }
 
 }  // namespace hoist

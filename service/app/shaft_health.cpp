@@ -67,6 +67,10 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   const LoadEstimate* est = ctx_.core.estimate();
   m.estimator_sensors = est ? static_cast<int32_t>(est->sensors) : 0;
   m.estimate_in_use = ctx_.core.estimateInUse();
+  const SensorTimingCounters& tc = ctx_.core.sensorTiming();
+  m.sensor_clock_refused = tc.clock_refused;
+  m.sensor_time_backwards = tc.time_backwards;
+  m.sensor_dropped = tc.too_late + tc.superseded;
   m.alarms_active = al.activeCount();
   m.alarms_unacked = al.unackedCount();
   m.alarms_shelved = al.shelvedCount();

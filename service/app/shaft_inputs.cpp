@@ -195,6 +195,10 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
                         "commands this tick", user, budget));
     return;
   }
+  if (cmd->action == AlarmAction::Calibrate) {
+    calibrate(*cmd, user);
+    return;
+  }
   const int n = ctx_.core.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
   const char* what = cmd->action == AlarmAction::Ack      ? "acknowledge"
                      : cmd->action == AlarmAction::Shelve ? "shelve"
@@ -226,6 +230,18 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   out_.publishAlarmEvents();
   cause.user.clear();
   cause.requested_shelve = 0.0;
+}
+
+void ShaftInputs::calibrate(const AlarmCommand& cmd, const std::string& user) {
+  // The live calibration: no alarm changes; audited as an effective command.
+  if (!ctx_.core.calibrate(cmd.known_fa, cmd.known_b, cmd.calibrate_duration)) {
+    logJunk(fmt::format("calibration from '{}' ignored: [estimator] is not enabled", user));
+    return;
+  }
+  ++ctx_.stats.commands_applied;
+  ctx_.log.info("{}AUDIT operator '{}': calibrate: the load is known, Fa = {} N at b = {} m (M = {} N m), for {} s "
+                "from t = {:.2f} s", ctx_.tag, user, cmd.known_fa, cmd.known_b, cmd.known_fa * cmd.known_b,
+                cmd.calibrate_duration, ctx_.core.publishedTime(ctx_.core.modelTime()));
 }
 
 void ShaftInputs::requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user) {
@@ -430,10 +446,38 @@ void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   if (!sensorSeqNewer(m.seq, ctx_.stats.imu_seq, "HOIST_CAGE_IMU")) return;
-  ctx_.stats.last_imu_wall = ctx_.wallNow();
-  ++ctx_.stats.sensor_accepted;
   // A channel that is implausible on its own is left out of this sample.
-  ctx_.core.onCageImu(a_ok ? m.f_y : NAN, w_ok ? m.omega : NAN);
+  const double wall = ctx_.wallNow();
+  const SensorVerdict v = ctx_.core.onCageImu(m.utime, a_ok ? m.f_y : NAN, w_ok ? m.omega : NAN, wall,
+                                               bus::wallUtime());
+  if (!sensorTimeOk(v, m.utime, "HOIST_CAGE_IMU")) return;
+  ctx_.stats.last_imu_wall = wall;
+  ++ctx_.stats.sensor_accepted;
+}
+
+bool ShaftInputs::sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* channel) {
+  // Refused by its time: counted (HOIST_HEALTH), logged (rate-limited), and
+  // SENSOR_FAULT raised by the model room (published here).
+  const double off = ctx_.core.lastSensorOffset();
+  switch (v) {
+    case SensorVerdict::Queued: return true;
+    case SensorVerdict::NoClock: return false;  // no model time yet (--clock input before the winder)
+    case SensorVerdict::ClockOffset:
+      std::snprintf(text_, sizeof text_, "utime %lld is %+.3f s from the daemon's clock (%s), beyond "
+                    "sensors.max_clock_offset = %g s: the sensor's clock is off; not used (SENSOR_FAULT)",
+                    static_cast<long long>(utime), off,
+                    ctx_.core.clock() == ClockMode::Wall ? "wall clock" : "the winder's utime",
+                    ctx_.cfg.estimator.max_clock_offset);
+      break;
+    case SensorVerdict::TimeBackwards:
+      std::snprintf(text_, sizeof text_, "utime %lld not after the last accepted sample's: time went backwards "
+                    "(a replay, or the sensor's clock stepped back); not used (SENSOR_FAULT)",
+                    static_cast<long long>(utime));
+      break;
+  }
+  rejectSensor(channel, text_);
+  out_.publishAlarmEvents();
+  return false;
 }
 
 void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
@@ -445,9 +489,11 @@ void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   if (!sensorSeqNewer(m.seq, ctx_.stats.rope_seq, "HOIST_ROPE_LOAD")) return;
-  ctx_.stats.last_rope_wall = ctx_.wallNow();
+  const double wall = ctx_.wallNow();
+  const SensorVerdict v = ctx_.core.onRopeLoad(m.utime, m.force, wall, bus::wallUtime());
+  if (!sensorTimeOk(v, m.utime, "HOIST_ROPE_LOAD")) return;
+  ctx_.stats.last_rope_wall = wall;
   ++ctx_.stats.sensor_accepted;
-  ctx_.core.onRopeLoad(m.force);
 }
 
 }  // namespace hoist::svc

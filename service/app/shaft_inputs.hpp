@@ -91,10 +91,13 @@ class ShaftInputs {
   template <class Msg>
   bool decodeSensor(const lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel);  // checked decode, or reject
   bool sensorSeqNewer(std::int64_t seq, SensorSequence& sq, const char* channel);  // SensorSequence, or reject
+  bool sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* channel);     // TwinCore's time verdict, or reject
   void handlerFailed(const char* what, const char* channel);
   void logReject(RejectReason r, const char* detail);
   void rejectPlan(PlanReject r, const char* detail);
   void logJunk(const std::string& what);
+  /// A valid calibration command: hand it to the model room, audit it.
+  void calibrate(const AlarmCommand& cmd, const std::string& user);
   /// A valid re-announce request: honour it now, or merge it into the pending one.
   void requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user);
   /// Honour the pending re-announce request if the interval allows.

@@ -174,9 +174,48 @@ void ShaftOutputs::publishEstimate(std::int64_t utime, bool batch) {
   const double wall = ctx_.wallNow();
   const ShaftStats& st = ctx_.stats;
   toEstimateMessage(*e, c, ctx_.core.publishedTime(e->t), st.last_imu_wall < 0.0 ? -1.0 : wall - st.last_imu_wall,
-                    st.last_rope_wall < 0.0 ? -1.0 : wall - st.last_rope_wall, ctx_.core.estimateInUse(),
-                    estimate_msg_);
+                    st.last_rope_wall < 0.0 ? -1.0 : wall - st.last_rope_wall, ctx_.core.estimateGate(),
+                    ctx_.core.modelTime(), ctx_.core.calibrating(), estimate_msg_);
   encodeAndPublish(ctx_.ch.estimate, estimate_msg_, estimate_buf_, batch);
+  logGateEvents();
+}
+
+void ShaftOutputs::logGateEvents() {
+  const EstimateGate& g = ctx_.core.estimateGate();
+  const std::int64_t n = g.events();
+  if (n - gate_seen_ > EstimateGate::kEvents) {
+    ctx_.log.warn("{}{} estimate switch/load-change log lines lost (more than {} between two steps)", ctx_.tag,
+                  n - gate_seen_ - EstimateGate::kEvents, EstimateGate::kEvents);
+    gate_seen_ = n - EstimateGate::kEvents;
+  }
+  const double hold = ctx_.cfg.estimator.clear_hold;
+  for (; gate_seen_ < n; ++gate_seen_) {
+    const GateEvent& e = g.event(gate_seen_);
+    const double t = ctx_.core.publishedTime(e.t);
+    switch (e.type) {
+      case GateEvent::Type::Switch:
+        if (e.to_estimate)
+          ctx_.log.info("{}alarms now judge the load estimate (t = {:.2f} s); an active alarm clears only after "
+                        "{} s of it", ctx_.tag, t, hold);
+        else
+          ctx_.log.warn("{}alarms now judge the open-loop twin, not the load estimate (t = {:.2f} s): {}{}{}{}{}; "
+                        "an active alarm clears only after {} s of it", ctx_.tag, t,
+                        (e.not_used & kNotUsedNoSensors) ? "no sensor in use " : "",
+                        (e.not_used & kNotUsedMismatch) ? "MODEL_MISMATCH " : "",
+                        (e.not_used & kNotUsedImplausible) ? "estimate outside the physical bounds " : "",
+                        (e.not_used & kNotUsedNonFinite) ? "non-finite estimate " : "",
+                        (e.not_used & kNotUsedSensorFault) ? "sensor fault " : "", hold);
+        break;
+      case GateEvent::Type::LoadChange:
+        ctx_.log.warn("{}load change detected (t = {:.2f} s): Fa {:.0f} -> {:.0f} N, M {:.0f} -> {:.0f} N m so far; "
+                      "alarms hold their state for {} s", ctx_.tag, t, e.Fa0, e.Fa1, e.M0, e.M1, hold);
+        break;
+      case GateEvent::Type::LoadSettled:
+        ctx_.log.info("{}load change held {} s (t = {:.2f} s): Fa {:.0f} -> {:.0f} N ({:+.0f} N), M {:.0f} -> {:.0f} "
+                      "N m ({:+.0f} N m)", ctx_.tag, hold, t, e.Fa0, e.Fa1, e.Fa1 - e.Fa0, e.M0, e.M1, e.M1 - e.M0);
+        break;
+    }
+  }
 }
 
 void ShaftOutputs::publishShape(std::int64_t utime, bool batch) {
@@ -208,6 +247,8 @@ void ShaftOutputs::publishAlarmEvents() {
   tc.predicted_clearance_scenario = cause.predicted_clearance_scenario;
   tc.predicted_slack_scenario = cause.predicted_slack_scenario;
   tc.slack_threshold = cause.slack_threshold;
+  tc.sensor = core.lastSensorFault().sensor;
+  tc.sensor_reason = core.lastSensorFault().reason;
   alarm_msg_.user.assign(cause.user);  // who caused these events ("" for the twin itself)
   RtLog& log = ctx_.log;
   const std::string& tag = ctx_.tag;

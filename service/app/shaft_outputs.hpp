@@ -93,6 +93,10 @@ class ShaftOutputs {
   hoist::estimate_t estimate_msg_;    ///< preallocated HOIST_ESTIMATE (flat)
   std::vector<std::uint8_t> estimate_buf_;  ///< encode buffer of estimate_msg_
   std::int64_t estimate_seq_ = 0;     ///< HOIST_ESTIMATE.seq of the next message
+  std::int64_t gate_seen_ = 0;        ///< EstimateGate events logged so far
+  /// Log the alarms' switches between the estimate and the open loop and
+  /// the load changes (through the RtLog ring: off the real-time path).
+  void logGateEvents();
   hoist::guide_shape_t shape_msg_;    ///< preallocated HOIST_GUIDE_SHAPE (sized to the shape's depths)
   hoist::alarm_t alarm_msg_;          ///< preallocated HOIST_ALARM (strings reserved)
   hoist::health_t health_msg_;        ///< preallocated HOIST_HEALTH (reason names set once)

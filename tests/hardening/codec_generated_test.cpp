@@ -255,7 +255,8 @@ TEST(CodecGenerated, NameTablesMatchTheLcmConstants) {
   EXPECT_EQ(names::kindName(alarm_t::KIND_CAGE_POS_Y), "CAGE_POS_Y");
   EXPECT_EQ(names::kindName(alarm_t::KIND_PREDICTED_SLACK), "PREDICTED_SLACK");
   EXPECT_EQ(names::kindName(alarm_t::KIND_MODEL_MISMATCH), "MODEL_MISMATCH");
-  EXPECT_EQ(names::kKindNames.size(), 12u);
+  EXPECT_EQ(names::kindName(alarm_t::KIND_SENSOR_FAULT), "SENSOR_FAULT");
+  EXPECT_EQ(names::kKindNames.size(), 13u);
   EXPECT_EQ(names::levelName(3), "?");
   EXPECT_EQ(names::levelName(-1), "?");
   EXPECT_EQ(names::eventName(0), "?");

@@ -452,7 +452,7 @@ TEST(AlarmEngine, SlotTableGivesEachAlarmItsKindLevelAndSettings) {
       {AlarmKind::ModelDomain, AlarmLevel::Critical},    {AlarmKind::DuplicatePublisher, AlarmLevel::Warning},
       {AlarmKind::RopeSlack, AlarmLevel::Critical},      {AlarmKind::RopeOverload, AlarmLevel::Critical},
       {AlarmKind::PredictedClearance, AlarmLevel::Warning}, {AlarmKind::PredictedSlack, AlarmLevel::Warning},
-      {AlarmKind::ModelMismatch, AlarmLevel::Warning}};
+      {AlarmKind::ModelMismatch, AlarmLevel::Warning},   {AlarmKind::SensorFault, AlarmLevel::Warning}};
   for (const auto& [k, l] : expected) EXPECT_NE(eng.find(k, l), nullptr) << toString(k) << "/" << toString(l);
   // Settings by rule.
   const AlarmSettings& neg_c = eng.find(AlarmKind::CageNegY, AlarmLevel::Critical)->settings();

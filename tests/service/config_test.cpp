@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 
 #include "hoist/bus/channels.hpp"
 #include "hoist/service/config_file.hpp"
@@ -247,4 +248,56 @@ TEST(ServiceConfig, RopeForceAlarmKeysAreValidated) {
     const std::string e = errorOf(c.text);
     EXPECT_NE(e.find(c.want), std::string::npos) << c.text << " -> " << e;
   }
+}
+
+namespace {
+/// loadTwinConfig() of `text` written to a file (the daemon's own [sensors] /
+/// [estimator] keys are read there); the error text, or "" when it loads.
+std::string loadError(const std::string& text, TwinConfig* out = nullptr) {
+  char path[] = "/tmp/hoist_config_testXXXXXX";
+  const int fd = mkstemp(path);
+  if (fd < 0) return "mkstemp failed";
+  FILE* f = fdopen(fd, "w");
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+  std::string err;
+  try {
+    const TwinConfig c = loadTwinConfig(path);
+    if (out) *out = c;
+  } catch (const std::exception& e) {
+    err = e.what();
+  }
+  std::remove(path);
+  return err;
+}
+}  // namespace
+
+TEST(SensorConfig, ClockOffsetAndClearHoldReadValidatedAndPrinted) {
+  TwinConfig c;
+  EXPECT_EQ(loadError("[sensors]\nimu_accel_noise = 0.004\nmax_clock_offset = 0.25\n"
+                      "[estimator]\nenabled = true\nclear_hold = 3\n", &c), "");
+  EXPECT_EQ(c.estimator.max_clock_offset, 0.25);
+  EXPECT_EQ(c.estimator.clear_hold, 3.0);
+  EXPECT_EQ(c.estimator.settings.noise.imu_accel, 0.004);  // the estimator's keys beside them
+  EXPECT_TRUE(c.estimator.enabled);
+  // Defaults.
+  TwinConfig d;
+  EXPECT_EQ(loadError("", &d), "");
+  EXPECT_EQ(d.estimator.max_clock_offset, 0.5);
+  EXPECT_EQ(d.estimator.clear_hold, 2.0);
+  // Printed back (--print-config) and read again.
+  const std::string text = toToml(c);
+  EXPECT_NE(text.find("max_clock_offset = 0.25"), std::string::npos) << text;
+  EXPECT_NE(text.find("clear_hold = 3.0"), std::string::npos) << text;
+  TwinConfig e;
+  EXPECT_EQ(loadError(text, &e), "");
+  EXPECT_EQ(e.estimator.max_clock_offset, 0.25);
+  EXPECT_EQ(e.estimator.clear_hold, 3.0);
+  // Bad values name the file line and key.
+  const std::string neg = loadError("[sensors]\n\nmax_clock_offset = -1\n");
+  EXPECT_NE(neg.find(":3: sensors.max_clock_offset: must be in (0, 10]"), std::string::npos) << neg;
+  const std::string big = loadError("[estimator]\nclear_hold = 100\n");
+  EXPECT_NE(big.find(":2: estimator.clear_hold: must be in [0, 60]"), std::string::npos) << big;
+  const std::string type = loadError("[sensors]\nmax_clock_offset = \"soon\"\n");
+  EXPECT_NE(type.find("sensors.max_clock_offset: must be a number"), std::string::npos) << type;
 }

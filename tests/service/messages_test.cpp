@@ -3,6 +3,8 @@
 // literal channel names for LCM's regex subscribe.
 #include <gtest/gtest.h>
 
+#include <tuple>
+
 #include <cmath>
 #include <cstring>
 #include <regex>
@@ -157,6 +159,70 @@ TEST(Messages, AckValidation) {
     a.shelve_duration = d;
     EXPECT_FALSE(validateAck(a, why)) << d;
   }
+}
+
+TEST(Messages, CalibrationCommandIsValidated) {
+  hoist::alarm_ack_t a{};
+  a.action = hoist::alarm_ack_t::ACTION_CALIBRATE;
+  a.known_fa = 0.0;  // the empty conveyance
+  a.known_b = 0.0;
+  a.calibrate_duration = 60.0;
+  const char* why = "";
+  auto c = validateAck(a, why);
+  ASSERT_TRUE(c) << why;
+  EXPECT_EQ(c->action, AlarmAction::Calibrate);
+  EXPECT_EQ(c->calibrate_duration, 60.0);
+  a.known_fa = 1500.0;
+  a.known_b = -0.7;
+  c = validateAck(a, why);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->known_fa, 1500.0);
+  EXPECT_EQ(c->known_b, -0.7);
+  for (const auto& [fa, b, s] : {std::tuple{-1.0, 0.0, 60.0}, std::tuple{std::nan(""), 0.0, 60.0},
+                                 std::tuple{2e7, 0.0, 60.0}, std::tuple{100.0, 1e3, 60.0},
+                                 std::tuple{100.0, 0.0, 0.0}, std::tuple{100.0, 0.0, 601.0},
+                                 std::tuple{100.0, 0.0, static_cast<double>(INFINITY)}}) {
+    a.known_fa = fa;
+    a.known_b = b;
+    a.calibrate_duration = s;
+    EXPECT_FALSE(validateAck(a, why)) << fa << " " << b << " " << s;
+    EXPECT_NE(std::string(why).find("calibrate needs"), std::string::npos) << why;
+  }
+  // A client without the fields (the 5-argument rule) cannot calibrate.
+  hoist::contract::AlarmCommand out;
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 5, 0.0, out), hoist::contract::CommandError::BadCalibration);
+}
+
+TEST(Messages, SensorFaultTextNamesTheSensorAndWhy) {
+  AlarmEvent e;
+  e.kind = AlarmKind::SensorFault;
+  e.level = AlarmLevel::Warning;
+  e.type = AlarmEventType::Raise;
+  e.value = 2.003;
+  e.threshold = 0.5;
+  e.active = true;
+  AlarmTextContext ctx;
+  ctx.sensor = SensorId::CageImu;
+  ctx.sensor_reason = SensorFaultReason::ClockOffset;
+  char buf[512];
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_NE(std::string(buf).find("SENSOR_FAULT WARNING raised: HOIST_CAGE_IMU: its clock is +2.003 s from the "
+                                  "daemon's (sensors.max_clock_offset = 0.5 s)"), std::string::npos) << buf;
+  ctx.sensor = SensorId::RopeLoad;
+  ctx.sensor_reason = SensorFaultReason::TimeBackwards;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_NE(std::string(buf).find("HOIST_ROPE_LOAD: a sample's utime went backwards"), std::string::npos) << buf;
+  ctx.sensor = SensorId::Estimate;
+  ctx.sensor_reason = SensorFaultReason::Implausible;
+  e.value = 10.0;
+  e.threshold = 1.2;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_NE(std::string(buf).find("the load estimate is implausible (10 beyond the physical bound 1.2)"),
+            std::string::npos) << buf;
+  e.type = AlarmEventType::Clear;
+  e.active = false;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  EXPECT_NE(std::string(buf).find("SENSOR_FAULT WARNING cleared"), std::string::npos) << buf;
 }
 
 TEST(Messages, PrintableAndRegexEscape) {

@@ -3,6 +3,13 @@
 //   hoist-alarm-ack [--kind CAGE_POS_Y|...|*] [--level warning|critical|both]
 //                   [--shelve SECONDS | --unshelve] [--user NAME]
 //                   [--lcm-url URL] [--channel-prefix P]
+//   hoist-alarm-ack --calibrate FA,B,SECONDS [--user NAME] ...
+//
+// --calibrate declares the load known for the load estimator's live
+// calibration (alarm_ack_t ACTION_CALIBRATE: the empty conveyance at the
+// bank with its own Fa and b, or a test weight) for SECONDS from now; the
+// daemon logs it with the user (AUDIT line) and HOIST_ESTIMATE.calibrating
+// shows it in force.
 //
 // Default: acknowledge every active alarm ("*", both levels).  The daemon
 // answers on HOIST_ALARM with an ACK / SHELVE / UNSHELVE event (watch it with
@@ -21,6 +28,7 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/bus/lcm_util.hpp"
+#include "hoist/contract/alarm_command.hpp"
 #include "hoist/contract/alarm_vocabulary.hpp"
 
 int main(int argc, char** argv) {
@@ -62,7 +70,39 @@ int main(int argc, char** argv) {
                        return {};
                      },
                      "SECONDS<=" + std::to_string(static_cast<long>(max_shelve)), "max shelve"));
-  app.add_flag("--unshelve", unshelve, "end a shelve early")->excludes(sh);
+  auto* un = app.add_flag("--unshelve", unshelve, "end a shelve early")->excludes(sh);
+  std::string calibrate;
+  double known_fa = 0.0, known_b = 0.0, known_s = 0.0;
+  app.add_option("--calibrate", calibrate,
+                 "FA,B,SECONDS: declare the load known -- eccentric force FA N (>= 0) at offset B m -- for SECONDS s "
+                 "(at most " + std::to_string(static_cast<long>(hoist::contract::kMaxCalibration)) +
+                     "): the load estimator's live calibration (docs/estimation.md)")
+      ->excludes(sh)
+      ->excludes(un)
+      ->check(CLI::Validator(
+          [&](std::string& v) -> std::string {
+            hoist::contract::AlarmCommand c;
+            double f[3] = {0.0, 0.0, 0.0};
+            std::vector<std::string> parts;
+            for (std::size_t at = 0;;) {
+              const std::size_t comma = v.find(',', at);
+              parts.push_back(v.substr(at, comma == std::string::npos ? std::string::npos : comma - at));
+              if (comma == std::string::npos) break;
+              at = comma + 1;
+            }
+            if (parts.size() != 3) return "expected FA,B,SECONDS (three numbers), got '" + v + "'";
+            for (int i = 0; i < 3; ++i)
+              if (!CLI::detail::lexical_cast(parts[static_cast<std::size_t>(i)], f[i]))
+                return "expected FA,B,SECONDS (three numbers), got '" + v + "'";
+            if (hoist::contract::validateAlarmCommand("", 0, hoist::alarm_ack_t::ACTION_CALIBRATE, 0.0, f[0], f[1],
+                                                      f[2], c) != hoist::contract::CommandError::None)
+              return "FA must be in [0, 1e7] N, |B| <= 100 m, SECONDS in (0, 600]; got '" + v + "'";
+            known_fa = f[0];
+            known_b = f[1];
+            known_s = f[2];
+            return {};
+          },
+          "FA,B,SECONDS", "calibration"));
   app.add_option("--user", user, "operator name (logged by the daemon; default: $USER)");
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
   app.add_option("--channel-prefix", prefix, "prefix of the daemon's channels");
@@ -85,6 +125,15 @@ int main(int argc, char** argv) {
   m.action = unshelve ? hoist::alarm_ack_t::ACTION_UNSHELVE
                       : (shelve > 0 ? hoist::alarm_ack_t::ACTION_SHELVE : hoist::alarm_ack_t::ACTION_ACK);
   m.shelve_duration = shelve;
+  const bool cal = !calibrate.empty();
+  if (cal) {
+    m.kind = "";
+    m.level = 0;
+    m.action = hoist::alarm_ack_t::ACTION_CALIBRATE;
+    m.known_fa = known_fa;
+    m.known_b = known_b;
+    m.calibrate_duration = known_s;
+  }
   m.user = user;
   if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-alarm-ack", app.count("--lcm-url") > 0, url,
                                                             hoist::bus::resolveLcmUrl(url));
@@ -103,6 +152,11 @@ int main(int argc, char** argv) {
   if (lcm.publish(channel, &m) != 0) {
     std::cerr << "hoist-alarm-ack: publish on " << channel << " failed\n";
     return 1;
+  }
+  if (cal) {
+    std::cout << "sent CALIBRATE Fa=" << known_fa << " N b=" << known_b << " m for " << known_s << " s user=" << user
+              << " on " << channel << "\n";
+    return 0;
   }
   std::cout << "sent " << (unshelve ? "UNSHELVE" : shelve > 0 ? "SHELVE" : "ACK") << " kind=" << kind
             << " level=" << level << (shelve > 0 ? " for " + std::to_string(shelve) + " s" : "") << " user=" << user

@@ -78,7 +78,10 @@
 #include <string>
 #include <vector>
 
+#include "hoist/band_innovation.hpp"
+#include "hoist/change_detector.hpp"
 #include "hoist/fast_solver.hpp"
+#include "hoist/sensor_monitor.hpp"
 
 namespace hoist {
 
@@ -109,6 +112,18 @@ struct EstimatorSettings {
   double min_window_fill = 0.5; ///< the NIS test needs the window at least this full (fraction of nis_window)
   int max_rate = 1000;          ///< largest update rate the NIS window is sized for [Hz]
   double sensor_timeout = 0.5;  ///< a sensor not updated for this long is not "in use" [s]
+  // Sensor health and the learned noise (hoist/sensor_monitor.hpp).
+  double model_band = 0.05;     ///< low-pass time constant splitting the model's band from the noise [s]
+  double noise_memory = 2.0;    ///< memory of the learned high-frequency noise variance [s]
+  double quiet_ratio = 0.25;    ///< a channel whose high-pass sigma is below quiet_ratio x its noise is quiet
+  double quiet_memory = 1.0;    ///< memory of the quiet test [s]
+  double stuck_time = 1.0;      ///< the same value for this long is a stuck channel [s]
+  double noisy_factor = 5.0;    ///< a learned noise above noisy_factor x the datasheet's is a fault
+  double band_block = 0.2;      ///< block of the band-limited innovations (NIS test, CUSUM) [s]
+  // Load changes at rest (hoist/change_detector.hpp): CUSUM on the band-limited innovations.
+  double change_drift = 1.0;    ///< CUSUM reference k [sigma per block]
+  double change_threshold = 6.0;  ///< CUSUM decision level h [sigma]
+  double change_holdoff = 2.0;  ///< the CUSUM runs once the cage has been at rest this long [s]
 
   /// Throws std::invalid_argument naming the first bad value (its [estimator]/[sensors] key).
   void validate() const;
@@ -143,13 +158,28 @@ struct LoadEstimate {
   bool drift_exceeded = false;  ///< ... because of a drifting load
   unsigned sensors = 0;      ///< SensorBits updated within their timeout
   bool fa_observed = false, moment_observed = false;
+  // Sensor health (hoist/sensor_monitor.hpp): SensorFaultBits per channel;
+  // sensorFaultReason() names them.  A faulty channel's samples are still
+  // applied (the daemon decides what to do: SENSOR_FAULT).
+  unsigned fault_imu_accel = 0, fault_imu_rate = 0, fault_rope_load = 0;
+  unsigned faulty = 0;       ///< SensorBits of the channels with any fault
+  bool imu_quiet = false;    ///< f_y or omega quiet or stuck: quieter than its own noise (the NIS's lower side)
+  bool rope_quiet = false;   ///< rope_load quiet or stuck
+  /// The noise sigma each channel is weighted with: max(datasheet, learned
+  /// from the high-frequency part of its innovations) [m/s^2, rad/s, N].
+  double noise_imu_accel = 0.0, noise_imu_rate = 0.0, noise_rope_load = 0.0;
+  // Load changes (one event for Fa and M, whichever channel saw it).
+  double change_t = -1.0;    ///< time of the last load change (-1: none since initialize())
+  double change_Fa = 0.0;    ///< its size so far: Fa now - Fa before it [N]
+  double change_moment = 0.0;  ///< M now - M before it [N m]
+  double change_level = 0.0; ///< the larger CUSUM statistic / its threshold (1 = a change)
 };
 
 /// Counts since initialize().
 struct EstimatorCounters {
   std::int64_t accepted = 0;   ///< updates applied (per sensor message)
   std::int64_t gated = 0;      ///< samples rejected by the innovation gate
-  std::int64_t load_changes = 0;  ///< covariance re-opened after gate_reset rejections
+  std::int64_t load_changes = 0;  ///< load changes: CUSUM at rest, or gate_reset rejections in a row
   std::int64_t implausible = 0;   ///< non-finite or out-of-range samples refused
 };
 
@@ -218,7 +248,12 @@ class LoadEstimator {
 
  private:
   bool updateLateral(double f_y, double omega, unsigned which);
-  void reopen(double& P, double sigma0);
+  /// A load change (CUSUM or gate_reset, either channel): re-opens Fa and M.
+  void loadChange();
+  /// The CUSUM of a channel at rest; true: a change.
+  bool changeAtRest(ChangeDetector& c, double z);
+  /// An accepted innovation of channel `ch` into its band block (NIS window, CUSUM).
+  void band(int ch, double nu, double S, double e);
   void pushNis(double nis, int dof);
   bool moving() const;
 
@@ -254,9 +289,15 @@ class LoadEstimator {
   bool have_update_ = false;
   // drift during a trip
   bool was_moving_ = false;
+  bool trip_ref_warm_ = false;             // the trip's reference was taken after the warm-up
   double trip_Fa0_ = 0.0, trip_PFa0_ = 0.0, trip_M0_ = 0.0, trip_PM0_ = 0.0, trip_QFa_ = 0.0, trip_QM_ = 0.0;
   double trip_drift_ = 0.0;
   bool nis_flag_ = false, drift_flag_ = false;  // the two MODEL_MISMATCH conditions
+  SensorMonitor mon_[3];                   // per channel (kImuAccel, kImuRate, kRope)
+  BandInnovation band_[3];                 // per channel: innovations summed over band_block
+  ChangeDetector cusum_fa_, cusum_m_;      // load changes at rest
+  double rest_since_ = 0.0;                // time the cage came to rest
+  double change_t_ = -1.0, change_Fa0_ = 0.0, change_M0_ = 0.0;  // the last load change and the loads before it
   LoadEstimate est_;
   EstimatorCounters counts_;
 };

@@ -3,6 +3,7 @@
 #include "hoist/contract/alarm_command.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace hoist::contract {
 
@@ -12,6 +13,7 @@ const char* toString(AlarmAction a) {
     case AlarmAction::Shelve: return "SHELVE";
     case AlarmAction::Unshelve: return "UNSHELVE";
     case AlarmAction::Reannounce: return "REANNOUNCE";
+    case AlarmAction::Calibrate: return "CALIBRATE";
   }
   return "?";
 }
@@ -23,13 +25,33 @@ const char* toString(CommandError e) {
     case CommandError::BadLevel: return "bad_level";
     case CommandError::BadAction: return "bad_action";
     case CommandError::BadShelveDuration: return "bad_shelve_duration";
+    case CommandError::BadCalibration: return "bad_calibration";
   }
   return "?";
 }
 
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
                                   AlarmCommand& out) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return validateAlarmCommand(kind, level, action, shelve_duration, nan, nan, nan, out);
+}
+
+CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
+                                  double known_fa, double known_b, double calibrate_duration, AlarmCommand& out) {
   AlarmCommand c;
+  if (action == static_cast<int>(AlarmAction::Calibrate)) {
+    // The load, not an alarm: kind and level are ignored.
+    if (!(std::isfinite(known_fa) && known_fa >= 0.0 && known_fa <= kMaxCalibrationForce) ||
+        !(std::isfinite(known_b) && std::abs(known_b) <= kMaxCalibrationOffset) ||
+        !(std::isfinite(calibrate_duration) && calibrate_duration > 0.0 && calibrate_duration <= kMaxCalibration))
+      return CommandError::BadCalibration;
+    c.action = AlarmAction::Calibrate;
+    c.known_fa = known_fa;
+    c.known_b = known_b;
+    c.calibrate_duration = calibrate_duration;
+    out = c;
+    return CommandError::None;
+  }
   if (!kind.empty() && kind != "*") {
     c.kind = parseAlarmKind(kind);
     if (!c.kind) return CommandError::UnknownKind;

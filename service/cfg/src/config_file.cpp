@@ -174,11 +174,55 @@ void parseServiceSections(const toml::table& tbl, const std::string& source, Twi
   }
 }
 
+namespace {
+
+/// The daemon's own keys of [sensors] and [estimator] (the estimator's
+/// keys are hoist::io::kEstimatorFields): section, key, member.
+struct DaemonSensorKey {
+  const char* section;
+  const char* key;
+  double EstimatorConfig::*member;
+};
+constexpr DaemonSensorKey kDaemonSensorKeys[] = {
+    {"sensors", "max_clock_offset", &EstimatorConfig::max_clock_offset},
+    {"estimator", "clear_hold", &EstimatorConfig::clear_hold},
+};
+
+/// Read the daemon's own keys into `out` and remove them from `tbl` (the
+/// estimator's reader then sees only its keys).  Errors name file:line:key.
+void takeDaemonSensorKeys(toml::table& tbl, const std::string& source, EstimatorConfig& out) {
+  for (const DaemonSensorKey& k : kDaemonSensorKeys) {
+    toml::table* sec = tbl[k.section].as_table();
+    if (!sec) continue;  // absent, or not a table (the estimator's reader says so)
+    const toml::node* n = sec->get(k.key);
+    if (!n) continue;
+    const std::string dotted = std::string(k.section) + "." + k.key;
+    if (const auto* i = n->as_integer()) out.*k.member = static_cast<double>(i->get());
+    else if (const auto* f = n->as_floating_point()) out.*k.member = f->get();
+    else
+      throw hoist::io::ConfigError(source, hoist::io::lineOf(*n), dotted,
+                                   std::string("must be a number, got ") + hoist::io::typeName(*n));
+    const int line = hoist::io::lineOf(*n);
+    sec->erase(k.key);
+    try {
+      out.validate();
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      if (what.rfind(dotted + ":", 0) == 0)
+        throw hoist::io::ConfigError(source, line, dotted, what.substr(dotted.size() + 2));
+      throw;
+    }
+  }
+}
+
+}  // namespace
+
 TwinConfig loadTwinConfig(const std::string& path) {
-  const toml::table tbl = hoist::io::loadTomlFile(path);
+  toml::table tbl = hoist::io::loadTomlFile(path);
   TwinConfig cfg;
   cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, hoist::io::daemonSections());
   parseServiceSections(tbl, path, cfg);
+  takeDaemonSensorKeys(tbl, path, cfg.estimator);
   const hoist::io::EstimatorConfig e = hoist::io::estimatorConfigFromToml(tbl, path);
   cfg.estimator.enabled = e.enabled;
   cfg.estimator.settings = e.settings;
@@ -224,7 +268,17 @@ std::string toToml(const TwinConfig& c) {
   writeKeys(os, "alarms", kAlarmKeys, c.alarms);
   os << "\n";
   writeKeys(os, "forecast", kForecastKeys, c.forecast);
-  os << "\n" << hoist::io::toToml(hoist::io::EstimatorConfig{c.estimator.enabled, c.estimator.settings});
+  // The estimator's sections, with the daemon's own keys at the head of each.
+  std::string est = hoist::io::toToml(hoist::io::EstimatorConfig{c.estimator.enabled, c.estimator.settings});
+  for (const DaemonSensorKey& k : kDaemonSensorKeys) {
+    const std::string header = std::string("[") + k.section + "]\n";
+    std::ostringstream line;
+    line << k.key << " = " << Num{c.estimator.*k.member} << "\n";
+    const std::size_t at = est.find(header);
+    if (at == std::string::npos) est += "\n" + header + line.str();
+    else est.insert(at + header.size(), line.str());
+  }
+  os << "\n" << est;
   return os.str();
 }
 

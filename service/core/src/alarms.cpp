@@ -226,6 +226,7 @@ constexpr std::array<SlotRow, AlarmEngine::kSlots> kSlotTable{{
     {AlarmKind::PredictedClearance, AlarmLevel::Warning, Rule::Prediction, nullptr},
     {AlarmKind::PredictedSlack, AlarmLevel::Warning, Rule::Prediction, nullptr},
     {AlarmKind::ModelMismatch, AlarmLevel::Warning, Rule::Flag, nullptr},
+    {AlarmKind::SensorFault, AlarmLevel::Warning, Rule::Flag, nullptr},
 }};
 
 /// The slot of (kind, level), or -1 if there is no such alarm.
@@ -265,6 +266,7 @@ constexpr int kRopeOverload = slot(AlarmKind::RopeOverload, AlarmLevel::Critical
 constexpr int kPredictedClearance = slot(AlarmKind::PredictedClearance, AlarmLevel::Warning);
 constexpr int kPredictedSlack = slot(AlarmKind::PredictedSlack, AlarmLevel::Warning);
 constexpr int kModelMismatch = slot(AlarmKind::ModelMismatch, AlarmLevel::Warning);
+constexpr int kSensorFault = slot(AlarmKind::SensorFault, AlarmLevel::Warning);
 
 /// The settings of `row` under `cfg`.
 AlarmSettings settingsOf(const SlotRow& row, const AlarmConfig& cfg) {
@@ -322,13 +324,18 @@ AlarmEngine::AlarmEngine(const AlarmConfig& cfg) : cfg_(cfg) {
 void AlarmEngine::setModelFaultDetail(double value, double limit) { alarms_[kModelFault].setDetail(value, limit); }
 
 void AlarmEngine::updateRopeForce(double now, double lambda0, double static_force, AlarmEvents& out) {
+  updateRopeForce(now, lambda0, lambda0, static_force, out);
+}
+
+void AlarmEngine::updateRopeForce(double now, double lambda0_slack, double lambda0_overload, double static_force,
+                                  AlarmEvents& out) {
   if (std::isfinite(static_force) && static_force > 0.0) {
     const double db = cfg_.force_deadband * static_force;
     alarms_[kRopeSlack].setThreshold(cfg_.slack_fraction * static_force, db);
     alarms_[kRopeOverload].setThreshold(cfg_.overload_fraction * static_force, db);
   }
-  alarms_[kRopeSlack].update(now, lambda0, out);
-  alarms_[kRopeOverload].update(now, lambda0, out);
+  alarms_[kRopeSlack].update(now, lambda0_slack, out);
+  alarms_[kRopeOverload].update(now, lambda0_overload, out);
 }
 
 double AlarmEngine::ropeSlackThreshold() const { return alarms_[kRopeSlack].settings().threshold; }
@@ -379,6 +386,11 @@ void AlarmEngine::setPredictedSlack(double now, bool predicted, double seconds, 
 void AlarmEngine::setModelMismatch(double now, bool mismatch, double statistic, double bound, AlarmEvents& out) {
   if (mismatch) alarms_[kModelMismatch].setDetail(statistic, bound);
   alarms_[kModelMismatch].update(now, mismatch ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setSensorFault(double now, bool fault, double value, double limit, AlarmEvents& out) {
+  if (fault) alarms_[kSensorFault].setDetail(value, limit);
+  alarms_[kSensorFault].update(now, fault ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

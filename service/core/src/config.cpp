@@ -104,4 +104,9 @@ void ForecastConfig::validate(double service_rate) const {
   checkRange("modes", modes, 1, kMaxModes, false, f);
 }
 
+void EstimatorConfig::validate() const {
+  checkRange("max_clock_offset", max_clock_offset, 0.0, 10.0, true, "sensors.");
+  checkRange("clear_hold", clear_hold, 0.0, 60.0, false, "estimator.");
+}
+
 }  // namespace hoist::svc

@@ -101,7 +101,8 @@ TickBudget measureTickBudget(const TwinConfig& cfg, int max_ticks, double max_se
     toCageMessage(core.output(), cage_msg);
     cage_msg.encode(cage_buf.data(), 0, static_cast<int>(cage_buf.size()));
     if (const LoadEstimate* e = core.estimate()) {
-      toEstimateMessage(*e, *core.estimatorCounters(), core.output().t, 0.0, 0.0, core.estimateInUse(), estimate_msg);
+      toEstimateMessage(*e, *core.estimatorCounters(), core.output().t, 0.0, 0.0, core.estimateGate(), core.modelTime(),
+                        core.calibrating(), estimate_msg);
       estimate_msg.encode(estimate_buf.data(), 0, static_cast<int>(estimate_buf.size()));
     }
     const double cage = usSince(p0);

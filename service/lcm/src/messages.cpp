@@ -33,8 +33,15 @@ void toCageMessage(const CageOutput& o, hoist::cage_state_t& m) {
 }
 
 void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double t, double imu_age,
-                       double rope_load_age, bool in_use, hoist::estimate_t& m) {
-  m.in_use = in_use;
+                       double rope_load_age, const EstimateGate& gate, double model_t, bool calibrating,
+                       hoist::estimate_t& m) {
+  m.in_use = gate.inUse();
+  m.not_used = static_cast<int32_t>(gate.notUsed());
+  m.holding = gate.holding(model_t);
+  m.use_switches = gate.switches();
+  m.load_change_Fa = gate.lastChangeFa();
+  m.load_change_moment = gate.lastChangeM();
+  m.calibrating = calibrating;
   m.t = t;
   m.l = e.kin.l;
   m.v = e.kin.v;
@@ -188,6 +195,32 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
                       "sleeves and the sensors (docs/estimation.md)%s",
                       kind, level, verb, e.value, e.threshold, state);
       break;
+    case AlarmKind::SensorFault:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: no sensor refused or disbelieved for %g s%s", kind, level,
+                      TwinCore::kSensorFaultHold, state);
+      else if (ctx.sensor_reason == SensorFaultReason::ClockOffset)
+        std::snprintf(buf, n, "%s %s %s: %s: its clock is %+.3f s from the daemon's (sensors.max_clock_offset = "
+                      "%g s); its samples are refused, the estimate goes on without them%s",
+                      kind, level, verb, toString(ctx.sensor), e.value, e.threshold, state);
+      else if (ctx.sensor_reason == SensorFaultReason::TimeBackwards)
+        std::snprintf(buf, n, "%s %s %s: %s: a sample's utime went backwards (a replay, or the sensor's clock "
+                      "stepped back); refused and counted (HOIST_HEALTH.sensor_time_backwards)%s",
+                      kind, level, verb, toString(ctx.sensor), state);
+      else if (ctx.sensor_reason == SensorFaultReason::Implausible)
+        std::snprintf(buf, n, "%s %s %s: %s is implausible (%.4g beyond the physical bound %.4g): a sensor "
+                      "lies or fails; the alarms judge the open-loop twin%s",
+                      kind, level, verb, toString(ctx.sensor), e.value, e.threshold, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: %s is %s (%s; its noise %.3g against the datasheet's %.3g): a sensor "
+                      "that fails or lies; the alarms judge the open-loop twin%s",
+                      kind, level, verb, toString(ctx.sensor), toString(ctx.sensor_reason),
+                      ctx.sensor_reason == SensorFaultReason::Quiet   ? "far quieter than its own noise: flat, zeroed "
+                                                                        "or held"
+                      : ctx.sensor_reason == SensorFaultReason::Stuck ? "the very same value repeated"
+                                                                      : "far noisier than its datasheet",
+                      e.value, e.threshold, state);
+      break;
     case AlarmKind::PredictedSlack:
       if (e.type == AlarmEventType::Clear)
         std::snprintf(buf, n, "%s %s cleared: no forecast scenario brings the hoisting-rope force below the slack "
@@ -203,12 +236,16 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
 
 std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*& why) {
   AckCommand c;
-  switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, c)) {
+  switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.known_fa, ack.known_b,
+                               ack.calibrate_duration, c)) {
     case CommandError::None: return c;
     case CommandError::UnknownKind: why = "unknown alarm kind"; break;
     case CommandError::BadLevel: why = "bad level (0 both, 1 warning, 2 critical)"; break;
-    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce)"; break;
+    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce, 5 calibrate)"; break;
     case CommandError::BadShelveDuration: why = "shelve_duration must be a finite number > 0 s"; break;
+    case CommandError::BadCalibration:
+      why = "calibrate needs known_fa in [0, 1e7] N, |known_b| <= 100 m and calibrate_duration in (0, 600] s";
+      break;
   }
   return std::nullopt;
 }

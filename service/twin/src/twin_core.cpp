@@ -103,6 +103,17 @@ class InputClock final : public ClockPolicy {
 
   TickResult tick(TwinCore&, double, double) override { return {}; }
   double staleTimeout(const TwinCore& c) const override { return c.cfg_.service.stale_timeout; }
+  double sensorTime(const TwinCore& c, std::int64_t utime, double, std::int64_t, double& offset) const override {
+    // The daemon's clock is the winder stream's: the sample's time on it.
+    // Before the first winder input there is none: the sample is applied at
+    // the first step (as hoist-estimate applies the first row's sensors).
+    if (!c.started_ || !c.have_input_) {
+      offset = 0.0;
+      return -std::numeric_limits<double>::infinity();
+    }
+    offset = static_cast<double>(utime - c.last_.utime) * 1e-6;
+    return t_base_ + static_cast<double>(utime - utime_base_) * 1e-6;
+  }
 
  private:
   static InputResult reject(TwinCore& c, InputResult& res, RejectReason r) {
@@ -205,6 +216,12 @@ class WallClock final : public ClockPolicy {
   }
 
   double staleTimeout(const TwinCore& c) const override { return c.periodStaleTimeout(); }
+  double sensorTime(const TwinCore&, std::int64_t utime, double wall_now, std::int64_t wall_utime,
+                    double& offset) const override {
+    // Model time is the daemon's wall clock: the sample is `offset` from now.
+    offset = static_cast<double>(utime - wall_utime) * 1e-6;
+    return wall_now + offset;
+  }
 };
 
 std::unique_ptr<ClockPolicy> makeClock(ClockMode mode) {
@@ -224,8 +241,14 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
       range_(validLengthRange(cfg.shaft)),
-      bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))) {
+      bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))),
+      // The predictions kept cover max_clock_offset at the step rate, and more.
+      timing_(cfg.estimator.max_clock_offset,
+              std::max<std::size_t>(64, static_cast<std::size_t>(std::ceil(1.5 * cfg.estimator.max_clock_offset *
+                                                                             cfg.service.rate)) + 16)),
+      gate_(cfg.alarms, cfg.estimator.clear_hold) {
   cfg_.service.validate();
+  cfg_.estimator.validate();
   // Envelope evaluations may be deferred below the GUIDE_ROPE WARNING
   // alarm's clear level: taken from that alarm's own settings.
   const AlarmSettings& gw = alarms_.find(AlarmKind::GuideRope, AlarmLevel::Warning)->settings();
@@ -261,35 +284,100 @@ void TwinCore::acceptSample(const WinderSample& s, double wall_now) {
   if (stale_) setStale(false);
 }
 
-void TwinCore::onCageImu(double f_y, double omega) {
-  if (!est_) return;
-  if (std::isfinite(f_y)) {
-    imu_.f_y = f_y;
-    imu_.has_accel = true;
-  }
-  if (std::isfinite(omega)) {
-    imu_.omega = omega;
-    imu_.has_rate = true;
-  }
+SensorVerdict TwinCore::onCageImu(std::int64_t utime, double f_y, double omega, double wall_now,
+                                  std::int64_t wall_utime) {
+  return offerSensor(SensorId::CageImu, utime, f_y, omega, wall_now, wall_utime);
 }
 
-void TwinCore::onRopeLoad(double force) {
-  if (!est_ || !std::isfinite(force)) return;
-  rope_force_ = force;
-  rope_pending_ = true;
+SensorVerdict TwinCore::onRopeLoad(std::int64_t utime, double force, double wall_now, std::int64_t wall_utime) {
+  if (!std::isfinite(force)) return SensorVerdict::NoClock;
+  return offerSensor(SensorId::RopeLoad, utime, force, 0.0, wall_now, wall_utime);
+}
+
+SensorVerdict TwinCore::offerSensor(SensorId s, std::int64_t utime, double a, double b, double wall_now,
+                                    std::int64_t wall_utime) {
+  if (!est_) return SensorVerdict::NoClock;
+  double offset = 0.0;
+  const double ts = clock_->sensorTime(*this, utime, wall_now, wall_utime, offset);
+  sensor_offset_ = offset;
+  const SensorVerdict v = s == SensorId::CageImu ? timing_.offerImu(utime, offset, ts, a, b)
+                                                 : timing_.offerRope(utime, offset, ts, a);
+  if (v == SensorVerdict::ClockOffset)
+    noteSensorFault(s, SensorFaultReason::ClockOffset, offset, timing_.maxClockOffset());
+  else if (v == SensorVerdict::TimeBackwards)
+    noteSensorFault(s, SensorFaultReason::TimeBackwards, offset, 0.0);
+  return v;
+}
+
+bool TwinCore::calibrate(double Fa, double b, double duration) {
+  if (!est_ || !std::isfinite(Fa) || !std::isfinite(b) || !(duration > 0.0)) return false;
+  known_Fa_ = Fa;
+  known_b_ = b;
+  known_until_ = t_ + duration;
+  return true;
+}
+
+void TwinCore::noteSensorFault(SensorId s, SensorFaultReason r, double value, double limit) {
+  sensor_fault_ = SensorFaultInfo{s, r, value, limit};
+  sensor_fault_until_ = t_ + kSensorFaultHold;
+  alarms_.setSensorFault(t_, true, value, limit, events_);
+  out_.alarm_level = alarms_.highestActive();
 }
 
 void TwinCore::estimatorStep(const CageResponse& r) {
   // The same sequence as hoist::estimateRecorded (hoist-estimate): predict,
-  // the IMU, the rope load, finish.
+  // the IMU, the rope load, finish -- each sample at its own time, aligned
+  // to this step (hoist/sensor_alignment.hpp).
   est_->predict(r);
-  if (imu_.has_accel && imu_.has_rate) est_->updateImu(imu_.f_y, imu_.omega);
-  else if (imu_.has_accel) est_->updateImuAccel(imu_.f_y);
-  else if (imu_.has_rate) est_->updateImuRate(imu_.omega);
-  if (rope_pending_) est_->updateRopeLoad(rope_force_);
-  imu_ = {};
-  rope_pending_ = false;
+  const double g = cfg_.shaft.g;
+  const SensorPrediction now{t_, sensorModel(r, g), sensorModel(est_->sensitivity(), g)};
+  timing_.record(now);
+  const LoadEstimate& e = est_->estimate();
+  const double Fa_c = cfg_.shaft.Fa, M_c = cfg_.shaft.Fa * cfg_.shaft.b;
+  const DueSamples d = timing_.take(now, e.Fa - Fa_c, e.moment - M_c);
+  if (d.accel && d.rate) est_->updateImu(d.f_y, d.omega);
+  else if (d.accel) est_->updateImuAccel(d.f_y);
+  else if (d.rate) est_->updateImuRate(d.omega);
+  if (d.rope) est_->updateRopeLoad(d.force);
   est_->finish();
+}
+
+unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
+  unsigned why = 0;
+  if (e.sensors == 0) why |= kNotUsedNoSensors;
+  if (e.mismatch) why |= kNotUsedMismatch;
+  if (!(std::isfinite(e.y_c) && std::isfinite(e.theta) && std::isfinite(e.lambda[0]) && std::isfinite(e.Fa) &&
+        std::isfinite(e.moment)))
+    return why | kNotUsedNonFinite;
+  // Physical bounds: the state the estimate implies within the twin's own
+  // plausibility bounds, and no negative payload (beyond its 3 sigma).
+  const double h = cfg_.shaft.h;
+  const double lateral = std::max(std::abs(e.y_c - h * e.theta), std::abs(e.y_c + h * e.theta));
+  double value = 0.0, limit = 0.0;
+  if (lateral > bounds_.lateral) value = lateral, limit = bounds_.lateral;
+  else if (std::abs(e.theta) > bounds_.theta) value = e.theta, limit = bounds_.theta;
+  else if (e.fa_observed && e.Fa + 3.0 * std::max(e.sigma_Fa, 0.0) < 0.0) value = e.Fa, limit = 0.0;
+  else
+    for (double l : e.lambda)
+      if (std::abs(l) > bounds_.force) value = l, limit = bounds_.force;
+  if (value != 0.0 || limit != 0.0) {
+    why |= kNotUsedImplausible;
+    noteSensorFault(SensorId::Estimate, SensorFaultReason::Implausible, value, limit);
+  }
+  // A sensor the estimator's monitor finds quiet, stuck or noisy
+  // (hoist/sensor_monitor.hpp): its channel lies, the estimate is not used.
+  if (e.faulty != 0) {
+    why |= kNotUsedSensorFault;
+    const bool imu = (e.fault_imu_accel | e.fault_imu_rate) != 0;
+    const unsigned bits = imu ? (e.fault_imu_accel | e.fault_imu_rate) : e.fault_rope_load;
+    const SensorFaultReason r = (bits & kFaultQuiet)   ? SensorFaultReason::Quiet
+                                : (bits & kFaultStuck) ? SensorFaultReason::Stuck
+                                                       : SensorFaultReason::Noisy;
+    const double learned = imu ? e.noise_imu_accel : e.noise_rope_load;
+    const double sheet = imu ? est_->settings().noise.imu_accel : est_->settings().noise.rope_load;
+    noteSensorFault(imu ? SensorId::CageImu : SensorId::RopeLoad, r, learned, sheet);
+  }
+  return why;
 }
 
 void TwinCore::initializeAt(double t, const Kinematics& k) {
@@ -301,6 +389,8 @@ void TwinCore::initializeAt(double t, const Kinematics& k) {
     if (started_) est_->restart(t, k);
     else est_->initialize(t, k);
     est_synced_ = true;
+    timing_.reset(started_);  // a restart: the queued samples are of the old stream
+    gate_.reset();
   }
   t_ = t;
   kin_ = k;
@@ -428,25 +518,32 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
       alarms_.setModelFault(t, false, events_);
       // With the load estimator healthy, the clearance and rope-force alarms
       // judge the state the estimated load implies (the guide-rope envelope
-      // stays the twin's); HOIST_CAGE keeps the open-loop state.
-      double lambda0 = out_.lambda[0];
+      // stays the twin's); HOIST_CAGE keeps the open-loop state.  Which one,
+      // and the hold after a switch or a load change: EstimateGate.
+      const Judgement open{out_.clearance, out_.lambda[0], out_.lambda[0]};
+      const Judgement* judged = &open;
       est_in_use_ = false;
       if (est_ && est_synced_) {
         estimatorStep(solver_->response());
         const LoadEstimate& e = est_->estimate();
-        est_in_use_ = e.sensors != 0 && !e.mismatch && std::isfinite(e.y_c) && std::isfinite(e.theta) &&
-                      std::isfinite(e.lambda[0]);
-        if (est_in_use_) {
-          out_.clearance = computeClearance(e.y_c, e.theta, h, out_.clearance.guide_deflection, cfg_.alarms);
-          lambda0 = e.lambda[0];
+        const unsigned not_used = estimateNotUsed(e);
+        Judgement est = open;
+        if (!(not_used & (kNotUsedNonFinite | kNotUsedImplausible))) {
+          est.clearance = computeClearance(e.y_c, e.theta, h, out_.clearance.guide_deflection, cfg_.alarms);
+          est.lambda0_slack = est.lambda0_overload = e.lambda[0];
         }
+        judged = &gate_.step(t, not_used == 0, not_used, est, open, est_->counters().load_changes, e.Fa, e.moment);
+        est_in_use_ = gate_.inUse();
         alarms_.setModelMismatch(t, e.mismatch, e.nis_exceeded ? e.nis_window : e.drift,
                                  e.nis_exceeded ? e.nis_bound : est_->settings().drift_sigma, events_);
       }
+      alarms_.setSensorFault(t, t < sensor_fault_until_, sensor_fault_.value, sensor_fault_.limit, events_);
+      out_.clearance = judged->clearance;
       const std::size_t first = events_.size();
       alarms_.updateClearance(t, out_.clearance, events_);
       // Rope force against the static force at this length.
-      alarms_.updateRopeForce(t, lambda0, solver_->model().staticRopeForce(out_.kin.l), events_);
+      alarms_.updateRopeForce(t, judged->lambda0_slack, judged->lambda0_overload,
+                              solver_->model().staticRopeForce(out_.kin.l), events_);
       if (est_in_use_) events_.markFromEstimate(first);
       out_.rope_slack_threshold = alarms_.ropeSlackThreshold();
       out_.rope_overload_threshold = alarms_.ropeOverloadThreshold();
@@ -585,6 +682,7 @@ void TwinCore::housekeeping(double wall_now) {
   else
     stale_now = clock_->mode() == ClockMode::Wall && wall_now - start_wall_ > cfg_.service.stale_timeout;
   if (stale_now && !stale_) setStale(true);
+  if (est_) alarms_.setSensorFault(t_, t_ < sensor_fault_until_, sensor_fault_.value, sensor_fault_.limit, events_);
   alarms_.poll(t_, events_);
   out_.alarm_level = alarms_.highestActive();
   out_.degraded = degradedNow();
@@ -598,6 +696,7 @@ int TwinCore::command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLe
     case AlarmAction::Shelve: n = alarms_.shelve(t_, kind, level, shelve_duration, events_); break;
     case AlarmAction::Unshelve: n = alarms_.unshelve(t_, kind, level, events_); break;
     case AlarmAction::Reannounce: n = alarms_.reannounce(t_, kind, level, events_); break;
+    case AlarmAction::Calibrate: break;  // not an alarm command: calibrate()
   }
   out_.alarm_level = alarms_.highestActive();
   out_.degraded = degradedNow();

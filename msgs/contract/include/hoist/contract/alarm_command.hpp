@@ -16,11 +16,21 @@ namespace hoist::contract {
 /// no state: it asks the daemon to announce the current state of every
 /// alarm that has one (a client that just started learns of alarms raised
 /// before it); the daemon honours at most one a second per shaft.
-enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3, Reannounce = 4 };
+/// Calibrate declares the load known for a while (the load estimator's live
+/// calibration, alarm_ack_t.ACTION_CALIBRATE).
+enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3, Reannounce = 4, Calibrate = 5 };
 
 /// Why a command was refused.
-enum class CommandError { None, UnknownKind, BadLevel, BadAction, BadShelveDuration };
-inline constexpr int kCommandErrors = 5;
+enum class CommandError { None, UnknownKind, BadLevel, BadAction, BadShelveDuration, BadCalibration };
+inline constexpr int kCommandErrors = 6;
+
+/// The longest calibration an operator may declare [s].
+inline constexpr double kMaxCalibration = 600.0;
+/// The largest known load force / |offset| a calibration may declare (a
+/// bound on the number, not the conveyance's rating: the daemon checks
+/// that against [load]) [N], [m].
+inline constexpr double kMaxCalibrationForce = 1.0e7;
+inline constexpr double kMaxCalibrationOffset = 100.0;
 
 const char* toString(AlarmAction a);   ///< "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE"
 const char* toString(CommandError e);  ///< "ok", "unknown_kind", "bad_level", "bad_action", "bad_shelve_duration"
@@ -31,6 +41,9 @@ struct AlarmCommand {
   std::optional<AlarmKind> kind;
   AlarmLevel level = AlarmLevel::None;
   double shelve_duration = 0.0;  ///< [s], > 0 and finite for Shelve
+  double known_fa = 0.0;          ///< Calibrate: the known eccentric force [N]
+  double known_b = 0.0;           ///< Calibrate: its offset [m]
+  double calibrate_duration = 0.0;  ///< Calibrate: for how long [s]
 };
 
 /// Validates the fields of an alarm_ack_t: `kind` an alarm kind name
@@ -40,6 +53,13 @@ struct AlarmCommand {
 /// Fills `out` and returns CommandError::None when valid.
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
                                   AlarmCommand& out);
+/// The same with the calibration fields (alarm_ack_t.known_fa, known_b,
+/// calibrate_duration): for Calibrate, known_fa finite in [0,
+/// kMaxCalibrationForce], |known_b| <= kMaxCalibrationOffset, duration in
+/// (0, kMaxCalibration]; else BadCalibration.  The 5-argument form refuses
+/// Calibrate (a client without the fields cannot calibrate).
+CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
+                                  double known_fa, double known_b, double calibrate_duration, AlarmCommand& out);
 
 /// At most `max` characters of `s`, every byte outside printable ASCII
 /// replaced by '?', "..." appended when cut (for network strings in logs).

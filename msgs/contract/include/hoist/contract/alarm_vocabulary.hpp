@@ -16,9 +16,10 @@ enum class AlarmKind : std::uint8_t {
   CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher,
   RopeSlack, RopeOverload,            // live rope-force alarms
   PredictedClearance, PredictedSlack,  // look-ahead forecasts
-  ModelMismatch                       // the load estimator: the shaft does not behave like its model
+  ModelMismatch,                      // the load estimator: the shaft does not behave like its model
+  SensorFault                         // a sensor of the estimator refused or not believed (names the sensor and why)
 };
-inline constexpr int kAlarmKinds = 12;
+inline constexpr int kAlarmKinds = 13;
 
 /// Values match alarm_t.LEVEL_*.
 enum class AlarmLevel : std::int8_t { None = 0, Warning = 1, Critical = 2 };

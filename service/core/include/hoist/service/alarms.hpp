@@ -25,7 +25,8 @@
 //     scenario crosses the CRITICAL clearance threshold / brings lambda_0
 //     below the slack threshold within the forecast horizon) are WARNINGs,
 //     never latched, raised at once (no on-delay: the forecast itself is the
-//     early warning);
+//     early warning); MODEL_MISMATCH and SENSOR_FAULT (the load estimator's
+//     model check, and a sensor refused or not believed) are WARNING flags;
 //   * the condition comes on when value >= threshold has held for on_delay
 //     and goes off when value < threshold - deadband has held for off_delay
 //     (so a value hovering at the threshold cannot chatter); a low alarm
@@ -234,7 +235,7 @@ class AlarmEngine {
  public:
   /// The number of binary alarms; which ones, in which order, is the slot
   /// table in alarms.cpp (kSlotTable).
-  static constexpr int kSlots = 15;
+  static constexpr int kSlots = 16;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
   const AlarmConfig& config() const { return cfg_; }
@@ -255,6 +256,11 @@ class AlarmEngine {
   /// as in alarm (fail safe), a non-finite or non-positive static_force
   /// leaves the thresholds as they were.
   void updateRopeForce(double now, double lambda0, double static_force, AlarmEvents& out);
+  /// The same with a value of its own for each alarm (TwinCore's clear hold
+  /// feeds each the more alarming of two sources: the lower force to
+  /// ROPE_SLACK, the higher to ROPE_OVERLOAD).
+  void updateRopeForce(double now, double lambda0_slack, double lambda0_overload, double static_force,
+                       AlarmEvents& out);
   /// The thresholds in force [N] (HOIST_CAGE.rope_slack_threshold, _overload_threshold).
   double ropeSlackThreshold() const;
   double ropeOverloadThreshold() const;
@@ -272,6 +278,11 @@ class AlarmEngine {
   /// `bound` are reported (the window's NIS and its bound, or the load's
   /// drift and drift_sigma).
   void setModelMismatch(double now, bool mismatch, double statistic, double bound, AlarmEvents& out);
+  /// SENSOR_FAULT (WARNING): `fault` true while a sensor of the load
+  /// estimator is refused or not believed (TwinCore says which and why:
+  /// lastSensorFault()); `value` and `limit` are reported (e.g. the clock
+  /// offset and max_clock_offset [s]).
+  void setSensorFault(double now, bool fault, double value, double limit, AlarmEvents& out);
   /// Runs shelve expiry and re-announcement without a new value.
   void poll(double now, AlarmEvents& out);
 

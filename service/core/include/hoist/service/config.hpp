@@ -142,6 +142,22 @@ struct ForecastConfig {
 struct EstimatorConfig {
   bool enabled = false;
   EstimatorSettings settings;  ///< validated by EstimatorSettings::validate()
+  /// [sensors] max_clock_offset: a sensor sample whose utime is further than
+  /// this from the daemon's clock (--clock wall: the wall clock at arrival;
+  /// --clock input: the latest winder utime) is refused, counted and raises
+  /// SENSOR_FAULT; within it each sample is applied at its own time
+  /// (hoist/sensor_alignment.hpp), (0, 10] s.
+  double max_clock_offset = 0.5;
+  /// [estimator] clear_hold: after the alarms switch between the estimate
+  /// and the open-loop twin, or after a load change, an active alarm clears
+  /// only once the new estimate has held this long (model time; meanwhile
+  /// the alarms judge the more alarming of the new state and the one judged
+  /// before), [0, 60] s.
+  double clear_hold = 2.0;
+
+  /// Throws std::invalid_argument "sensors.max_clock_offset: ..." /
+  /// "estimator.clear_hold: ..." (the daemon's own keys of these sections).
+  void validate() const;
 };
 
 struct TwinConfig {

@@ -25,9 +25,12 @@ void toCageMessage(const CageOutput& o, hoist::cage_state_t& m);
 /// Fill `m` from the load estimate (utime, seq and instance_id are the
 /// caller's).  `t` is the published time; the ages are seconds since each
 /// sensor's last accepted sample (< 0: never).  A value that is not observed
-/// (sigma < 0) is published as 0 with sigma -1, never as NaN.
+/// (sigma < 0) is published as 0 with sigma -1, never as NaN.  `gate`: whether
+/// the alarms judge it (in_use, not_used, holding at model time `model_t`);
+/// `calibrating`: a declared known load is in force.
 void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double t, double imu_age,
-                       double rope_load_age, bool in_use, hoist::estimate_t& m);
+                       double rope_load_age, const EstimateGate& gate, double model_t, bool calibrating,
+                       hoist::estimate_t& m);
 
 /// What the alarm text needs besides the event.
 struct AlarmTextContext {
@@ -42,6 +45,9 @@ struct AlarmTextContext {
   const char* predicted_clearance_scenario = "";
   const char* predicted_slack_scenario = "";
   double slack_threshold = 0.0;
+  /// SENSOR_FAULT: which sensor and why (TwinCore::lastSensorFault()).
+  SensorId sensor = SensorId::CageImu;
+  SensorFaultReason sensor_reason = SensorFaultReason::ClockOffset;
 };
 
 /// A readable one-line description of an alarm event into buf[0..n)

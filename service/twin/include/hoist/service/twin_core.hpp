@@ -49,6 +49,8 @@
 #include "hoist/contract/alarm_command.hpp"
 #include "hoist/service/alarms.hpp"
 #include "hoist/service/config.hpp"
+#include "hoist/service/estimate_gate.hpp"
+#include "hoist/service/sensor_timing.hpp"
 #include "hoist/service/input_validator.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/plausibility.hpp"
@@ -106,6 +108,13 @@ class ClockPolicy {
   virtual TickResult tick(TwinCore& core, double t, double wall_now) = 0;
   /// The staleness timeout in force [s].
   virtual double staleTimeout(const TwinCore& core) const = 0;
+  /// Model time of a sensor sample stamped `utime` that arrived at
+  /// `wall_now` (the wall clock then: `wall_utime`); `offset`: utime minus
+  /// the daemon's clock [s] (wall: the wall clock; input: the latest winder
+  /// utime).  NaN when there is no model time yet (input clock before the
+  /// first winder input).
+  virtual double sensorTime(const TwinCore& core, std::int64_t utime, double wall_now, std::int64_t wall_utime,
+                            double& offset) const = 0;
 };
 std::unique_ptr<ClockPolicy> makeClock(ClockMode mode);
 
@@ -259,11 +268,37 @@ class TwinCore {
 
   // ---- load estimator ([estimator], hoist/load_estimator.hpp) ---------------
   /// A validated cage IMU sample (f_y [m/s^2], omega [rad/s]; NaN = that
-  /// channel absent): applied at the next model step (input clock: the step of
-  /// the next winder input; wall clock: the next tick).  No-op when disabled.
-  void onCageImu(double f_y, double omega);
+  /// channel absent) stamped `utime` [us], arriving at `wall_now` [s] when the
+  /// wall clock reads `wall_utime` [us]: applied at its own time
+  /// (hoist/service/sensor_timing.hpp) at the first model step at or after
+  /// it.  A clock further off than [sensors] max_clock_offset or a utime
+  /// going back is refused, counted and raises SENSOR_FAULT.  Disabled: NoClock.
+  SensorVerdict onCageImu(std::int64_t utime, double f_y, double omega, double wall_now, std::int64_t wall_utime);
   /// A validated rope-load sample [N], likewise.
-  void onRopeLoad(double force);
+  SensorVerdict onRopeLoad(std::int64_t utime, double force, double wall_now, std::int64_t wall_utime);
+  /// The live calibration (alarm_ack_t ACTION_CALIBRATE): the load is known
+  /// -- force Fa [N] at offset b [m] -- from now for `duration` seconds of
+  /// model time; the estimator learns the accelerometer's offset from it.
+  /// false (nothing changes): no estimator.  A new declaration replaces one
+  /// in force.
+  bool calibrate(double Fa, double b, double duration);
+  /// A declared known load is in force at the current model time.
+  bool calibrating() const { return est_ && t_ < known_until_; }
+  /// The clock offset of the last offered sensor sample [s] (for the log).
+  double lastSensorOffset() const { return sensor_offset_; }
+  /// The last SENSOR_FAULT cause: which sensor, why, the value and its limit.
+  struct SensorFaultInfo {
+    SensorId sensor = SensorId::CageImu;
+    SensorFaultReason reason = SensorFaultReason::ClockOffset;
+    double value = 0.0, limit = 0.0;
+  };
+  const SensorFaultInfo& lastSensorFault() const { return sensor_fault_; }
+  /// SENSOR_FAULT stays raised this long after its last cause [s of model time].
+  static constexpr double kSensorFaultHold = 5.0;
+  const SensorTimingCounters& sensorTiming() const { return timing_.counters(); }
+  /// The alarms' source (estimate or open loop), its hold, and the switch
+  /// and load-change events (estimate_gate.hpp).
+  const EstimateGate& estimateGate() const { return gate_; }
   bool estimatorEnabled() const { return est_ != nullptr; }
   /// The estimate after the last step (null when disabled or not yet started).
   const LoadEstimate* estimate() const { return est_ && est_synced_ ? &est_->estimate() : nullptr; }
@@ -335,13 +370,18 @@ class TwinCore {
   std::unique_ptr<LoadEstimator> est_;  // null when disabled
   bool est_synced_ = false;     // its sensitivities stepped exactly as the solver (false after a refused step)
   bool est_in_use_ = false;     // the last step's alarms used the estimate (sensors in use, no mismatch)
-  struct PendingImu {
-    bool has_accel = false, has_rate = false;
-    double f_y = 0.0, omega = 0.0;
-  } imu_;                       // the latest cage IMU sample not yet applied
-  bool rope_pending_ = false;   // a rope-load sample not yet applied
-  double rope_force_ = 0.0;
-  void estimatorStep(const CageResponse& r);  // predict, apply the pending samples, finish
+  SensorTiming timing_;         // the sensor samples, queued to their own time
+  EstimateGate gate_;           // which state the alarms judge; the clear hold
+  double sensor_offset_ = 0.0;  // clock offset of the last offered sample [s]
+  SensorFaultInfo sensor_fault_;
+  double sensor_fault_until_ = -1.0;  // SENSOR_FAULT condition until this model time
+  double known_Fa_ = 0.0, known_b_ = 0.0, known_until_ = -1.0;  // calibrate(): the declared load, until when
+  void noteSensorFault(SensorId s, SensorFaultReason r, double value, double limit);
+  SensorVerdict offerSensor(SensorId s, std::int64_t utime, double a, double b, double wall_now,
+                            std::int64_t wall_utime);
+  void estimatorStep(const CageResponse& r);  // predict, apply the due samples, finish
+  /// Why the estimate may not judge the alarms (NotUsedBits; 0: usable).
+  unsigned estimateNotUsed(const LoadEstimate& e);
   double catchup_until_ = -1.0;   // degraded through this model time after a limited catch-up
   // deferred starts (deferStarts)
   bool defer_starts_ = false;     // first inputs / new streams wait for completeStart()
