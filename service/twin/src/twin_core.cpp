@@ -340,6 +340,10 @@ void TwinCore::estimatorStep(const CageResponse& r) {
   else if (d.rate) est_->updateImuRate(d.omega);
   if (d.rope) est_->updateRopeLoad(d.force);
   est_->finish();
+  // What the sensors read at this step (the trip room's record, issue 32).
+  meas_.t = t_;
+  meas_.z = SensorValues{d.accel ? d.f_y : 0.0, d.rate ? d.omega : 0.0, d.rope ? d.force : 0.0};
+  meas_.present = (d.accel ? kSensorImuAccel : 0u) | (d.rate ? kSensorImuRate : 0u) | (d.rope ? kSensorRopeLoad : 0u);
 }
 
 unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
