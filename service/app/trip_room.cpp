@@ -110,7 +110,8 @@ void TripRoom::afterStep(const TwinCore& core, std::int64_t wall_us) {
   for (const BinaryAlarm& a : core.alarms().alarms())
     if (a.active()) bits |= 1u << static_cast<unsigned>(a.kind());
   t.alarms = bits;
-  if (!ring_.push(t)) counts_.dropped.fetch_add(1, std::memory_order_relaxed);
+  if (ring_.push(t)) counts_.ticks.fetch_add(1, std::memory_order_relaxed);
+  else counts_.dropped.fetch_add(1, std::memory_order_relaxed);
 }
 
 void TripRoom::start() {

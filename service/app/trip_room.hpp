@@ -66,6 +66,7 @@ class TripRing {
 /// The room's figures (atomics: the worker writes, HOIST_HEALTH and the
 /// final log line read).
 struct TripCounters {
+  std::atomic<std::int64_t> ticks{0};        ///< ticks copied into the ring (loop side)
   std::atomic<std::int64_t> trips{0};        ///< trips recorded (records built)
   std::atomic<std::int64_t> stored{0};       ///< records written to the database
   std::atomic<std::int64_t> queued{0};       ///< records put into the PostgreSQL outage queue
