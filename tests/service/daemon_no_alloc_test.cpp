@@ -223,6 +223,8 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   EXPECT_GT(trip_ticks1 - trip_ticks0, 1000);
   EXPECT_EQ(d.shaft(0).trips()->counters().dropped.load(), 0);
   EXPECT_TRUE(d.shaft(2).trips() == nullptr);
+  std::error_code ec;
+  std::filesystem::remove_all(hdir, ec);
   // The watched window did the real work.
   // (3.3 s at 1 kHz and 100 Hz: 3300 and 330 ticks on an idle machine; a
   // loaded one skips some -- the point is that the loop ran, alarms and all)
