@@ -18,6 +18,7 @@
 #include "hoist/history/sqlite_store.hpp"
 #include "hoist/health_t.hpp"
 #include "lcm_fixtures.hpp"
+#include "trip_profile.hpp"
 
 using namespace hoist::test;
 using namespace std::chrono_literals;
@@ -26,34 +27,13 @@ namespace {
 
 constexpr double kRest = 4.0, kTravel = 50.0, kVmax = 4.0, kAmax = 1.0;
 
-/// Rest, down kTravel m, rest, up kTravel m, rest: (t, v, a) at 100 Hz.
-double writeProfile(const std::string& path) {
-  std::ofstream prof(path);
-  prof << "t,v,a\n";
-  const double dt = 0.01, ta = kVmax / kAmax, tc = (kTravel - kVmax * ta) / kVmax, trip = 2 * ta + tc;
-  const double total = 3 * kRest + 2 * trip;
-  for (int i = 0; i * dt <= total + 1e-9; ++i) {
-    const double t = i * dt;
-    double v = 0.0, a = 0.0, sign = 1.0, u = -1.0;
-    if (t > kRest && t < kRest + trip) u = t - kRest;
-    else if (t > 2 * kRest + trip && t < 2 * kRest + 2 * trip) u = t - 2 * kRest - trip, sign = -1.0;
-    if (u >= 0) {
-      if (u < ta) v = kAmax * u, a = kAmax;
-      else if (u < ta + tc) v = kVmax;
-      else v = std::max(0.0, kVmax - kAmax * (u - ta - tc)), a = -kAmax;
-    }
-    prof << t << "," << sign * v << "," << sign * a << "\n";
-  }
-  return trip;
-}
-
 class TripHistoryDaemon : public LcmProcessTest {
  protected:
   std::string path(const std::string& f) const { return (dir_ / f).string(); }
   /// The measurements (hoist-sim: a heavier load off the axis than the twin's
   /// config) and the daemon's configuration with [history] at db.
   void makeRun(const std::string& db) {
-    writeProfile(path("profile.csv"));
+    writeDownUpProfile(path("profile.csv"), kRest, kTravel, kVmax, kAmax);
     std::ofstream(path("truth.toml")) << "[load]\neccentric_force = 1500.0\noffset = 0.6\n[model]\nmodes = 12\n";
     ASSERT_EQ(runProcess({HOIST_SIM, "--config", path("truth.toml"), "--profile", path("profile.csv"),
                           "--write-measurements", path("meas.csv"), "--sensor-noise", "0.002,0.0001,20", "--seed",
