@@ -2,10 +2,12 @@
 // JSON form and the outage queue's files (queue.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
+#include "hoist/history/condition_config.hpp"
 #include "hoist/history/config.hpp"
 #include "hoist/history/queue.hpp"
 #include "hoist/history/record_json.hpp"
@@ -156,4 +158,32 @@ TEST(RecordQueue, KeepsOrderAndMovesDamagedFilesAside) {
   q.remove(p[0]);
   EXPECT_EQ(q.pending().front().seq, p[1].seq);
   EXPECT_EQ(crc32("123456789", 9), 0xCBF43926u);  // the standard check value
+}
+
+TEST(ConditionConfig, KeysDefaultsAndErrorsWithTheLine) {
+  const auto c = conditionSettingsFromToml(
+      io::parseToml("[condition]\ndepth_bin = 20.0\nmax_sigma = 0.05\nbaseline_trips = 6\npreload_warning = 0.9\n"),
+      "c.toml");
+  EXPECT_EQ(c.depth_bin, 20.0);
+  EXPECT_EQ(c.max_sigma, 0.05);
+  EXPECT_EQ(c.baseline_trips, 6);
+  EXPECT_EQ(c.preload_warning, 0.9);
+  EXPECT_EQ(c.preload_critical, 0.70);  // untouched keys keep their defaults
+  auto err = [](const std::string& text) {
+    try {
+      conditionSettingsFromToml(io::parseToml(text, "c.toml"), "c.toml");
+    } catch (const io::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(err("[condition]\n\npreload_critical = 0.9\n").find("c.toml:3: condition.preload_critical"), std::string::npos);
+  EXPECT_NE(err("[condition]\ndepth_bin = -1\n").find("c.toml:2: condition.depth_bin: must be > 0"), std::string::npos);
+  EXPECT_NE(err("[condition]\ndepth_bins = 5\n").find("did you mean 'depth_bin'"), std::string::npos);
+  EXPECT_NE(err("[condition]\nbaseline_trips = 2.5\n").find("condition.baseline_trips"), std::string::npos);
+  // hoist-twind's configuration may hold [history] and [condition] beside the shaft's sections.
+  const auto sections = configSections();
+  EXPECT_NE(std::find(sections.begin(), sections.end(), "history"), sections.end());
+  EXPECT_NE(std::find(sections.begin(), sections.end(), "condition"), sections.end());
+  EXPECT_NO_THROW(io::shaftParamsFromToml(io::parseToml("[history]\nkeep_days = 1\n[condition]\n"), "c.toml", sections));
 }
