@@ -13,7 +13,7 @@
 // taken at t: alignToNow() forms z', and the estimator updates with it at its
 // current step.  The innovation is then exactly the one at ts; the gain uses
 // h(t) instead of h(ts) (h moves with depth: about 0.1 % per 50 ms at 10 m/s,
-// docs/estimation.md "Timing").
+// docs/service.md "The estimator's sensors").
 //
 // PredictionHistory keeps (t, base, h) of the recent steps in a ring sized
 // once (the late samples it can align: at most its span), interpolated
