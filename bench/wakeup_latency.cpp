@@ -50,8 +50,21 @@ int main(int argc, char** argv) {
       return 0;
     }
     else if (a == "-h" || a == "--help") {
-      std::puts("hoist-wakeup-latency [--rate HZ] [--seconds S] [--rt-priority N] [--cpus CPU] [--mlockall] [--version]\n"
-                "The machine's timer wake-up latency on an absolute schedule (cyclictest-like); JSON on stdout.");
+      std::puts(
+          "Usage: hoist-wakeup-latency [OPTIONS]\n"
+          "The machine's timer wake-up latency on an absolute schedule (cyclictest-like); JSON on stdout.\n"
+          "The baseline of bench/rt_report.sh: what the daemon's loop cannot do better than.\n"
+          "\n"
+          "Options:\n"
+          "  --rate HZ          wake-ups per second, 1..10000 (default 1000)\n"
+          "  --seconds S        how long to measure [s], > 0 (default 60)\n"
+          "  --rt-priority N    run SCHED_FIFO at this priority, 1..99 (default: SCHED_OTHER)\n"
+          "  --cpus CPU         pin to these CPUs, e.g. 1 or 2-3 (default: not pinned)\n"
+          "  --mlockall         lock all memory (mlockall)\n"
+          "  --version          print the version and exit\n"
+          "  -h, --help         this help\n"
+          "\n"
+          "Exit status: 0 measured, 2 bad usage.");
       return 0;
     } else {
       std::fprintf(stderr, "hoist-wakeup-latency: unknown option %s (see --help)\n", a.c_str());

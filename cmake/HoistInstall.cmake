@@ -19,7 +19,7 @@
 #   P/include/hoist/            model headers, generated C++ message headers, hoist/io, hoist/bus
 #   P/lib/<multiarch>/          libhoist_model.a, libhoist_io.a
 #   P/lib/<multiarch>/cmake/hoist/  hoistConfig.cmake: find_package(hoist) -> hoist::model, hoist::io, hoist::msgs
-#   P/share/java/hoist_msgs.jar the Java message classes (lcm-spy, Java clients)
+#   P/share/java/hoist-msgs.jar the Java message classes (lcm-spy, Java clients)
 #   P/share/doc/hoist-twin/     README, CHANGELOG, docs/, examples (demo.toml, read_twin.py)
 #   P/share/hoist-twin/dash/web the dashboard's web files, when tools/dash/web exists
 #   P/lib/python3/dist-packages/hoist  the Python module (python/CMakeLists.txt), when HOIST_PYTHON
@@ -45,8 +45,9 @@ if(TARGET hoist_msgs_java)
   # The wrapper finds lcm.jar, jchart2d.jar and ../share/java/hoist_msgs.jar itself.
   install(PROGRAMS ${CMAKE_RUNTIME_OUTPUT_DIRECTORY}/hoist-lcm-spy DESTINATION ${CMAKE_INSTALL_BINDIR}
           COMPONENT runtime)
+  # Installed as hoist-msgs.jar: Debian's jar names have no '_' (lintian bad-jar-name).
   install(FILES ${CMAKE_BINARY_DIR}/msgs/hoist_msgs.jar DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/java
-          COMPONENT runtime)
+          RENAME hoist-msgs.jar COMPONENT runtime)
 endif()
 
 # ---- LCM types: definitions and generated C++ headers -------------------------------
@@ -104,6 +105,18 @@ if(HOIST_HELP2MAN)
       list(APPEND _hoist_man ${_out}.gz)
     endif()
   endforeach()
+  if(TARGET hoist_msgs_java)  # hoist-lcm-spy: a script generated with the Java classes
+    set(_out ${CMAKE_BINARY_DIR}/man/hoist-lcm-spy.1)
+    add_custom_command(
+      OUTPUT ${_out}.gz
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/man
+      COMMAND ${HOIST_HELP2MAN} --no-info --no-discard-stderr --section=1
+              "--name=hoist-lcm-spy, part of hoist-twin (digital twin of a mine-shaft hoist)" --output=${_out}
+              ${CMAKE_RUNTIME_OUTPUT_DIRECTORY}/hoist-lcm-spy
+      COMMAND gzip -9nf ${_out}
+      DEPENDS hoist_msgs_java VERBATIM)
+    list(APPEND _hoist_man ${_out}.gz)
+  endif()
   add_custom_target(hoist_man ALL DEPENDS ${_hoist_man})
   install(FILES ${_hoist_man} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1 COMPONENT runtime)
 else()

@@ -90,6 +90,14 @@ broker="mqtt://127.0.0.1:$bport"
 echo "== started a private mosquitto on 127.0.0.1:$bport (log: $logdir/mosquitto.log)"
 
 echo "== LCM $url; logs in $logdir"
+if [[ $sparkplug -eq 1 ]]; then
+  # Subscribed before the bridge starts: its NBIRTH and DBIRTH (not retained)
+  # are the first lines shown.  (cut line-buffered: whole lines only.)
+  echo "== mosquitto_sub -t 'spBv1.0/#' -F '%t (%l bytes) %x'  (Sparkplug B: protobuf, shown as hex, cut to 160 characters)"
+  mosquitto_sub -h 127.0.0.1 -p "$bport" -t 'spBv1.0/#' -F '%t (%l bytes) %x' > >(stdbuf -oL cut -c1-160) &
+  pids+=($!)
+  sleep 0.3  # (subscribed)
+fi
 "$bin/hoist-twind" --config "$here/service/config/demo.toml" --clock input --lcm-url "$url" 2> "$logdir/hoist-twind.log" &
 pids+=($!)
 spargs=()
@@ -109,9 +117,6 @@ wait_for_line() {  # FILE TEXT
 wait_for_line "$logdir/hoist-twind.log" "hoist-twind started"
 wait_for_line "$logdir/hoist-mqtt.log" "shaft 'default'"
 if [[ $sparkplug -eq 1 ]]; then
-  echo "== mosquitto_sub -t 'spBv1.0/#' -F '%t (%l bytes) %x'  (Sparkplug B: protobuf, shown as hex, cut to 160 characters)"
-  mosquitto_sub -h 127.0.0.1 -p "$bport" -t 'spBv1.0/#' -F '%t (%l bytes) %x' > >(cut -c1-160) &
-  pids+=($!)
   sleep "$pause"
   echo "== replay: the paper's trip at speed $speed"
   "$bin/hoist-replay" --lcm-url "$url" --profile paper --speed "$speed" -q
@@ -133,7 +138,8 @@ echo "== mosquitto_sub -v -t 'hoist/#'  (cage states at 1 Hz for the demo; paylo
 # The subscriber's own pid is kept (not a pipeline's last element), so it is
 # stopped at the end; the cut behind it ends at its EOF.  (A pipeline in the
 # background left mosquitto_sub running, holding the terminal's output open.)
-mosquitto_sub -h 127.0.0.1 -p "$bport" -v -t 'hoist/#' > >(cut -c1-160) &
+# cut is line-buffered (stdbuf -oL): two subscribers never interleave mid-line.
+mosquitto_sub -h 127.0.0.1 -p "$bport" -v -t 'hoist/#' > >(stdbuf -oL cut -c1-160) &
 pids+=($!)
 sleep "$pause"
 echo "== replay: the paper's trip at speed $speed"
@@ -144,7 +150,7 @@ mosquitto_pub -h 127.0.0.1 -p "$bport" -q 1 -t hoist/default/cmd/ack -m '{"kind"
 sleep "$pause"
 echo "== what a SCADA client connecting now gets at once (retained): mosquitto_sub --retained-only -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status'"
 timeout 5 mosquitto_sub -h 127.0.0.1 -p "$bport" -v --retained-only -W 2 -t 'hoist/+/alarm/#' -t 'hoist/_bridge/+/status' \
-  2>/dev/null < /dev/null | cut -c1-200 || true
+  2>/dev/null < /dev/null | stdbuf -oL cut -c1-200 || true
 cleanup
 echo "== bridge log:"
 cat "$logdir/hoist-mqtt.log"

@@ -135,7 +135,7 @@ fi
 echo "== daemon: $bin/hoist-twind --config $config --clock $clock --lcm-url '$url'"
 "$bin/hoist-twind" --config "$config" --clock "$clock" --lcm-url "$url" 2> "$logdir/hoist-twind.log" &
 daemon_pid=$!
-"$bin/hoist-monitor" --lcm-url "$url" &
+"$bin/hoist-monitor" --lcm-url "$url" --no-forecast &   # (as the README's sample: no forecast lines)
 monitor_pid=$!
 # The replay starts once the daemon runs (its start-up measures a tick, which
 # a loaded machine makes slow): at most 15 s, then anyway.

@@ -438,7 +438,11 @@ const LoadEstimate& LoadEstimator::finish() {
   // echo then reaches the model's band.  The NIS window collects from then
   // on and is tested once it is min_window_fill full again.
   const double warm = set_.min_window_fill * set_.nis_window;
-  if (tick_dof_ > 0) {
+  // A tick the daemon flagged degraded stays out of the model check
+  // (excludeTickFromModelCheck); its updates still applied.
+  const bool skip = skip_nis_;
+  skip_nis_ = false;
+  if (tick_dof_ > 0 && !skip) {
     if (!have_update_) {
       have_update_ = true;
       first_t_ = t_;

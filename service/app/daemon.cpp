@@ -284,13 +284,18 @@ void Daemon::logStarted() {
   for (const auto& sp : shafts_) {
     const ShaftTwin& s = *sp;
     const TwinConfig& c = s.config();
-    out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}{}{}, input {}, outputs {} {} {} {}, "
+    // Every channel the shaft uses (the optional ones only when configured).
+    const bus::Channels& ch = s.channels();
+    const bool est = c.estimator.enabled, fc = c.forecast.enabled;
+    std::string ins = ch.winder + " " + ch.ack, outs = ch.cage + " " + ch.shape + " " + ch.alarm + " " + ch.health;
+    if (fc) ins += " " + ch.trip_plan, outs += " " + ch.forecast;
+    if (est) ins += " " + ch.cage_imu + " " + ch.rope_load, outs += " " + ch.estimate;
+    out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}{}{}, inputs {}, outputs {}, "
                "n={} modes, L={} m, h={} m, l0={} m, instance {}",
                s.tag(), n == 1 ? "started" : "shaft",
                toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url),
                lcm_out_ ? ", outputs to " : "", lcm_out_ ? bus::describeLcmUrl(opt_.lcm_url_out) : std::string(),
-               s.channels().winder, s.channels().cage, s.channels().shape, s.channels().alarm,
-               s.channels().health, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
+               ins, outs, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
   }
   if (n > 1) out_->info("hoist-twind started: {} shafts on one loop, {} schedule(s)", n, groups_.size());
 }
@@ -412,13 +417,24 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   // Deferred starts and exact envelopes: at most the group's budgets in this tick.
   TickAllowance left{g.start_budget, g.envelope_budget};
   const auto ns_rx0 = ns_receive_, ns_fl0 = ns_flush_;
+  // Staleness is judged after the inputs already queued are read: a loop
+  // that wakes late (or a shaft whose tick starts late behind a slow one)
+  // must not find an input stale that waits on the socket (INPUT_STALE
+  // chatter, v = a = 0 fed to the twin).  So the socket is drained first,
+  // and again before a shaft whose tick starts more than half a period
+  // after the last drain.
+  drainInput();
+  auto drained_at = Clock::now();
   std::size_t i = 0;
   for (ShaftTwin* s : g.shafts) {
     s->tick(k, deadline, skipped, left);
     if (miss) [[unlikely]] noteMissShaft(*miss, g, i, period_us);
-    if (++i % kDrainEvery == 0) {
-      flushOutputs();
-      if (input_.udpm()) drainInput();
+    const bool every = ++i % kDrainEvery == 0;
+    const auto t_now = Clock::now();
+    if (every || t_now - drained_at > g.period / 2) {
+      if (every) flushOutputs();
+      drainInput();
+      drained_at = t_now;
     }
   }
   flushOutputs();

@@ -5,8 +5,10 @@
 //
 // Several --config files host several shafts in one process (one loop), each
 // with its own [service].channel_prefix.
-// Subscribes to HOIST_WINDER (winder_t) and HOIST_ALARM_ACK (alarm_ack_t);
-// publishes HOIST_CAGE, HOIST_GUIDE_SHAPE, HOIST_ALARM and HOIST_HEALTH (see
+// Subscribes to HOIST_WINDER (winder_t) and HOIST_ALARM_ACK (alarm_ack_t),
+// HOIST_TRIP_PLAN with [forecast], HOIST_CAGE_IMU and HOIST_ROPE_LOAD with
+// [estimator]; publishes HOIST_CAGE, HOIST_GUIDE_SHAPE, HOIST_ALARM and
+// HOIST_HEALTH, HOIST_FORECAST and HOIST_ESTIMATE likewise (see
 // msgs/*.lcm and docs/service.md).  Exit status: 0 after a clean stop
 // (SIGINT/SIGTERM/--duration), 1 if a well-formed LCM URL cannot be opened,
 // 2 for a bad command line, configuration or LCM URL.
@@ -64,7 +66,10 @@ int main(int argc, char** argv) {
       "Follows the winder (LCM channel HOIST_WINDER) with the Wang et al. (2016) model and\n"
       "publishes the cage state (HOIST_CAGE), guide-rope shape (HOIST_GUIDE_SHAPE), clearance\n"
       "alarms (HOIST_ALARM; commands on HOIST_ALARM_ACK) and its own health (HOIST_HEALTH).\n"
-      "Runs with the paper's shaft when given no --config."};
+      "With [forecast] enabled: the look-ahead (HOIST_FORECAST) along the winder's plan\n"
+      "(HOIST_TRIP_PLAN).  With [estimator] enabled: the load estimate (HOIST_ESTIMATE) from the\n"
+      "cage IMU (HOIST_CAGE_IMU) and the rope load cell (HOIST_ROPE_LOAD).  Every channel name\n"
+      "takes the shaft's channel_prefix.  Runs with the paper's shaft when given no --config."};
   app.name("hoist-twind");  // usage lines name the program, not the path it was run by
   app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-twind ") + hoist::kVersionString);

@@ -249,6 +249,8 @@ void ShaftOutputs::publishAlarmEvents() {
   tc.slack_threshold = cause.slack_threshold;
   tc.sensor = core.lastSensorFault().sensor;
   tc.sensor_reason = core.lastSensorFault().reason;
+  if (const LoadEstimate* est = core.estimate())
+    tc.mismatch_test = est->nis_exceeded ? "nis" : est->drift_exceeded ? "drift" : "";
   alarm_msg_.user.assign(cause.user);  // who caused these events ("" for the twin itself)
   RtLog& log = ctx_.log;
   const std::string& tag = ctx_.tag;

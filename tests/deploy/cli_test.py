@@ -8,7 +8,10 @@
     option and the fault, in every program that takes one;
   * hoist-alarm-ack --shelve beyond the daemon's limit exits 2 naming the limit;
   * hoist-sim and hoist-study document --initial with the same values and default;
-  * the shipped configs (example.toml, demo.toml) are accepted by hoist-twind.
+  * the shipped configs (example.toml, demo.toml) are accepted by hoist-twind;
+  * every other tool that takes the daemon's --config accepts every section of
+    the shipped example.toml (says once which it ignores), and a misspelt key
+    in a section it does use is still an error naming the key.
 usage: cli_test.py BIN_DIR PROJECT_VERSION CONFIG_DIR
 """
 import os
@@ -123,6 +126,52 @@ if os.path.exists(twind):
         path = os.path.join(config_dir, cfg)
         rc, out = run([twind, "--config", path, "--print-config"])
         check(rc == 0 and "[alarms]" in out, f"hoist-twind accepts the shipped {cfg}", out[-2000:])
+
+# Every tool that takes hoist-twind's --config: the example is accepted whole.
+# (No daemon runs here: the timing tests give up after --health-timeout, which
+# is not a configuration error, exit 2.)
+example = os.path.join(config_dir, "example.toml")
+misspelt = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"cli_test_{os.getpid()}_misspelt.toml")
+with open(example) as f:
+    text = f.read()
+with open(misspelt, "w") as f:
+    f.write(text.replace("[cage]\n", "[cage]\nmas_typo = 1.0\n", 1))
+quiet_url = ["--lcm-url", "udpm://239.255.76.67:7936?ttl=0"]
+# hoist-estimate's input: a short trip's measurements, written by hoist-sim.
+meas = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"cli_test_{os.getpid()}_meas.csv")
+if os.path.exists(os.path.join(bin_dir, "hoist-sim")):
+    run([os.path.join(bin_dir, "hoist-sim"), "--profile", "trapezoid:vmax=4,travel=20,l0=50,t_end=2", "--modes", "2",
+         "--write-measurements", meas, "-q"])
+config_tools = [
+    ("hoist-timing-test", [], ["--duration", "0.5", "--health-timeout", "0.5"] + quiet_url),
+    ("hoist-replay", ["--timing-test"], ["--duration", "0.5", "--health-timeout", "0.5"] + quiet_url),
+    ("hoist-study", ["advise"], ["--samples", "3", "--modes", "2", "--clearance", "0.05", "--max-sleeve-force", "1e9",
+                                 "--profile", "trapezoid:vmax=4,travel=20,l0=50,t_end=2", "--no-plots", "-j", "1",
+                                 "--out-dir", os.path.join(os.environ.get("TMPDIR", "/tmp"),
+                                                           f"cli_test_{os.getpid()}_advise")]),
+    ("hoist-sim", [], ["--profile", "trapezoid:vmax=4,travel=20,l0=50,t_end=2", "--modes", "2", "--out", os.devnull,
+                       "-q"]),
+    ("hoist-estimate", [], ["--measurements", meas, "--out", os.devnull, "--modes", "2", "-q"]),
+]
+for p, pre, post in config_tools:
+    exe = os.path.join(bin_dir, p)
+    if not os.path.exists(exe):
+        print(f"skip {p} --config: not built")
+        continue
+    rc, out = run([exe] + pre + ["--config", example] + post)
+    check(rc != 2 and "unknown section" not in out,
+          f"{' '.join([p] + pre)} --config example.toml: every section accepted (exit {rc})", out[-1500:])
+    if p not in ("hoist-sim", "hoist-estimate"):  # (they read [sensors]/[estimator] too: nothing to say)
+        check(out.count("ignoring [") == 1 and "[service]" in out,
+              f"{' '.join([p] + pre)} says once which sections it ignores", out[-1500:])
+    rc, out = run([exe] + pre + ["--config", misspelt] + post)
+    check(rc == 2 and "mas_typo" in out, f"{' '.join([p] + pre)} --config: a misspelt shaft key exits 2 naming it "
+          f"(exit {rc})", out[-1500:])
+os.unlink(misspelt)
+if os.path.exists(meas):
+    os.unlink(meas)
+import shutil
+shutil.rmtree(os.path.join(os.environ.get("TMPDIR", "/tmp"), f"cli_test_{os.getpid()}_advise"), ignore_errors=True)
 
 print(f"\n{len(failures)} failure(s)")
 sys.exit(1 if failures else 0)

@@ -40,7 +40,9 @@ dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./conffiles | grep -qx /etc/hoist-twin/
 dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./conffiles | grep -qx /etc/hoist-twin/mqtt/example.toml ||
   fail "/etc/hoist-twin/mqtt/example.toml is not a conffile"
 dpkg-deb --ctrl-tarfile "$deb" | tar -t | grep -q prerm || fail "no prerm (removal would leave instances running)"
-dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./prerm | grep -q "systemctl stop" || fail "the prerm stops nothing"
+dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./prerm | grep -q "deb-systemd-invoke stop" || fail "the prerm stops nothing (deb-systemd-invoke stop)"
+dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./prerm | grep -v daemon-reload | grep -Eq "^(.+;)?[[:space:]]*systemctl\b" &&
+  fail "the prerm calls systemctl (lintian maintainer-script-calls-systemctl): use deb-systemd-invoke/-helper"
 # The prerm disables enabled instances on removal (links in a scratch root), keeps them on upgrade.
 dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./prerm >"$work/prerm"
 mkdir -p "$work/droot/etc/systemd/system/multi-user.target.wants"
@@ -90,8 +92,20 @@ if command -v readelf >/dev/null 2>&1; then
   for b in "$work"/root/usr/bin/*; do
     head -c 4 "$b" | grep -q ELF || continue
     readelf -S "$b" | grep -q "\.symtab\|\.debug_info" && fail "$(basename "$b") is not stripped"
+    # Hardening (HOIST_HARDENING; what hardening-check looks for): PIE, full
+    # RELRO + BIND_NOW, the stack protector, fortified calls.
+    n=$(basename "$b")
+    readelf -h "$b" | grep -q "Type:.*DYN" || fail "$n is not PIE"
+    readelf -lW "$b" | grep -q GNU_RELRO || fail "$n has no RELRO"
+    readelf -dW "$b" | grep -q "BIND_NOW\|FLAGS_1.*NOW" || fail "$n is not linked with -z now (BIND_NOW)"
+    readelf --dyn-syms -W "$b" | grep -q "__stack_chk_fail" || fail "$n has no stack protector"
+    # Fortified: some __*_chk call, unless nothing fortifiable is called at all (as hardening-check says).
+    if ! readelf --dyn-syms -W "$b" | grep -q "__[a-z_]*_chk@"; then
+      readelf --dyn-syms -W "$b" | grep -Eq " (memcpy|memmove|snprintf|sprintf|vsnprintf|strcpy|printf|fprintf|read|fgets)@" &&
+        fail "$n calls fortifiable functions but none fortified (_FORTIFY_SOURCE)"
+    fi
   done
-  echo "ok: the programs are stripped"
+  echo "ok: the programs are stripped and hardened (PIE, RELRO, BIND_NOW, stack protector, fortify)"
 fi
 grep -q "^ExecStart=/usr/bin/hoist-twind" "$work/root/usr/lib/systemd/system/hoist-twind@.service" ||
   fail "the packaged unit does not run /usr/bin/hoist-twind"

@@ -32,7 +32,7 @@ fi
   fail "the installed example.toml is refused"
 if [ -x "$root/usr/bin/hoist-lcm-spy" ]; then
   cp=$("$root/usr/bin/hoist-lcm-spy" --print-classpath) || fail "installed hoist-lcm-spy --print-classpath"
-  case "$cp" in *"$root/usr/bin/../share/java/hoist_msgs.jar"*) ;; *) fail "installed hoist-lcm-spy class path: $cp" ;; esac
+  case "$cp" in *"$root/usr/bin/../share/java/hoist-msgs.jar"*) ;; *) fail "installed hoist-lcm-spy class path: $cp" ;; esac
   echo "ok: installed hoist-lcm-spy uses $cp"
 fi
 # Nothing installed names the build tree (hoistTargets.cmake carried

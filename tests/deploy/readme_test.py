@@ -7,7 +7,11 @@ files it names prepared) or SKIPPED by a rule below that says why (a live LCM
 session, minutes of run time, root, a GUI).  A command that no rule knows
 fails the test: add it to RUN or SKIP here when you add it to the README.
 Also checks that the options the README lists for a program are in its --help,
-that scripts/demo.sh --help lists --mqtt and hoist-twind's --log-level help every level.
+that scripts/demo.sh --help lists --mqtt and hoist-twind's --log-level help every level,
+that the install command installs every package cpack makes (and names it),
+that the wall-screen dashboard (--bind 0.0.0.0) has its --allow-host and
+hoist-dash warns when bound beyond loopback without one, and that the
+Sparkplug demo shows the edge node's births before its data.
 usage: readme_test.py README BIN_DIR SOURCE_DIR WORK_DIR
 """
 import os
@@ -39,7 +43,8 @@ SKIP = [
     (r"^build/bin/hoist-sim .*--method paper", "the paper's literal method: slow (tests/model compare it)"),
     (r"^build/bin/hoist-(sim study|study) ", "a study of several minute-long runs (tests/study)"),
     (r"^export LCM_DEFAULT_URL=", "environment of the live session below"),
-    (r"^(build/bin/)?hoist-twind( &)?$|^lcm-logger |^lcm-logplayer |^build/bin/hoist-replay |^build/bin/hoist-log2csv run\.lcm",
+    (r"^kill -INT %2 %1 && wait$", "ends the live session above (its jobs)"),
+    (r"^(build/bin/)?hoist-twind( --clock input)?( &)?$|^lcm-logger |^lcm-logplayer |^build/bin/hoist-replay |^build/bin/hoist-log2csv run\.lcm",
      "a live LCM session of minutes (tests/integration, deploy_python_reader)"),
     (r"^build/bin/hoist-lcm-spy", "a GUI (deploy_lcm_spy opens it under Xvfb)"),
     (r"^build/bin/hoist-dash ", "a server that runs until stopped (tests/dash)"),
@@ -138,6 +143,80 @@ if os.path.exists(twind):
     desc = m.group(0).split("\n", 1)[1] if m and "\n" in m.group(0) else ""
     check(all(l in desc for l in ("trace", "debug", "info", "warn", "error", "critical", "off")),
           "hoist-twind --help: --log-level lists every level it accepts (critical too)", m.group(0) if m else out)
+
+# Every channel of the generated channel table (msgs/*.lcm "@channel NAME") is in the README's
+# channel table and in hoist-twind --help.
+import glob
+channels = sorted({m.group(1) for f in glob.glob(os.path.join(src_dir, "msgs", "*.lcm"))
+                   for m in re.finditer(r"@channel (HOIST_[A-Z_]+)", open(f, encoding="utf-8").read())})
+check(len(channels) >= 11, f"{len(channels)} channels in msgs/*.lcm")
+table = {m.group(1) for m in re.finditer(r"^\| `(HOIST_[A-Z_]+)` \|", text, re.M)}
+for c in channels:
+    check(c in table, f"the README's channel table lists {c}")
+if os.path.exists(twind):
+    h = subprocess.run([twind, "--help"], capture_output=True, text=True, timeout=60, env=env).stdout
+    for c in channels:
+        check(c in h, f"hoist-twind --help names {c}")
+
+# The install: every package cpack makes is installed by the README's command and named in its text.
+build_dir = os.path.dirname(os.path.abspath(bin_dir))
+cpack_cfg = os.path.join(build_dir, "CPackConfig.cmake")
+if os.path.exists(cpack_cfg):
+    cfg = open(cpack_cfg, encoding="utf-8").read()
+    pkgs = sorted(set(re.findall(r'set\(CPACK_DEBIAN_[A-Z]+_PACKAGE_NAME "([^"]+)"\)', cfg)))
+    check(len(pkgs) >= 2, f"cpack makes {pkgs}")
+    installs = [c for _, c in cmds if re.match(r"^(sudo )?apt(-get)? install ", c)]
+    check(len(installs) == 1, "the README has one apt install command", "\n".join(installs))
+    for p in pkgs:
+        check(any(f"./build/{p}_*.deb" in c for c in installs), f"the README's install command installs {p}",
+              "\n".join(installs))
+        check(f"**{p}**" in text, f"the README names the package {p} and what it holds")
+else:
+    print(f"skip the install check: no {cpack_cfg}")
+
+# The wall-screen dashboard: reachable from other machines (an --allow-host).
+walls = [c for _, c in cmds if "hoist-dash" in c and "--bind 0.0.0.0" in c]
+check(bool(walls), "the README shows a wall-screen dashboard (--bind 0.0.0.0)")
+for c in walls:
+    check("--allow-host" in c, f"the wall-screen example names the hosts it answers (--allow-host): {c}")
+dash = os.path.join(bin_dir, "hoist-dash")
+if os.path.exists(dash):
+    # Bound beyond loopback without --allow-host: a warning at start-up (it then serves until stopped).
+    p = subprocess.Popen([dash, "--read-only", "--bind", "0.0.0.0", "--port", "0", "--lcm-url",
+                          "udpm://239.255.76.67:7937?ttl=0"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                         text=True, env=env)
+    time.sleep(2.0)
+    p.terminate()
+    try:
+        out = p.communicate(timeout=10)[0]
+    except subprocess.TimeoutExpired:
+        p.kill()
+        out = p.communicate()[0]
+    check("--allow-host" in out and "warn" in out.lower(),
+          "hoist-dash --bind 0.0.0.0 without --allow-host warns at start-up", out[-1500:])
+
+# The Sparkplug demo: the subscriber hears the births (NBIRTH, DBIRTH) before any data.
+mosq = shutil.which("mosquitto") or ("/usr/sbin/mosquitto" if os.path.exists("/usr/sbin/mosquitto") else None)
+needed = ["hoist-twind", "hoist-mqtt", "hoist-replay"]
+if mosq and shutil.which("mosquitto_sub") and all(os.path.exists(os.path.join(bin_dir, b)) for b in needed):
+    denv = dict(env)
+    denv["HOIST_BIN_DIR"] = bin_dir
+    denv["PATH"] = os.path.dirname(mosq) + os.pathsep + denv["PATH"]
+    try:
+        r = subprocess.run(["bash", os.path.join(src_dir, "scripts/demo.sh"), "--no-setup", "--mqtt", "--sparkplug",
+                            "--quick", "--port", "7938"], capture_output=True, text=True, timeout=120, env=denv,
+                           stdin=subprocess.DEVNULL)
+        rc, out = r.returncode, r.stdout + r.stderr
+    except subprocess.TimeoutExpired:
+        rc, out = -1, "timed out after 120 s"
+    shown = out.split("== bridge log:")[0]
+    topics = [l.split()[0] for l in shown.splitlines() if l.startswith("spBv1.0/")]
+    first_data = next((i for i, t in enumerate(topics) if "/DDATA/" in t or "/NDATA/" in t), len(topics))
+    births = [t for t in topics[:first_data] if "/NBIRTH/" in t or "/DBIRTH/" in t]
+    check(rc == 0 and any("/NBIRTH/" in t for t in births) and any("/DBIRTH/" in t for t in births),
+          f"the Sparkplug demo shows NBIRTH and DBIRTH before its data (exit {rc})", shown[-2500:])
+else:
+    print("skip the Sparkplug demo: mosquitto, mosquitto_sub or the programs are missing")
 
 print(f"{len(failures)} failure(s)")
 sys.exit(1 if failures else 0)

@@ -299,6 +299,12 @@ TEST(Codec, TerminalSafeEscapesControlSequences) {
   EXPECT_EQ(terminalSafe("a\nb\rc\td\x7f"), "a\\x0ab\\x0dc\\x09d\\x7f");
   EXPECT_EQ(terminalSafe("\xc2\x9b" "31m"), "\\u009b31m");  // C1 CSI
   EXPECT_EQ(terminalSafe("caf\xc3\xa9"), "caf\xc3\xa9");
+  // Bidi controls and line separators (issue 33): escaped, other 3-byte
+  // characters kept.
+  EXPECT_EQ(terminalSafe("a\xe2\x80\xae" "b"), "a\\u202eb");  // RIGHT-TO-LEFT OVERRIDE
+  EXPECT_EQ(terminalSafe("\xe2\x81\xa6x\xe2\x81\xa9"), "\\u2066x\\u2069");  // isolates
+  EXPECT_EQ(terminalSafe("\xe2\x80\x8f\xe2\x80\xa8"), "\\u200f\\u2028");
+  EXPECT_EQ(terminalSafe("\xe2\x82\xac 5"), "\xe2\x82\xac 5");  // the euro sign stays
   EXPECT_EQ(terminalSafe(std::string(300, 'x'), 10), std::string(10, 'x') + "...");
   for (char c : terminalSafe("\x1b\x07\x08\x00\x9b\xff")) EXPECT_GE(static_cast<unsigned char>(c), 0x20);
 }

@@ -145,6 +145,49 @@ TEST(BinaryAlarm, AcknowledgedWhileActiveClearsWhenTheConditionGoes) {
   EXPECT_FALSE(a.acked());
 }
 
+TEST(BinaryAlarm, ReturnedToNormalUnacknowledgedCanBeAcknowledged) {
+  // ISA-18.2 RTN UNACK: an unlatched alarm whose condition went away before
+  // anyone acknowledged it stays listed until it is acknowledged.
+  BinaryAlarm a(AlarmKind::InputStale, AlarmLevel::Warning, settings(0.5));
+  AlarmEvents ev;
+  EXPECT_FALSE(a.acknowledge(0.0, ev));  // never raised: nothing to acknowledge
+  EXPECT_FALSE(a.rtnUnacked());
+  a.update(0.1, 1.0, ev);
+  a.update(0.2, 0.0, ev);
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(ev[1].type, AlarmEventType::Clear);
+  EXPECT_FALSE(ev[1].acked);
+  EXPECT_TRUE(a.rtnUnacked());
+  ev.clear();
+  EXPECT_TRUE(a.acknowledge(0.3, ev));
+  ASSERT_EQ(ev.size(), 1u);  // the ACK alone: the alarm was already announced clear
+  EXPECT_EQ(ev[0].type, AlarmEventType::Ack);
+  EXPECT_FALSE(ev[0].active);
+  EXPECT_TRUE(ev[0].acked);
+  EXPECT_FALSE(a.rtnUnacked());
+  EXPECT_FALSE(a.acknowledge(0.4, ev));  // once only
+  // The next excursion needs its own acknowledgement.
+  ev.clear();
+  a.update(0.5, 1.0, ev);
+  EXPECT_FALSE(a.acked());
+  a.update(0.6, 0.0, ev);
+  EXPECT_TRUE(a.rtnUnacked());
+}
+
+TEST(AlarmEngine, AcknowledgeAllReachesReturnedToNormalAlarms) {
+  // hoist-alarm-ack --kind '*' (kind empty, level None).
+  AlarmEngine eng;
+  AlarmEvents ev;
+  eng.setInputStale(1.0, true, ev);
+  eng.setInputStale(1.1, false, ev);
+  ev.clear();
+  EXPECT_EQ(eng.acknowledge(1.2, std::nullopt, AlarmLevel::None, ev), 1);
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, AlarmKind::InputStale);
+  EXPECT_EQ(ev[0].type, AlarmEventType::Ack);
+  EXPECT_EQ(eng.acknowledge(1.3, std::nullopt, AlarmLevel::None, ev), 0);
+}
+
 TEST(BinaryAlarm, ShelvingSuppressesAndExpires) {
   BinaryAlarm a(AlarmKind::CagePosY, AlarmLevel::Warning, settings(1.0));
   AlarmEvents ev;
@@ -249,8 +292,9 @@ TEST(AlarmEngine, WarningThenCriticalOnOneSide) {
   EXPECT_EQ(eng.highestActive(), AlarmLevel::Critical);
   EXPECT_EQ(eng.activeCount(), 1);
   ev.clear();
-  // Acknowledge all CAGE_POS_Y alarms.
-  EXPECT_EQ(eng.acknowledge(0.4, AlarmKind::CagePosY, AlarmLevel::None, ev), 1);
+  // Acknowledge all CAGE_POS_Y alarms: the latched CRITICAL and the WARNING
+  // that returned to normal unacknowledged (RTN UNACK).
+  EXPECT_EQ(eng.acknowledge(0.4, AlarmKind::CagePosY, AlarmLevel::None, ev), 2);
   EXPECT_EQ(eng.highestActive(), AlarmLevel::None);
   EXPECT_EQ(eng.activeCount(), 0);
   // The other side never alarmed.

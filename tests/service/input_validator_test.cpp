@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "hoist/service/input_validator.hpp"
@@ -101,6 +102,51 @@ TEST(InputValidator, Time) {
   EXPECT_TRUE(v.check(s).ok);
 }
 
+TEST(InputValidator, AForgedSampleFarAheadCostsTheGenuineStreamAtMostOneSample) {
+  // Issue 33: one forged winder sample 0.9 s ahead (utime and seq) cost the
+  // genuine stream 0.3-0.4 s (every sample up to its utime was
+  // time_backwards).  Now the next genuine sample replaces it.
+  for (const std::int64_t forged_seq : {std::int64_t{11}, std::int64_t{100000}}) {
+    InputValidator v(limits());
+    int accepted = 0, rejected = 0;
+    auto feed = [&](const WinderSample& s) {
+      const Verdict r = v.check(s);
+      if (r.ok) {
+        v.accept(s);
+        ++accepted;
+      } else {
+        ++rejected;
+      }
+      return r;
+    };
+    for (int k = 0; k <= 10; ++k) ASSERT_TRUE(feed(sample(k, 0.01 * k)).ok);
+    ASSERT_TRUE(feed(sample(forged_seq, 0.10 + 0.9)).ok) << "consistent and within max_time_step: accepted";
+    accepted = rejected = 0;
+    const Verdict r = feed(sample(11, 0.11));
+    EXPECT_TRUE(r.ok) << "seq " << forged_seq;
+    EXPECT_TRUE(r.replaces_last);
+    for (int k = 12; k < 100; ++k) EXPECT_TRUE(feed(sample(k, 0.01 * k)).ok) << k;
+    EXPECT_EQ(rejected, 0);
+    EXPECT_EQ(v.replaced(), 1);
+    EXPECT_EQ(v.last().seq, 99);
+  }
+}
+
+TEST(InputValidator, DuplicatesAndReplaysAreStillRejected) {
+  InputValidator v(limits());
+  for (int k = 0; k <= 10; ++k) v.accept(sample(k, 0.01 * k));
+  // The last sample again, and an older one: no replacement.
+  EXPECT_EQ(v.check(sample(10, 0.10)).reason, RejectReason::DuplicateSeq);
+  EXPECT_EQ(v.check(sample(9, 0.09)).reason, RejectReason::DuplicateSeq);
+  EXPECT_EQ(v.check(sample(8, 0.095)).reason, RejectReason::DuplicateSeq);
+  // A sample between the last two, but inconsistent with the one before: rejected.
+  v.accept(sample(11, 0.9));
+  EXPECT_FALSE(v.check(sample(11, 0.2, 9.0)).ok);
+  // Only one step back: after two samples ahead the stream is theirs.
+  v.accept(sample(12, 0.91));
+  EXPECT_FALSE(v.check(sample(11, 0.11)).ok);
+}
+
 TEST(InputValidator, LengthJumpAgainstTheSpeedPrediction) {
   InputValidator v(limits());
   v.accept(withLength(sample(0, 0.0, 5.0), 100.0));
@@ -134,6 +180,29 @@ TEST(InputCounters, CountByReason) {
 // are rejected; a sender that restarts (a jump back of kRestartJump or more)
 // is followed at once; one forged sample far ahead costs the genuine sender
 // at most kResyncAfter - 1 samples, not the whole gap.
+TEST(SensorSequence, NegativeSequenceNumbersAreHandledLikePositiveOnes) {
+  // Issue 33: a negative seq disabled the rule (last < 0 meant "none yet"),
+  // so duplicates went through.
+  using V = SensorSequence::Verdict;
+  for (const std::int64_t base : {std::int64_t{-50}, std::int64_t{10}, INT64_MIN + 5, INT64_MAX - 20}) {
+    SensorSequence s;
+    EXPECT_EQ(s.next(base), V::Accept) << base;
+    EXPECT_EQ(s.next(base + 1), V::Accept) << base;
+    EXPECT_EQ(s.next(base + 1), V::Old) << "a repeat, base " << base;
+    EXPECT_EQ(s.next(base), V::Old) << "a replayed sample, base " << base;
+    EXPECT_EQ(s.next(base + 3), V::Accept) << base;
+  }
+  // Across zero, and a restart from far below.
+  SensorSequence s;
+  EXPECT_EQ(s.next(-2), V::Accept);
+  EXPECT_EQ(s.next(-1), V::Accept);
+  EXPECT_EQ(s.next(0), V::Accept);
+  EXPECT_EQ(s.next(0), V::Old);
+  EXPECT_EQ(s.next(-1), V::Old);
+  EXPECT_EQ(s.next(INT64_MIN), V::Restart) << "far back: the sender restarted (no overflow)";
+  EXPECT_EQ(s.next(INT64_MIN), V::Old);
+}
+
 TEST(SensorSequence, OldRejectedRestartFollowedForgeryBounded) {
   using V = SensorSequence::Verdict;
   SensorSequence s;

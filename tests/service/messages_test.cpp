@@ -52,6 +52,79 @@ TEST(Messages, CageMappingCopiesEveryField) {
   EXPECT_EQ(m.rope_overload_threshold, 13272.0);
 }
 
+TEST(Messages, AnUnobservedLoadIsPublishedWithANegativeSigma) {
+  // estimate_t.lcm: "A sigma < 0 means not observed".  Without a rope load
+  // cell the filter still carries Fa's prior sigma (5000 N): not published.
+  LoadEstimate e;
+  e.Fa = 1000.0;
+  e.sigma_Fa = 5000.0;
+  e.moment = 150.0;
+  e.sigma_moment = 3.0;
+  e.b = 0.15;
+  e.sigma_b = 0.01;
+  e.fa_observed = false;
+  e.moment_observed = true;
+  hoist::estimate_t m{};
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, -1.0, true, m);
+  EXPECT_EQ(m.Fa, 1000.0);
+  EXPECT_LT(m.sigma_Fa, 0.0);
+  EXPECT_FALSE(m.fa_observed);
+  EXPECT_EQ(m.sigma_moment, 3.0);
+  EXPECT_LT(m.sigma_b, 0.0) << "b needs both sensors";
+  // Observed: the filter's sigma as it is; and M unobserved likewise.
+  e.fa_observed = true;
+  e.moment_observed = false;
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, true, m);
+  EXPECT_EQ(m.sigma_Fa, 5000.0);
+  EXPECT_LT(m.sigma_moment, 0.0);
+  EXPECT_LT(m.sigma_b, 0.0);
+  e.moment_observed = true;
+  toEstimateMessage(e, EstimatorCounters{}, 1.0, 0.0, 0.0, true, m);
+  EXPECT_EQ(m.sigma_b, 0.01);
+}
+
+TEST(Messages, ModelMismatchTextNamesItsTestAndIsCutAtAWord) {
+  AlarmEvent e;
+  e.kind = AlarmKind::ModelMismatch;
+  e.level = AlarmLevel::Warning;
+  e.type = AlarmEventType::Raise;
+  e.value = 1464.0;
+  e.threshold = 1455.0;
+  e.active = true;
+  e.from_estimate = true;
+  e.latched = true;
+  e.shelved = true;
+  AlarmTextContext ctx;
+  char buf[256];
+  ctx.mismatch_test = "nis";
+  describeAlarm(e, ctx, buf, sizeof buf);
+  std::string t(buf);
+  EXPECT_NE(t.find("NIS 1464 exceeds its bound 1455"), std::string::npos) << t;
+  EXPECT_EQ(t.find("drift"), std::string::npos) << t;
+  ctx.mismatch_test = "drift";
+  e.value = 4.2;
+  e.threshold = 3.5;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  t = buf;
+  EXPECT_NE(t.find("load drifted 4.2 sigma during the trip (bound 3.5)"), std::string::npos) << t;
+  EXPECT_EQ(t.find("NIS"), std::string::npos) << t;
+  // Too long for the buffer: cut at a word, marked "...".
+  char small[80];
+  describeAlarm(e, ctx, small, sizeof small);
+  t = small;
+  ASSERT_LE(t.size(), sizeof small - 1);
+  ASSERT_GE(t.size(), 3u);
+  EXPECT_EQ(t.substr(t.size() - 3), "...") << t;
+  const std::string kept = t.substr(0, t.size() - 3);
+  EXPECT_NE(kept.back(), ' ') << t;
+  std::string whole(1024, '\0');
+  describeAlarm(e, ctx, whole.data(), whole.size());
+  whole.resize(std::strlen(whole.c_str()));
+  ASSERT_GT(whole.size(), kept.size());
+  EXPECT_EQ(whole.compare(0, kept.size(), kept), 0) << "a prefix of the whole text";
+  EXPECT_EQ(whole[kept.size()], ' ') << "cut between words, not in one: " << t;
+}
+
 TEST(Messages, RopeForceAlarmTextStatesForceThresholdAndStaticForce) {
   AlarmConfig cfg;
   AlarmTextContext ctx;
@@ -121,10 +194,11 @@ TEST(Messages, AlarmTextNamesWhatTheOperatorNeeds) {
   ctx.fault_what = "y_c";
   describeAlarm(e, ctx, buf, sizeof buf);
   EXPECT_NE(std::string(buf).find("y_c = -1e+159 beyond the plausibility bound 3"), std::string::npos) << buf;
-  // Truncation keeps the terminator.
+  // Truncation keeps the terminator, and cuts at a word ("...").
   char small[16];
   describeAlarm(e, ctx, small, sizeof small);
-  EXPECT_EQ(std::strlen(small), 15u);
+  EXPECT_LE(std::strlen(small), 15u);
+  EXPECT_EQ(std::string(small).substr(std::strlen(small) - 3), "...") << small;
 }
 
 TEST(Messages, AckValidation) {

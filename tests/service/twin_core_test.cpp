@@ -300,6 +300,48 @@ TEST(TwinCoreInput, RejectedInputWithoutEncoderIsDegradedUntilAnEncoderLength) {
   }
 }
 
+TEST(TwinCoreWall, ADegradedTickIsNoEvidenceForTheModelCheck) {
+  // Issue 35 item 6: the samples of a tick the daemon flags degraded (here:
+  // the loop fell behind beyond max_catchup_periods) must not count against
+  // the model (MODEL_MISMATCH's NIS window); an ordinary tick's still do.
+  TwinConfig cfg = smallConfig();
+  cfg.estimator.enabled = true;
+  TwinCore core(cfg, ClockMode::Wall);
+  WinderSample s;
+  s.utime = kT0;
+  s.has_length = true;
+  s.length = cfg.shaft.l0;
+  const double sy = cfg.estimator.settings.noise.imu_accel;
+  double wall = 0.0;
+  auto tickWith = [&](double w, double f_y) {
+    s.seq += 1;
+    s.utime = kT0 + std::llround(w * 1e6);
+    ASSERT_TRUE(core.onInput(s, w - 0.001).accepted);
+    core.onCageImu(f_y, 0.0);
+    core.tick(w, w);
+    core.housekeeping(w);
+  };
+  for (int k = 1; k <= 100; ++k) tickWith(wall = 0.01 * k, (k % 2 ? 1.0 : -1.0) * sy);
+  ASSERT_NE(core.estimate(), nullptr);
+  ASSERT_FALSE(core.degraded());
+  const double window0 = core.estimate()->nis_window;
+  const int dof0 = core.estimate()->nis_dof;
+  ASSERT_GT(dof0, 0);
+  // A 0.5-s stall, then a tick whose IMU sample is 4 sigma off.
+  wall += 0.5;
+  tickWith(wall, 4.0 * sy);
+  ASSERT_EQ(core.catchupLimited(), 1);
+  ASSERT_TRUE(core.degraded());
+  EXPECT_GT(core.estimate()->nis, 4.0) << "the sample was applied (its NIS is reported)";
+  EXPECT_EQ(core.estimate()->nis_dof, dof0) << "but it is not in the model check's window";
+  EXPECT_EQ(core.estimate()->nis_window, window0);
+  // The next ordinary tick counts again.
+  tickWith(wall += 0.01, 4.0 * sy);
+  EXPECT_FALSE(core.degraded());
+  EXPECT_GT(core.estimate()->nis_dof, dof0);
+  EXPECT_GT(core.estimate()->nis_window, window0);
+}
+
 TEST(TwinCoreWall, StaleInputHoldsAndRaisesAnAlarm) {
   TwinConfig cfg = smallConfig();
   cfg.service.stale_timeout = 0.5;

@@ -83,6 +83,33 @@ TEST(TimingVerdict, LateFeederIsInconclusiveAndRejectionsFail) {
   EXPECT_EQ(formatReport(r, o, e).rfind("VERDICT: INCONCLUSIVE", 0), 0u);
 }
 
+TEST(TimingVerdict, ALateFeederDoesNotExcuseTheDaemonsOwnStepTime) {
+  // Issue 33: --max-step-p99-us 0.001 cannot pass on any machine; a feeder
+  // late on a busy machine made the verdict INCONCLUSIVE.  The step time is
+  // the daemon's own: FAIL.  A lateness budget stays INCONCLUSIVE.
+  using namespace hoist::replay;
+  TimingTestOptions o;
+  o.rate = 1000.0;
+  o.prefixes = {""};
+  TimingResult r = healthyRun(1);
+  for (int i = 0; i < 100; ++i) r.feeder_late.add(5000.0);  // p99 over one period (1 ms)
+  o.budgets.step_p99_us = 0.001;
+  Evaluation e = evaluate(r, o);
+  EXPECT_EQ(e.verdict, Verdict::Fail);
+  ASSERT_EQ(e.violations.size(), 1u);
+  EXPECT_NE(e.violations[0].find("--max-step-p99-us"), std::string::npos);
+  bool said = false;
+  for (const auto& n : e.notes) said = said || n.find("the verdict is FAIL") != std::string::npos;
+  EXPECT_TRUE(said) << "the report says why the late feeder does not matter";
+  o.budgets.step_p99_us.reset();
+  o.budgets.late_p99_us = 1.0;  // the daemon's lateness: a late feeder may explain it
+  e = evaluate(r, o);
+  EXPECT_EQ(e.verdict, Verdict::Inconclusive);
+  r.shafts[0].restarted = true;  // a restart is the daemon's own
+  e = evaluate(r, o);
+  EXPECT_EQ(e.verdict, Verdict::Fail);
+}
+
 TEST(TimingVerdict, ManyShaftsListOnlyTheWorst) {
   using namespace hoist::replay;
   TimingTestOptions o;

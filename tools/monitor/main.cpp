@@ -14,7 +14,8 @@
 // forecast starts from and, per scenario, its worst (smallest) clearance and
 // when, and the time to violation -- seconds until the first CRITICAL and
 // WARNING threshold crossing ("none" within the horizon) -- and the
-// smallest hoisting-rope force; a scenario stopped early says why.  Run one
+// smallest hoisting-rope force; a scenario stopped early says why (--no-forecast:
+// no such line; scripts/demo.sh, as the README's sample).  Run one
 // monitor per shaft (--channel-prefix).
 //
 // Load estimate: when the daemon publishes HOIST_ESTIMATE ([estimator]
@@ -170,7 +171,7 @@ class Monitor {
     std::printf("%9.2f %9.2f %9.2f %+10.3f %+11.4f %10.1f %11.1f  %s%s%s\n", cage_.t, cage_.l, cage_.v,
                 cage_.y_c * 1e3, cage_.theta * 1e3, fmax, cage_.min_clearance * 1e3, alarms.c_str(),
                 stale.c_str(), bad.c_str());
-    if (have_forecast_) std::printf("%s\n", forecastLine(Clock::now()).c_str());
+    if (have_forecast_ && show_forecast_) std::printf("%s\n", forecastLine(Clock::now()).c_str());
     if (have_estimate_) std::printf("%s\n", estimateLine(Clock::now()).c_str());
     std::fflush(stdout);
   }
@@ -256,6 +257,7 @@ class Monitor {
   std::string cage_channel_;
   long cages_ = 0;
   double stale_s_ = 2.0;
+  bool show_forecast_ = true;  // --no-forecast: false
   Clock::time_point start_ = Clock::now();
 
  private:
@@ -310,6 +312,9 @@ int main(int argc, char** argv) {
   double stale = 2.0;
   app.add_option("--stale", stale, "flag the data STALE after this many seconds without HOIST_CAGE/HEALTH (default 2)")
       ->check(CLI::PositiveNumber);
+  bool no_forecast = false;
+  app.add_flag("--no-forecast", no_forecast,
+               "no forecast line under each line (the look-ahead's scenarios; scripts/demo.sh shows none)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -332,6 +337,7 @@ int main(int argc, char** argv) {
   const hoist::bus::Channels ch(prefix);
   mon.cage_channel_ = ch.cage;
   mon.stale_s_ = stale;
+  mon.show_forecast_ = !no_forecast;
   // The receive path for the URL (our own for udpm://, LCM's otherwise,
   // exact names either way: hoist/bus/subscriber.hpp).
   hoist::bus::Subscriber rx(lcm);

@@ -74,7 +74,9 @@ def main():
     ap.add_argument("--lcm-url", default="udpm://239.255.76.67:7667?ttl=0")
     ap.add_argument("--channel-prefix", default="")
     ap.add_argument("--count", type=int, default=0, help="stop after this many HOIST_CAGE messages (0: never)")
-    ap.add_argument("--timeout", type=float, default=0, help="give up after this many seconds (0: never)")
+    ap.add_argument("--timeout", type=float, default=0,
+                    help="give up when --count cage states have not arrived within this many seconds of the "
+                         "start (a bound on the whole run, not on the gap between messages; 0: never)")
     ap.add_argument("--raw", action="store_true", help="use the plain-socket reader even if `lcm` is installed")
     a = ap.parse_args()
     try:
@@ -98,7 +100,9 @@ def main():
     t0, seen = time.monotonic(), 0
     for channel, data in source:
         if a.timeout and time.monotonic() - t0 > a.timeout:
-            print(f"read_twin.py: no {cage_ch} for {a.timeout} s", file=sys.stderr)
+            wanted = f" of the {a.count} wanted (--count)" if a.count else ""
+            print(f"read_twin.py: --timeout {a.timeout} s elapsed since the start: {seen}{wanted} {cage_ch} "
+                  f"messages received", file=sys.stderr)
             return 1
         if channel == cage_ch:
             try:

@@ -69,6 +69,7 @@
 #include "hoist/rope_load_t.hpp"
 #include "hoist/io/estimator_config.hpp"
 #include "hoist/io/config.hpp"
+#include "hoist/io/daemon_shaft.hpp"
 #include "cli_util.hpp"
 #include "timing_cli.hpp"
 
@@ -353,9 +354,12 @@ int main(int argc, char** argv) {
   } else {
     double l0 = 50.0;
     try {
-      if (!config_path.empty())
-        l0 = hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(config_path), config_path,
-                                            {"service", "alarms", "forecast"}).l0;
+      if (!config_path.empty()) {
+        // hoist-twind's whole file is accepted; only the shaft's l0 is used here.
+        std::string note;
+        l0 = hoist::io::loadDaemonShaft(config_path, "hoist-replay", &note).l0;
+        if (!note.empty() && !quiet) std::cerr << note << "\n";
+      }
     } catch (const std::exception& e) {
       std::cerr << "hoist-replay: " << e.what() << "\n";
       return 2;

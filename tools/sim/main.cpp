@@ -577,7 +577,9 @@ int main(int argc, char** argv) {
       ->needs(write_meas);
   app.add_option("--seed", o.seed, "seed of --write-measurements' noise (default 1)")->needs(write_meas);
   app.add_flag("--print-config", o.print_config, "print the effective shaft configuration as TOML and exit");
-  app.add_flag("-q,--quiet", o.quiet, "no progress, estimate or summary");
+  app.add_flag("-q,--quiet", o.quiet,
+               "no progress, estimate or summary (a long run, e.g. --method paper, then shows nothing for "
+               "minutes: add --progress)");
   app.add_flag("--progress", o.progress,
                "show progress on stderr even with -q or without a terminal (then one line per 10 %)");
   try {

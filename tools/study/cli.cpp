@@ -3,9 +3,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <sstream>
 
 #include "hoist/io/config.hpp"
+#include "hoist/io/daemon_shaft.hpp"
 #include "hoist/io/profile.hpp"
 #include "hoist/simulator.hpp"
 
@@ -131,8 +133,14 @@ namespace {
 // hoist_io's errors (ConfigError) already name file:line:key.
 ShaftParams studyLoadConfig(const std::string& path) {
   try {
-    // A daemon configuration is a shaft file plus [service]/[alarms]: accept it.
-    return hoist::io::shaftParamsFromToml(hoist::io::loadTomlFile(path), path, {"service", "alarms", "forecast"});
+    // A daemon configuration is a shaft file plus hoist-twind's sections:
+    // accept every one, use the shaft, say once what is ignored.
+    std::string note;
+    ShaftParams p = hoist::io::loadDaemonShaft(path, "hoist-study", &note);
+    static bool said = false;
+    if (!note.empty() && !said) std::cerr << note << "\n";
+    said = true;
+    return p;
   } catch (const std::exception& e) {
     throw UsageError(std::string("--config: ") + e.what());
   }

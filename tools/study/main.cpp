@@ -78,6 +78,20 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(2, 200));
   addCommon(advise, c, true, false);
 
+  // CLI11 says "A subcommand is required" for an unknown one: name it and the known ones.
+  auto known = [&app](const char* name) {
+    try {
+      return app.get_subcommand(name) != nullptr;
+    } catch (const CLI::OptionNotFound&) {
+      return false;
+    }
+  };
+  if (argc > 1 && argv[1][0] != '-' && !known(argv[1])) {
+    std::fprintf(stderr, "hoist-study: unknown subcommand '%s': the first argument is the study: response, preload, "
+                         "tension-difference, eccentric-load, mass, all, sweep or advise (see --help)\n",
+                 argv[1]);
+    return 2;
+  }
   // CLI11 says "A subcommand is required" before naming an unknown option.
   if (argc > 1 && argv[1][0] == '-') {
     const std::string a = argv[1];

@@ -80,18 +80,26 @@ Evaluation evaluate(const TimingResult& r, const TimingTestOptions& o) {
   if (e.misses > b.max_misses)
     e.violations.push_back(strf("deadline misses (--max-misses): measured %lld > allowed %lld",
                                 static_cast<long long>(e.misses), static_cast<long long>(b.max_misses)));
+  // Violations a late feeder cannot explain (the daemon's own: its model
+  // step time, a restart, a stall) make the verdict FAIL even when the
+  // feeder was late; the others (lateness, misses, end-to-end, rejections)
+  // then leave it INCONCLUSIVE.
+  bool own_violation = false;
   auto checkUs = [&](const std::optional<double>& budget, double measured, bool have, const char* what,
-                     const char* opt) {
+                     const char* opt, bool own = false) {
     if (!budget) return;
-    if (!have)
+    if (!have) {
       e.violations.push_back(strf("%s (%s): %s", what, opt, no_windows));
-    else if (measured > *budget)
+    } else if (measured > *budget) {
       e.violations.push_back(strf("%s (%s): measured %s us > allowed %.10g us", what, opt, us(measured).c_str(),
                                   *budget));
+      own_violation = own_violation || own;
+    }
   };
   checkUs(b.late_p99_us, e.late_p99, e.have_windows, "tick lateness p99, worst window", "--max-late-p99-us");
   checkUs(b.late_max_us, e.late_max, e.have_windows, "tick lateness max", "--max-late-max-us");
-  checkUs(b.step_p99_us, e.step_p99, e.have_windows, "model step time p99, worst window", "--max-step-p99-us");
+  checkUs(b.step_p99_us, e.step_p99, e.have_windows, "model step time p99, worst window", "--max-step-p99-us",
+          true);
   if (b.e2e_p99_us) {
     if (e.e2e.count() == 0)
       e.violations.push_back("end-to-end latency p99 (--max-e2e-p99-us): not measured: no HOIST_CAGE "
@@ -105,20 +113,29 @@ Evaluation evaluate(const TimingResult& r, const TimingTestOptions& o) {
                                 static_cast<long long>(e.rejected), static_cast<long long>(b.max_rejected)));
   // The daemon must keep running and reporting.
   for (const auto& s : r.shafts) {
-    if (s.restarted)
+    if (s.restarted) {
       e.violations.push_back(strf("hoist-twind on prefix %s restarted during the test (its uptime went back)",
                                   quoted(s.prefix).c_str()));
+      own_violation = true;
+    }
     const double stalled = std::max(3.0, 3.0 * s.health_interval_s);
-    if (!s.final_report && s.health_gap_s > stalled)
+    if (!s.final_report && s.health_gap_s > stalled) {
       e.violations.push_back(strf("HOIST_HEALTH on %sHOIST_HEALTH stopped %.1f s before the end of the test "
                                   "(hoist-twind stalled or died?)",
                                   s.prefix.c_str(), s.health_gap_s));
+      own_violation = true;
+    }
   }
 
   // Notes.
   const Histogram& f = r.feeder_late;
   const bool feeder_late = f.count() > 0 && f.quantile(0.99) > period_us;
-  if (feeder_late)
+  if (feeder_late && own_violation)
+    e.notes.push_back(strf("The feeder itself was late (its wake-up lateness p99 %s us exceeds one period, %s us), "
+                           "but a budget the feeder cannot affect was violated (the model step time, a restart "
+                           "or a stall of hoist-twind): the verdict is FAIL.",
+                           us(f.quantile(0.99)).c_str(), periodUs(o.rate).c_str()));
+  else if (feeder_late)
     e.notes.push_back(strf("The feeder itself was late: its wake-up lateness p99 %s us exceeds one period (%s us), "
                            "so this machine could not even feed the daemon on time; the verdict is "
                            "INCONCLUSIVE. Reduce the load, or run hoist-replay with real-time priority "
@@ -206,7 +223,7 @@ Evaluation evaluate(const TimingResult& r, const TimingTestOptions& o) {
   if (e.sent == 0) {
     e.verdict = Verdict::Inconclusive;
     e.notes.push_back("Nothing was fed: there is nothing to judge.");
-  } else if (feeder_late) {
+  } else if (feeder_late && !own_violation) {
     e.verdict = Verdict::Inconclusive;
   } else {
     e.verdict = e.violations.empty() ? Verdict::Pass : Verdict::Fail;

@@ -233,6 +233,11 @@ class LoadEstimator {
   bool updateImuAccel(double f_y);
   bool updateImuRate(double omega);
   bool updateRopeLoad(double force);
+  /// The caller marks this tick's samples as no evidence about the model
+  /// (hoist-twind: a tick it flags degraded, e.g. its loop fell behind): the
+  /// updates still apply, but the next finish() keeps their NIS out of the
+  /// window (est.nis still reports it).  Applies to one tick only.
+  void excludeTickFromModelCheck() { skip_nis_ = true; }
   /// Close the tick: NIS window, mismatch test, the estimate.
   const LoadEstimate& finish();
 
@@ -277,6 +282,7 @@ class LoadEstimator {
   double last_a_ = 0.0;                    // a at the last prediction  // oscillation envelopes (model error)
   double tick_nis_ = 0.0;
   int tick_dof_ = 0;
+  bool skip_nis_ = false;                  // excludeTickFromModelCheck() for this tick
   double last_upd_[3] = {-1e300, -1e300, -1e300};  // model time of each sensor's last accepted update
   bool seen_[3] = {false, false, false};
   // sliding NIS window (ring buffer; sized once)

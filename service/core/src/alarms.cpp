@@ -55,7 +55,7 @@ void BinaryAlarm::configure(AlarmKind kind, AlarmLevel level, const AlarmSetting
   kind_ = kind;
   level_ = level;
   s_ = s;
-  cond_ = active_ = acked_ = shelved_ = announced_ = pending_valid_ = touched_ = false;
+  cond_ = active_ = acked_ = shelved_ = announced_ = pending_valid_ = touched_ = raised_ = false;
   pending_since_ = shelved_until_ = last_announce_ = value_ = 0.0;
   // A low alarm's "no value yet" must read as clear (poll() feeds value_ back).
   if (s.low) value_ = std::numeric_limits<double>::max();
@@ -128,6 +128,7 @@ void BinaryAlarm::update(double now, double value, AlarmEvents& out) {
   if (cond_ && !active_) {
     active_ = true;
     acked_ = false;
+    raised_ = true;
   } else if (!cond_ && active_ && !(s_.latch && !acked_)) {
     active_ = false;
   }
@@ -140,7 +141,9 @@ void BinaryAlarm::update(double now, double value, AlarmEvents& out) {
 
 bool BinaryAlarm::acknowledge(double now, AlarmEvents& out) {
   expireShelve(now, out);
-  if (!active_ || acked_) return false;
+  // Active and unacknowledged, or returned to normal unacknowledged (ISA-18.2
+  // RTN UNACK: the row stays listed until this acknowledgement).
+  if (acked_ || !(active_ || raised_)) return false;
   acked_ = true;
   if (!cond_) active_ = false;  // a latched alarm whose condition is gone clears
   emit(AlarmEventType::Ack, now, out);

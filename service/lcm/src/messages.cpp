@@ -46,12 +46,14 @@ void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double
   m.l = e.kin.l;
   m.v = e.kin.v;
   m.a = e.kin.a;
+  // estimate_t's contract: a sigma < 0 means not observed (the filter's
+  // prior sigma of an unobserved load is no measurement uncertainty).
   m.Fa = e.Fa;
-  m.sigma_Fa = e.sigma_Fa;
+  m.sigma_Fa = e.fa_observed ? e.sigma_Fa : -1.0;
   m.b = e.b;
-  m.sigma_b = e.sigma_b;
+  m.sigma_b = e.fa_observed && e.moment_observed ? e.sigma_b : -1.0;
   m.moment = e.moment;
-  m.sigma_moment = e.sigma_moment;
+  m.sigma_moment = e.moment_observed ? e.sigma_moment : -1.0;
   m.x_c = e.x_c;
   m.sigma_x_c = e.sigma_x_c;
   m.y_c = e.y_c;
@@ -84,8 +86,36 @@ void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double
   m.implausible = c.implausible;
 }
 
+namespace {
+
+void describeAlarmWhole(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n);
+
+}  // namespace
+
 void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n) {
   if (n == 0) return;
+  char whole[1024];  // every text fits (the longest is about 400 bytes)
+  describeAlarmWhole(e, ctx, whole, sizeof whole);
+  const std::size_t len = std::strlen(whole);
+  if (len < n) {
+    std::memcpy(buf, whole, len + 1);
+    return;
+  }
+  // Cut at a word: the last space that leaves room for "...".
+  static constexpr char kMore[] = "...";
+  std::size_t cut = n > sizeof kMore ? n - sizeof kMore : 0;
+  while (cut > 0 && whole[cut] != ' ') --cut;
+  if (cut == 0) cut = n > sizeof kMore ? n - sizeof kMore : 0;  // one long word: cut in it
+  while (cut > 0 && whole[cut - 1] == ' ') --cut;
+  std::memcpy(buf, whole, cut);
+  std::size_t k = cut;
+  for (std::size_t i = 0; kMore[i] != '\0' && k + 1 < n; ++i) buf[k++] = kMore[i];
+  buf[k] = '\0';
+}
+
+namespace {
+
+void describeAlarmWhole(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n) {
   buf[0] = '\0';
   const char* verb = "";
   switch (e.type) {
@@ -189,10 +219,18 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
     case AlarmKind::ModelMismatch:
       if (e.type == AlarmEventType::Clear)
         std::snprintf(buf, n, "%s %s cleared: the shaft behaves like its model again%s", kind, level, state);
+      else if (std::strcmp(ctx.mismatch_test, "nis") == 0)
+        std::snprintf(buf, n, "%s %s %s: the shaft does not behave like its model: the estimator's windowed NIS "
+                      "%.4g exceeds its bound %.4g; check guide-rope preloads, sleeves and the sensors%s",
+                      kind, level, verb, e.value, e.threshold, state);
+      else if (std::strcmp(ctx.mismatch_test, "drift") == 0)
+        std::snprintf(buf, n, "%s %s %s: the shaft does not behave like its model: the estimated load drifted "
+                      "%.3g sigma during the trip (bound %.3g); check the load, guide-rope preloads and the "
+                      "sensors%s",
+                      kind, level, verb, e.value, e.threshold, state);
       else
-        std::snprintf(buf, n, "%s %s %s: the shaft does not behave like its model (statistic %.4g, bound %.4g: the "
-                      "estimator's windowed NIS or its load drift, see HOIST_ESTIMATE); check guide-rope preloads, "
-                      "sleeves and the sensors (docs/estimation.md)%s",
+        std::snprintf(buf, n, "%s %s %s: the shaft does not behave like its model (statistic %.4g, bound %.4g: "
+                      "the windowed NIS or the load drift, see HOIST_ESTIMATE)%s",
                       kind, level, verb, e.value, e.threshold, state);
       break;
     case AlarmKind::SensorFault:
@@ -233,6 +271,8 @@ void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, 
       break;
   }
 }
+
+}  // namespace
 
 std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*& why) {
   AckCommand c;

@@ -64,6 +64,9 @@ void TwinCore::estimatorStep(const CageResponse& r) {
   else if (d.accel) est_->updateImuAccel(d.f_y);
   else if (d.rate) est_->updateImuRate(d.omega);
   if (d.rope) est_->updateRopeLoad(d.force);
+  // A tick we flag degraded (fell behind, stale, fault hold, ...) is no
+  // evidence against the model: its NIS stays out of MODEL_MISMATCH's window.
+  if (degradedNow()) est_->excludeTickFromModelCheck();
   est_->finish();
   // What the sensors read at this step (the trip room's record, issue 32).
   meas_.t = t_;

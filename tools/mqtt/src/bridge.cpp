@@ -1336,7 +1336,8 @@ struct Bridge::Impl {
     for (const auto& [kind, a] : s.alarms) {
       if (!any_kind && kind != ack.kind) continue;
       for (int lv = 1; lv <= 2; ++lv)
-        if ((ack.level == 0 || ack.level == lv) && a.by_level[lv] && a.by_level[lv]->active && !a.by_level[lv]->acked)
+        // Active or returned to normal (RTN UNACK): not yet acknowledged.
+        if ((ack.level == 0 || ack.level == lv) && a.by_level[lv] && !a.by_level[lv]->acked)
           return true;
     }
     return false;
@@ -1399,7 +1400,7 @@ struct Bridge::Impl {
         if (view_complete) {
           ++cmd_rejected;
           ++cmd_by_reason[static_cast<int>(CommandReject::NoMatchingAlarm)];
-          const std::string why = fmt::format("no active, unacknowledged alarm {} (level {}) on shaft '{}'",
+          const std::string why = fmt::format("no unacknowledged alarm {} (level {}) on shaft '{}'",
                                               r.ack.kind.empty() || r.ack.kind == "*" ? std::string("of any kind")
                                                                                       : printable(r.ack.kind, 32),
                                               int(r.ack.level), s.name);

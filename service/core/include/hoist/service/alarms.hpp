@@ -170,7 +170,10 @@ class BinaryAlarm {
     s_.threshold = threshold;
     s_.deadband = deadband;
   }
-  /// Operator acknowledgement; false if there was nothing to acknowledge.
+  /// Operator acknowledgement of an active alarm, or of one that returned
+  /// to normal unacknowledged (RTN UNACK: its CLEAR carried acked = false;
+  /// the ACK event with active = false, acked = true ends the row); false
+  /// if there was nothing to acknowledge.
   bool acknowledge(double now, AlarmEvents& out);
   /// Shelve for `duration` seconds (> 0).  Re-shelving extends/shortens.
   bool shelve(double now, double duration, AlarmEvents& out);
@@ -189,6 +192,8 @@ class BinaryAlarm {
   bool condition() const { return cond_; }  ///< debounced condition
   bool active() const { return active_; }
   bool acked() const { return acked_; }
+  /// Returned to normal unacknowledged (ISA-18.2 RTN UNACK).
+  bool rtnUnacked() const { return !active_ && raised_ && !acked_; }
   bool shelved() const { return shelved_; }
   bool latched() const { return active_ && !cond_; }
   double value() const { return value_; }
@@ -207,6 +212,7 @@ class BinaryAlarm {
   bool pending_valid_ = false;
   bool active_ = false, acked_ = false, shelved_ = false, announced_ = false;
   bool touched_ = false;  // emitted an event since configure()
+  bool raised_ = false;   // became active since configure() (with acked_: RTN UNACK)
   double shelved_until_ = 0.0;
   double last_announce_ = 0.0;
   double value_ = 0.0;

@@ -65,6 +65,11 @@ struct Verdict {
   bool ok = true;
   RejectReason reason = RejectReason::Decode;  ///< valid when !ok
   std::int64_t skipped = 0;  ///< sequence numbers missing before this sample (ok only)
+  /// ok, checked against the sample before the last accepted one: the last
+  /// one had run ahead of the stream (e.g. a forged sample far ahead of its
+  /// peers) and accept() replaces it, so it costs the genuine stream at most
+  /// one sample instead of everything up to its utime/seq.
+  bool replaces_last = false;
 };
 
 class InputValidator {
@@ -82,31 +87,44 @@ class InputValidator {
   /// for consistency against it, so rejected input going stale does not
   /// open the door to the same inconsistent stream.
   void resync() {
-    have_last_ = false;
-    soft_ = true;
+    cur_.have_last_ = false;
+    cur_.soft_ = true;
+    have_prev_ = false;
   }
   /// The rope length integrated from v since the last encoder length (valid
   /// when hasLengthPrediction()).
-  bool hasLengthPrediction() const { return have_lpred_; }
-  double lengthPrediction() const { return l_pred_; }
-  bool hasReference() const { return have_last_; }
-  const WinderSample& last() const { return last_; }
+  bool hasLengthPrediction() const { return cur_.have_lpred_; }
+  double lengthPrediction() const { return cur_.l_pred_; }
+  bool hasReference() const { return cur_.have_last_; }
+  const WinderSample& last() const { return cur_.last_; }
+  /// Accepted samples that replaced a last one which had run ahead (Verdict::replaces_last).
+  std::int64_t replaced() const { return replaced_; }
 
  private:
-  /// Excess of the v change over the a-allowed range for `s` after last_.
-  double excess(const WinderSample& s, double dt) const;
+  /// The reference of the stream after one accepted sample.
+  struct Ref {
+    WinderSample last_;
+    bool have_last_ = false;
+    bool soft_ = false;  // resynced, last_ kept for a continuing stream
+    // consistency reference
+    std::int64_t ref_utime_ = 0;
+    double dv_excess_ = 0.0;  // accumulated since ref_utime_ [m/s]
+    bool have_lpred_ = false;
+    double l_pred_ = 0.0;     // length integrated from v since the last encoder length [m]
+  };
+  Verdict checkAgainst(const Ref& r, const WinderSample& s) const;
+  /// Excess of the v change over the a-allowed range for `s` after r.last_.
+  double excess(const Ref& r, const WinderSample& s, double dt) const;
   /// After resync(): does `s` continue the old stream?
-  bool continues(const WinderSample& s) const;
+  bool continues(const Ref& r, const WinderSample& s) const;
+  /// `s` lies between the sample before the last and the last one.
+  bool lastIsOutlierFor(const WinderSample& s) const;
 
   InputLimits lim_;
-  WinderSample last_;
-  bool have_last_ = false;
-  bool soft_ = false;  // resynced, last_ kept for a continuing stream
-  // consistency reference
-  std::int64_t ref_utime_ = 0;
-  double dv_excess_ = 0.0;  // accumulated since ref_utime_ [m/s]
-  bool have_lpred_ = false;
-  double l_pred_ = 0.0;     // length integrated from v since the last encoder length [m]
+  Ref cur_;   // after the last accepted sample
+  Ref prev_;  // before it (valid when have_prev_)
+  bool have_prev_ = false;
+  std::int64_t replaced_ = 0;
 };
 
 /// Accepted/rejected counters by reason (plain integers, no allocation).

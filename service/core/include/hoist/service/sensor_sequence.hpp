@@ -6,7 +6,8 @@
 // then the stream is taken as restarted at this seq.  The second rule bounds
 // what one forged sample with a seq far ahead can do (the genuine sender's
 // samples would otherwise all look old until its seq caught up: 500 ahead is
-// 5 s of a 100-Hz sensor) to kResyncAfter - 1 lost samples.
+// 5 s of a 100-Hz sensor) to kResyncAfter - 1 lost samples.  Negative
+// sequence numbers follow the same rules as positive ones.
 #pragma once
 
 #include <cstdint>
@@ -18,18 +19,21 @@ struct SensorSequence {
   static constexpr int kResyncAfter = 8;
   enum class Verdict : std::uint8_t { Accept, Old, Restart };
 
-  std::int64_t last = -1;  ///< the last accepted seq (-1: none yet)
+  std::int64_t last = 0;   ///< the last accepted seq (valid when have)
+  bool have = false;       ///< a seq was accepted (any int64, negative ones too)
   int old_run = 0;         ///< samples in a row rejected as old
-
   Verdict next(std::int64_t seq) {
-    if (last >= 0 && seq <= last) {
-      if (seq > last - kRestartJump && ++old_run < kResyncAfter) return Verdict::Old;
+    if (have && seq <= last) {
+      // last - seq >= 0 here; in unsigned arithmetic it cannot overflow.
+      const auto back = static_cast<std::uint64_t>(last) - static_cast<std::uint64_t>(seq);
+      if (back < static_cast<std::uint64_t>(kRestartJump) && ++old_run < kResyncAfter) return Verdict::Old;
       old_run = 0;
       last = seq;
       return Verdict::Restart;
     }
     old_run = 0;
     last = seq;
+    have = true;
     return Verdict::Accept;
   }
 };

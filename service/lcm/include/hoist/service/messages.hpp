@@ -48,10 +48,14 @@ struct AlarmTextContext {
   /// SENSOR_FAULT: which sensor and why (TwinCore::lastSensorFault()).
   SensorId sensor = SensorId::CageImu;
   SensorFaultReason sensor_reason = SensorFaultReason::ClockOffset;
+  /// MODEL_MISMATCH: which test fired ("nis": the windowed NIS over its
+  /// bound; "drift": a load drifting beyond drift_sigma; "" unknown).
+  const char* mismatch_test = "";
 };
 
 /// A readable one-line description of an alarm event into buf[0..n)
-/// (truncated, always terminated; no allocation).
+/// (always terminated; no allocation).  A text longer than n - 1 bytes is
+/// cut at the last word that fits and ends in "...".
 void describeAlarm(const AlarmEvent& e, const AlarmTextContext& ctx, char* buf, std::size_t n);
 
 // printable(): hoist/contract/alarm_command.hpp.
