@@ -171,6 +171,10 @@ void TripRoom::workerMain() {
 
 void TripRoom::take(const TripTick& t) {
   Worker& w = *w_;
+  // A tick without a finite state (no input yet, a model fault) is no part of a trip.
+  if (!std::isfinite(t.m.t) || !std::isfinite(t.m.k.l) || !std::isfinite(t.m.k.v) || !std::isfinite(t.m.k.a) ||
+      !std::isfinite(t.e.y_c) || !std::isfinite(t.e.theta))
+    return;
   if (!w.moving) w.cpu_trip0 = threadCpuNs();
   bool arrived = false;
   try {
