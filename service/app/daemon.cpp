@@ -65,6 +65,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     if (i > 0) hooks.slow_tick_at = -1.0;  // the slow tick is the first shaft's only
     shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, hooks,
                                                   instance_id_, lcm_out_.get()));
+    if (i < opt_.history.size() && opt_.history[i].enabled) shafts_.back()->enableTrips(opt_.history[i]);
     // Shaft i publishes its shapes at phase i of the shape divider.
     shafts_.back()->attachLoop(&split_, misses_.get(), static_cast<int>(i));
     const double rate = opt_.shafts[i].service.rate;
@@ -557,6 +558,7 @@ void Daemon::stop(const char* why) {
   flushOutputs();
   for (auto& s : shafts_) {
     s->publishHealth(true);
+    s->stopTrips();
     s->logFinal();
   }
   stopping_ = true;

@@ -18,6 +18,8 @@
 
 namespace hoist::svc {
 
+class TripRoom;
+
 using rt::RtLog;
 
 /// Operator names (alarm commands) are cut to this many printable characters.
@@ -82,6 +84,9 @@ struct ShaftContext {
   LoopSplit* split = nullptr;
   /// The daemon's miss record, for HOIST_HEALTH (nullptr: none).
   const MissLog* misses = nullptr;
+  /// This shaft's trip room (trip_room.hpp): every model step is copied
+  /// into it (nullptr: [history] off).
+  TripRoom* trips = nullptr;
 
   /// Wall time of `t` [s] on this shaft's clock.
   double wallAt(Clock::time_point t) const {

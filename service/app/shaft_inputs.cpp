@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "forecast_scheduler.hpp"
+#include "trip_room.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
@@ -147,6 +148,7 @@ void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
     ctx_.stats.step_hist.add(duration<double, std::micro>(t1 - t0).count());
     out_.publishStep(s.utime);
     if (forecast_) forecast_->afterStep(s.utime);
+    if (ctx_.trips) ctx_.trips->afterStep(core, s.utime);
   }
   out_.publishAlarmEvents();
 }

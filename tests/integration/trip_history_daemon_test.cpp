@@ -1,0 +1,141 @@
+// The daemon remembers every trip (issue 32, docs/condition.md "Live"), over
+// real UDP multicast on loopback (ports 7955-7957): hoist-sim writes the
+// measurements of a down-and-up sequence with our own model and seeded
+// sensor noise, hoist-replay --measurements feeds them to hoist-twind
+// --clock input with [history] on, and
+//   * the SQLite database holds one row per trip, read back with the Store
+//     and with Debian's sqlite3, equal to what hoist-trips ingest makes of
+//     the same file (the same pipeline, live and offline);
+//   * kill -9 of the daemon in the middle of the second trip leaves a
+//     database that passes PRAGMA integrity_check and holds the first trip.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <csignal>
+#include <fstream>
+#include <thread>
+
+#include "hoist/history/sqlite_store.hpp"
+#include "hoist/health_t.hpp"
+#include "lcm_fixtures.hpp"
+#include "trip_profile.hpp"
+
+using namespace hoist::test;
+using namespace std::chrono_literals;
+
+namespace {
+
+constexpr double kRest = 4.0, kTravel = 50.0, kVmax = 4.0, kAmax = 1.0;
+
+class TripHistoryDaemon : public LcmProcessTest {
+ protected:
+  std::string path(const std::string& f) const { return (dir_ / f).string(); }
+  /// The measurements (hoist-sim: a heavier load off the axis than the twin's
+  /// config) and the daemon's configuration with [history] at db.
+  void makeRun(const std::string& db) {
+    writeDownUpProfile(path("profile.csv"), kRest, kTravel, kVmax, kAmax);
+    std::ofstream(path("truth.toml")) << "[load]\neccentric_force = 1500.0\noffset = 0.6\n[model]\nmodes = 12\n";
+    ASSERT_EQ(runProcess({HOIST_SIM, "--config", path("truth.toml"), "--profile", path("profile.csv"),
+                          "--write-measurements", path("meas.csv"), "--sensor-noise", "0.002,0.0001,20", "--seed",
+                          "5", "-q"},
+                         path("sim.log"), 120s),
+              0)
+        << readFile(path("sim.log"));
+    std::ofstream(path("shaft7.toml")) << "[model]\nmodes = 8\n[estimator]\nenabled = true\n[condition]\ndepth_bin = 20.0\n"
+                                          "[history]\nurl = \"sqlite://" << db << "\"\n";
+  }
+};
+
+}  // namespace
+
+TEST_F(TripHistoryDaemon, EveryTripIsOneRowLiveAsOffline) {
+  start(7955, "TripHistoryLive", {"HOIST_HEALTH"});
+  const std::string db = path("live.sqlite"), offline = path("offline.sqlite");
+  makeRun(db);
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", path("shaft7.toml"), "--clock", "input"};
+  auto d = startDaemonAndWait(*listener_, argv, path("twind.log"));
+  {
+    Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", "8", "-q"},
+              path("replay.log"));
+    listener_->waitFor([&] { return !r.running(); }, 60s);
+    ASSERT_EQ(r.wait(1s), 0) << readFile(path("replay.log"));
+  }
+  listener_->waitFor([] { return false; }, 500ms);  // the last rows reach the daemon
+  stopDaemonCleanly(*d, path("twind.log"));
+  const std::string log = readFile(path("twind.log"));
+  EXPECT_NE(log.find("trip history: 2 trips recorded, 2 stored, 0 queued, 0 failed, 0 ticks dropped"),
+            std::string::npos)
+      << log;
+
+  auto live = hoist::history::openSqliteStore(db, true);
+  hoist::history::ListFilter f;
+  f.with_bins = true;
+  const auto rows = live->list(f);
+  ASSERT_EQ(rows.size(), 2u) << log;
+  EXPECT_EQ(rows[0].shaft, "shaft7");  // the configuration's name
+  EXPECT_EQ(rows[0].trip, 1);
+  EXPECT_EQ(rows[1].trip, 2);
+  EXPECT_EQ(rows[0].direction, hoist::TripDirection::Down);
+  EXPECT_EQ(rows[1].direction, hoist::TripDirection::Up);
+  EXPECT_NEAR(rows[0].depth_end - rows[0].depth_start, kTravel, 1.0);
+  EXPECT_NEAR(rows[0].peak_speed, kVmax, 0.05);
+  EXPECT_GT(rows[0].wall_end_us, rows[0].wall_start_us);
+  EXPECT_GT(rows[1].wall_start_us, rows[0].wall_end_us);
+  EXPECT_GE(rows[0].bins.size(), 2u);
+  // The load the config does not know, seen at both ends of the trip.
+  EXPECT_NEAR(rows[1].Fa_end, 1500.0, 100.0);
+  // The second trip starts with the moment known: its preload scale is
+  // identified, and the truth (the nominal preload, s = 1) lies within 3 sigma.
+  ASSERT_GT(rows[1].id.sigma_scale, 0.0) << rows[1].id.note;
+  EXPECT_LT(std::abs(rows[1].id.scale - 1.0), 3.0 * rows[1].id.sigma_scale);
+
+  // The sqlite3 CLI agrees (a real database, not our reader's view of it).
+  const auto cli = runCaptured("/usr/bin/sqlite3", {db, "PRAGMA integrity_check; SELECT count(*) FROM trips;"});
+  EXPECT_EQ(cli.output, "ok\n2\n");
+
+  // hoist-trips ingest runs the same pipeline on the same file.
+  std::ofstream(path("offline.toml")) << "[model]\nmodes = 8\n[estimator]\nenabled = true\n[condition]\ndepth_bin = 20.0\n";
+  const auto in = runCaptured(HOIST_TRIPS, {"ingest", "--config", path("offline.toml"), "--measurements",
+                                            path("meas.csv"), "--db", offline});
+  ASSERT_EQ(in.status, 0) << in.output;
+  const auto off = hoist::history::openSqliteStore(offline, true)->list(f);
+  ASSERT_EQ(off.size(), rows.size());
+  for (std::size_t i = 0; i < off.size(); ++i) {
+    SCOPED_TRACE("trip " + std::to_string(i + 1));
+    EXPECT_NEAR(rows[i].t_start, off[i].t_start, 1e-6);
+    EXPECT_NEAR(rows[i].t_end, off[i].t_end, 1e-6);
+    EXPECT_NEAR(rows[i].depth_start, off[i].depth_start, 1e-6);
+    EXPECT_NEAR(rows[i].Fa_end, off[i].Fa_end, 1e-6 * std::abs(off[i].Fa_end) + 1e-6);
+    EXPECT_NEAR(rows[i].id.scale, off[i].id.scale, 1e-6);
+    EXPECT_NEAR(rows[i].id.sigma_scale, off[i].id.sigma_scale, 1e-6);
+    EXPECT_EQ(rows[i].bins.size(), off[i].bins.size());
+  }
+  std::printf("live: trip 1 preload scale %.4f +- %.4f, trip 2 %.4f +- %.4f (offline %.4f, %.4f)\n", rows[0].id.scale,
+              rows[0].id.sigma_scale, rows[1].id.scale, rows[1].id.sigma_scale, off[0].id.scale, off[1].id.scale);
+}
+
+TEST_F(TripHistoryDaemon, Kill9MidTripKeepsEveryFinishedTrip) {
+  start(7956, "TripHistoryKill", {"HOIST_HEALTH"});
+  const std::string db = path("kill.sqlite");
+  makeRun(db);
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", path("shaft7.toml"), "--clock", "input"};
+  auto d = startDaemonAndWait(*listener_, argv, path("twind.log"));
+  // Real time: the first trip ends (arrival confirmed) about kRest + trip + 2 s
+  // in; kill in the middle of the second.
+  const double trip = 2 * kVmax / kAmax + (kTravel - kVmax * kVmax / kAmax) / kVmax;
+  Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", "4", "-q"},
+            path("replay.log"));
+  const double kill_at = (2 * kRest + 1.5 * trip) / 4.0;
+  std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(kill_at * 1000)));
+  ASSERT_TRUE(d->running());
+  d->signal(SIGKILL);
+  EXPECT_EQ(d->wait(10s), 128 + SIGKILL);
+  r.signal(SIGTERM);
+  r.wait(5s);
+  const auto cli = runCaptured("/usr/bin/sqlite3", {db, "PRAGMA integrity_check; SELECT count(*) FROM trips;"});
+  EXPECT_EQ(cli.output, "ok\n1\n") << readFile(path("twind.log"));
+  auto s = hoist::history::openSqliteStore(db, true);
+  const auto rows = s->list();
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].direction, hoist::TripDirection::Down);
+}
