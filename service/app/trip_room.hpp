@@ -63,8 +63,8 @@ class TripRing {
   alignas(64) std::atomic<std::size_t> tail_{0};  // next read (consumer)
 };
 
-/// The room's figures (atomics: the worker writes, HOIST_HEALTH and the
-/// final log line read).
+/// The room's figures (atomics: the loop and the worker write, the final
+/// log line and the tests read; not in HOIST_HEALTH yet).
 struct TripCounters {
   std::atomic<std::int64_t> ticks{0};        ///< ticks copied into the ring (loop side)
   std::atomic<std::int64_t> trips{0};        ///< trips recorded (records built)
