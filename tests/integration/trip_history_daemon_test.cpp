@@ -7,11 +7,13 @@
 //     and with Debian's sqlite3, equal to what hoist-trips ingest makes of
 //     the same file (the same pipeline, live and offline);
 //   * kill -9 of the daemon in the middle of the second trip leaves a
-//     database that passes PRAGMA integrity_check and holds the first trip.
+//     database that passes PRAGMA integrity_check and holds the first trip;
+//   * a bad [history] or [condition] key is exit 2 naming file, line and key.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <csignal>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -148,4 +150,43 @@ TEST_F(TripHistoryDaemon, Kill9MidTripKeepsEveryFinishedTrip) {
   const auto rows = s->list();
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_EQ(rows[0].direction, hoist::TripDirection::Down);
+}
+
+// [history] and [condition] are validated at start-up: a bad key is exit 2
+// naming the file, the line and the key (no LCM needed: --print-config);
+// good keys are printed back, enabled = false included.
+TEST(TripHistoryConfig, BadKeysGiveStatus2NamingFileLineAndKey) {
+  const auto dir = std::filesystem::path(HOIST_TEST_WORK_DIR) / "TripHistoryConfig";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  struct Case {
+    const char* text;
+    const char* key;
+  };
+  const Case cases[] = {
+      {"[history]\nenabled = 3\n", "history.enabled"},
+      {"[history]\nkeep_days = -1\n", "history.keep_days"},
+      {"[history]\nbogus = 1\n", "history.bogus"},
+      {"[history]\nurl = \"mysql://host/db\"\n", "history.url"},
+      {"[history]\nretry_seconds = \"soon\"\n", "history.retry_seconds"},
+      {"[condition]\ndepth_bin = 0.0\n", "condition.depth_bin"},
+      {"[condition]\npreload_warning = 2.0\n", "condition.preload_warning"},
+      {"[condition]\npreload_critical = 0.9\n", "condition.preload_critical"},
+  };
+  int k = 0;
+  for (const Case& c : cases) {
+    const std::string cfg = (dir / ("bad" + std::to_string(k++) + ".toml")).string();
+    std::ofstream(cfg) << "\n" << c.text;
+    const auto r = runCaptured(HOIST_TWIND, {"--config", cfg, "--print-config"});
+    EXPECT_EQ(r.status, 2) << c.text << r.output;
+    EXPECT_NE(r.output.find(cfg + ":3: " + c.key), std::string::npos) << c.text << r.output;
+  }
+  const std::string good = (dir / "good.toml").string();
+  std::ofstream(good) << "[history]\nenabled = false\nkeep_days = 30\n[condition]\ndepth_bin = 5.0\n";
+  const auto r = runCaptured(HOIST_TWIND, {"--config", good, "--print-config"});
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("[history]\nenabled = false\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("keep_days = 30\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("depth_bin = 5.0\n"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "history.sqlite")) << "--print-config opens no database";
 }
