@@ -142,12 +142,8 @@ void TripRoom::workerMain() {
     counts_.store_open.store(true, std::memory_order_release);
     log->info("{}trip history: recording every trip into {} (schema {})", tag, store_desc_,
               w_->store->schemaVersion());
-    if (h.keep_days > 0) {
-      const std::int64_t pruned = w_->store->prune(h.keep_days, w_->tick.wall_us > 0 ? w_->tick.wall_us
-                                   : std::chrono::duration_cast<std::chrono::microseconds>(
-                                         std::chrono::system_clock::now().time_since_epoch()).count());
-      if (pruned > 0) log->info("{}trip history: {} trips older than history.keep_days = {} pruned", tag, pruned, h.keep_days);
-    }
+    pruneOld(std::chrono::duration_cast<std::chrono::microseconds>(
+                 std::chrono::system_clock::now().time_since_epoch()).count());
   } catch (const std::exception& e) {
     log->error("{}trip history: the database cannot be opened: {}; trips are detected and counted but not "
                "stored (the twin runs on)", tag, e.what());
@@ -166,6 +162,18 @@ void TripRoom::workerMain() {
     } catch (const std::exception& e) {
       log->warn("{}trip history: flush at stop: {}", tag, e.what());
     }
+  }
+}
+
+void TripRoom::pruneOld(std::int64_t now_us) {
+  const int keep_days = hist_.store.keep_days;
+  if (keep_days <= 0 || !w_->store) return;
+  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  try {
+    const std::int64_t pruned = w_->store->prune(keep_days, now_us);
+    if (pruned > 0) logger()->info("{}trip history: {} trips older than history.keep_days = {} pruned", tag, pruned, keep_days);
+  } catch (const std::exception& e) {
+    logger()->warn("{}trip history: pruning trips older than history.keep_days = {} failed: {}", tag, keep_days, e.what());
   }
 }
 
@@ -234,6 +242,7 @@ void TripRoom::finishTrip() {
               "{:.0f} ms CPU", tag, r.trip, history::toString(p), r.direction == TripDirection::Down ? "down" : "up",
               r.depth_start, r.depth_end, r.id.scale, r.id.sigma_scale, r.id.informative ? "" : " (not informative)", r.alarms.size(),
               cpu * 1e-6);
+    pruneOld(now.wall_us);  // a daemon that runs for months keeps keep_days too
   } catch (const std::exception& e) {
     counts_.failed.fetch_add(1, std::memory_order_relaxed);
     log->error("{}trip history: the record of a trip could not be written: {}", tag, e.what());

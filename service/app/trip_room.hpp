@@ -10,7 +10,8 @@
 //
 // One worker thread per shaft (started by start(), SCHED_OTHER nice 10 as
 // the forecast workers, hoist::rt::yieldToRealtimeLoop) opens the history
-// database (hoist::history::Store) off the loop, drains the ring every
+// database (hoist::history::Store) off the loop (pruning trips older than
+// [history] keep_days then and after each trip), drains the ring every
 // kDrainPeriod, runs the trip pipeline (hoist::TripRecorder: TripDetector,
 // TripAccumulator, identifyPreload) and, at each trip's end, fills in the
 // shaft's name, the wall-clock times and the alarms raised during the trip
@@ -103,6 +104,7 @@ class TripRoom {
   void workerMain();
   void take(const TripTick& t);  // worker: one tick into the recorder
   void finishTrip();             // worker: the record to the store
+  void pruneOld(std::int64_t now_us);  // worker: [history] keep_days (at open and after each trip)
 
   TwinConfig cfg_;
   TripHistoryConfig hist_;

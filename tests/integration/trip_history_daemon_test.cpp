@@ -8,6 +8,7 @@
 //     the same file (the same pipeline, live and offline);
 //   * kill -9 of the daemon in the middle of the second trip leaves a
 //     database that passes PRAGMA integrity_check and holds the first trip;
+//   * keep_days prunes after each trip, not only at start-up;
 //   * a bad [history] or [condition] key is exit 2 naming file, line and key.
 #include <gtest/gtest.h>
 
@@ -41,7 +42,7 @@ class TripHistoryDaemon : public LcmProcessTest {
   std::string path(const std::string& f) const { return (dir_ / f).string(); }
   /// The measurements (hoist-sim: a heavier load off the axis than the twin's
   /// config) and the daemon's configuration with [history] at db.
-  void makeRun(const std::string& db) {
+  void makeRun(const std::string& db, const std::string& more_history = "") {
     writeDownUpProfile(path("profile.csv"), kRest, kTravel, kVmax, kAmax);
     std::ofstream(path("truth.toml")) << "[load]\neccentric_force = 1500.0\noffset = 0.6\n[model]\nmodes = 12\n";
     ASSERT_EQ(runProcess({HOIST_SIM, "--config", path("truth.toml"), "--profile", path("profile.csv"),
@@ -51,7 +52,7 @@ class TripHistoryDaemon : public LcmProcessTest {
               0)
         << readFile(path("sim.log"));
     std::ofstream(path("shaft7.toml")) << "[model]\nmodes = 8\n[estimator]\nenabled = true\n[condition]\ndepth_bin = 20.0\n"
-                                          "[history]\nurl = \"sqlite://" << db << "\"\n";
+                                          "[history]\nurl = \"sqlite://" << db << "\"\n" << more_history;
   }
 };
 
@@ -150,6 +151,45 @@ TEST_F(TripHistoryDaemon, Kill9MidTripKeepsEveryFinishedTrip) {
   const auto rows = s->list();
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_EQ(rows[0].direction, hoist::TripDirection::Down);
+}
+
+TEST_F(TripHistoryDaemon, KeepDaysPrunesAfterEachTripNotOnlyAtStart) {
+  start(7957, "TripHistoryKeep", {"HOIST_HEALTH"});
+  const std::string db = path("keep.sqlite");
+  makeRun(db, "keep_days = 30\n");
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", path("shaft7.toml"), "--clock", "input"};
+  auto d = startDaemonAndWait(*listener_, argv, path("twind.log"));
+  ASSERT_TRUE(listener_->waitFor(
+      [&] { return readFile(path("twind.log")).find("recording every trip into") != std::string::npos; }, 30s))
+      << readFile(path("twind.log"));
+  // A trip of another shaft that ended 100 days ago, written after the
+  // daemon's start-up prune: only a prune after a trip removes it.
+  {
+    auto s = hoist::history::openSqliteStore(db);
+    hoist::TripRecord old;
+    old.shaft = "retired";
+    const auto now_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                            std::chrono::system_clock::now().time_since_epoch()).count();
+    old.wall_end_us = now_us - 100LL * 86400 * 1000000;
+    old.wall_start_us = old.wall_end_us - 60 * 1000000;
+    old.t_end = 60.0;
+    s->put(old);
+  }
+  {
+    Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", kLiveSpeed, "-q"},
+              path("replay.log"));
+    listener_->waitFor([&] { return !r.running(); }, 60s);
+    ASSERT_EQ(r.wait(1s), 0) << readFile(path("replay.log"));
+  }
+  EXPECT_TRUE(listener_->waitFor([&] { return readFile(path("twind.log")).find("trip 2 recorded") != std::string::npos; },
+                                 60s));
+  stopDaemonCleanly(*d, path("twind.log"));
+  const std::string log = readFile(path("twind.log"));
+  EXPECT_NE(log.find("trip history: 1 trips older than history.keep_days = 30 pruned"), std::string::npos) << log;
+  const auto rows = hoist::history::openSqliteStore(db, true)->list();
+  ASSERT_EQ(rows.size(), 2u) << log;  // shaft7's two trips (ended now), not the retired one
+  EXPECT_EQ(rows[0].shaft, "shaft7");
+  EXPECT_EQ(rows[1].shaft, "shaft7");
 }
 
 // [history] and [condition] are validated at start-up: a bad key is exit 2
