@@ -54,6 +54,20 @@ class TripHistoryDaemon : public LcmProcessTest {
     std::ofstream(path("shaft7.toml")) << "[model]\nmodes = 8\n[estimator]\nenabled = true\n[condition]\ndepth_bin = 20.0\n"
                                           "[history]\nurl = \"sqlite://" << db << "\"\n" << more_history;
   }
+  /// hoist-replay feeds meas.csv to the daemon `d` (twind.log); the second
+  /// trip's record is built on the worker (its identification takes seconds
+  /// under a sanitizer): waited for before the daemon is stopped.
+  void replayBothTripsAndStop(Process& d) {
+    {
+      Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", kLiveSpeed, "-q"},
+                path("replay.log"));
+      listener_->waitFor([&] { return !r.running(); }, 60s);
+      ASSERT_EQ(r.wait(1s), 0) << readFile(path("replay.log"));
+    }
+    EXPECT_TRUE(listener_->waitFor(
+        [&] { return readFile(path("twind.log")).find("trip 2 recorded") != std::string::npos; }, 60s));
+    stopDaemonCleanly(d, path("twind.log"));
+  }
 };
 
 }  // namespace
@@ -64,17 +78,7 @@ TEST_F(TripHistoryDaemon, EveryTripIsOneRowLiveAsOffline) {
   makeRun(db);
   std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", path("shaft7.toml"), "--clock", "input"};
   auto d = startDaemonAndWait(*listener_, argv, path("twind.log"));
-  {
-    Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", kLiveSpeed, "-q"},
-              path("replay.log"));
-    listener_->waitFor([&] { return !r.running(); }, 60s);
-    ASSERT_EQ(r.wait(1s), 0) << readFile(path("replay.log"));
-  }
-  // The second trip's record is built on the worker (its identification
-  // takes seconds under a sanitizer): wait for it before stopping.
-  EXPECT_TRUE(listener_->waitFor([&] { return readFile(path("twind.log")).find("trip 2 recorded") != std::string::npos; },
-                                 60s));
-  stopDaemonCleanly(*d, path("twind.log"));
+  replayBothTripsAndStop(*d);
   const std::string log = readFile(path("twind.log"));
   EXPECT_NE(log.find("trip history: 2 trips recorded, 2 stored, 0 queued, 0 failed, 0 ticks dropped"),
             std::string::npos)
@@ -175,15 +179,7 @@ TEST_F(TripHistoryDaemon, KeepDaysPrunesAfterEachTripNotOnlyAtStart) {
     old.t_end = 60.0;
     s->put(old);
   }
-  {
-    Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", kLiveSpeed, "-q"},
-              path("replay.log"));
-    listener_->waitFor([&] { return !r.running(); }, 60s);
-    ASSERT_EQ(r.wait(1s), 0) << readFile(path("replay.log"));
-  }
-  EXPECT_TRUE(listener_->waitFor([&] { return readFile(path("twind.log")).find("trip 2 recorded") != std::string::npos; },
-                                 60s));
-  stopDaemonCleanly(*d, path("twind.log"));
+  replayBothTripsAndStop(*d);
   const std::string log = readFile(path("twind.log"));
   EXPECT_NE(log.find("trip history: 1 trips older than history.keep_days = 30 pruned"), std::string::npos) << log;
   const auto rows = hoist::history::openSqliteStore(db, true)->list();
