@@ -217,6 +217,13 @@ TEST(TripHistoryConfig, BadKeysGiveStatus2NamingFileLineAndKey) {
     EXPECT_EQ(r.status, 2) << c.text << r.output;
     EXPECT_NE(r.output.find(cfg + ":3: " + c.key), std::string::npos) << c.text << r.output;
   }
+  // An unknown [history] key lists the daemon's own key too.
+  const std::string typo = (dir / "typo.toml").string();
+  std::ofstream(typo) << "[history]\nenable = false\n";
+  const auto t = runCaptured(HOIST_TWIND, {"--config", typo, "--print-config"});
+  EXPECT_EQ(t.status, 2) << t.output;
+  EXPECT_NE(t.output.find("history.enable: unknown key"), std::string::npos) << t.output;
+  EXPECT_NE(t.output.find("enabled"), std::string::npos) << t.output;
   const std::string good = (dir / "good.toml").string();
   std::ofstream(good) << "[history]\nenabled = false\nkeep_days = 30\n[condition]\ndepth_bin = 5.0\n";
   const auto r = runCaptured(HOIST_TWIND, {"--config", good, "--print-config"});

@@ -30,7 +30,13 @@ TripHistoryConfig loadTripHistoryConfig(const std::string& path) {
       sec->erase("enabled");
     }
   }
-  c.store = history::historyConfigFromToml(tbl, path);
+  try {
+    c.store = history::historyConfigFromToml(tbl, path);
+  } catch (const hoist::io::ConfigError& e) {
+    // The shared reader lists its own keys; the daemon also takes enabled.
+    if (e.key().rfind("history.", 0) != 0 || e.message().find("unknown key") == std::string::npos) throw;
+    throw hoist::io::ConfigError(e.source(), e.line(), e.key(), e.message() + ", and (hoist-twind) enabled");
+  }
   c.condition = history::conditionSettingsFromToml(tbl, path);
   return c;
 }
