@@ -82,6 +82,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
                                                   instance_id_, lcm_out_.get()));
     if (!opt_.state_dir.empty() && opt_.shafts[i].estimator.enabled)
       shafts_.back()->keepAccelOffset(opt_.state_dir + "/" + accelOffsetFileName(opt_.labels[i]), out_);
+    if (i < opt_.history.size() && opt_.history[i].enabled) shafts_.back()->enableTrips(opt_.history[i]);
     // Shaft i publishes its shapes at phase i of the shape divider.
     shafts_.back()->attachLoop(&split_, misses_.get(), static_cast<int>(i));
     const double rate = opt_.shafts[i].service.rate;
@@ -575,6 +576,7 @@ void Daemon::stop(const char* why) {
   for (auto& s : shafts_) {
     s->publishHealth(true);
     s->stopOffsetKeeper();
+    s->stopTrips();
     s->logFinal();
   }
   stopping_ = true;

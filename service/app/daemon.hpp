@@ -39,6 +39,7 @@
 #include "forecast_pool.hpp"
 #include "miss_record.hpp"
 #include "hoist/service/config.hpp"
+#include "hoist/service/history_config.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
@@ -55,6 +56,8 @@ using rt::RealtimeRequest;
 struct DaemonOptions {
   std::vector<TwinConfig> shafts;   ///< effective configuration of each shaft (command line applied)
   std::vector<std::string> labels;  ///< log-line label per shaft ("" when there is one shaft)
+  /// [history] + [condition] per shaft (missing or disabled: no trip room).
+  std::vector<TripHistoryConfig> history;
   std::string lcm_url;              ///< resolved URL ("" = LCM default)
   std::string lcm_url_out;          ///< outputs go here ("" = lcm_url)
   double duration = 0.0;            ///< stop after this many seconds (0 = run until signalled)

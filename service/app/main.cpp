@@ -78,6 +78,7 @@ int main(int argc, char** argv) {
   double rate = 0.0, duration = 0.0;
   int rt_priority = 0;
   bool print_config = false, mlock = false, force = false;
+  std::string history_default;
   app.add_option("--config", config_paths,
                  "shaft TOML (+ [service], [alarms]); default: the paper's shaft.  Repeat it to host "
                  "several shafts in one process, each with its own [service].channel_prefix")
@@ -95,6 +96,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.add_option("--history-default", history_default,
+                 "the trip database when [history] url is empty (default: history.sqlite beside the "
+                 "configuration; the installed service passes sqlite:///var/lib/hoist-twin/history.sqlite).  "
+                 "Trips are recorded when a --config is given, unless [history] enabled = false");
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
   app.add_flag("--force", force,
                "run even when the start-up measurement says a tick cannot fit its period (exit 2 otherwise)");
@@ -179,8 +184,15 @@ int main(int argc, char** argv) {
       if (config_paths.size() > 1)
         label = cfg.service.channel_prefix.empty() ? std::filesystem::path(path).stem().string()
                                                    : cfg.service.channel_prefix;
+      TripHistoryConfig hist = loadTripHistoryConfig(path);
+      if (hist.store.url.empty() && !history_default.empty()) {
+        hist.store.url = history_default;
+        (void)hoist::history::parseDatabaseUrl(history_default, "--history-default");  // names the option
+      }
       opt.shafts.push_back(std::move(cfg));
       opt.labels.push_back(label);
+      if (!label.empty()) hist.shaft = label;
+      opt.history.push_back(std::move(hist));
     }
     if (!cpus.empty()) opt.realtime.cpus = parseCpuList(cpus, "--cpus");
   } catch (const std::exception& e) {
@@ -190,7 +202,7 @@ int main(int argc, char** argv) {
   if (print_config) {
     for (std::size_t i = 0; i < opt.shafts.size(); ++i) {
       if (opt.shafts.size() > 1) std::cout << (i ? "\n" : "") << "# ---- --config " << config_paths[i] << "\n";
-      std::cout << toToml(opt.shafts[i]);
+      std::cout << toToml(opt.shafts[i]) << "\n" << toToml(opt.history[i]);
     }
     return 0;
   }

@@ -19,6 +19,7 @@
 namespace hoist::svc {
 
 class OffsetKeeper;
+class TripRoom;
 
 using rt::RtLog;
 
@@ -87,6 +88,9 @@ struct ShaftContext {
   /// This shaft's kept accelerometer offset (offset_keeper.hpp): told after
   /// every stepped tick, so it sees a calibration end (nullptr: not kept).
   OffsetKeeper* offsets = nullptr;
+  /// This shaft's trip room (trip_room.hpp): every model step is copied
+  /// into it (nullptr: [history] off).
+  TripRoom* trips = nullptr;
 
   /// Wall time of `t` [s] on this shaft's clock.
   double wallAt(Clock::time_point t) const {

@@ -8,6 +8,7 @@
 
 #include "forecast_scheduler.hpp"
 #include "offset_keeper.hpp"
+#include "trip_room.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
@@ -149,6 +150,7 @@ void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
     out_.publishStep(s.utime);
     if (forecast_) forecast_->afterStep(s.utime);
     if (ctx_.offsets) ctx_.offsets->afterTick(core);
+    if (ctx_.trips) ctx_.trips->afterStep(core, s.utime);
   }
   out_.publishAlarmEvents();
 }

@@ -86,6 +86,10 @@ void TwinCore::estimatorStep(const CageResponse& r) {
   // evidence against the model: its NIS stays out of MODEL_MISMATCH's window.
   if (degradedNow()) est_->excludeTickFromModelCheck();
   est_->finish();
+  // What the sensors read at this step (the trip room's record, issue 32).
+  meas_.t = t_;
+  meas_.z = SensorValues{d.accel ? d.f_y : 0.0, d.rate ? d.omega : 0.0, d.rope ? d.force : 0.0};
+  meas_.present = (d.accel ? kSensorImuAccel : 0u) | (d.rate ? kSensorImuRate : 0u) | (d.rope ? kSensorRopeLoad : 0u);
 }
 
 unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
