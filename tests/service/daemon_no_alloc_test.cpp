@@ -245,7 +245,7 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   EXPECT_GE(a1.forecasts_from_estimate - a0.forecasts_from_estimate, 4) << logs.str();
   EXPECT_GE(b1.forecasts - b0.forecasts, 8) << logs.str();
   EXPECT_GE(a1.plans_accepted - a0.plans_accepted, 20);
-  EXPECT_EQ(a1.plans_rejected, 0);
+  EXPECT_EQ(a1.plans_rejected, 0) << logs.str();
   const std::string log = logs.str();
   EXPECT_NE(log.find("[A] ALARM INPUT_STALE"), std::string::npos) << log;
   EXPECT_NE(log.find("[B] alarm: INPUT_STALE WARNING cleared"), std::string::npos) << log;
