@@ -2,10 +2,7 @@
 #include "daemon.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <csignal>
-#include <cstdio>
-#include <ctime>
 #include <limits>
 #include <map>
 #include <systemd/sd-daemon.h>
@@ -27,17 +24,6 @@ using std::chrono::duration_cast;
 using rt::nanos;
 using rt::processCpuNanos;
 
-namespace {
-
-/// CPU time of the calling thread [ns] (0 if unavailable).
-std::int64_t threadCpuNanos() {
-  timespec ts{};
-  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
-
-}  // namespace
-
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
       out_(std::move(log)),
@@ -56,8 +42,6 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
   if (!opt_.lcm_url_out.empty() && opt_.lcm_url_out != opt_.lcm_url)
     lcm_out_ = std::make_unique<lcm::LCM>(opt_.lcm_url_out);
   opt_.labels.resize(opt_.shafts.size());
-  misses_ = std::make_unique<MissLog>();
-  miss_log_timer_ = std::make_unique<asio::steady_timer>(io_);
   // One ShaftTwin per configuration, one schedule (timer) per distinct rate.
   std::map<double, RateGroup*> by_rate;
   for (std::size_t i = 0; i < opt_.shafts.size(); ++i) {
@@ -66,7 +50,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, hooks,
                                                   instance_id_, lcm_out_.get()));
     // Shaft i publishes its shapes at phase i of the shape divider.
-    shafts_.back()->attachLoop(&split_, misses_.get(), static_cast<int>(i));
+    shafts_.back()->attachLoop(&split_, &misses_.log(), static_cast<int>(i));
     const double rate = opt_.shafts[i].service.rate;
     const int budget = opt_.shafts[i].service.max_starts_per_tick;
     const int env_budget = opt_.shafts[i].service.max_exact_envelopes_per_tick;
@@ -111,7 +95,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
 }
 
 Daemon::~Daemon() {
-  stopWatchdog();
+  watchdog_.stop();
   if (pool_) pool_->stop();
   // The descriptor belongs to LCM: never let Asio close it.
   if (lcm_fd_.is_open()) lcm_fd_.release();
@@ -129,7 +113,7 @@ bool Daemon::start() {
   startForecasts();
   // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
   // never receives them.
-  startWatchdog();
+  watchdog_.start();
   unblockStopSignals();
   armSignals();
   startSchedules();
@@ -270,12 +254,10 @@ void Daemon::startSchedules() {
   for (auto& sp : shafts_) sp->rebase(start_);
   for (auto& g : groups_) {
     g->k = 1;
-    g->last_start = start_;
-    g->split_at = split_;
-    g->cpu_at = threadCpuNanos();
+    misses_.startWindow(g->window, start_, MissRecorder::threadCpuNanos());
     armTimer(*g);
   }
-  armMissLog();
+  misses_.startLogging();
 }
 
 void Daemon::logStarted() {
@@ -310,7 +292,7 @@ int Daemon::run() {
 
 bool Daemon::finish() {
   sd_notify(0, "STOPPING=1");
-  stopWatchdog();
+  watchdog_.stop();
   if (pool_) pool_->stop();
   log_.flush();
   const bool ok = writeReport();
@@ -406,11 +388,10 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   // The outputs queued by the shafts go out at the same points.
   // A tick that skipped deadlines is a miss: its record takes the split of
   // the loop's time since this schedule's previous tick (miss_record.hpp).
-  const std::int64_t cpu_now = threadCpuNanos();  // one clock_gettime per tick (not per shaft)
-  MissRecord* miss = skipped > 0 ? &beginMiss(g, now, deadline, skipped, cpu_now) : nullptr;
-  g.split_at = split_;
-  g.last_start = now;
-  g.cpu_at = cpu_now;
+  const std::int64_t cpu_now = MissRecorder::threadCpuNanos();  // one clock_gettime per tick (not per shaft)
+  const MissTick mt{g.index, g.rate, g.k, static_cast<int>(g.shafts.size())};
+  MissRecord* miss = skipped > 0 ? &misses_.begin(mt, g.window, start_, now, deadline, skipped, cpu_now) : nullptr;
+  misses_.startWindow(g.window, now, cpu_now);
   const std::int64_t work0 = split_.sum();
   const double period_us = duration<double, std::micro>(g.period).count();
   // Deferred starts and exact envelopes: at most the group's budgets in this tick.
@@ -427,7 +408,7 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   std::size_t i = 0;
   for (ShaftTwin* s : g.shafts) {
     s->tick(k, deadline, skipped, left);
-    if (miss) [[unlikely]] noteMissShaft(*miss, g, i, period_us);
+    if (miss) [[unlikely]] MissRecorder::noteShaft(*miss, *s, g.ids[i], period_us);
     const bool every = ++i % kDrainEvery == 0;
     const auto t_now = Clock::now();
     if (every || t_now - drained_at > g.period / 2) {
@@ -440,93 +421,13 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   const std::int64_t tick_ns = nanos(Clock::now() - now);
   split_.other += std::max<std::int64_t>(0, tick_ns - (split_.sum() - work0));
   ns_ticks_ += tick_ns - (ns_receive_ - ns_rx0) - (ns_flush_ - ns_fl0);
-  if (miss) misses_->commit();
+  if (miss) misses_.commit();
   if (opt_.duration > 0.0 && duration<double>(Clock::now() - start_).count() >= opt_.duration) {
     stop("--duration elapsed");
     return;
   }
   g.k = k + 1;
   armTimer(g);
-}
-
-// ---- the miss record (miss_record.hpp) -------------------------------------------
-
-MissRecord& Daemon::beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
-                              std::int64_t skipped, std::int64_t cpu_now) {
-  MissRecord& r = misses_->begin();
-  r.utime = bus::wallUtime();
-  r.wall = duration<double>(now - start_).count();
-  r.model_t = static_cast<double>(g.k) / g.rate;
-  r.group = g.index;
-  r.rate = g.rate;
-  r.tick = g.k;
-  r.skipped = skipped;
-  r.late_us = duration<double, std::micro>(now - deadline).count();
-  r.shafts = static_cast<int>(g.shafts.size());
-  const LoopSplit& a = g.split_at;
-  const LoopSplit& b = split_;
-  r.work = LoopSplit{b.receive - a.receive, b.step - a.step,     b.envelope - a.envelope, b.publish - a.publish,
-                     b.forecast - a.forecast, b.start - a.start, b.health - a.health,     b.other - a.other};
-  r.window_us = duration<double, std::micro>(now - g.last_start).count();
-  const double work_us = 1e-3 * static_cast<double>(r.work.sum());
-  // The loop works first (the previous tick, inputs) and then idles until
-  // the deadline; what is left of the interval is the timer's: its wake-up,
-  // the kernel, a stall of the machine.
-  const double to_deadline_us = duration<double, std::micro>(deadline - g.last_start).count();
-  r.idle_us = std::max(0.0, to_deadline_us - work_us);
-  r.timer_us = std::max(0.0, r.window_us - work_us - r.idle_us);
-  r.cpu_us = g.cpu_at > 0 && cpu_now > 0 ? 1e-3 * static_cast<double>(cpu_now - g.cpu_at) : -1.0;
-  return r;
-}
-
-void Daemon::noteMissShaft(MissRecord& r, const RateGroup& g, std::size_t j, double period_us) {
-  const ShaftTwin& s = *g.shafts[j];
-  const double late = s.lastLateUs();
-  const int id = g.ids[j];
-  if (late > period_us) ++r.shafts_late;
-  if (r.first_shaft < 0) {
-    r.first_shaft = id;
-    r.first_late_us = late;
-  }
-  if (r.worst_shaft < 0 || late > r.worst_late_us) {
-    r.worst_shaft = id;
-    r.worst_late_us = late;
-  }
-  g.shafts[j]->noteMiss(r.seq, late);
-}
-
-void Daemon::armMissLog() {
-  miss_log_timer_->expires_after(std::chrono::seconds(1));
-  miss_log_timer_->async_wait([this](const boost::system::error_code& ec) { onMissLog(ec); });
-}
-
-void Daemon::onMissLog(const boost::system::error_code& ec) {
-  if (ec || stopping_) return;
-  const std::int64_t total = misses_->total();
-  if (total > misses_logged_) {
-    // The worst of the new ones that the ring still keeps.
-    const std::int64_t oldest = total - static_cast<std::int64_t>(misses_->kept());
-    const MissRecord* w = nullptr;
-    for (std::int64_t q = std::max(misses_logged_, oldest); q < total; ++q) {
-      const MissRecord& r = misses_->at(static_cast<std::size_t>(q - oldest));
-      if (!w || r.late_us > w->late_us) w = &r;
-    }
-    if (w) {
-      const LoopSplit& x = w->work;
-      auto ms = [](std::int64_t ns) { return 1e-6 * static_cast<double>(ns); };
-      log_.warn("deadline misses: {} in the last second ({} since start); the worst: tick {} of the {} Hz schedule "
-                "(t = {:.2f} s) {:.2f} ms late, {} deadline(s) skipped, {} of {} shafts more than a period late; "
-                "since the previous tick [ms]: receive {:.2f}, step {:.2f}, envelope {:.2f}, publish {:.2f}, "
-                "forecast {:.2f}, start {:.2f}, health {:.2f}, other {:.2f}, timer {:.2f}, idle {:.2f}; "
-                "the loop thread's CPU time {:.2f}",
-                total - misses_logged_, total, w->tick, w->rate, w->model_t, 1e-3 * w->late_us, w->skipped,
-                w->shafts_late, w->shafts, ms(x.receive), ms(x.step), ms(x.envelope), ms(x.publish),
-                ms(x.forecast), ms(x.start), ms(x.health), ms(x.other), 1e-3 * w->timer_us, 1e-3 * w->idle_us,
-                1e-3 * w->cpu_us);
-    }
-    misses_logged_ = total;
-  }
-  armMissLog();
 }
 
 void Daemon::armSignals() {
@@ -561,7 +462,7 @@ void Daemon::stop(const char* why) {
   }
   stopping_ = true;
   for (auto& g : groups_) g->timer->cancel();
-  miss_log_timer_->cancel();
+  misses_.stop();
   signals_.cancel();
   if (lcm_fd_.is_open()) {
     lcm_fd_.cancel();
@@ -572,50 +473,6 @@ void Daemon::stop(const char* why) {
     out_fd_.release();
   }
   io_.stop();
-}
-
-// ---- systemd watchdog --------------------------------------------------------------
-
-void Daemon::startWatchdog() {
-  // WATCHDOG_USEC (set by systemd from WatchdogSec=) enables it; ping at half
-  // the timeout, as sd_watchdog_enabled(3) recommends.
-  std::uint64_t usec = 0;
-  if (sd_watchdog_enabled(0, &usec) <= 0 || usec == 0) return;
-  const auto interval = std::chrono::microseconds(std::max<std::uint64_t>(usec / 2, 1000));
-  out_->info("systemd watchdog: {} ms timeout; pinging every {} ms while the loop makes progress", usec / 1000,
-             interval.count() / 1000);
-  wd_quit_ = false;
-  watchdog_ = std::thread([this, interval] { watchdogMain(interval); });
-}
-
-void Daemon::stopWatchdog() {
-  if (!watchdog_.joinable()) return;
-  {
-    std::lock_guard lk(wd_mu_);
-    wd_quit_ = true;
-  }
-  wd_cv_.notify_all();
-  watchdog_.join();
-}
-
-void Daemon::watchdogMain(std::chrono::microseconds interval) {
-  std::uint64_t last = progress_.load(std::memory_order_relaxed);
-  bool stalled = false;
-  std::unique_lock lk(wd_mu_);
-  while (!wd_cv_.wait_for(lk, interval, [this] { return wd_quit_; })) {
-    const std::uint64_t now = progress_.load(std::memory_order_relaxed);
-    if (now != last) {
-      sd_notify(0, "WATCHDOG=1");
-      if (stalled) out_->warn("systemd watchdog: the loop makes progress again; pings resumed");
-      stalled = false;
-      last = now;
-    } else if (!stalled) {
-      stalled = true;
-      out_->error("systemd watchdog: no tick for {} ms; withholding the ping (systemd restarts the service "
-                  "if this lasts WatchdogSec)",
-                  interval.count() / 1000);
-    }
-  }
 }
 
 // ---- the run report (run_report.hpp) --------------------------------------------
@@ -634,7 +491,7 @@ bool Daemon::writeReport() const {
   f.ns_receive = ns_receive_;
   f.ns_flush = ns_flush_;
   f.cpu_ns = processCpuNanos() - cpu0_;
-  f.misses = misses_.get();
+  f.misses = &misses_.log();
   for (const auto& sp : shafts_) f.shafts.push_back(sp.get());
   return writeRunReport(opt_.report_path, f, *out_);
 }

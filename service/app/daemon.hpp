@@ -37,13 +37,14 @@
 #include <vector>
 
 #include "forecast_pool.hpp"
-#include "miss_record.hpp"
+#include "miss_recorder.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
 #include "hoist/bus/subscriber.hpp"
 #include "hoist/bus/udpm_sender.hpp"
+#include "watchdog.hpp"
 
 namespace hoist::svc {
 
@@ -95,7 +96,7 @@ class Daemon {
   std::uint64_t loopProgress() const { return progress_.load(std::memory_order_relaxed); }
   std::int64_t instanceId() const { return instance_id_; }
   /// The miss record (miss_record.hpp): every deadline miss of the loop.
-  const MissLog& misses() const { return *misses_; }
+  const MissLog& misses() const { return misses_.log(); }
   /// The loop-time split so far (cumulative).
   const LoopSplit& loopSplit() const { return split_; }
 
@@ -114,11 +115,9 @@ class Daemon {
     /// Exact guide-rope envelopes per tick: the smallest [service]
     /// max_exact_envelopes_per_tick of the group (0 there = no budget).
     int envelope_budget = 0;
-    // The miss record: the loop's split and the time when this schedule's
-    // previous tick began.
-    LoopSplit split_at{};
-    Clock::time_point last_start{};
-    std::int64_t cpu_at = 0;  ///< the loop thread's CPU time then [ns]
+    /// The miss record: the loop's split and the time when this schedule's
+    /// previous tick began (miss_recorder.hpp).
+    MissWindow window{};
   };
 
   // start(), step by step
@@ -140,23 +139,9 @@ class Daemon {
   void onOutReadable(const boost::system::error_code& ec);
   void armTimer(RateGroup& g);
   void onTick(RateGroup& g, const boost::system::error_code& ec);
-  // The miss record (miss_record.hpp), kept apart from the loop itself:
-  /// A tick that skipped deadlines: a record of when, which and the split
-  /// of the loop's time since the schedule's previous tick.
-  MissRecord& beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
-                        std::int64_t skipped, std::int64_t cpu_now);
-  /// Shaft j of the group ran its step in the late tick.
-  static void noteMissShaft(MissRecord& r, const RateGroup& g, std::size_t j, double period_us);
-  /// Once a second, outside the ticks: one log line for the misses since the
-  /// previous line (their number and the worst one's split).
-  void armMissLog();
-  void onMissLog(const boost::system::error_code& ec);
   void stop(const char* why);
   void armSignals();
   bool writeReport() const;
-  void startWatchdog();
-  void stopWatchdog();
-  void watchdogMain(std::chrono::microseconds interval);
 
   DaemonOptions opt_;
   std::shared_ptr<spdlog::logger> out_;
@@ -183,9 +168,7 @@ class Daemon {
   std::vector<std::unique_ptr<ShaftTwin>> shafts_;
   std::vector<std::unique_ptr<RateGroup>> groups_;
   LoopSplit split_;                        ///< the loop's time by phase, cumulative (miss_record.hpp)
-  std::unique_ptr<MissLog> misses_;        ///< every deadline miss (preallocated ring)
-  std::int64_t misses_logged_ = 0;         ///< misses_->total() at the last miss-log line
-  std::unique_ptr<boost::asio::steady_timer> miss_log_timer_;  ///< the miss-log second
+  MissRecorder misses_{io_, log_, split_};  ///< every deadline miss and its log line (miss_recorder.hpp)
   /// The one forecast pool of the process: serves every shaft with
   /// [forecast] enabled and --clock wall.  Declared after shafts_ so that it
   /// stops (joins its workers) before the jobs it serves are destroyed.
@@ -196,16 +179,12 @@ class Daemon {
   bool started_ = false, stopping_ = false;
   const char* stop_reason_ = "";
 
-  // systemd (sd_notify): READY=1 once the loop is armed; WATCHDOG=1 from a
-  // supervisor thread, only when the loop's tick counter moved since the
-  // previous check.  The loop only bumps the counter (one relaxed atomic add:
-  // no lock, no allocation, no system call); a hung loop stops the pings and
-  // systemd restarts the service after WatchdogSec.
+  // systemd (sd_notify): READY=1 once the loop is armed; WATCHDOG=1 from the
+  // watchdog's thread (watchdog.hpp), only when the loop's tick counter moved
+  // since the previous check.  The loop only bumps the counter (one relaxed
+  // atomic add: no lock, no allocation, no system call).
   std::atomic<std::uint64_t> progress_{0};
-  std::thread watchdog_;
-  std::mutex wd_mu_;
-  std::condition_variable wd_cv_;
-  bool wd_quit_ = false;
+  Watchdog watchdog_{progress_, out_};
 };
 
 }  // namespace hoist::svc
