@@ -30,7 +30,6 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
       log_(out_, 4096),
       lcm_(opt_.lcm_url),
       lcm_fd_(io_),
-      out_fd_(io_),
       signals_(io_) {
   if (opt_.shafts.empty()) throw std::invalid_argument("no shaft configured");
   for (int sig : {SIGINT, SIGTERM, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) signals_.add(sig);
@@ -99,7 +98,6 @@ Daemon::~Daemon() {
   if (pool_) pool_->stop();
   // The descriptor belongs to LCM: never let Asio close it.
   if (lcm_fd_.is_open()) lcm_fd_.release();
-  if (out_fd_.is_open()) out_fd_.release();  // out_receiver_ closes it
   log_.stop();
 }
 
@@ -109,7 +107,7 @@ bool Daemon::start() {
   if (!openInput()) return false;
   openOutput();
   armLcm();
-  watchOutputGroup();
+  if (lcm_out_) out_watch_.open(opt_.lcm_url_out, shafts_);  // a second publisher of our outputs there
   startForecasts();
   // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
   // never receives them.
@@ -183,43 +181,6 @@ void Daemon::openOutput() {
   } else {
     out_->warn("own output socket for {} failed ({}); publishing through LCM", bus::describeLcmUrl(out_url), why_out);
     sender_.reset();
-  }
-}
-
-void Daemon::watchOutputGroup() {
-  // [service] lcm_url_out elsewhere: the input socket cannot see a second
-  // publisher of our outputs, so a receive-only socket on the output group
-  // watches our own HOIST_HEALTH channels.
-  if (lcm_out_) {
-    UdpmUrl out_udpm;
-    std::string out_why;
-    if (!parseUdpmUrl(opt_.lcm_url_out, out_udpm, out_why)) {
-      out_->warn("[service] lcm_url_out {} is not a udpm:// URL ({}): a second publisher on the output "
-                 "channels (DUPLICATE_PUBLISHER) cannot be detected",
-                 bus::describeLcmUrl(opt_.lcm_url_out), out_why);
-    } else {
-      out_receiver_ = std::make_unique<UdpmReceiver>();
-      if (!out_receiver_->open(out_udpm, out_why)) {
-        out_->warn("cannot watch the output URL {} for a second publisher ({}); DUPLICATE_PUBLISHER "
-                   "detection is off",
-                   bus::describeLcmUrl(opt_.lcm_url_out), out_why);
-        out_receiver_.reset();
-      } else {
-        for (auto& s : shafts_) s->watchOwnOutputs(out_receiver_.get());
-        // All our outputs arrive on that group: let the kernel drop all but
-        // the HOIST_HEALTH channels, so that the loop does not wake for its
-        // own cage and shape messages (the point of lcm_url_out).
-        std::vector<std::size_t> lens;
-        for (auto& s : shafts_) {
-          const std::size_t P = s->channels().health.size() - bus::kChannelHealth.size();
-          if (std::find(lens.begin(), lens.end(), P) == lens.end()) lens.push_back(P);
-        }
-        if (!out_receiver_->acceptOnlySuffix(bus::kChannelHealth, lens, out_why))
-          out_->warn("no kernel filter on the output-URL watch ({}): it reads every output datagram", out_why);
-        out_fd_.assign(out_receiver_->fd());
-        armOutWatch();
-      }
-    }
   }
 }
 
@@ -318,22 +279,6 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
   // Drain what is queued, bounded so the timers are never starved.
   drainInput();
   if (!stopping_) armLcm();
-}
-
-void Daemon::armOutWatch() {
-  out_fd_.async_wait(asio::posix::stream_descriptor::wait_read,
-                     [this](const boost::system::error_code& ec) { onOutReadable(ec); });
-}
-
-void Daemon::onOutReadable(const boost::system::error_code& ec) {
-  if (stopping_ || ec == asio::error::operation_aborted) return;
-  if (ec) {
-    log_.error("output-URL watch descriptor error: {}; DUPLICATE_PUBLISHER detection stops", ec.message());
-    return;
-  }
-  // Mostly our own outputs come back here (loopback); bounded like the input.
-  out_receiver_->drain(256);
-  if (!stopping_) armOutWatch();
 }
 
 void Daemon::flushOutputs() {
@@ -468,10 +413,7 @@ void Daemon::stop(const char* why) {
     lcm_fd_.cancel();
     lcm_fd_.release();
   }
-  if (out_fd_.is_open()) {
-    out_fd_.cancel();
-    out_fd_.release();
-  }
+  out_watch_.stop();
   io_.stop();
 }
 

@@ -38,6 +38,7 @@
 
 #include "forecast_pool.hpp"
 #include "miss_recorder.hpp"
+#include "output_watch.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
@@ -125,7 +126,6 @@ class Daemon {
   void applyRealtimeSettings();  ///< mlockall / SCHED_FIFO / affinity as asked, reported
   bool openInput();              ///< own udpm receive path (or LCM's); shafts subscribed
   void openOutput();             ///< own udpm publisher for udpm output URLs
-  void watchOutputGroup();       ///< lcm_url_out elsewhere: watch our own HOIST_HEALTH there
   void startForecasts();         ///< the forecast pool's workers
   void unblockStopSignals();     ///< the stop signals, handled on the loop thread
   void startSchedules();         ///< the clock starts; shafts announce themselves; timers armed
@@ -135,8 +135,6 @@ class Daemon {
   void drainInput();  ///< the receive path: dispatch what is queued (timed)
   void flushOutputs();  ///< the own publisher: send what the tick queued (timed)
   void onLcmReadable(const boost::system::error_code& ec);
-  void armOutWatch();
-  void onOutReadable(const boost::system::error_code& ec);
   void armTimer(RateGroup& g);
   void onTick(RateGroup& g, const boost::system::error_code& ec);
   void stop(const char* why);
@@ -157,13 +155,10 @@ class Daemon {
   std::unique_ptr<UdpmSender> sender_;      ///< own publisher for udpm output URLs (udpm_sender.hpp); else LCM's
   std::int64_t ns_flush_ = 0;               ///< cost split: steady-clock ns in sender_->flush()
   std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
-  /// Receive-only socket on the udpm lcm_url_out group: dispatches only our
-  /// own HOIST_HEALTH channels (another instance_id there is a second
-  /// publisher, DUPLICATE_PUBLISHER), by exact name, nothing stored per name.
-  std::unique_ptr<UdpmReceiver> out_receiver_;
   std::int64_t instance_id_ = 0;       ///< random per process (HOIST_CAGE/HOIST_HEALTH.instance_id)
   boost::asio::posix::stream_descriptor lcm_fd_;
-  boost::asio::posix::stream_descriptor out_fd_;  ///< out_receiver_'s socket (owned by it)
+  /// lcm_url_out elsewhere: our own HOIST_HEALTH watched there (output_watch.hpp)
+  OutputWatch out_watch_{io_, log_, out_};
   boost::asio::signal_set signals_;
   std::vector<std::unique_ptr<ShaftTwin>> shafts_;
   std::vector<std::unique_ptr<RateGroup>> groups_;
