@@ -4,18 +4,7 @@
 // (client publish), with their errors answered as status messages.  Called
 // by the server (server.hpp) on the hub's thread for a Client it owns; the
 // rest of the hub is hub.cpp.
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <ctime>
-#include <optional>
 
-#include <spdlog/spdlog.h>
-
-#include "hoist/bus/channels.hpp"
-#include "hoist/msg/codec.hpp"
 #include "hub.hpp"
 
 namespace hoist::dash {

@@ -5,16 +5,9 @@
 // prefixes that give one shaft name raise a status.  Called on the hub's
 // thread; the rest of the hub is hub.cpp.
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <ctime>
-#include <optional>
 
 #include <spdlog/spdlog.h>
 
-#include "hoist/bus/channels.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hub.hpp"
 

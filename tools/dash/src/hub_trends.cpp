@@ -7,14 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
-#include <ctime>
-#include <optional>
 
-#include <spdlog/spdlog.h>
-
-#include "hoist/bus/channels.hpp"
-#include "hoist/msg/codec.hpp"
 #include "hub.hpp"
 
 namespace hoist::dash {
