@@ -24,7 +24,10 @@
 #   forecasts on ([forecast] enabled; without it every config says
 #   enabled = false, as the daemon's default is on), and estimator=true, which turns the load
 #   estimator on ([estimator] enabled; the feeder sends no sensor samples, so
-#   this is the cost of its per-tick step without the O(1) updates).  The feeder (--feeder PATH; default this build's
+#   this is the cost of its per-tick step without the O(1) updates), and
+#   history=true, which records every trip ([history] enabled: the trip
+#   room's per-tick copy and its workers; without it every config says
+#   enabled = false, as the daemon's default is on with a config file).  The feeder (--feeder PATH; default this build's
 #   hoist-replay) is the same for every daemon.
 # Defaults: counts "100 200 300 400", 60 s each, 100 Hz, [service] max_step
 # 0.01 s (one model step per tick), outputs to [service] lcm_url_out on port
@@ -124,6 +127,8 @@ for setting in "${settings[@]}"; do
       est_section=""
       # Forecasts off unless forecast=true (they default to on in the daemon)
       fc_section="[forecast]"$'\n'"enabled = false"$'\n'
+      # The trip history off unless history=true (on by default with a config file)
+      hist_section="[history]"$'\n'"enabled = false"$'\n'
       if [[ "$spec" == *,* ]]; then
         IFS=',' read -r -a kvs <<< "${spec#*,}"
         for kv in "${kvs[@]}"; do
@@ -131,6 +136,8 @@ for setting in "${settings[@]}"; do
           if [[ "${kv%%=*}" == estimator ]]; then est_section="[estimator]"$'\n'"enabled = ${kv#*=}"$'\n'; continue; fi
           # forecast=true: the look-ahead forecasts on ([forecast] enabled, the defaults otherwise)
           if [[ "${kv%%=*}" == forecast ]]; then fc_section="[forecast]"$'\n'"enabled = ${kv#*=}"$'\n'; continue; fi
+          # history=true: every trip recorded ([history] enabled, history.sqlite in the configs' folder)
+          if [[ "${kv%%=*}" == history ]]; then hist_section="[history]"$'\n'"enabled = ${kv#*=}"$'\n'; continue; fi
           extra+="${kv%%=*} = ${kv#*=}"$'\n'
         done
       fi
@@ -141,8 +148,8 @@ for setting in "${settings[@]}"; do
       outline=""
       [[ $same_url -eq 0 ]] && outline="lcm_url_out = \"$url_out\""$'\n'
       for ((i = 1; i <= N; i++)); do
-        printf '[model]\nmodes = %s\nstatic_correction = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n%s%s%s%s' \
-          "$modes" "$corr_toml" "$rate" "$max_step" "$i" "$outline" "$extra" "$est_section" "$fc_section" > "$cfgdir/shaft$i.toml"
+        printf '[model]\nmodes = %s\nstatic_correction = %s\n[service]\nrate = %s.0\nmax_step = %s\nchannel_prefix = "shaft%d/"\n%s%s%s%s%s' \
+          "$modes" "$corr_toml" "$rate" "$max_step" "$i" "$outline" "$extra" "$est_section" "$fc_section" "$hist_section" > "$cfgdir/shaft$i.toml"
         cfgs+=(--config "$cfgdir/shaft$i.toml")
       done
       echo "[multishaft] n = $modes (correction $corr), N = $N, daemon $name: daemon (all threads) on CPU $daemon_cpu, feeder on CPU $feeder_cpu, $seconds s ..." >&2

@@ -45,9 +45,14 @@ if(TARGET hoist_msgs_java)
   # The wrapper finds lcm.jar, jchart2d.jar and ../share/java/hoist_msgs.jar itself.
   install(PROGRAMS ${CMAKE_RUNTIME_OUTPUT_DIRECTORY}/hoist-lcm-spy DESTINATION ${CMAKE_INSTALL_BINDIR}
           COMPONENT runtime)
-  # Installed as hoist-msgs.jar: Debian's jar names have no '_' (lintian bad-jar-name).
+  # Java policy 2.4 (lintian bad-jar-name): the jar is NAME-VERSION.jar, no '_',
+  # with the unversioned NAME.jar a relative symlink to it (what the wrapper
+  # and Java clients name).
   install(FILES ${CMAKE_BINARY_DIR}/msgs/hoist_msgs.jar DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/java
-          RENAME hoist-msgs.jar COMPONENT runtime)
+          RENAME hoist-msgs-${PROJECT_VERSION}.jar COMPONENT runtime)
+  file(CREATE_LINK hoist-msgs-${PROJECT_VERSION}.jar ${CMAKE_BINARY_DIR}/msgs/hoist-msgs.jar SYMBOLIC)
+  install(FILES ${CMAKE_BINARY_DIR}/msgs/hoist-msgs.jar DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/java
+          COMPONENT runtime)
 endif()
 
 # ---- LCM types: definitions and generated C++ headers -------------------------------

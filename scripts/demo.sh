@@ -7,9 +7,14 @@
 # a private loopback multicast URL (ttl=0: nothing leaves this machine) and is
 # stopped cleanly at the end (or on Ctrl-C).  The live dashboard (hoist-dash)
 # runs alongside: open the URL it prints in a browser.
+# The cage also carries simulated sensors (an IMU and a rope load cell, from
+# hoist-sim on a shaft whose load the twin's config does not know): the
+# "estimate:" lines show the twin finding the payload and its offset, with
+# their sigmas, beside the open-loop tilt it would show without sensors.
 #
 #   scripts/demo.sh [--no-setup] [--speed X] [--profile SPEC|FILE]
 #                   [--config FILE] [--port N] [--with-length]
+#                   [--true-load FA,B] [--no-sensors]
 #                   [--dash-port N] [--no-dash] [--mqtt [...]]
 #
 #   --no-setup     skip scripts/setup.sh (the build must exist)
@@ -21,7 +26,11 @@
 #   --config FILE  daemon configuration (default: service/config/demo.toml,
 #                  the paper's shaft with tight clearances so alarms show)
 #   --port N       UDP port of the private LCM URL (default 7690)
-#   --with-length  send the encoder rope length too
+#   --with-length  send the encoder rope length too (without sensors; the
+#                  sensors' replay always sends it)
+#   --true-load FA,B  the load the simulated sensors carry: FA [N] at offset
+#                  B [m] (default 1600,-0.6; the config says 1000 N at 1 m)
+#   --no-sensors   the winder only: the twin runs open loop
 #   --dash-port N  TCP port of the dashboard, http://127.0.0.1:N/ (default 8080)
 #   --no-dash      do not start the dashboard
 #   --mqtt [...]   the same twin seen through MQTT: scripts/demo-mqtt.sh [...]
@@ -34,6 +43,8 @@ config="$here/service/config/demo.toml"
 port=7690
 dash_port=8080
 dash=1
+sensors=1
+true_load=1600,-0.6
 replay_extra=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -45,8 +56,13 @@ while [[ $# -gt 0 ]]; do
     --with-length) replay_extra+=(--with-length); shift ;;
     --dash-port) dash_port="$2"; shift 2 ;;
     --no-dash) dash=0; shift ;;
+    --no-sensors) sensors=0; shift ;;
+    --true-load)
+      [[ "${2:-}" =~ ^-?[0-9.]+(e-?[0-9]+)?,-?[0-9.]+(e-?[0-9]+)?$ ]] ||
+        { echo "demo.sh: --true-load takes FA,B (newtons, metres), e.g. 1600,-0.6; got '${2:-}'" >&2; exit 2; }
+      true_load="$2"; shift 2 ;;
     --mqtt) shift; [[ $setup -eq 0 ]] && set -- --no-setup "$@"; exec "$here/scripts/demo-mqtt.sh" "$@" ;;
-    -h|--help) sed -n '2,27p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d' | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -61,7 +77,9 @@ if [[ $setup -eq 1 ]]; then
   fi
 fi
 bin="${HOIST_BIN_DIR:-$here/build/bin}"   # HOIST_BIN_DIR: use another build
-for b in hoist-twind hoist-replay hoist-monitor; do
+programs=(hoist-twind hoist-replay hoist-monitor)
+[[ $sensors -eq 1 ]] && programs+=(hoist-sim)
+for b in "${programs[@]}"; do
   if [[ ! -x "$bin/$b" ]]; then
     echo "demo.sh: $bin/$b not found; run scripts/setup.sh (or drop --no-setup)" >&2
     exit 2
@@ -107,6 +125,33 @@ trap cleanup EXIT
 trap 'echo; echo "demo.sh: interrupted"; cleanup; exit 130' INT TERM
 
 echo "== hoist-twin demo: LCM $url, logs in $logdir"
+replay_input=(--profile "$profile" "${replay_extra[@]}")
+if [[ $sensors -eq 1 ]]; then
+  # The shaft the sensors ride in: the twin's config with another load.  The
+  # twin's own config gets the load estimator (unless it has an [estimator]).
+  fa=${true_load%,*} b=${true_load#*,}
+  # [load] of the config dropped, ours appended (one table per name in TOML).
+  awk '/^\[/{skip=($0 ~ /^\[load\][[:space:]]*(#.*)?$/)} !skip' "$config" > "$logdir/true-shaft.toml"
+  printf '\n[load]\neccentric_force = %s\noffset = %s\n' "$fa" "$b" >> "$logdir/true-shaft.toml"
+  twin_config="$logdir/twin.toml"
+  cp "$config" "$twin_config"
+  grep -q '^\[estimator\]' "$config" || printf '\n[estimator]\nenabled = true\n' >> "$twin_config"
+  if ! "$bin/hoist-sim" --config "$logdir/true-shaft.toml" --profile "$profile" --seed 7 -q \
+        --write-measurements "$logdir/sensors.csv" 2> "$logdir/hoist-sim.log"; then
+    echo "demo.sh: hoist-sim could not simulate the sensors:" >&2
+    cat "$logdir/hoist-sim.log" >&2
+    exit 1
+  fi
+  config_load=$("$bin/hoist-twind" --config "$config" --print-config 2>/dev/null |
+                awk '/^\[load\]/{in_load=1; next} /^\[/{in_load=0}
+                     in_load && $1=="eccentric_force"{fa=$3} in_load && $1=="offset"{b=$3}
+                     END{printf "%s N at b %s m", fa, b}')
+  echo "== sensors: a cage IMU and a rope load cell simulated by hoist-sim on a shaft whose load is"
+  echo "   Fa $fa N at b $b m; the twin's config says $config_load.  The 'estimate:' lines show"
+  echo "   what the twin finds, with its sigmas; 'open' is the tilt the twin would show without sensors."
+  replay_input=(--measurements "$logdir/sensors.csv")
+  config="$twin_config"
+fi
 clock=wall
 if ! awk -v s="$speed" 'BEGIN { exit !(s == 1) }'; then clock=input; fi
 if [[ $dash -eq 1 ]]; then
@@ -151,7 +196,7 @@ if ! kill -0 "$daemon_pid" 2>/dev/null; then
   exit 1
 fi
 echo "== replay: the $profile trip at speed $speed (Ctrl-C stops everything)"
-"$bin/hoist-replay" --lcm-url "$url" --profile "$profile" --speed "$speed" -q "${replay_extra[@]}"
+"$bin/hoist-replay" --lcm-url "$url" "${replay_input[@]}" --speed "$speed" -q
 sleep 2.2   # the last monitor lines, and the input going stale
 cleanup
 echo "== daemon log (alarms and final health):"

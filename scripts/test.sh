@@ -49,7 +49,7 @@ if [[ ${#ctest_args[@]} -eq 0 ]]; then
   mkdir -p "$(dirname "$side_log")"
   n_wait=$(ctest --test-dir "$build_dir" -N -R "$waiting" | sed -n 's/^Total Tests: //p')
   echo "[test] ${n_wait:-0} tests that mostly wait run beside the others (their output at the end: $side_log)"
-  ctest --test-dir "$build_dir" --output-on-failure -j4 --timeout 600 -R "$waiting" >"$side_log" 2>&1 &
+  ctest --test-dir "$build_dir" --output-on-failure -j3 --timeout 600 -R "$waiting" >"$side_log" 2>&1 &
   side_pid=$!
   ctest --test-dir "$build_dir" --output-on-failure -j"$(nproc)" --timeout 600 -E "$waiting"
   rc=$?

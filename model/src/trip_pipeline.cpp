@@ -54,8 +54,10 @@ bool TripRecorder::add(const MeasurementSample& m, const LoadEstimate& e, double
       if (pending_.empty()) {
         acc_.begin(m, e, guide_deflection);
       } else {
-        acc_.begin(pending_.front().first, pending_.front().second, guide_deflection);
-        for (std::size_t i = 1; i < pending_.size(); ++i) acc_.add(pending_[i].first, pending_[i].second);
+        // Each kept tick with its own guide-rope deflection (the clearance of a creep before the departure).
+        acc_.begin(pending_.front().m, pending_.front().e, pending_.front().guide_deflection);
+        for (std::size_t i = 1; i < pending_.size(); ++i)
+          acc_.add(pending_[i].m, pending_[i].e, pending_[i].guide_deflection);
         acc_.add(m, e, guide_deflection);
       }
       pending_.clear();
@@ -64,12 +66,12 @@ bool TripRecorder::add(const MeasurementSample& m, const LoadEstimate& e, double
       acc_.add(m, e, guide_deflection);
       rec_ = acc_.finish(det_.arrivalTime(), det_.arrival());
       rec_.trip = ++trips_;
-      pending_.assign(1, {m, e});
+      pending_.assign(1, Pending{m, e, guide_deflection});
       return true;
     case TripEvent::NotATrip:
       ++not_a_trip_;
       acc_.abandon();
-      pending_.assign(1, {m, e});
+      pending_.assign(1, Pending{m, e, guide_deflection});
       return false;
     case TripEvent::None:
       break;
@@ -77,9 +79,9 @@ bool TripRecorder::add(const MeasurementSample& m, const LoadEstimate& e, double
   if (det_.moving()) {
     acc_.add(m, e, guide_deflection);
   } else if (det_.still(m.k)) {
-    pending_.assign(1, {m, e});
+    pending_.assign(1, Pending{m, e, guide_deflection});
   } else if (!pending_.empty()) {
-    pending_.emplace_back(m, e);
+    pending_.push_back(Pending{m, e, guide_deflection});
   }
   return false;
 }

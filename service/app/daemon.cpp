@@ -1,6 +1,7 @@
 // hoist-twind's event loop: see daemon.hpp.
 #include "daemon.hpp"
 
+#include <cctype>
 #include <algorithm>
 #include <csignal>
 #include <limits>
@@ -23,6 +24,20 @@ using std::chrono::duration_cast;
 
 using rt::nanos;
 using rt::processCpuNanos;
+
+namespace {
+/// The state file of a shaft's accelerometer offset: "accel_offset", or
+/// "accel_offset.<label>" with several shafts (the label's characters other
+/// than letters, digits, '-' and '_' as '_').
+std::string accelOffsetFileName(const std::string& label) {
+  std::string f = "accel_offset";
+  if (label.empty()) return f;
+  f += '.';
+  for (const char c : label)
+    f += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+  return f;
+}
+}  // namespace
 
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
@@ -48,6 +63,9 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     if (i > 0) hooks.slow_tick_at = -1.0;  // the slow tick is the first shaft's only
     shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, hooks,
                                                   instance_id_, lcm_out_.get()));
+    if (!opt_.state_dir.empty() && opt_.shafts[i].estimator.enabled)
+      shafts_.back()->keepAccelOffset(opt_.state_dir + "/" + accelOffsetFileName(opt_.labels[i]), out_);
+    if (i < opt_.history.size() && opt_.history[i].enabled) shafts_.back()->enableTrips(opt_.history[i]);
     // Shaft i publishes its shapes at phase i of the shape divider.
     shafts_.back()->attachLoop(&split_, &misses_.log(), static_cast<int>(i));
     const double rate = opt_.shafts[i].service.rate;
@@ -403,6 +421,8 @@ void Daemon::stop(const char* why) {
   flushOutputs();
   for (auto& s : shafts_) {
     s->publishHealth(true);
+    s->stopOffsetKeeper();
+    s->stopTrips();
     s->logFinal();
   }
   stopping_ = true;

@@ -40,6 +40,7 @@
 #include "miss_recorder.hpp"
 #include "output_watch.hpp"
 #include "hoist/service/config.hpp"
+#include "hoist/service/history_config.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
@@ -57,11 +58,17 @@ using rt::RealtimeRequest;
 struct DaemonOptions {
   std::vector<TwinConfig> shafts;   ///< effective configuration of each shaft (command line applied)
   std::vector<std::string> labels;  ///< log-line label per shaft ("" when there is one shaft)
+  /// [history] + [condition] per shaft (missing or disabled: no trip room).
+  std::vector<TripHistoryConfig> history;
   std::string lcm_url;              ///< resolved URL ("" = LCM default)
   std::string lcm_url_out;          ///< outputs go here ("" = lcm_url)
   double duration = 0.0;            ///< stop after this many seconds (0 = run until signalled)
   RealtimeRequest realtime;         ///< optional mlockall / SCHED_FIFO / affinity
   std::string report_path;          ///< write the run report (JSON) here at stop ("" = none)
+  /// The daemon's state directory (--state-dir, else systemd's
+  /// $STATE_DIRECTORY): each shaft's learned accelerometer offset is kept
+  /// there (offset_keeper.hpp; "" = not kept).
+  std::string state_dir;
   std::string command_line;         ///< for the report
   TestHooks hooks;                  ///< test-only fault injection
   double test_stall_at = -1.0;      ///< test only: at this many seconds the loop thread hangs for good

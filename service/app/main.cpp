@@ -74,10 +74,11 @@ int main(int argc, char** argv) {
   app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
   app.set_version_flag("--version", std::string("hoist-twind ") + hoist::kVersionString);
   std::vector<std::string> config_paths;
-  std::string lcm_url, clock, prefix, log_level = "info", cpus, report;
+  std::string lcm_url, clock, prefix, log_level = "info", cpus, report, state_dir;
   double rate = 0.0, duration = 0.0;
   int rt_priority = 0;
   bool print_config = false, mlock = false, force = false;
+  std::string history_default;
   app.add_option("--config", config_paths,
                  "shaft TOML (+ [service], [alarms]); default: the paper's shaft.  Repeat it to host "
                  "several shafts in one process, each with its own [service].channel_prefix")
@@ -95,6 +96,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.add_option("--history-default", history_default,
+                 "the trip database when [history] url is empty (default: history.sqlite beside the "
+                 "configuration; the installed service passes sqlite:///var/lib/hoist-twin/history.sqlite).  "
+                 "Trips are recorded when a --config is given, unless [history] enabled = false");
   app.add_flag("--print-config", print_config, "print the effective configuration as TOML and exit");
   app.add_flag("--force", force,
                "run even when the start-up measurement says a tick cannot fit its period (exit 2 otherwise)");
@@ -103,6 +108,9 @@ int main(int argc, char** argv) {
   rt->add_option("--rt-priority", rt_priority, "run the loop thread SCHED_FIFO at this priority, 1..99")
       ->check(CLI::Range(1, 99));
   rt->add_option("--cpus", cpus, "pin the loop thread to these CPUs, e.g. 1 or 2-3");
+  app.add_option("--state-dir", state_dir,
+                 "keep state across restarts in DIR: each shaft's learned accelerometer offset (a calibration's "
+                 "result; [estimator] enabled). Default: $STATE_DIRECTORY (systemd's StateDirectory=), else none");
   app.add_option("--report", report,
                  "at stop, write a run report (JSON: step time and tick lateness histograms with "
                  "p50/p99/p99.9/max per shaft, deadline misses, counters, real-time settings) to FILE");
@@ -176,8 +184,15 @@ int main(int argc, char** argv) {
       if (config_paths.size() > 1)
         label = cfg.service.channel_prefix.empty() ? std::filesystem::path(path).stem().string()
                                                    : cfg.service.channel_prefix;
+      TripHistoryConfig hist = loadTripHistoryConfig(path);
+      if (hist.store.url.empty() && !history_default.empty()) {
+        hist.store.url = history_default;
+        (void)hoist::history::parseDatabaseUrl(history_default, "--history-default");  // names the option
+      }
       opt.shafts.push_back(std::move(cfg));
       opt.labels.push_back(label);
+      if (!label.empty()) hist.shaft = label;
+      opt.history.push_back(std::move(hist));
     }
     if (!cpus.empty()) opt.realtime.cpus = parseCpuList(cpus, "--cpus");
   } catch (const std::exception& e) {
@@ -187,7 +202,7 @@ int main(int argc, char** argv) {
   if (print_config) {
     for (std::size_t i = 0; i < opt.shafts.size(); ++i) {
       if (opt.shafts.size() > 1) std::cout << (i ? "\n" : "") << "# ---- --config " << config_paths[i] << "\n";
-      std::cout << toToml(opt.shafts[i]);
+      std::cout << toToml(opt.shafts[i]) << "\n" << toToml(opt.history[i]);
     }
     return 0;
   }
@@ -275,6 +290,21 @@ int main(int argc, char** argv) {
   opt.realtime.mlockall = mlock;
   opt.realtime.fifo_priority = rt_priority;
   opt.report_path = report;
+  if (state_dir.empty()) {
+    // systemd: StateDirectory= sets $STATE_DIRECTORY (colon-separated when several).
+    if (const char* env = std::getenv("STATE_DIRECTORY"); env && *env) {
+      state_dir = env;
+      state_dir = state_dir.substr(0, state_dir.find(':'));
+    }
+  }
+  if (!state_dir.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(state_dir, ec)) {
+      std::cerr << "hoist-twind: configuration error: --state-dir " << state_dir << ": not a directory\n";
+      return 2;
+    }
+  }
+  opt.state_dir = state_dir;
   if (const std::string bad = report.empty() ? "" : hoist::io::outputPathError(report, "--report"); !bad.empty()) { std::cerr << "hoist-twind: configuration error: " << bad << "\n"; return 2; }
   for (int i = 0; i < argc; ++i) opt.command_line += (i ? " " : "") + std::string(argv[i]);
 

@@ -18,6 +18,9 @@
 
 namespace hoist::svc {
 
+class OffsetKeeper;
+class TripRoom;
+
 using rt::RtLog;
 
 /// Operator names (alarm commands) are cut to this many printable characters.
@@ -82,6 +85,12 @@ struct ShaftContext {
   LoopSplit* split = nullptr;
   /// The daemon's miss record, for HOIST_HEALTH (nullptr: none).
   const MissLog* misses = nullptr;
+  /// This shaft's kept accelerometer offset (offset_keeper.hpp): told after
+  /// every stepped tick, so it sees a calibration end (nullptr: not kept).
+  OffsetKeeper* offsets = nullptr;
+  /// This shaft's trip room (trip_room.hpp): every model step is copied
+  /// into it (nullptr: [history] off).
+  TripRoom* trips = nullptr;
 
   /// Wall time of `t` [s] on this shaft's clock.
   double wallAt(Clock::time_point t) const {

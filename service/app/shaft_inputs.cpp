@@ -7,6 +7,8 @@
 #include <optional>
 
 #include "forecast_scheduler.hpp"
+#include "offset_keeper.hpp"
+#include "trip_room.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
@@ -147,6 +149,8 @@ void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
     ctx_.stats.step_hist.add(duration<double, std::micro>(t1 - t0).count());
     out_.publishStep(s.utime);
     if (forecast_) forecast_->afterStep(s.utime);
+    if (ctx_.offsets) ctx_.offsets->afterTick(core);
+    if (ctx_.trips) ctx_.trips->afterStep(core, s.utime);
   }
   out_.publishAlarmEvents();
 }

@@ -58,6 +58,22 @@ void ShaftTwin::slowTickHook(double wall) {
   }
 }
 
+void ShaftTwin::enableTrips(const TripHistoryConfig& hist) {
+  trips_ = std::make_unique<TripRoom>(ctx_.cfg, hist, hist.shaft);
+  ctx_.trips = trips_.get();
+}
+
+void ShaftTwin::stopTrips() {
+  if (!trips_) return;
+  trips_->stop();
+  const TripCounters& c = trips_->counters();
+  const std::int64_t trips = c.trips.load();
+  ctx_.log.info("{}trip history: {} trips recorded, {} stored, {} queued, {} failed, {} ticks dropped (ring full), "
+                "{} motions shorter than a trip; worker CPU {:.1f} ms ({:.1f} ms per trip)",
+                ctx_.tag, trips, c.stored.load(), c.queued.load(), c.failed.load(), c.dropped.load(),
+                c.not_a_trip.load(), c.cpu_ns.load() * 1e-6, trips > 0 ? c.cpu_ns.load() * 1e-6 / trips : 0.0);
+}
+
 void ShaftTwin::subscribe(InputRouter* router) {
   // Our own health channel is watched here when outputs share the input URL.
   inputs_.subscribe(router, &outputs_.lcm() == &in_);
@@ -67,8 +83,25 @@ void ShaftTwin::setForecastPool(ForecastPool* pool, double phase) {
   if (forecast_) forecast_->setPool(pool, phase);
 }
 
+void ShaftTwin::keepAccelOffset(const std::string& path, std::shared_ptr<spdlog::logger> log) {
+  if (!ctx_.cfg.estimator.enabled) return;
+  offsets_ = std::make_unique<OffsetKeeper>(path, ctx_.tag, std::move(log));
+  if (const auto r = offsets_->load()) {
+    if (!ctx_.core.setAccelOffset(r->offset, r->sigma))
+      ctx_.log.warn("{}accelerometer offset: {} holds a value the estimator refused ({} +- {} m/s^2): ignored",
+                    ctx_.tag, path, r->offset, r->sigma);
+  }
+  ctx_.offsets = offsets_.get();
+}
+
+void ShaftTwin::stopOffsetKeeper() {
+  if (offsets_) offsets_->stop();
+}
+
 void ShaftTwin::start(Clock::time_point start, double health_phase) {
   ctx_.start = start;
+  if (offsets_) offsets_->start();
+  if (trips_) trips_->start();
   publishHealth();  // announce ourselves at once
   // Shafts of one daemon spread their later health messages over the period.
   health_.start(health_phase);
@@ -144,7 +177,9 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
         forecast_->afterStep(utime);
         if (split) split->forecast += nanos(Clock::now() - p1);
       }
+      if (ctx_.trips) ctx_.trips->afterStep(core, utime);
     }
+    if (r.stepped && ctx_.offsets) ctx_.offsets->afterTick(core);
   } else {
     core.housekeeping(wall);
   }

@@ -26,9 +26,11 @@
 #include "forecast_scheduler.hpp"
 #include "hoist/bus/udpm_receiver.hpp"
 #include "shaft_context.hpp"
+#include "offset_keeper.hpp"
 #include "shaft_health.hpp"
 #include "shaft_inputs.hpp"
 #include "shaft_outputs.hpp"
+#include "trip_room.hpp"
 #include "hoist/bus/udpm_sender.hpp"
 
 namespace hoist::svc {
@@ -113,6 +115,19 @@ class ShaftTwin {
   void publishHealth(bool final_report = false);
   /// The final health line and per-reason rejection counts, in the log.
   void logFinal() const { health_.logFinal(); }
+  /// Keep the estimator's learned accelerometer offset in `path` across
+  /// restarts (offset_keeper.hpp): applies a kept one now; before start().
+  /// Nothing without [estimator] enabled.  `log`: the daemon's logger (the
+  /// keeper's writer thread logs through it, not through the loop's RtLog).
+  void keepAccelOffset(const std::string& path, std::shared_ptr<spdlog::logger> log);
+  /// Write a pending offset and join the keeper's writer.
+  void stopOffsetKeeper();
+  /// [history] enabled: record every trip (trip_room.hpp); before start().
+  /// Throws std::invalid_argument for bad [condition] settings.
+  void enableTrips(const TripHistoryConfig& hist);
+  /// Drain and join the trip room's worker; one log line of its figures.
+  void stopTrips();
+  const TripRoom* trips() const { return trips_.get(); }
 
   const TwinConfig& config() const { return ctx_.cfg; }
   const bus::Channels& channels() const { return ctx_.ch; }
@@ -126,8 +141,10 @@ class ShaftTwin {
   lcm::LCM& in_;                                 ///< receives (LCM's path) and, without lcm_out, publishes
   ShaftOutputs outputs_;                         ///< every outgoing message
   std::unique_ptr<ForecastScheduler> forecast_;  ///< look-ahead forecasts (nullptr without [forecast] enabled)
+  std::unique_ptr<OffsetKeeper> offsets_;        ///< the kept accelerometer offset (nullptr: not kept)
   ShaftInputs inputs_;                           ///< every input channel
   ShaftHealth health_;                           ///< statistics into HOIST_HEALTH, the report's figures
+  std::unique_ptr<TripRoom> trips_;              ///< the shaft's memory (nullptr: [history] off)
   static constexpr int kLogCatchup = 0;          ///< log limiter key: limited catch-up
   LogRateLimiter<1> log_limit_{5};               ///< rate limit of the tick's warning lines
   bool fault_injected_ = false;                  ///< TestHooks::inject_fault_at has fired

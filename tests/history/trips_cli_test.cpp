@@ -13,6 +13,7 @@
 #include "hoist/history/sqlite_store.hpp"
 #include "process.hpp"
 #include "sample_record.hpp"
+#include "trip_profile.hpp"
 
 namespace fs = std::filesystem;
 using hoist::test::CapturedRun;
@@ -179,24 +180,8 @@ TEST_F(TripsCli, BadOptionsExit2NamingTheOption) {
 // trip pipeline: two trips, in order, stored; the same file again with the
 // same --first-trip stores nothing twice.
 TEST_F(TripsCli, IngestsARecordingThroughTheTripPipeline) {
-  std::ofstream prof(path("profile.csv"));
-  prof << "t,v,a\n";
-  const double dt = 0.01, amax = 1.0, vmax = 4.0, travel = 100.0;
-  const double ta = vmax / amax, tc = (travel - vmax * ta) / vmax, trip = 2 * ta + tc;
-  const double rest = 4.0, total = 3 * rest + 2 * trip;
-  for (int i = 0; i * dt <= total + 1e-9; ++i) {
-    const double t = i * dt;
-    double v = 0.0, a = 0.0, sign = 1.0, u = -1.0;
-    if (t > rest && t < rest + trip) u = t - rest;
-    else if (t > 2 * rest + trip && t < 2 * rest + 2 * trip) u = t - 2 * rest - trip, sign = -1.0;
-    if (u >= 0) {
-      if (u < ta) v = amax * u, a = amax;
-      else if (u < ta + tc) v = vmax;
-      else v = std::max(0.0, vmax - amax * (u - ta - tc)), a = -amax;
-    }
-    prof << t << "," << sign * v << "," << sign * a << "\n";
-  }
-  prof.close();
+  const double amax = 1.0, vmax = 4.0, travel = 100.0;
+  hoist::test::writeDownUpProfile(path("profile.csv"), 4.0, travel, vmax, amax);
   const auto sim = hoist::test::runCaptured(HOIST_SIM, {"--profile", path("profile.csv"), "--modes", "12",
                                                         "--write-measurements", path("meas.csv"), "--seed", "3", "-q",
                                                         "--out", path("sim.csv")});

@@ -91,11 +91,11 @@ TEST_F(TimingTest, GenerousBudgetsPass) {
   EXPECT_NE(r.find("| duration | 4 s"), std::string::npos);
   EXPECT_NE(r.find("hoist-timing-test --lcm-url"), std::string::npos) << "the command is in the report";
   EXPECT_NE(r.find("## Violated budgets\n\nnone"), std::string::npos) << r;
-  // About 400 inputs sent (the feeder may skip a period under load), nearly all accepted.
+  // About 100 inputs sent (4 s at 25 Hz; the feeder may skip a period under load), nearly all accepted.
   ASSERT_TRUE(std::regex_search(r, m, std::regex(R"(\| inputs sent / accepted / lost \| (\d+) / (\d+) / (-?\d+) \|)")))
       << r;
-  EXPECT_GE(std::stoi(m[1].str()), 390);
-  EXPECT_LE(std::stoi(m[1].str()), 400);
+  EXPECT_GE(std::stoi(m[1].str()), 97);
+  EXPECT_LE(std::stoi(m[1].str()), 100);
   EXPECT_GE(std::stoi(m[2].str()), std::stoi(m[1].str()) - 5);
   // The summary is printed too.
   EXPECT_NE(out.find("VERDICT: PASS"), std::string::npos) << out;

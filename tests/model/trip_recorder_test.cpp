@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "hoist/clearance.hpp"
 #include "hoist/trip_pipeline.hpp"
 #include "hoist/trip_recorder.hpp"
 #include "trip_truth.hpp"
@@ -125,6 +126,41 @@ TEST(TripAccumulator, FiguresOfAHandMadeTrip) {
   EXPECT_NEAR(r.bins[1].y_c_mean, 1e-3 * 15.0 / 30.0, 2e-6);
   EXPECT_NEAR(r.bins[1].theta_rms, 2e-4, 1e-12);
   EXPECT_FALSE(acc.active());
+}
+
+TEST(TripRecorder, TicksKeptBeforeTheDepartureKeepTheirGuideDeflection) {
+  // Rest, a creep between rest_speed and the departure threshold (kept: the
+  // trip starts at the last still sample), the trip, the arrival.  The guide
+  // rope is deflected by 0.25 m during the creep only: the record's smallest
+  // clearance is the creep's (guide_rope_gap - 0.25), at the creep's depth.
+  ShaftParams twin;
+  twin.n = 8;
+  TripRecorder rec(twin, EstimatorSettings{}, ConditionSettings{}, 0.01);
+  LoadEstimate e;
+  MeasurementSample m;
+  double t = 0.0, l = 100.0;
+  bool arrived = false;
+  auto feed = [&](double v, double dur, double deflection) {
+    for (double u = 0.0; u < dur - 1e-9; u += 0.01) {
+      t += 0.01;
+      l += v * 0.01;
+      m.t = t;
+      m.k = kin(l, v, 0.0);
+      e.t = t;
+      arrived = rec.add(m, e, deflection) || arrived;
+    }
+  };
+  feed(0.0, 2.0, 0.0);
+  const double l_creep = l + 0.015 * 0.01;  // the creep's first sample
+  feed(0.015, 0.5, 0.25);  // above rest_speed 0.01, below the departure at 0.02
+  feed(2.0, 10.0, 0.0);
+  feed(0.0, 2.0, 0.0);
+  ASSERT_TRUE(arrived);
+  const TripRecord& r = rec.record();
+  EXPECT_NEAR(r.depth_start, l_creep - 0.015 * 0.01, 1e-9);  // the last still sample
+  const double expected = cageClearance(0.0, 0.0, twin.h, 0.25, ConditionSettings{}.clearance).min_clearance;
+  EXPECT_NEAR(r.min_clearance, expected, 1e-12);
+  EXPECT_NEAR(r.min_clearance_depth, l_creep, 1e-9);
 }
 
 TEST(RecordTrips, TwoTripsOfOurOwnModel) {

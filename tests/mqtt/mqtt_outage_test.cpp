@@ -298,7 +298,11 @@ void expectExactlyOnceInOrder(const std::string& what, const std::vector<std::in
 }
 
 /// Cage samples: decimated to [bridge] cage_rate by the bridge, so a subset of
-/// what was sent -- but in order, once, and with no hole (no 1 s without one).
+/// what was sent -- but in order, once, and with no hole: no 3 s without one
+/// (the outage would leave a 120-s hole; a busy machine that stalls the
+/// bridge's loop for a second or two makes it keep only the latest sample,
+/// by design: seen 1.2-1.6 s with two outage tests, the soak and two CPU-bound
+/// tests on 2 cores).
 void expectSamplesInOrderWithoutHoles(const std::vector<std::int64_t>& sent, const std::vector<std::int64_t>& got_raw) {
   int redelivered = 0;
   const auto got = collapse(got_raw, redelivered);
@@ -315,7 +319,7 @@ void expectSamplesInOrderWithoutHoles(const std::vector<std::int64_t>& sent, con
   }
   EXPECT_EQ(got.front(), sent.front());
   EXPECT_EQ(got.back(), sent.back());
-  EXPECT_LE(worst_gap, 1'000'000) << "a hole of " << worst_gap / 1e6 << " s in the cage samples";
+  EXPECT_LE(worst_gap, 3'000'000) << "a hole of " << worst_gap / 1e6 << " s in the cage samples";
   EXPECT_GE(got.size() * 10, sent.size() * 9) << got.size() << " of " << sent.size() << " cage samples";
   std::cout << "[ outage  ] cage: " << sent.size() << " sent at 5 Hz, " << got.size()
             << " received (bridge at 10 Hz), largest gap " << worst_gap / 1e6 << " s\n";

@@ -19,6 +19,8 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <unistd.h>
 #include <spdlog/sinks/ostream_sink.h>
 #include <sstream>
 #include <thread>
@@ -174,6 +176,17 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
     opt.shafts.push_back(c);
     opt.labels.push_back("C" + std::to_string(i));
   }
+  // [history] on for A and B (issue 32): every step is copied into their
+  // trip rooms' rings on the loop thread; the workers record the trips.
+  const auto hdir = std::filesystem::temp_directory_path() / ("daemon_no_alloc_history_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(hdir);
+  TripHistoryConfig hist;
+  hist.enabled = true;
+  hist.store.url = (hdir / "history.sqlite").string();
+  hist.config_dir = hdir.string();
+  hist.shaft = "A";
+  opt.history = {hist, hist};
+  opt.history[1].shaft = "B";
   opt.lcm_url = kUrl;
   Daemon d(std::move(opt), captureLogger(logs));
   ASSERT_TRUE(d.start());
@@ -192,6 +205,7 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   };
   loopFor(1.0s);  // warm-up: first input, re-initialization, first events, first health
   const ShaftRunStats a0 = d.shaft(0).runStats(), b0 = d.shaft(1).runStats(), c0 = d.shaft(2).runStats();
+  const std::int64_t trip_ticks0 = d.shaft(0).trips()->counters().ticks.load();
   long allocs = 0;
   {
     AllocationWatch watch;
@@ -199,11 +213,18 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
     allocs = watch.count();
   }
   const ShaftRunStats a1 = d.shaft(0).runStats(), b1 = d.shaft(1).runStats(), c1 = d.shaft(2).runStats();
+  const std::int64_t trip_ticks1 = d.shaft(0).trips()->counters().ticks.load();
   feed.join();
   d.requestStop("test over");
   d.finish();
 
   EXPECT_EQ(allocs, 0) << "heap allocations on the loop thread after start-up";
+  // The trip room took every step of the window, none dropped.
+  EXPECT_GT(trip_ticks1 - trip_ticks0, 1000);
+  EXPECT_EQ(d.shaft(0).trips()->counters().dropped.load(), 0);
+  EXPECT_TRUE(d.shaft(2).trips() == nullptr);
+  std::error_code ec;
+  std::filesystem::remove_all(hdir, ec);
   // The watched window did the real work.
   // (3.3 s at 1 kHz and 100 Hz: 3300 and 330 ticks on an idle machine; a
   // loaded one skips some -- the point is that the loop ran, alarms and all)

@@ -37,7 +37,9 @@
 #include <cstdio>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -50,6 +52,7 @@
 #include "hoist/io/results.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/profile.hpp"
+#include "hoist/trip_recorder.hpp"
 
 namespace {
 
@@ -59,7 +62,7 @@ struct Options {
   std::string config, measurements, out;
   int modes = 0;
   double max_step = -1.0;
-  bool progress = false, quiet = false;
+  bool progress = false, quiet = false, no_trips = false;
   std::vector<std::string> known_load;  // T0,T1,FA,B each
   std::string offset_in, offset_out;
 };
@@ -230,14 +233,36 @@ int run(const Options& o) {
   unsigned faults[3] = {0, 0, 0};  // every fault bit seen, per channel
   std::string first_implausible, changes;
   double last_change = -1.0;
+  long n_changes = 0;
+  constexpr long kShownChanges = 8;
   double first_mismatch = std::nan("");
   std::string first_why;  // what raised it first: the NIS window against its bound, or a drifting load
   int last_decile = 0;
   const bool tty = ::isatty(2);
+  // Each trip of the data (departure to arrival, the daemon's TripRecorder)
+  // and whether its IMU could see a 30 % guide-rope preload loss
+  // (identifyPreload: about a second of CPU per trip at n = 25).  Only for
+  // the summary: not with -q or --no-trips.
+  std::optional<hoist::TripRecorder> trips;
+  if (!o.quiet && !o.no_trips) {
+    hoist::ConditionSettings cond;
+    cond.accel_offset_sigma = set.accel_offset_sigma;
+    trips.emplace(p, set, cond, max_step);
+  }
+  std::vector<std::string> trip_lines;
+  std::size_t sample_index = 0;  // estimateRecorded reports once per sample, in order
   try {
     hoist::estimateRecorded(
         p, set, max_step, samples, cal,
         [&](const hoist::LoadEstimate& e, const hoist::EstimatorCounters& c) {
+          if (trips && sample_index < samples.size() && trips->add(samples[sample_index], e)) {
+            const hoist::TripRecord& r = trips->record();
+            trip_lines.push_back("trip " + std::to_string(r.trip) + " (" +
+                                 (r.direction == hoist::TripDirection::Down ? "down " : "up ") +
+                                 fmt("%.0f", r.depth_start) + " -> " + fmt("%.0f", r.depth_end) + " m, t = " +
+                                 fmt("%.1f", r.t_start) + " .. " + fmt("%.1f", r.t_end) + " s): " + r.id.note);
+          }
+          ++sample_index;
           line.clear();
           appendRow(line, e, c);
           out.write(line);
@@ -260,8 +285,12 @@ int run(const Options& o) {
           faults[1] |= e.fault_imu_rate;
           faults[2] |= e.fault_rope_load;
           if (e.change_t >= 0.0 && e.change_t != last_change) {
-            if (last_change >= 0.0 || !changes.empty()) changes += "; ";
-            changes += "t = " + fmt("%.2f", e.change_t) + " s";
+            // The first kShownChanges by time; the rest counted (a config
+            // whose noise is far below the data's makes hundreds).
+            if (++n_changes <= kShownChanges) {
+              if (!changes.empty()) changes += "; ";
+              changes += "t = " + fmt("%.2f", e.change_t) + " s";
+            }
             last_change = e.change_t;
           }
           last = e;
@@ -312,9 +341,16 @@ int run(const Options& o) {
     for (int i = 0; i < 3; ++i)
       if (faults[i]) s << " Sensor fault: " << names[i] << " " << hoist::sensorFaultReason(faults[i]) << ".";
     if (!changes.empty())
-      s << " Load changes at " << changes << "; the last by " << fmt("%.1f", last.change_Fa) << " N and "
+      s << " Load changes at " << changes
+        << (n_changes > kShownChanges ? " and " + std::to_string(n_changes - kShownChanges) + " more" : std::string())
+        << "; the last by " << fmt("%.1f", last.change_Fa) << " N and "
         << fmt("%.1f", last.change_moment) << " N m.";
     s << "\n";
+    if (trips) {
+      if (trip_lines.empty())
+        s << "hoist-estimate: no whole trip in the data (rest, motion, rest): no preload detectability to state.\n";
+      for (const std::string& t : trip_lines) s << "hoist-estimate: " << t << ".\n";
+    }
     std::cout << s.str();
   }
   return 0;
@@ -357,6 +393,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--offset-out", o.offset_out, "write the learned accelerometer offset and its sigma to FILE");
   app.add_flag("--progress", o.progress, "show progress on stderr");
+  app.add_flag("--no-trips", o.no_trips,
+               "do not state per trip whether the IMU could see a 30 % guide-rope preload loss (that identifies "
+               "the preload scale of each trip: about 1 s of CPU per trip at n = 25)");
   app.add_flag("-q,--quiet", o.quiet, "no summary and no warnings");
   try {
     app.parse(argc, argv);

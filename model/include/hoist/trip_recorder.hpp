@@ -13,7 +13,6 @@
 
 #include <cstdint>
 #include <string_view>
-#include <utility>
 #include <vector>
 
 #include "hoist/trip_accumulator.hpp"
@@ -40,7 +39,12 @@ class TripRecorder {
  private:
   TripDetector det_;
   TripAccumulator acc_;
-  std::vector<std::pair<MeasurementSample, LoadEstimate>> pending_;  // since the last still sample
+  struct Pending {  // one tick since the last still sample, as add() got it
+    MeasurementSample m;
+    LoadEstimate e;
+    double guide_deflection;
+  };
+  std::vector<Pending> pending_;  // since the last still sample
   TripRecord rec_;
   std::int64_t trips_ = 0, not_a_trip_ = 0;
 };

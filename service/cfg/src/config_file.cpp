@@ -2,6 +2,7 @@
 #include "hoist/service/config_file.hpp"
 
 #include "hoist/io/estimator_config.hpp"
+#include "hoist/history/condition_config.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -220,7 +221,7 @@ void takeDaemonSensorKeys(toml::table& tbl, const std::string& source, Estimator
 TwinConfig loadTwinConfig(const std::string& path) {
   toml::table tbl = hoist::io::loadTomlFile(path);
   TwinConfig cfg;
-  cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, hoist::io::daemonSections());
+  cfg.shaft = hoist::io::shaftParamsFromToml(tbl, path, hoist::history::configSections());  // [history], [condition]: history_config.hpp
   parseServiceSections(tbl, path, cfg);
   takeDaemonSensorKeys(tbl, path, cfg.estimator);
   const hoist::io::EstimatorConfig e = hoist::io::estimatorConfigFromToml(tbl, path);

@@ -50,6 +50,16 @@ bool TwinCore::calibrate(double Fa, double b, double duration) {
   return true;
 }
 
+bool TwinCore::setAccelOffset(double offset, double sigma) {
+  if (!est_) return false;
+  try {
+    est_->setAccelOffset(offset, sigma);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+  return true;
+}
+
 void TwinCore::noteSensorFault(SensorId s, SensorFaultReason r, double value, double limit) {
   sensor_fault_ = SensorFaultInfo{s, r, value, limit};
   sensor_fault_until_ = t_ + kSensorFaultHold;
@@ -76,6 +86,10 @@ void TwinCore::estimatorStep(const CageResponse& r) {
   // evidence against the model: its NIS stays out of MODEL_MISMATCH's window.
   if (degradedNow()) est_->excludeTickFromModelCheck();
   est_->finish();
+  // What the sensors read at this step (the trip room's record, issue 32).
+  meas_.t = t_;
+  meas_.z = SensorValues{d.accel ? d.f_y : 0.0, d.rate ? d.omega : 0.0, d.rope ? d.force : 0.0};
+  meas_.present = (d.accel ? kSensorImuAccel : 0u) | (d.rate ? kSensorImuRate : 0u) | (d.rope ? kSensorRopeLoad : 0u);
 }
 
 unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {

@@ -282,6 +282,10 @@ class TwinCore {
   /// false (nothing changes): no estimator, or Fa < 0.  A new declaration
   /// replaces one in force.  The learned offset: estimate().accel_offset.
   bool calibrate(double Fa, double b, double duration);
+  /// Start the estimator from a learned accelerometer offset [m/s^2] and its
+  /// sigma (a calibration kept across restarts: LoadEstimator::setAccelOffset).
+  /// false (nothing changes): no estimator, or a value it refuses.
+  bool setAccelOffset(double offset, double sigma);
   /// A declared known load is in force at the current model time.
   bool calibrating() const { return est_ && t_ < known_until_; }
   /// The clock offset of the last offered sensor sample [s] (for the log).
@@ -302,6 +306,10 @@ class TwinCore {
   bool estimatorEnabled() const { return est_ != nullptr; }
   /// The estimate after the last step (null when disabled or not yet started).
   const LoadEstimate* estimate() const { return est_ && est_synced_ ? &est_->estimate() : nullptr; }
+  /// The sensor values applied at the last estimator step (t, z, present;
+  /// present = 0 when none was due; the kinematics are left to the caller:
+  /// output().kin).  The daemon's trip room copies it every tick (issue 32).
+  const MeasurementSample& lastMeasurement() const { return meas_; }
   const EstimatorCounters* estimatorCounters() const { return est_ ? &est_->counters() : nullptr; }
   /// The last step's clearance and rope-force alarms were judged on the
   /// estimate (it has sensors in use and no MODEL_MISMATCH).
@@ -368,6 +376,7 @@ class TwinCore {
   std::int64_t steps_ = 0, faults_ = 0, resets_ = 0, domain_errors_ = 0, catchups_ = 0;
   // load estimator ([estimator] enabled; docs/estimation.md)
   std::unique_ptr<LoadEstimator> est_;  // null when disabled
+  MeasurementSample meas_;      // the sensors applied at the last estimator step (lastMeasurement)
   bool est_synced_ = false;     // its sensitivities stepped exactly as the solver (false after a refused step)
   bool est_in_use_ = false;     // the last step's alarms used the estimate (sensors in use, no mismatch)
   SensorTiming timing_;         // the sensor samples, queued to their own time

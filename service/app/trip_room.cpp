@@ -1,0 +1,252 @@
+// One shaft's memory: see trip_room.hpp.
+#include "trip_room.hpp"
+
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "hoist/history/store.hpp"
+#include "hoist/rt/realtime.hpp"
+#include "hoist/trip_recorder.hpp"
+
+namespace hoist::svc {
+
+namespace {
+constexpr auto kDrainPeriod = std::chrono::milliseconds(20);
+
+std::int64_t threadCpuNs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+std::shared_ptr<spdlog::logger> logger() {
+  auto l = spdlog::get("hoist-twind");
+  return l ? l : spdlog::default_logger();
+}
+
+/// [condition] plus what the daemon's other sections say ([alarms] gaps).
+ConditionSettings conditionFor(const TwinConfig& cfg, const TripHistoryConfig& h) {
+  ConditionSettings c = h.condition;
+  c.clearance.gap_pos_y = cfg.alarms.gap_pos_y;
+  c.clearance.gap_neg_y = cfg.alarms.gap_neg_y;
+  c.clearance.guide_rope_gap = cfg.alarms.guide_rope_gap;
+  c.clearance.warning_fraction = cfg.alarms.warning_fraction;
+  c.clearance.critical_fraction = cfg.alarms.critical_fraction;
+  return c;
+}
+}  // namespace
+
+// ---- the ring --------------------------------------------------------------
+
+TripRing::TripRing(std::size_t capacity) : buf_(capacity) {
+  if (capacity < 2) throw std::invalid_argument("TripRing: capacity must be >= 2");
+}
+
+bool TripRing::push(const TripTick& t) {
+  const std::size_t h = head_.load(std::memory_order_relaxed);
+  const std::size_t next = (h + 1) % buf_.size();
+  if (next == tail_.load(std::memory_order_acquire)) return false;  // full
+  buf_[h] = t;
+  head_.store(next, std::memory_order_release);
+  return true;
+}
+
+bool TripRing::pop(TripTick& out) {
+  const std::size_t t = tail_.load(std::memory_order_relaxed);
+  if (t == head_.load(std::memory_order_acquire)) return false;  // empty
+  out = buf_[t];
+  tail_.store((t + 1) % buf_.size(), std::memory_order_release);
+  return true;
+}
+
+// ---- the room --------------------------------------------------------------
+
+struct TripRoom::Worker {
+  Worker(const TwinConfig& cfg, const ConditionSettings& cond)
+      : rec(cfg.shaft, cfg.estimator.settings, cond, cfg.service.max_step) {}
+  TripRecorder rec;
+  std::unique_ptr<history::Store> store;
+  std::uint32_t seen = 0;        // alarm kinds already added to the trip under way
+  TripTick tick;                 // the tick being taken
+  std::int64_t cpu_trip0 = 0;    // thread CPU at the trip's first tick
+  bool moving = false;
+};
+
+TripRoom::TripRoom(const TwinConfig& cfg, const TripHistoryConfig& hist, std::string shaft_name, std::size_t capacity)
+    : cfg_(cfg),
+      hist_(hist),
+      shaft_(std::move(shaft_name)),
+      ring_(capacity ? capacity
+                     : std::max<std::size_t>(1024, static_cast<std::size_t>(30.0 * cfg.service.rate))),
+      w_(std::make_unique<Worker>(cfg, conditionFor(cfg, hist))) {}
+
+TripRoom::~TripRoom() { stop(); }
+
+void TripRoom::afterStep(const TwinCore& core, std::int64_t wall_us) {
+  TripTick& t = scratch_;
+  const CageOutput& o = core.output();
+  if (const LoadEstimate* e = core.estimate()) {
+    t.e = *e;
+    t.m = core.lastMeasurement();
+  } else {
+    t.e = LoadEstimate{};
+    t.e.t = o.t;
+    t.e.kin = o.kin;
+    t.e.y_c = o.y_c;
+    t.e.theta = o.theta;
+    t.e.lambda = o.lambda;
+    t.m = MeasurementSample{};
+  }
+  t.m.t = core.modelTime();
+  t.m.k = o.kin;
+  t.guide_deflection = o.clearance.guide_deflection;
+  t.wall_us = wall_us;
+  std::uint32_t bits = 0;
+  for (const BinaryAlarm& a : core.alarms().alarms())
+    if (a.active()) bits |= 1u << static_cast<unsigned>(a.kind());
+  t.alarms = bits;
+  if (ring_.push(t)) counts_.ticks.fetch_add(1, std::memory_order_relaxed);
+  else counts_.dropped.fetch_add(1, std::memory_order_relaxed);
+}
+
+void TripRoom::start() {
+  if (worker_.joinable()) return;
+  quit_.store(false);
+  worker_ = std::thread([this] { workerMain(); });
+}
+
+void TripRoom::stop() {
+  if (!worker_.joinable()) return;
+  quit_.store(true, std::memory_order_release);
+  worker_.join();
+}
+
+std::string TripRoom::describeStore() const {
+  return counts_.store_open.load(std::memory_order_acquire) ? store_desc_ : std::string();
+}
+
+void TripRoom::workerMain() {
+  hoist::rt::yieldToRealtimeLoop(kNice);
+  auto log = logger();
+  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  try {
+    history::HistoryConfig h = hist_.store;
+    const history::StoreOptions o = history::resolveStoreOptions(h, hist_.config_dir);
+    w_->store = history::openStore(o);
+    store_desc_ = w_->store->describe();
+    counts_.store_open.store(true, std::memory_order_release);
+    log->info("{}trip history: recording every trip into {} (schema {})", tag, store_desc_,
+              w_->store->schemaVersion());
+    pruneOld(std::chrono::duration_cast<std::chrono::microseconds>(
+                 std::chrono::system_clock::now().time_since_epoch()).count());
+  } catch (const std::exception& e) {
+    log->error("{}trip history: the database cannot be opened: {}; trips are detected and counted but not "
+               "stored (the twin runs on)", tag, e.what());
+  }
+  for (;;) {
+    const bool quitting = quit_.load(std::memory_order_acquire);
+    const std::int64_t c0 = threadCpuNs();
+    while (ring_.pop(w_->tick)) take(w_->tick);
+    counts_.cpu_ns.fetch_add(threadCpuNs() - c0, std::memory_order_relaxed);
+    if (quitting) break;
+    std::this_thread::sleep_for(kDrainPeriod);
+  }
+  if (w_->store) {
+    try {
+      w_->store->flush();
+    } catch (const std::exception& e) {
+      log->warn("{}trip history: flush at stop: {}", tag, e.what());
+    }
+  }
+}
+
+void TripRoom::pruneOld(std::int64_t now_us) {
+  const int keep_days = hist_.store.keep_days;
+  if (keep_days <= 0 || !w_->store) return;
+  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  try {
+    const std::int64_t pruned = w_->store->prune(keep_days, now_us);
+    if (pruned > 0) logger()->info("{}trip history: {} trips older than history.keep_days = {} pruned", tag, pruned, keep_days);
+  } catch (const std::exception& e) {
+    logger()->warn("{}trip history: pruning trips older than history.keep_days = {} failed: {}", tag, keep_days, e.what());
+  }
+}
+
+void TripRoom::take(const TripTick& t) {
+  Worker& w = *w_;
+  // A tick without a finite state (no input yet, a model fault) is no part of a trip.
+  if (!std::isfinite(t.m.t) || !std::isfinite(t.m.k.l) || !std::isfinite(t.m.k.v) || !std::isfinite(t.m.k.a) ||
+      !std::isfinite(t.e.y_c) || !std::isfinite(t.e.theta))
+    return;
+  if (!w.moving) w.cpu_trip0 = threadCpuNs();
+  bool arrived = false;
+  try {
+    arrived = w.rec.add(t.m, t.e, t.guide_deflection);
+  } catch (const std::exception& e) {
+    // A step the identification's solver refused: this trip is lost, the next one starts afresh.
+    counts_.failed.fetch_add(1, std::memory_order_relaxed);
+    logger()->warn("{}trip history: a trip's record failed: {}", shaft_.empty() ? "" : "[" + shaft_ + "] ", e.what());
+    w.rec.reset();
+    w.moving = false;
+    w.seen = 0;
+    return;
+  }
+  if (w.rec.moving()) {
+    w.moving = true;
+    const std::uint32_t fresh = t.alarms & ~w.seen;
+    if (fresh) {
+      for (int k = 0; k < contract::kAlarmKinds; ++k)
+        if (fresh & (1u << k)) w.rec.addAlarm(contract::toString(static_cast<AlarmKind>(k)));
+      w.seen |= fresh;
+    }
+  }
+  counts_.not_a_trip.store(w.rec.notATrip(), std::memory_order_relaxed);
+  if (arrived) finishTrip();
+  if (!w.rec.moving()) {
+    w.moving = false;
+    w.seen = t.alarms;  // raised before the departure: not counted unless raised again
+  }
+}
+
+void TripRoom::finishTrip() {
+  Worker& w = *w_;
+  TripRecord& r = w.rec.record();
+  const TripTick& now = w.tick;
+  r.shaft = shaft_;
+  r.trip = 0;  // the store numbers it
+  // Wall clock: the tick's wall time, shifted by the model-time difference.
+  auto wallAt = [&now](double t_model) {
+    return now.wall_us - static_cast<std::int64_t>(std::llround((now.m.t - t_model) * 1e6));
+  };
+  r.wall_start_us = wallAt(r.t_start);
+  r.wall_end_us = wallAt(r.t_end);
+  counts_.trips.fetch_add(1, std::memory_order_relaxed);
+  const std::int64_t cpu = threadCpuNs() - w.cpu_trip0;
+  counts_.cpu_ns_last.store(cpu, std::memory_order_relaxed);
+  auto log = logger();
+  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  if (!w.store) {
+    counts_.failed.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  try {
+    const history::PutResult p = w.store->put(r);
+    if (p == history::PutResult::Queued) counts_.queued.fetch_add(1, std::memory_order_relaxed);
+    else counts_.stored.fetch_add(1, std::memory_order_relaxed);
+    log->info("{}trip {} recorded ({}): {} {:.1f} -> {:.1f} m, preload scale {:.3f} +- {:.3f}{}, {} alarms, "
+              "{:.0f} ms CPU", tag, r.trip, history::toString(p), r.direction == TripDirection::Down ? "down" : "up",
+              r.depth_start, r.depth_end, r.id.scale, r.id.sigma_scale, r.id.informative ? "" : " (not informative)", r.alarms.size(),
+              cpu * 1e-6);
+    pruneOld(now.wall_us);  // a daemon that runs for months keeps keep_days too
+  } catch (const std::exception& e) {
+    counts_.failed.fetch_add(1, std::memory_order_relaxed);
+    log->error("{}trip history: the record of a trip could not be written: {}", tag, e.what());
+  }
+}
+
+}  // namespace hoist::svc

@@ -1,0 +1,123 @@
+// TripRoom: one shaft's memory (issue 32, docs/condition.md "Live").
+//
+// The loop thread copies one compact TripTick per model step (afterStep:
+// the winder's kinematics, the sensor values applied with their presence
+// bits, the load estimate, the guide-rope deflection, the wall clock and the
+// active alarm kinds) into a preallocated single-producer single-consumer
+// ring: no allocation, no lock, no I/O, a fixed copy.  A full ring drops
+// the tick (counted: the trip's record then misses samples) -- the loop
+// never waits.
+//
+// One worker thread per shaft (started by start(), SCHED_OTHER nice 10 as
+// the forecast workers, hoist::rt::yieldToRealtimeLoop) opens the history
+// database (hoist::history::Store) off the loop (pruning trips older than
+// [history] keep_days then and after each trip), drains the ring every
+// kDrainPeriod, runs the trip pipeline (hoist::TripRecorder: TripDetector,
+// TripAccumulator, identifyPreload) and, at each trip's end, fills in the
+// shaft's name, the wall-clock times and the alarms raised during the trip
+// and puts the record into the store.  A store that cannot be opened or a
+// put that fails is logged and counted; the twin runs on.  The worker logs
+// through spdlog directly (not the loop's RtLog).
+//
+// Lifetimes: owned by ShaftTwin; stop() (or the destructor) joins the
+// worker after it has drained the ring (a trip under way at stop is not
+// recorded: it did not end).  counters() may be read from any thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "hoist/load_estimator.hpp"
+#include "hoist/service/config.hpp"
+#include "hoist/service/history_config.hpp"
+#include "hoist/service/twin_core.hpp"
+
+namespace hoist::svc {
+
+/// What the loop copies per step.
+struct TripTick {
+  MeasurementSample m;             ///< t (model), kinematics, sensors applied, present bits
+  LoadEstimate e;                  ///< the estimate (default with the estimator off)
+  double guide_deflection = 0.0;   ///< the guide-rope envelope's deflection [m]
+  std::int64_t wall_us = 0;        ///< wall clock of the step [us since the epoch]
+  std::uint32_t alarms = 0;        ///< bit k: AlarmKind k active
+};
+
+/// Fixed-capacity SPSC ring of TripTick (lock-free; one producer thread,
+/// one consumer thread).
+class TripRing {
+ public:
+  explicit TripRing(std::size_t capacity);
+  /// Producer: false when full (nothing written).
+  bool push(const TripTick& t);
+  /// Consumer: false when empty.
+  bool pop(TripTick& out);
+  std::size_t capacity() const { return buf_.size(); }
+
+ private:
+  std::vector<TripTick> buf_;
+  alignas(64) std::atomic<std::size_t> head_{0};  // next write (producer)
+  alignas(64) std::atomic<std::size_t> tail_{0};  // next read (consumer)
+};
+
+/// The room's figures (atomics: the loop and the worker write, the final
+/// log line and the tests read; not in HOIST_HEALTH yet).
+struct TripCounters {
+  std::atomic<std::int64_t> ticks{0};        ///< ticks copied into the ring (loop side)
+  std::atomic<std::int64_t> trips{0};        ///< trips recorded (records built)
+  std::atomic<std::int64_t> stored{0};       ///< records written to the database
+  std::atomic<std::int64_t> queued{0};       ///< records put into the PostgreSQL outage queue
+  std::atomic<std::int64_t> failed{0};       ///< records the store refused or could not write
+  std::atomic<std::int64_t> dropped{0};      ///< ticks dropped: the ring was full (loop side)
+  std::atomic<std::int64_t> not_a_trip{0};   ///< motions shorter than a trip
+  std::atomic<std::int64_t> cpu_ns{0};       ///< worker CPU time, all of it [ns]
+  std::atomic<std::int64_t> cpu_ns_last{0};  ///< worker CPU time of the last trip's record [ns]
+  std::atomic<bool> store_open{false};       ///< the database is open
+};
+
+class TripRoom {
+ public:
+  /// Ring of `capacity` ticks (default: 30 s at the step rate, at least 1024).
+  /// Throws std::invalid_argument for bad [condition] settings.
+  TripRoom(const TwinConfig& cfg, const TripHistoryConfig& hist, std::string shaft_name, std::size_t capacity = 0);
+  ~TripRoom();
+  TripRoom(const TripRoom&) = delete;
+  TripRoom& operator=(const TripRoom&) = delete;
+
+  /// Loop thread, after each model step: one tick copied into the ring.
+  /// Allocation-free; never blocks.
+  void afterStep(const TwinCore& core, std::int64_t wall_us);
+  /// Start the worker (opens the database on it).
+  void start();
+  /// Drain the ring, join the worker.  Idempotent.
+  void stop();
+
+  const TripCounters& counters() const { return counts_; }
+  /// The store's description ("sqlite /path"), known once open ("" before).
+  std::string describeStore() const;
+
+ private:
+  void workerMain();
+  void take(const TripTick& t);  // worker: one tick into the recorder
+  void finishTrip();             // worker: the record to the store
+  void pruneOld(std::int64_t now_us);  // worker: [history] keep_days (at open and after each trip)
+
+  TwinConfig cfg_;
+  TripHistoryConfig hist_;
+  std::string shaft_;
+  TripRing ring_;
+  TripTick scratch_;  // the loop's staging copy (no stack copy of a large struct per step)
+  TripCounters counts_;
+  std::thread worker_;
+  std::atomic<bool> quit_{false};
+  struct Worker;                  // the worker's state (recorder, store): worker thread only
+  std::unique_ptr<Worker> w_;
+  std::string store_desc_;        // written by the worker before store_open is set
+  static constexpr int kNice = 10;
+};
+
+}  // namespace hoist::svc
