@@ -13,7 +13,10 @@
 //     closed stderr never stops the daemon (docs/service.md, Signals).
 // It hosts one or more shafts (ShaftTwin: config, channels, model, alarms);
 // all the math is in TwinCore (hoist_twin); this file only moves bytes and
-// keeps time.
+// keeps time.  Rooms of their own that the Daemon owns: the miss record's
+// writer (MissRecorder, miss_recorder.hpp), the systemd watchdog (Watchdog,
+// watchdog.hpp) and the output-URL watch (OutputWatch, output_watch.hpp);
+// the map is docs/architecture.md.
 //
 // Real time: every outgoing message and its encode buffer are allocated at
 // start-up; log lines from the loop go through RtLog's preallocated ring to a
