@@ -3,10 +3,7 @@
 
 #include <cctype>
 #include <algorithm>
-#include <cmath>
 #include <csignal>
-#include <cstdio>
-#include <ctime>
 #include <limits>
 #include <map>
 #include <systemd/sd-daemon.h>
@@ -29,17 +26,6 @@ using rt::nanos;
 using rt::processCpuNanos;
 
 namespace {
-
-/// CPU time of the calling thread [ns] (0 if unavailable).
-std::int64_t threadCpuNanos() {
-  timespec ts{};
-  if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return 0;
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
-
-}  // namespace
-
-namespace {
 /// The state file of a shaft's accelerometer offset: "accel_offset", or
 /// "accel_offset.<label>" with several shafts (the label's characters other
 /// than letters, digits, '-' and '_' as '_').
@@ -59,7 +45,6 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
       log_(out_, 4096),
       lcm_(opt_.lcm_url),
       lcm_fd_(io_),
-      out_fd_(io_),
       signals_(io_) {
   if (opt_.shafts.empty()) throw std::invalid_argument("no shaft configured");
   for (int sig : {SIGINT, SIGTERM, SIGQUIT, SIGHUP, SIGUSR1, SIGUSR2}) signals_.add(sig);
@@ -71,8 +56,6 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
   if (!opt_.lcm_url_out.empty() && opt_.lcm_url_out != opt_.lcm_url)
     lcm_out_ = std::make_unique<lcm::LCM>(opt_.lcm_url_out);
   opt_.labels.resize(opt_.shafts.size());
-  misses_ = std::make_unique<MissLog>();
-  miss_log_timer_ = std::make_unique<asio::steady_timer>(io_);
   // One ShaftTwin per configuration, one schedule (timer) per distinct rate.
   std::map<double, RateGroup*> by_rate;
   for (std::size_t i = 0; i < opt_.shafts.size(); ++i) {
@@ -84,7 +67,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
       shafts_.back()->keepAccelOffset(opt_.state_dir + "/" + accelOffsetFileName(opt_.labels[i]), out_);
     if (i < opt_.history.size() && opt_.history[i].enabled) shafts_.back()->enableTrips(opt_.history[i]);
     // Shaft i publishes its shapes at phase i of the shape divider.
-    shafts_.back()->attachLoop(&split_, misses_.get(), static_cast<int>(i));
+    shafts_.back()->attachLoop(&split_, &misses_.log(), static_cast<int>(i));
     const double rate = opt_.shafts[i].service.rate;
     const int budget = opt_.shafts[i].service.max_starts_per_tick;
     const int env_budget = opt_.shafts[i].service.max_exact_envelopes_per_tick;
@@ -129,11 +112,10 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
 }
 
 Daemon::~Daemon() {
-  stopWatchdog();
+  watchdog_.stop();
   if (pool_) pool_->stop();
   // The descriptor belongs to LCM: never let Asio close it.
   if (lcm_fd_.is_open()) lcm_fd_.release();
-  if (out_fd_.is_open()) out_fd_.release();  // out_receiver_ closes it
   log_.stop();
 }
 
@@ -143,11 +125,11 @@ bool Daemon::start() {
   if (!openInput()) return false;
   openOutput();
   armLcm();
-  watchOutputGroup();
+  if (lcm_out_) out_watch_.open(opt_.lcm_url_out, shafts_);  // a second publisher of our outputs there
   startForecasts();
   // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
   // never receives them.
-  startWatchdog();
+  watchdog_.start();
   unblockStopSignals();
   armSignals();
   startSchedules();
@@ -220,43 +202,6 @@ void Daemon::openOutput() {
   }
 }
 
-void Daemon::watchOutputGroup() {
-  // [service] lcm_url_out elsewhere: the input socket cannot see a second
-  // publisher of our outputs, so a receive-only socket on the output group
-  // watches our own HOIST_HEALTH channels.
-  if (lcm_out_) {
-    UdpmUrl out_udpm;
-    std::string out_why;
-    if (!parseUdpmUrl(opt_.lcm_url_out, out_udpm, out_why)) {
-      out_->warn("[service] lcm_url_out {} is not a udpm:// URL ({}): a second publisher on the output "
-                 "channels (DUPLICATE_PUBLISHER) cannot be detected",
-                 bus::describeLcmUrl(opt_.lcm_url_out), out_why);
-    } else {
-      out_receiver_ = std::make_unique<UdpmReceiver>();
-      if (!out_receiver_->open(out_udpm, out_why)) {
-        out_->warn("cannot watch the output URL {} for a second publisher ({}); DUPLICATE_PUBLISHER "
-                   "detection is off",
-                   bus::describeLcmUrl(opt_.lcm_url_out), out_why);
-        out_receiver_.reset();
-      } else {
-        for (auto& s : shafts_) s->watchOwnOutputs(out_receiver_.get());
-        // All our outputs arrive on that group: let the kernel drop all but
-        // the HOIST_HEALTH channels, so that the loop does not wake for its
-        // own cage and shape messages (the point of lcm_url_out).
-        std::vector<std::size_t> lens;
-        for (auto& s : shafts_) {
-          const std::size_t P = s->channels().health.size() - bus::kChannelHealth.size();
-          if (std::find(lens.begin(), lens.end(), P) == lens.end()) lens.push_back(P);
-        }
-        if (!out_receiver_->acceptOnlySuffix(bus::kChannelHealth, lens, out_why))
-          out_->warn("no kernel filter on the output-URL watch ({}): it reads every output datagram", out_why);
-        out_fd_.assign(out_receiver_->fd());
-        armOutWatch();
-      }
-    }
-  }
-}
-
 void Daemon::startForecasts() {
   if (!pool_ || pool_->empty()) return;
   pool_->start();
@@ -288,12 +233,10 @@ void Daemon::startSchedules() {
   for (auto& sp : shafts_) sp->rebase(start_);
   for (auto& g : groups_) {
     g->k = 1;
-    g->last_start = start_;
-    g->split_at = split_;
-    g->cpu_at = threadCpuNanos();
+    misses_.startWindow(g->window, start_, MissRecorder::threadCpuNanos());
     armTimer(*g);
   }
-  armMissLog();
+  misses_.startLogging();
 }
 
 void Daemon::logStarted() {
@@ -328,7 +271,7 @@ int Daemon::run() {
 
 bool Daemon::finish() {
   sd_notify(0, "STOPPING=1");
-  stopWatchdog();
+  watchdog_.stop();
   if (pool_) pool_->stop();
   log_.flush();
   const bool ok = writeReport();
@@ -354,22 +297,6 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
   // Drain what is queued, bounded so the timers are never starved.
   drainInput();
   if (!stopping_) armLcm();
-}
-
-void Daemon::armOutWatch() {
-  out_fd_.async_wait(asio::posix::stream_descriptor::wait_read,
-                     [this](const boost::system::error_code& ec) { onOutReadable(ec); });
-}
-
-void Daemon::onOutReadable(const boost::system::error_code& ec) {
-  if (stopping_ || ec == asio::error::operation_aborted) return;
-  if (ec) {
-    log_.error("output-URL watch descriptor error: {}; DUPLICATE_PUBLISHER detection stops", ec.message());
-    return;
-  }
-  // Mostly our own outputs come back here (loopback); bounded like the input.
-  out_receiver_->drain(256);
-  if (!stopping_) armOutWatch();
 }
 
 void Daemon::flushOutputs() {
@@ -424,11 +351,10 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   // The outputs queued by the shafts go out at the same points.
   // A tick that skipped deadlines is a miss: its record takes the split of
   // the loop's time since this schedule's previous tick (miss_record.hpp).
-  const std::int64_t cpu_now = threadCpuNanos();  // one clock_gettime per tick (not per shaft)
-  MissRecord* miss = skipped > 0 ? &beginMiss(g, now, deadline, skipped, cpu_now) : nullptr;
-  g.split_at = split_;
-  g.last_start = now;
-  g.cpu_at = cpu_now;
+  const std::int64_t cpu_now = MissRecorder::threadCpuNanos();  // one clock_gettime per tick (not per shaft)
+  const MissTick mt{g.index, g.rate, g.k, static_cast<int>(g.shafts.size())};
+  MissRecord* miss = skipped > 0 ? &misses_.begin(mt, g.window, start_, now, deadline, skipped, cpu_now) : nullptr;
+  misses_.startWindow(g.window, now, cpu_now);
   const std::int64_t work0 = split_.sum();
   const double period_us = duration<double, std::micro>(g.period).count();
   // Deferred starts and exact envelopes: at most the group's budgets in this tick.
@@ -445,7 +371,7 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   std::size_t i = 0;
   for (ShaftTwin* s : g.shafts) {
     s->tick(k, deadline, skipped, left);
-    if (miss) [[unlikely]] noteMissShaft(*miss, g, i, period_us);
+    if (miss) [[unlikely]] MissRecorder::noteShaft(*miss, *s, g.ids[i], period_us);
     const bool every = ++i % kDrainEvery == 0;
     const auto t_now = Clock::now();
     if (every || t_now - drained_at > g.period / 2) {
@@ -458,93 +384,13 @@ void Daemon::onTick(RateGroup& g, const boost::system::error_code& ec) {
   const std::int64_t tick_ns = nanos(Clock::now() - now);
   split_.other += std::max<std::int64_t>(0, tick_ns - (split_.sum() - work0));
   ns_ticks_ += tick_ns - (ns_receive_ - ns_rx0) - (ns_flush_ - ns_fl0);
-  if (miss) misses_->commit();
+  if (miss) misses_.commit();
   if (opt_.duration > 0.0 && duration<double>(Clock::now() - start_).count() >= opt_.duration) {
     stop("--duration elapsed");
     return;
   }
   g.k = k + 1;
   armTimer(g);
-}
-
-// ---- the miss record (miss_record.hpp) -------------------------------------------
-
-MissRecord& Daemon::beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
-                              std::int64_t skipped, std::int64_t cpu_now) {
-  MissRecord& r = misses_->begin();
-  r.utime = bus::wallUtime();
-  r.wall = duration<double>(now - start_).count();
-  r.model_t = static_cast<double>(g.k) / g.rate;
-  r.group = g.index;
-  r.rate = g.rate;
-  r.tick = g.k;
-  r.skipped = skipped;
-  r.late_us = duration<double, std::micro>(now - deadline).count();
-  r.shafts = static_cast<int>(g.shafts.size());
-  const LoopSplit& a = g.split_at;
-  const LoopSplit& b = split_;
-  r.work = LoopSplit{b.receive - a.receive, b.step - a.step,     b.envelope - a.envelope, b.publish - a.publish,
-                     b.forecast - a.forecast, b.start - a.start, b.health - a.health,     b.other - a.other};
-  r.window_us = duration<double, std::micro>(now - g.last_start).count();
-  const double work_us = 1e-3 * static_cast<double>(r.work.sum());
-  // The loop works first (the previous tick, inputs) and then idles until
-  // the deadline; what is left of the interval is the timer's: its wake-up,
-  // the kernel, a stall of the machine.
-  const double to_deadline_us = duration<double, std::micro>(deadline - g.last_start).count();
-  r.idle_us = std::max(0.0, to_deadline_us - work_us);
-  r.timer_us = std::max(0.0, r.window_us - work_us - r.idle_us);
-  r.cpu_us = g.cpu_at > 0 && cpu_now > 0 ? 1e-3 * static_cast<double>(cpu_now - g.cpu_at) : -1.0;
-  return r;
-}
-
-void Daemon::noteMissShaft(MissRecord& r, const RateGroup& g, std::size_t j, double period_us) {
-  const ShaftTwin& s = *g.shafts[j];
-  const double late = s.lastLateUs();
-  const int id = g.ids[j];
-  if (late > period_us) ++r.shafts_late;
-  if (r.first_shaft < 0) {
-    r.first_shaft = id;
-    r.first_late_us = late;
-  }
-  if (r.worst_shaft < 0 || late > r.worst_late_us) {
-    r.worst_shaft = id;
-    r.worst_late_us = late;
-  }
-  g.shafts[j]->noteMiss(r.seq, late);
-}
-
-void Daemon::armMissLog() {
-  miss_log_timer_->expires_after(std::chrono::seconds(1));
-  miss_log_timer_->async_wait([this](const boost::system::error_code& ec) { onMissLog(ec); });
-}
-
-void Daemon::onMissLog(const boost::system::error_code& ec) {
-  if (ec || stopping_) return;
-  const std::int64_t total = misses_->total();
-  if (total > misses_logged_) {
-    // The worst of the new ones that the ring still keeps.
-    const std::int64_t oldest = total - static_cast<std::int64_t>(misses_->kept());
-    const MissRecord* w = nullptr;
-    for (std::int64_t q = std::max(misses_logged_, oldest); q < total; ++q) {
-      const MissRecord& r = misses_->at(static_cast<std::size_t>(q - oldest));
-      if (!w || r.late_us > w->late_us) w = &r;
-    }
-    if (w) {
-      const LoopSplit& x = w->work;
-      auto ms = [](std::int64_t ns) { return 1e-6 * static_cast<double>(ns); };
-      log_.warn("deadline misses: {} in the last second ({} since start); the worst: tick {} of the {} Hz schedule "
-                "(t = {:.2f} s) {:.2f} ms late, {} deadline(s) skipped, {} of {} shafts more than a period late; "
-                "since the previous tick [ms]: receive {:.2f}, step {:.2f}, envelope {:.2f}, publish {:.2f}, "
-                "forecast {:.2f}, start {:.2f}, health {:.2f}, other {:.2f}, timer {:.2f}, idle {:.2f}; "
-                "the loop thread's CPU time {:.2f}",
-                total - misses_logged_, total, w->tick, w->rate, w->model_t, 1e-3 * w->late_us, w->skipped,
-                w->shafts_late, w->shafts, ms(x.receive), ms(x.step), ms(x.envelope), ms(x.publish),
-                ms(x.forecast), ms(x.start), ms(x.health), ms(x.other), 1e-3 * w->timer_us, 1e-3 * w->idle_us,
-                1e-3 * w->cpu_us);
-    }
-    misses_logged_ = total;
-  }
-  armMissLog();
 }
 
 void Daemon::armSignals() {
@@ -581,61 +427,14 @@ void Daemon::stop(const char* why) {
   }
   stopping_ = true;
   for (auto& g : groups_) g->timer->cancel();
-  miss_log_timer_->cancel();
+  misses_.stop();
   signals_.cancel();
   if (lcm_fd_.is_open()) {
     lcm_fd_.cancel();
     lcm_fd_.release();
   }
-  if (out_fd_.is_open()) {
-    out_fd_.cancel();
-    out_fd_.release();
-  }
+  out_watch_.stop();
   io_.stop();
-}
-
-// ---- systemd watchdog --------------------------------------------------------------
-
-void Daemon::startWatchdog() {
-  // WATCHDOG_USEC (set by systemd from WatchdogSec=) enables it; ping at half
-  // the timeout, as sd_watchdog_enabled(3) recommends.
-  std::uint64_t usec = 0;
-  if (sd_watchdog_enabled(0, &usec) <= 0 || usec == 0) return;
-  const auto interval = std::chrono::microseconds(std::max<std::uint64_t>(usec / 2, 1000));
-  out_->info("systemd watchdog: {} ms timeout; pinging every {} ms while the loop makes progress", usec / 1000,
-             interval.count() / 1000);
-  wd_quit_ = false;
-  watchdog_ = std::thread([this, interval] { watchdogMain(interval); });
-}
-
-void Daemon::stopWatchdog() {
-  if (!watchdog_.joinable()) return;
-  {
-    std::lock_guard lk(wd_mu_);
-    wd_quit_ = true;
-  }
-  wd_cv_.notify_all();
-  watchdog_.join();
-}
-
-void Daemon::watchdogMain(std::chrono::microseconds interval) {
-  std::uint64_t last = progress_.load(std::memory_order_relaxed);
-  bool stalled = false;
-  std::unique_lock lk(wd_mu_);
-  while (!wd_cv_.wait_for(lk, interval, [this] { return wd_quit_; })) {
-    const std::uint64_t now = progress_.load(std::memory_order_relaxed);
-    if (now != last) {
-      sd_notify(0, "WATCHDOG=1");
-      if (stalled) out_->warn("systemd watchdog: the loop makes progress again; pings resumed");
-      stalled = false;
-      last = now;
-    } else if (!stalled) {
-      stalled = true;
-      out_->error("systemd watchdog: no tick for {} ms; withholding the ping (systemd restarts the service "
-                  "if this lasts WatchdogSec)",
-                  interval.count() / 1000);
-    }
-  }
 }
 
 // ---- the run report (run_report.hpp) --------------------------------------------
@@ -654,7 +453,7 @@ bool Daemon::writeReport() const {
   f.ns_receive = ns_receive_;
   f.ns_flush = ns_flush_;
   f.cpu_ns = processCpuNanos() - cpu0_;
-  f.misses = misses_.get();
+  f.misses = &misses_.log();
   for (const auto& sp : shafts_) f.shafts.push_back(sp.get());
   return writeRunReport(opt_.report_path, f, *out_);
 }

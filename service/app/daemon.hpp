@@ -13,7 +13,10 @@
 //     closed stderr never stops the daemon (docs/service.md, Signals).
 // It hosts one or more shafts (ShaftTwin: config, channels, model, alarms);
 // all the math is in TwinCore (hoist_twin); this file only moves bytes and
-// keeps time.
+// keeps time.  Rooms of their own that the Daemon owns: the miss record's
+// writer (MissRecorder, miss_recorder.hpp), the systemd watchdog (Watchdog,
+// watchdog.hpp) and the output-URL watch (OutputWatch, output_watch.hpp);
+// the map is docs/architecture.md.
 //
 // Real time: every outgoing message and its encode buffer are allocated at
 // start-up; log lines from the loop go through RtLog's preallocated ring to a
@@ -37,7 +40,8 @@
 #include <vector>
 
 #include "forecast_pool.hpp"
-#include "miss_record.hpp"
+#include "miss_recorder.hpp"
+#include "output_watch.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/history_config.hpp"
 #include "hoist/rt/realtime.hpp"
@@ -45,6 +49,7 @@
 #include "shaft_twin.hpp"
 #include "hoist/bus/subscriber.hpp"
 #include "hoist/bus/udpm_sender.hpp"
+#include "watchdog.hpp"
 
 namespace hoist::svc {
 
@@ -102,7 +107,7 @@ class Daemon {
   std::uint64_t loopProgress() const { return progress_.load(std::memory_order_relaxed); }
   std::int64_t instanceId() const { return instance_id_; }
   /// The miss record (miss_record.hpp): every deadline miss of the loop.
-  const MissLog& misses() const { return *misses_; }
+  const MissLog& misses() const { return misses_.log(); }
   /// The loop-time split so far (cumulative).
   const LoopSplit& loopSplit() const { return split_; }
 
@@ -121,11 +126,9 @@ class Daemon {
     /// Exact guide-rope envelopes per tick: the smallest [service]
     /// max_exact_envelopes_per_tick of the group (0 there = no budget).
     int envelope_budget = 0;
-    // The miss record: the loop's split and the time when this schedule's
-    // previous tick began.
-    LoopSplit split_at{};
-    Clock::time_point last_start{};
-    std::int64_t cpu_at = 0;  ///< the loop thread's CPU time then [ns]
+    /// The miss record: the loop's split and the time when this schedule's
+    /// previous tick began (miss_recorder.hpp).
+    MissWindow window{};
   };
 
   // start(), step by step
@@ -133,7 +136,6 @@ class Daemon {
   void applyRealtimeSettings();  ///< mlockall / SCHED_FIFO / affinity as asked, reported
   bool openInput();              ///< own udpm receive path (or LCM's); shafts subscribed
   void openOutput();             ///< own udpm publisher for udpm output URLs
-  void watchOutputGroup();       ///< lcm_url_out elsewhere: watch our own HOIST_HEALTH there
   void startForecasts();         ///< the forecast pool's workers
   void unblockStopSignals();     ///< the stop signals, handled on the loop thread
   void startSchedules();         ///< the clock starts; shafts announce themselves; timers armed
@@ -143,27 +145,11 @@ class Daemon {
   void drainInput();  ///< the receive path: dispatch what is queued (timed)
   void flushOutputs();  ///< the own publisher: send what the tick queued (timed)
   void onLcmReadable(const boost::system::error_code& ec);
-  void armOutWatch();
-  void onOutReadable(const boost::system::error_code& ec);
   void armTimer(RateGroup& g);
   void onTick(RateGroup& g, const boost::system::error_code& ec);
-  // The miss record (miss_record.hpp), kept apart from the loop itself:
-  /// A tick that skipped deadlines: a record of when, which and the split
-  /// of the loop's time since the schedule's previous tick.
-  MissRecord& beginMiss(const RateGroup& g, Clock::time_point now, Clock::time_point deadline,
-                        std::int64_t skipped, std::int64_t cpu_now);
-  /// Shaft j of the group ran its step in the late tick.
-  static void noteMissShaft(MissRecord& r, const RateGroup& g, std::size_t j, double period_us);
-  /// Once a second, outside the ticks: one log line for the misses since the
-  /// previous line (their number and the worst one's split).
-  void armMissLog();
-  void onMissLog(const boost::system::error_code& ec);
   void stop(const char* why);
   void armSignals();
   bool writeReport() const;
-  void startWatchdog();
-  void stopWatchdog();
-  void watchdogMain(std::chrono::microseconds interval);
 
   DaemonOptions opt_;
   std::shared_ptr<spdlog::logger> out_;
@@ -179,20 +165,15 @@ class Daemon {
   std::unique_ptr<UdpmSender> sender_;      ///< own publisher for udpm output URLs (udpm_sender.hpp); else LCM's
   std::int64_t ns_flush_ = 0;               ///< cost split: steady-clock ns in sender_->flush()
   std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
-  /// Receive-only socket on the udpm lcm_url_out group: dispatches only our
-  /// own HOIST_HEALTH channels (another instance_id there is a second
-  /// publisher, DUPLICATE_PUBLISHER), by exact name, nothing stored per name.
-  std::unique_ptr<UdpmReceiver> out_receiver_;
   std::int64_t instance_id_ = 0;       ///< random per process (HOIST_CAGE/HOIST_HEALTH.instance_id)
   boost::asio::posix::stream_descriptor lcm_fd_;
-  boost::asio::posix::stream_descriptor out_fd_;  ///< out_receiver_'s socket (owned by it)
+  /// lcm_url_out elsewhere: our own HOIST_HEALTH watched there (output_watch.hpp)
+  OutputWatch out_watch_{io_, log_, out_};
   boost::asio::signal_set signals_;
   std::vector<std::unique_ptr<ShaftTwin>> shafts_;
   std::vector<std::unique_ptr<RateGroup>> groups_;
   LoopSplit split_;                        ///< the loop's time by phase, cumulative (miss_record.hpp)
-  std::unique_ptr<MissLog> misses_;        ///< every deadline miss (preallocated ring)
-  std::int64_t misses_logged_ = 0;         ///< misses_->total() at the last miss-log line
-  std::unique_ptr<boost::asio::steady_timer> miss_log_timer_;  ///< the miss-log second
+  MissRecorder misses_{io_, log_, split_};  ///< every deadline miss and its log line (miss_recorder.hpp)
   /// The one forecast pool of the process: serves every shaft with
   /// [forecast] enabled and --clock wall.  Declared after shafts_ so that it
   /// stops (joins its workers) before the jobs it serves are destroyed.
@@ -203,16 +184,12 @@ class Daemon {
   bool started_ = false, stopping_ = false;
   const char* stop_reason_ = "";
 
-  // systemd (sd_notify): READY=1 once the loop is armed; WATCHDOG=1 from a
-  // supervisor thread, only when the loop's tick counter moved since the
-  // previous check.  The loop only bumps the counter (one relaxed atomic add:
-  // no lock, no allocation, no system call); a hung loop stops the pings and
-  // systemd restarts the service after WatchdogSec.
+  // systemd (sd_notify): READY=1 once the loop is armed; WATCHDOG=1 from the
+  // watchdog's thread (watchdog.hpp), only when the loop's tick counter moved
+  // since the previous check.  The loop only bumps the counter (one relaxed
+  // atomic add: no lock, no allocation, no system call).
   std::atomic<std::uint64_t> progress_{0};
-  std::thread watchdog_;
-  std::mutex wd_mu_;
-  std::condition_variable wd_cv_;
-  bool wd_quit_ = false;
+  Watchdog watchdog_{progress_, out_};
 };
 
 }  // namespace hoist::svc

@@ -10,6 +10,10 @@
 // and every handler runs inside one try/catch (a throw is counted as
 // "handler_exception" in HOIST_HEALTH and logged, rate-limited).
 //
+// Files: shaft_inputs.cpp (routes, winder samples, operator commands, trip
+// plans, our own outputs from another publisher) and
+// shaft_inputs_sensors.cpp (the load estimator's sensors).
+//
 // Real time: winder samples and trip plans decode into preallocated
 // messages (no allocation); operator commands are rare and may allocate
 // (their strings), bounded per tick (see handleAck).

@@ -1,4 +1,5 @@
-// hoist-replay --timing-test: feeder, listener and the run (see timing_test.hpp).
+// hoist-replay --timing-test: the listener and the run (see timing_test.hpp);
+// the feeder is timing_feeder.*.
 //
 // Threads: the feeder (own LCM instance, publish only, absolute schedule on
 // CLOCK_MONOTONIC, signals blocked) and the main thread (the listener:
@@ -40,6 +41,7 @@
 #include "hoist/bus/subscriber.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/winder_t.hpp"
+#include "timing_feeder.hpp"
 #include "timing_test.hpp"
 
 namespace hoist::replay {
@@ -52,153 +54,6 @@ void onSignal(int sig) {
   g_signal.store(sig);
   g_signal_count.fetch_add(1);
 }
-
-std::int64_t monotonicNs() {
-  timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
-
-
-/// Publish times of one shaft's inputs, indexed by seq (preallocated; the
-/// feeder writes, the listener reads).
-class Ring {
- public:
-  explicit Ring(std::size_t size_pow2) : slots_(new Slot[size_pow2]), mask_(size_pow2 - 1) {}
-  void put(std::int64_t seq, std::int64_t utime) {
-    Slot& s = slots_[static_cast<std::size_t>(seq) & mask_];
-    s.seq.store(-1, std::memory_order_relaxed);
-    s.utime.store(utime, std::memory_order_relaxed);
-    s.seq.store(seq, std::memory_order_release);
-  }
-  bool get(std::int64_t seq, std::int64_t& utime) const {
-    if (seq < 0) return false;
-    const Slot& s = slots_[static_cast<std::size_t>(seq) & mask_];
-    if (s.seq.load(std::memory_order_acquire) != seq) return false;
-    utime = s.utime.load(std::memory_order_relaxed);
-    return s.seq.load(std::memory_order_acquire) == seq;
-  }
-  std::size_t size() const { return mask_ + 1; }
-
- private:
-  struct Slot {
-    std::atomic<std::int64_t> seq{-1};
-    std::atomic<std::int64_t> utime{0};
-  };
-  std::unique_ptr<Slot[]> slots_;
-  std::size_t mask_;
-};
-
-/// The paper's trapezoid trip (hoist::HoistProfile::trapezoid) down `travel`
-/// and back up, repeated: the cage never rests (it reverses at each end).
-class RoundTrip {
- public:
-  RoundTrip(double l0, double travel, double vmax, double amax) {
-    const double D = std::fabs(travel);
-    trip_ = D >= vmax * vmax / amax ? D / vmax + vmax / amax : 2.0 * std::sqrt(D / amax);
-    const auto n = static_cast<long>(std::ceil(trip_ / 0.01));
-    const double dt = trip_ / static_cast<double>(n);
-    const HoistProfile there = HoistProfile::trapezoid(l0, vmax, amax, travel, trip_, dt);
-    const HoistProfile back = HoistProfile::trapezoid(there.samples().back().k.l, vmax, amax, -travel, trip_, dt);
-    std::vector<ProfileSample> s = there.samples();
-    s.pop_back();  // the turn: the return trip's first sample (its acceleration)
-    for (const auto& b : back.samples()) s.push_back({b.t + trip_, b.k});
-    s.back() = ProfileSample{2.0 * trip_, there.samples().front().k};
-    profile_ = HoistProfile(std::move(s));
-  }
-  Kinematics at(double t) const { return profile_.at(std::fmod(t, 2.0 * trip_)); }
-  double tripTime() const { return trip_; }
-
- private:
-  double trip_ = 0.0;
-  HoistProfile profile_;
-};
-
-struct Feeder {
-  const TimingTestOptions& o;
-  lcm::LCM& lcm;
-  const RoundTrip& trip;
-  std::vector<std::string> channels;
-  std::vector<Ring>& rings;
-  std::unique_ptr<std::atomic<std::int64_t>[]> sent;
-  std::vector<std::int64_t> failed;
-  Histogram late;
-  std::int64_t skipped = 0;
-  std::atomic<bool> stop{false}, done{false};
-  std::atomic<std::int64_t> last_utime{0};
-  std::int64_t start_ns = 0, end_ns = 0;
-
-  Feeder(const TimingTestOptions& opt, lcm::LCM& l, const RoundTrip& rt, std::vector<Ring>& r)
-      : o(opt), lcm(l), trip(rt), rings(r), sent(new std::atomic<std::int64_t>[opt.prefixes.size()]),
-        failed(opt.prefixes.size(), 0) {
-    for (std::size_t i = 0; i < o.prefixes.size(); ++i) {
-      channels.push_back(hoist::bus::channel(o.prefixes[i], hoist::bus::kChannelWinder));
-      sent[i].store(0);
-    }
-  }
-
-  /// Sleep until `deadline` (CLOCK_MONOTONIC ns), in slices of at most
-  /// 100 ms so that a stop request is seen; false if stopped.
-  bool sleepUntil(std::int64_t deadline) {
-    for (;;) {
-      if (stop.load(std::memory_order_relaxed)) return false;
-      const std::int64_t now = monotonicNs();
-      if (now >= deadline) return true;
-      const std::int64_t until = std::min(deadline, now + 100'000'000);
-      timespec ts{static_cast<time_t>(until / 1000000000), static_cast<long>(until % 1000000000)};
-      const int r = clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
-      if (r != 0 && r != EINTR) return !stop.load();
-    }
-  }
-
-  void run() {
-    const std::int64_t n = std::max<std::int64_t>(1, std::llround(o.duration * o.rate));
-    const double period_ns = 1e9 / o.rate;
-    std::vector<std::uint8_t> buf(256);
-    std::vector<std::int64_t> seq(channels.size(), 0);
-    hoist::winder_t msg{};
-    msg.has_length = true;
-    start_ns = monotonicNs();
-    std::int64_t k = 0;
-    while (k < n) {
-      const std::int64_t deadline = start_ns + std::llround(static_cast<double>(k) * period_ns);
-      if (!sleepUntil(deadline)) break;
-      const std::int64_t now = monotonicNs();
-      late.add(static_cast<double>(now - deadline) * 1e-3);
-      // More than a period late: skip the periods that passed (the schedule
-      // stays absolute; seq stays contiguous).
-      const auto passed = static_cast<std::int64_t>(static_cast<double>(now - start_ns) / period_ns);
-      if (passed > k) {
-        skipped += std::min(passed, n) - k;
-        k = passed;
-        if (k >= n) break;
-      }
-      const Kinematics kin = trip.at(static_cast<double>(k) / o.rate);
-      msg.v = kin.v;
-      msg.a = kin.a;
-      msg.length = kin.l;
-      for (std::size_t i = 0; i < channels.size(); ++i) {
-        const std::int64_t utime = hoist::bus::wallUtime();
-        msg.utime = utime;
-        msg.seq = seq[i];
-        const int len = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
-        // Recorded before publishing: the answer may come back at once.
-        rings[i].put(seq[i], utime);
-        if (len < 0 || lcm.publish(channels[i], buf.data(), static_cast<unsigned>(len)) != 0) {
-          ++failed[i];
-          continue;
-        }
-        ++seq[i];
-        sent[i].store(seq[i], std::memory_order_relaxed);
-        last_utime.store(utime, std::memory_order_relaxed);
-      }
-      ++k;
-    }
-    if (k >= n) sleepUntil(start_ns + std::llround(static_cast<double>(n) * period_ns));
-    end_ns = monotonicNs();
-    done.store(true);
-  }
-};
 
 /// Counters of one health report that are judged as deltas.
 struct Counters {

@@ -20,7 +20,7 @@
 //     naming the length and the limit, the model holds its last valid state
 //     and every output is flagged degraded.
 //
-// Clocks (a policy object, ClockPolicy, chosen at construction):
+// Clocks (a policy object, ClockPolicy, chosen at construction; twin_clocks.cpp):
 //   * InputClock -- onInput() steps the model exactly to each accepted
 //     sample's time t = (utime - utime_first) / 1e6 s; one output per input.
 //     Deterministic: the same input sequence gives bit-identical outputs.
