@@ -13,7 +13,11 @@
 namespace hoist::io {
 
 const std::vector<std::string>& daemonSections() {
-  static const std::vector<std::string> s = {"service", "alarms", "forecast", "sensors", "estimator"};
+  // [history] and [condition] are read by hoist_history (the trip memory);
+  // named here so that every tool reading the shaft from hoist-twind's file
+  // (hoist-sim, hoist-estimate, hoist-study) accepts a file that has them.
+  static const std::vector<std::string> s = {"service",   "alarms",  "forecast", "sensors",
+                                             "estimator", "history", "condition"};
   return s;
 }
 
