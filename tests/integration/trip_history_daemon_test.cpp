@@ -33,8 +33,10 @@ constexpr double kRest = 4.0, kTravel = 50.0, kVmax = 4.0, kAmax = 1.0;
 // daemon cannot keep up with 8x real time on a shared 2-core machine.
 #ifdef HOIST_SANITIZED
 constexpr const char* kLiveSpeed = "2";
+constexpr double kKillSpeed = 1.0;
 #else
 constexpr const char* kLiveSpeed = "8";
+constexpr double kKillSpeed = 4.0;
 #endif
 
 class TripHistoryDaemon : public LcmProcessTest {
@@ -140,10 +142,20 @@ TEST_F(TripHistoryDaemon, Kill9MidTripKeepsEveryFinishedTrip) {
   // Real time: the first trip ends (arrival confirmed) about kRest + trip + 2 s
   // in; kill in the middle of the second.
   const double trip = 2 * kVmax / kAmax + (kTravel - kVmax * kVmax / kAmax) / kVmax;
-  Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", "4", "-q"},
+  Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed",
+             std::to_string(kKillSpeed), "-q"},
             path("replay.log"));
-  const double kill_at = (2 * kRest + 1.5 * trip) / 4.0;
-  std::this_thread::sleep_for(std::chrono::milliseconds(static_cast<int>(kill_at * 1000)));
+  const auto t0 = std::chrono::steady_clock::now();
+  const double kill_at = (2 * kRest + 1.5 * trip) / kKillSpeed;
+  // The first trip's record is written before the kill (its identification
+  // takes seconds on the worker under a sanitizer or a loaded machine: a
+  // fixed delay killed the daemon before it, seen under ASan), then the kill
+  // comes in the middle of the second trip, with the replay still running.
+  ASSERT_TRUE(listener_->waitFor(
+      [&] { return readFile(path("twind.log")).find("trip 1 recorded") != std::string::npos; }, 90s))
+      << readFile(path("twind.log"));
+  std::this_thread::sleep_until(t0 + std::chrono::milliseconds(static_cast<int>(kill_at * 1000)));
+  ASSERT_TRUE(r.running()) << "the replay ended before the kill: it would not be mid-trip";
   ASSERT_TRUE(d->running());
   d->signal(SIGKILL);
   EXPECT_EQ(d->wait(10s), 128 + SIGKILL);
