@@ -4,6 +4,7 @@
 // two clock helpers; the rooms hold a reference to it.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -45,6 +46,10 @@ struct AlarmCause {
   const char* predicted_clearance_scenario = ""; ///< PREDICTED_CLEARANCE: the scenario that predicts it (static string)
   const char* predicted_slack_scenario = "";     ///< PREDICTED_SLACK: the scenario that predicts it (static string)
   double slack_threshold = 0.0;                  ///< PREDICTED_SLACK threshold of the latest forecast [N]
+  /// GUIDE_PRELOAD_LOW / SHAFT_FINGERPRINT: the trip room's latest texts
+  /// (copied from its ConditionState; fixed size, no allocation).
+  std::array<char, 240> preload_text{};
+  std::array<char, 240> fingerprint_text{};
 };
 
 struct ShaftContext {

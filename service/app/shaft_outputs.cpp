@@ -252,6 +252,8 @@ void ShaftOutputs::publishAlarmEvents() {
     tc.mismatch_test = est->nis_exceeded ? "nis" : est->drift_exceeded ? "drift" : "";
   tc.sensor = core.lastSensorFault().sensor;
   tc.sensor_reason = core.lastSensorFault().reason;
+  tc.preload_text = cause.preload_text.data();
+  tc.fingerprint_text = cause.fingerprint_text.data();
   alarm_msg_.user.assign(cause.user);  // who caused these events ("" for the twin itself)
   RtLog& log = ctx_.log;
   const std::string& tag = ctx_.tag;

@@ -63,6 +63,14 @@ void ShaftTwin::enableTrips(const TripHistoryConfig& hist) {
   ctx_.trips = trips_.get();
 }
 
+void ShaftTwin::applyCondition() {
+  const ConditionState* c = ctx_.trips->takeCondition();
+  if (!c) return;
+  ctx_.cause.preload_text = c->preload_text;
+  ctx_.cause.fingerprint_text = c->fingerprint_text;
+  ctx_.core.setCondition(c->preload, c->upper95, c->warning, c->critical, c->fingerprint, c->z, c->z_limit);
+}
+
 void ShaftTwin::stopTrips() {
   if (!trips_) return;
   trips_->stop();
@@ -184,6 +192,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
     core.housekeeping(wall);
   }
   inputs_.forgetSilentPublisher(wall);
+  if (ctx_.trips) applyCondition();
   outputs_.publishAlarmEvents();
 
   if (health_.due(wall)) {

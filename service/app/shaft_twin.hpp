@@ -127,6 +127,9 @@ class ShaftTwin {
   void enableTrips(const TripHistoryConfig& hist);
   /// Drain and join the trip room's worker; one log line of its figures.
   void stopTrips();
+  /// Loop: the trip room's newest condition verdict into the alarms
+  /// (GUIDE_PRELOAD_LOW, SHAFT_FINGERPRINT); nothing when none is new.
+  void applyCondition();
   const TripRoom* trips() const { return trips_.get(); }
 
   const TwinConfig& config() const { return ctx_.cfg; }

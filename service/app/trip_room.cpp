@@ -5,10 +5,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include <spdlog/spdlog.h>
 
+#include "hoist/history/condition_judge.hpp"
+#include "hoist/history/schema.hpp"
 #include "hoist/history/store.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/trip_recorder.hpp"
@@ -68,8 +71,10 @@ bool TripRing::pop(TripTick& out) {
 
 struct TripRoom::Worker {
   Worker(const TwinConfig& cfg, const ConditionSettings& cond)
-      : rec(cfg.shaft, cfg.estimator.settings, cond, cfg.service.max_step) {}
+      : rec(cfg.shaft, cfg.estimator.settings, cond, cfg.service.max_step), judge(cond), cond_settings(cond) {}
   TripRecorder rec;
+  history::ConditionJudge judge;  // GUIDE_PRELOAD_LOW, SHAFT_FINGERPRINT over the shaft's trips
+  ConditionSettings cond_settings;
   std::unique_ptr<history::Store> store;
   std::uint32_t seen = 0;        // alarm kinds already added to the trip under way
   TripTick tick;                 // the tick being taken
@@ -148,6 +153,16 @@ void TripRoom::workerMain() {
     log->error("{}trip history: the database cannot be opened: {}; trips are detected and counted but not "
                "stored (the twin runs on)", tag, e.what());
   }
+  if (w_->store) {
+    try {
+      const std::int64_t n = w_->judge.seed(*w_->store, shaft_);
+      log->info("{}shaft condition from {} stored trips: {}", tag, n, w_->judge.summary());
+    } catch (const std::exception& e) {
+      log->error("{}shaft condition: the stored trips cannot be read ({}): GUIDE_PRELOAD_LOW and SHAFT_FINGERPRINT "
+                 "are judged from this run's trips only", tag, e.what());
+    }
+  }
+  publishCondition();
   for (;;) {
     const bool quitting = quit_.load(std::memory_order_acquire);
     const std::int64_t c0 = threadCpuNs();
@@ -163,6 +178,25 @@ void TripRoom::workerMain() {
       log->warn("{}trip history: flush at stop: {}", tag, e.what());
     }
   }
+}
+
+void TripRoom::publishCondition() {
+  const Worker& w = *w_;
+  ConditionState& c = condition_.writeSlot();
+  const PreloadDecision p = w.judge.preload();
+  const FingerprintDecision f = w.judge.fingerprint();
+  c.preload = static_cast<AlarmLevel>(static_cast<int>(p.level));
+  c.upper95 = p.valid ? p.upper95 : 0.0;
+  c.warning = w.cond_settings.preload_warning;
+  c.critical = w.cond_settings.preload_critical;
+  c.fingerprint = f.active;
+  c.z = f.hits.empty() ? 0.0 : f.hits.front().z_last;
+  c.z_limit = w.cond_settings.fingerprint_sigma;
+  c.trips = w.judge.trips();
+  std::snprintf(c.preload_text.data(), c.preload_text.size(), "%s", p.text.c_str());
+  std::snprintf(c.fingerprint_text.data(), c.fingerprint_text.size(), "%s", f.text.c_str());
+  condition_.publish();
+  counts_.judged.store(true, std::memory_order_release);
 }
 
 void TripRoom::pruneOld(std::int64_t now_us) {
@@ -218,7 +252,6 @@ void TripRoom::finishTrip() {
   TripRecord& r = w.rec.record();
   const TripTick& now = w.tick;
   r.shaft = shaft_;
-  r.trip = 0;  // the store numbers it
   // Wall clock: the tick's wall time, shifted by the model-time difference.
   auto wallAt = [&now](double t_model) {
     return now.wall_us - static_cast<std::int64_t>(std::llround((now.m.t - t_model) * 1e6));
@@ -230,6 +263,25 @@ void TripRoom::finishTrip() {
   counts_.cpu_ns_last.store(cpu, std::memory_order_relaxed);
   auto log = logger();
   const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  // The condition alarms, judged before the record is stored (its alarms
+  // name them).  The judge needs the trip's number: the store's next one.
+  std::int64_t number = 0;
+  if (w.store) {
+    try {
+      number = w.store->nextTrip(shaft_);
+    } catch (const std::exception& e) {
+      log->warn("{}trip history: the next trip number cannot be read ({}); the store numbers the record", tag,
+                e.what());
+    }
+  }
+  r.trip = number > 0 ? number : w.judge.lastTrip() + 1;
+  const ConditionLevel before = w.judge.preload().level;
+  const bool finger_before = w.judge.fingerprint().active;
+  w.judge.judge(r);
+  publishCondition();
+  if (w.judge.preload().level != before || w.judge.fingerprint().active != finger_before)
+    log->warn("{}shaft condition changed after trip {}: {}", tag, r.trip, w.judge.summary());
+  if (number <= 0) r.trip = 0;
   if (!w.store) {
     counts_.failed.fetch_add(1, std::memory_order_relaxed);
     return;
@@ -238,10 +290,15 @@ void TripRoom::finishTrip() {
     const history::PutResult p = w.store->put(r);
     if (p == history::PutResult::Queued) counts_.queued.fetch_add(1, std::memory_order_relaxed);
     else counts_.stored.fetch_add(1, std::memory_order_relaxed);
-    log->info("{}trip {} recorded ({}): {} {:.1f} -> {:.1f} m, preload scale {:.3f} +- {:.3f}{}, {} alarms, "
-              "{:.0f} ms CPU", tag, r.trip, history::toString(p), r.direction == TripDirection::Down ? "down" : "up",
-              r.depth_start, r.depth_end, r.id.scale, r.id.sigma_scale, r.id.informative ? "" : " (not informative)", r.alarms.size(),
-              cpu * 1e-6);
+    char scale[96];
+    if (r.id.attempted && r.id.sigma_scale >= 0.0)
+      std::snprintf(scale, sizeof scale, "preload scale %.3f +- %.3f%s", r.id.scale, r.id.sigma_scale,
+                    r.id.informative ? "" : " (not informative)");
+    else
+      std::snprintf(scale, sizeof scale, "preload scale not identified");
+    log->info("{}trip {} recorded ({}): {} {:.1f} -> {:.1f} m, {}, alarms: {}, {:.0f} ms CPU", tag, r.trip,
+              history::toString(p), r.direction == TripDirection::Down ? "down" : "up", r.depth_start, r.depth_end,
+              scale, r.alarms.empty() ? std::string("none") : history::joinAlarms(r.alarms), cpu * 1e-6);
     pruneOld(now.wall_us);  // a daemon that runs for months keeps keep_days too
   } catch (const std::exception& e) {
     counts_.failed.fetch_add(1, std::memory_order_relaxed);

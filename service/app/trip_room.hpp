@@ -19,11 +19,23 @@
 // put that fails is logged and counted; the twin runs on.  The worker logs
 // through spdlog directly (not the loop's RtLog).
 //
+// The shaft's condition (GUIDE_PRELOAD_LOW, SHAFT_FINGERPRINT): the worker
+// keeps a hoist::history::ConditionJudge, seeded from the shaft's stored
+// trips when the database opens, and judges each new record before it is
+// stored (the record's alarms then name the condition alarms too).  After
+// the seeding and after each trip it hands a ConditionState to the loop
+// through a LatestMailbox; the loop takes it (takeCondition: no allocation,
+// no lock) and sets the alarms.  So a daemon restarted on a shaft whose
+// preload is low raises the alarm again from its history; a database that
+// cannot be read is logged as an error (the alarm cannot be judged) and the
+// judge goes on from the trips this run records.
+//
 // Lifetimes: owned by ShaftTwin; stop() (or the destructor) joins the
 // worker after it has drained the ring (a trip under way at stop is not
 // recorded: it did not end).  counters() may be read from any thread.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -32,6 +44,7 @@
 #include <vector>
 
 #include "hoist/load_estimator.hpp"
+#include "hoist/rt/latest_mailbox.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/history_config.hpp"
 #include "hoist/service/twin_core.hpp"
@@ -45,6 +58,18 @@ struct TripTick {
   double guide_deflection = 0.0;   ///< the guide-rope envelope's deflection [m]
   std::int64_t wall_us = 0;        ///< wall clock of the step [us since the epoch]
   std::uint32_t alarms = 0;        ///< bit k: AlarmKind k active
+};
+
+/// The condition alarms' inputs, from the worker to the loop (fixed size).
+struct ConditionState {
+  AlarmLevel preload = AlarmLevel::None;  ///< GUIDE_PRELOAD_LOW's level
+  double upper95 = 0.0;                   ///< the combined preload scale's 95 % upper bound
+  double warning = 0.85, critical = 0.70; ///< [condition] preload_warning, preload_critical
+  bool fingerprint = false;               ///< SHAFT_FINGERPRINT active
+  double z = 0.0, z_limit = 4.0;          ///< the strongest hit's last z; fingerprint_sigma
+  std::int64_t trips = 0;                 ///< the trips judged (stored ones included)
+  std::array<char, 240> preload_text{};   ///< the trend's text (cut to fit)
+  std::array<char, 240> fingerprint_text{};
 };
 
 /// Fixed-capacity SPSC ring of TripTick (lock-free; one producer thread,
@@ -77,6 +102,7 @@ struct TripCounters {
   std::atomic<std::int64_t> cpu_ns{0};       ///< worker CPU time, all of it [ns]
   std::atomic<std::int64_t> cpu_ns_last{0};  ///< worker CPU time of the last trip's record [ns]
   std::atomic<bool> store_open{false};       ///< the database is open
+  std::atomic<bool> judged{false};           ///< the condition has been judged once (after the seeding)
 };
 
 class TripRoom {
@@ -91,6 +117,9 @@ class TripRoom {
   /// Loop thread, after each model step: one tick copied into the ring.
   /// Allocation-free; never blocks.
   void afterStep(const TwinCore& core, std::int64_t wall_us);
+  /// Loop thread: the newest condition since the last call, or nullptr.
+  /// Valid until the next call.  Allocation-free; never blocks.
+  const ConditionState* takeCondition() { return condition_.take(); }
   /// Start the worker (opens the database on it).
   void start();
   /// Drain the ring, join the worker.  Idempotent.
@@ -105,6 +134,7 @@ class TripRoom {
   void take(const TripTick& t);  // worker: one tick into the recorder
   void finishTrip();             // worker: the record to the store
   void pruneOld(std::int64_t now_us);  // worker: [history] keep_days (at open and after each trip)
+  void publishCondition();             // worker: the judge's verdicts to the loop
 
   TwinConfig cfg_;
   TripHistoryConfig hist_;
@@ -116,6 +146,7 @@ class TripRoom {
   std::atomic<bool> quit_{false};
   struct Worker;                  // the worker's state (recorder, store): worker thread only
   std::unique_ptr<Worker> w_;
+  rt::LatestMailbox<ConditionState> condition_{ConditionState{}};  // worker -> loop
   std::string store_desc_;        // written by the worker before store_open is set
   static constexpr int kNice = 10;
 };

@@ -256,7 +256,9 @@ TEST(CodecGenerated, NameTablesMatchTheLcmConstants) {
   EXPECT_EQ(names::kindName(alarm_t::KIND_PREDICTED_SLACK), "PREDICTED_SLACK");
   EXPECT_EQ(names::kindName(alarm_t::KIND_MODEL_MISMATCH), "MODEL_MISMATCH");
   EXPECT_EQ(names::kindName(alarm_t::KIND_SENSOR_FAULT), "SENSOR_FAULT");
-  EXPECT_EQ(names::kKindNames.size(), 13u);
+  EXPECT_EQ(names::kindName(alarm_t::KIND_GUIDE_PRELOAD_LOW), "GUIDE_PRELOAD_LOW");
+  EXPECT_EQ(names::kindName(alarm_t::KIND_SHAFT_FINGERPRINT), "SHAFT_FINGERPRINT");
+  EXPECT_EQ(names::kKindNames.size(), 15u);
   EXPECT_EQ(names::levelName(3), "?");
   EXPECT_EQ(names::levelName(-1), "?");
   EXPECT_EQ(names::eventName(0), "?");

@@ -9,18 +9,27 @@
 //   * kill -9 of the daemon in the middle of the second trip leaves a
 //     database that passes PRAGMA integrity_check and holds the first trip;
 //   * keep_days prunes after each trip, not only at start-up;
+//   * the condition alarms come from the shaft's memory: a daemon started on
+//     a database whose preload fell to 0.6 raises GUIDE_PRELOAD_LOW WARNING
+//     and CRITICAL at once, naming the estimate; each new trip is judged
+//     before it is stored, numbered after the stored ones, and its record
+//     names the condition alarms the rule gives over the whole history;
 //   * a bad [history] or [condition] key is exit 2 naming file, line and key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <thread>
 
+#include "hoist/alarm_t.hpp"
+#include "hoist/history/condition_judge.hpp"
 #include "hoist/history/sqlite_store.hpp"
 #include "hoist/health_t.hpp"
 #include "lcm_fixtures.hpp"
+#include "sample_record.hpp"
 #include "trip_profile.hpp"
 
 using namespace hoist::test;
@@ -44,7 +53,7 @@ class TripHistoryDaemon : public LcmProcessTest {
   std::string path(const std::string& f) const { return (dir_ / f).string(); }
   /// The measurements (hoist-sim: a heavier load off the axis than the twin's
   /// config) and the daemon's configuration with [history] at db.
-  void makeRun(const std::string& db, const std::string& more_history = "") {
+  void makeRun(const std::string& db, const std::string& more_history = "", const std::string& more_condition = "") {
     writeDownUpProfile(path("profile.csv"), kRest, kTravel, kVmax, kAmax);
     std::ofstream(path("truth.toml")) << "[load]\neccentric_force = 1500.0\noffset = 0.6\n[model]\nmodes = 12\n";
     ASSERT_EQ(runProcess({HOIST_SIM, "--config", path("truth.toml"), "--profile", path("profile.csv"),
@@ -54,12 +63,12 @@ class TripHistoryDaemon : public LcmProcessTest {
               0)
         << readFile(path("sim.log"));
     std::ofstream(path("shaft7.toml")) << "[model]\nmodes = 8\n[estimator]\nenabled = true\n[condition]\ndepth_bin = 20.0\n"
-                                          "[history]\nurl = \"sqlite://" << db << "\"\n" << more_history;
+                                       << more_condition << "[history]\nurl = \"sqlite://" << db << "\"\n" << more_history;
   }
   /// hoist-replay feeds meas.csv to the daemon `d` (twind.log); the second
   /// trip's record is built on the worker (its identification takes seconds
   /// under a sanitizer): waited for before the daemon is stopped.
-  void replayBothTripsAndStop(Process& d) {
+  void replayBothTripsAndStop(Process& d, int last_trip = 2) {
     {
       Process r({HOIST_REPLAY, "--lcm-url", url_, "--measurements", path("meas.csv"), "--speed", kLiveSpeed, "-q"},
                 path("replay.log"));
@@ -67,7 +76,11 @@ class TripHistoryDaemon : public LcmProcessTest {
       ASSERT_EQ(r.wait(1s), 0) << readFile(path("replay.log"));
     }
     EXPECT_TRUE(listener_->waitFor(
-        [&] { return readFile(path("twind.log")).find("trip 2 recorded") != std::string::npos; }, 60s));
+        [&] {
+          return readFile(path("twind.log")).find("trip " + std::to_string(last_trip) + " recorded") !=
+                 std::string::npos;
+        },
+        60s));
     stopDaemonCleanly(d, path("twind.log"));
   }
 };
@@ -198,6 +211,86 @@ TEST_F(TripHistoryDaemon, KeepDaysPrunesAfterEachTripNotOnlyAtStart) {
   ASSERT_EQ(rows.size(), 2u) << log;  // shaft7's two trips (ended now), not the retired one
   EXPECT_EQ(rows[0].shaft, "shaft7");
   EXPECT_EQ(rows[1].shaft, "shaft7");
+}
+
+TEST_F(TripHistoryDaemon, ConditionAlarmsComeFromTheStoredTripsAndJudgeEachNewOne) {
+  start(7958, "TripHistoryCondition", {"HOIST_HEALTH", "HOIST_ALARM"});
+  const std::string db = path("cond.sqlite");
+  // Twelve earlier trips of this shaft: the preload identified at 1.0, then
+  // at 0.6 from trip 9 (informative, sigma 0.03), ended in the last hours.
+  const auto now_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                          std::chrono::system_clock::now().time_since_epoch()).count();
+  {
+    auto s = hoist::history::openSqliteStore(db);
+    for (int t = 1; t <= 12; ++t) {
+      hoist::TripRecord r = sampleRecord(t, "shaft7", 0);
+      r.alarms.clear();
+      r.mismatch = false;
+      r.wall_start_us = now_us - (13 - t) * 600'000'000LL;
+      r.wall_end_us = r.wall_start_us + 60'000'000LL;
+      r.id.scale = t <= 8 ? 1.0 : 0.6;
+      r.id.sigma_scale = 0.03;
+      r.id.informative = true;
+      s->put(r);
+    }
+  }
+  // Every live trip counts in the trend, however little it says (max_sigma
+  // 1): the new trips then move the estimate.
+  makeRun(db, "", "max_sigma = 1.0\n");
+  std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", path("shaft7.toml"), "--clock", "input"};
+  auto d = startDaemonAndWait(*listener_, argv, path("twind.log"));
+  // Before any input: the alarms rise from the stored trips alone.
+  auto raised = [&](std::int8_t level) {
+    for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
+      if (a.kind == "GUIDE_PRELOAD_LOW" && a.event_type == hoist::alarm_t::EVENT_RAISE && a.level == level) return a;
+    return hoist::alarm_t{};
+  };
+  ASSERT_TRUE(listener_->waitFor([&] { return !raised(hoist::alarm_t::LEVEL_CRITICAL).kind.empty(); }, 30s))
+      << readFile(path("twind.log"));
+  const hoist::alarm_t crit = raised(hoist::alarm_t::LEVEL_CRITICAL), warn = raised(hoist::alarm_t::LEVEL_WARNING);
+  EXPECT_EQ(warn.kind, "GUIDE_PRELOAD_LOW");
+  EXPECT_TRUE(crit.active);
+  EXPECT_NEAR(crit.threshold, 0.70, 1e-12);
+  EXPECT_NEAR(warn.threshold, 0.85, 1e-12);
+  EXPECT_LT(crit.value, 0.70);  // the 95 % upper bound
+  EXPECT_NE(crit.message.find("guide-rope preload scale 0.6"), std::string::npos) << crit.message;
+  EXPECT_NE(crit.message.find("from trips"), std::string::npos) << crit.message;
+  EXPECT_NE(crit.message.find("tensioning weights"), std::string::npos) << crit.message;
+  EXPECT_NE(readFile(path("twind.log")).find("shaft condition from 12 stored trips"), std::string::npos);
+
+  replayBothTripsAndStop(*d, 14);
+  const std::string log = readFile(path("twind.log"));
+  // The new trips follow the stored ones, and each record names the
+  // condition alarms the rule gives after it over the whole history.
+  hoist::history::ListFilter f;
+  f.with_bins = true;
+  const auto rows = hoist::history::openSqliteStore(db, true)->list(f);
+  ASSERT_EQ(rows.size(), 14u) << log;
+  EXPECT_EQ(rows[12].trip, 13);
+  EXPECT_EQ(rows[13].trip, 14);
+  hoist::ConditionSettings cond;
+  cond.depth_bin = 20.0;
+  cond.max_sigma = 1.0;
+  hoist::history::ConditionJudge judge(cond);
+  for (auto r : rows) {
+    const bool live_low = std::find(r.alarms.begin(), r.alarms.end(), "GUIDE_PRELOAD_LOW") != r.alarms.end();
+    r.alarms.clear();
+    judge.judge(r);
+    if (r.trip <= 12) continue;
+    SCOPED_TRACE("trip " + std::to_string(r.trip) + ": " + judge.summary());
+    std::printf("trip %lld: s = %.3f +- %.3f; %s\n", static_cast<long long>(r.trip), r.id.scale, r.id.sigma_scale,
+                judge.summary().c_str());
+    const bool low = std::find(r.alarms.begin(), r.alarms.end(), "GUIDE_PRELOAD_LOW") != r.alarms.end();
+    EXPECT_EQ(live_low, low);
+  }
+  // The CRITICAL alarm latches: the two nominal trips may lift the estimate,
+  // but nothing clears it silently (a CLEAR of the WARNING says why).
+  for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM")) {
+    if (a.kind != "GUIDE_PRELOAD_LOW" || a.event_type != hoist::alarm_t::EVENT_CLEAR) continue;
+    EXPECT_EQ(int{a.level}, int{hoist::alarm_t::LEVEL_WARNING}) << a.message;
+    EXPECT_NE(a.message.find("back above 0.85"), std::string::npos) << a.message;
+  }
+  std::printf("condition after the two live trips: %s\n", judge.summary().c_str());
 }
 
 // [history] and [condition] are validated at start-up: a bad key is exit 2

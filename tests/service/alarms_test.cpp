@@ -330,6 +330,50 @@ TEST(AlarmEngine, StaleAndFaultFlags) {
   EXPECT_EQ(eng.highestActive(), AlarmLevel::None);
 }
 
+// The shaft's memory's verdicts: GUIDE_PRELOAD_LOW's WARNING is active at
+// both levels, its CRITICAL latches; the events report the 95 % upper bound
+// against each level's limit; SHAFT_FINGERPRINT reports z against its limit.
+TEST(AlarmEngine, ConditionAlarmsFollowTheTrendAndTheCriticalLatches) {
+  AlarmConfig cfg;
+  cfg.reannounce = 0.0;  // only the changes
+  AlarmEngine eng(cfg);
+  AlarmEvents ev;
+  eng.setGuidePreloadLow(0.0, AlarmLevel::Warning, 0.80, 0.85, 0.70, ev);
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, AlarmKind::GuidePreloadLow);
+  EXPECT_EQ(ev[0].level, AlarmLevel::Warning);
+  EXPECT_EQ(ev[0].type, AlarmEventType::Raise);
+  EXPECT_DOUBLE_EQ(ev[0].value, 0.80);
+  EXPECT_DOUBLE_EQ(ev[0].threshold, 0.85);
+  ev.clear();
+  eng.setGuidePreloadLow(10.0, AlarmLevel::Critical, 0.64, 0.85, 0.70, ev);
+  ASSERT_EQ(ev.size(), 1u);  // the WARNING stays up: only the CRITICAL rises
+  EXPECT_EQ(ev[0].level, AlarmLevel::Critical);
+  EXPECT_DOUBLE_EQ(ev[0].threshold, 0.70);
+  EXPECT_EQ(eng.highestActive(), AlarmLevel::Critical);
+  ev.clear();
+  eng.setGuidePreloadLow(20.0, AlarmLevel::None, 0.95, 0.85, 0.70, ev);
+  ASSERT_EQ(ev.size(), 1u);  // the WARNING clears; the CRITICAL waits for an operator
+  EXPECT_EQ(ev[0].level, AlarmLevel::Warning);
+  EXPECT_EQ(ev[0].type, AlarmEventType::Clear);
+  EXPECT_TRUE(eng.find(AlarmKind::GuidePreloadLow, AlarmLevel::Critical)->active());
+  ev.clear();
+  eng.acknowledge(21.0, AlarmKind::GuidePreloadLow, AlarmLevel::Critical, ev);
+  EXPECT_EQ(eng.highestActive(), AlarmLevel::None);
+  ev.clear();
+  eng.setShaftFingerprint(30.0, true, 5.6, 4.0, ev);
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].kind, AlarmKind::ShaftFingerprint);
+  EXPECT_DOUBLE_EQ(ev[0].value, 5.6);
+  EXPECT_DOUBLE_EQ(ev[0].threshold, 4.0);
+  ev.clear();
+  eng.setShaftFingerprint(31.0, true, 5.9, 4.0, ev);  // still active: no new event
+  EXPECT_TRUE(ev.empty());
+  eng.setShaftFingerprint(40.0, false, 1.0, 4.0, ev);
+  ASSERT_EQ(ev.size(), 1u);
+  EXPECT_EQ(ev[0].type, AlarmEventType::Clear);
+}
+
 TEST(AlarmNames, RoundTrip) {
   for (int i = 0; i < kAlarmKinds; ++i) {
     const auto k = static_cast<AlarmKind>(i);
@@ -496,7 +540,9 @@ TEST(AlarmEngine, SlotTableGivesEachAlarmItsKindLevelAndSettings) {
       {AlarmKind::ModelDomain, AlarmLevel::Critical},    {AlarmKind::DuplicatePublisher, AlarmLevel::Warning},
       {AlarmKind::RopeSlack, AlarmLevel::Critical},      {AlarmKind::RopeOverload, AlarmLevel::Critical},
       {AlarmKind::PredictedClearance, AlarmLevel::Warning}, {AlarmKind::PredictedSlack, AlarmLevel::Warning},
-      {AlarmKind::ModelMismatch, AlarmLevel::Warning},   {AlarmKind::SensorFault, AlarmLevel::Warning}};
+      {AlarmKind::ModelMismatch, AlarmLevel::Warning},   {AlarmKind::SensorFault, AlarmLevel::Warning},
+      {AlarmKind::GuidePreloadLow, AlarmLevel::Warning}, {AlarmKind::GuidePreloadLow, AlarmLevel::Critical},
+      {AlarmKind::ShaftFingerprint, AlarmLevel::Warning}};
   for (const auto& [k, l] : expected) EXPECT_NE(eng.find(k, l), nullptr) << toString(k) << "/" << toString(l);
   // Settings by rule.
   const AlarmSettings& neg_c = eng.find(AlarmKind::CageNegY, AlarmLevel::Critical)->settings();

@@ -17,53 +17,16 @@
 #include <unistd.h>
 
 #include "hoist/history/condition_config.hpp"
+#include "hoist/history/condition_judge.hpp"
 #include "hoist/history/schema.hpp"
 #include "hoist/io/config.hpp"
 #include "hoist/io/estimator_config.hpp"
-#include "hoist/preload_trend.hpp"
-#include "hoist/shaft_fingerprint.hpp"
 #include "hoist/trip_pipeline.hpp"
 #include "trips.hpp"
 
 namespace hoist::trips {
 
 namespace {
-
-/// The alarms each new record raises, from the shaft's history before it.
-class AlarmJudge {
- public:
-  AlarmJudge(const ConditionSettings& c, history::Store& db, const std::string& shaft) : trend_(c), finger_(c) {
-    history::ListFilter f;
-    f.shaft = shaft;
-    f.with_bins = true;
-    const auto old = db.list(f);
-    const auto marks = db.baseline(shaft);
-    for (const auto& r : old)
-      if (std::binary_search(marks.begin(), marks.end(), r.trip)) finger_.markBaseline(r);
-    for (const auto& r : old) add(r);
-  }
-  void judge(TripRecord& r) {
-    add(r);
-    if (r.mismatch) r.alarms.push_back("MODEL_MISMATCH");
-    if (trend_.decision().level != ConditionLevel::None) r.alarms.push_back("GUIDE_PRELOAD_LOW");
-    if (finger_.decision().active) r.alarms.push_back("SHAFT_FINGERPRINT");
-  }
-  std::string summary() const {
-    const auto d = trend_.decision();
-    std::string s = d.text;
-    const auto fd = finger_.decision();
-    if (fd.active) s += (s.empty() ? "" : "; ") + fd.text;
-    return s;
-  }
-
- private:
-  void add(const TripRecord& r) {
-    trend_.add(r);
-    finger_.add(r);
-  }
-  PreloadTrend trend_;
-  ShaftFingerprint finger_;
-};
 
 std::string fmt(const char* f, double v) {
   char b[64];
@@ -106,7 +69,8 @@ int runIngest(const Options& o) {
                              : std::chrono::duration_cast<std::chrono::microseconds>(
                                    std::chrono::system_clock::now().time_since_epoch()).count();
   std::int64_t next = o.first_trip > 0 ? o.first_trip : db->nextTrip(o.shaft);
-  AlarmJudge judge(cond, *db, o.shaft);
+  history::ConditionJudge judge(cond);
+  judge.seed(*db, o.shaft);
   int stored = 0, dup = 0, queued = 0;
   for (auto& r : recs) {
     r.shaft = o.shaft;

@@ -11,7 +11,9 @@ namespace names = hoist::msg::enums::alarm_t;
 static_assert(names::kKindNames.size() == kAlarmKinds && names::kKindFirst == 0);
 static_assert(names::parseKind("CAGE_POS_Y") == static_cast<int>(AlarmKind::CagePosY) &&
               names::parseKind("PREDICTED_SLACK") == static_cast<int>(AlarmKind::PredictedSlack) &&
-              names::parseKind("SENSOR_FAULT") == static_cast<int>(AlarmKind::SensorFault));
+              names::parseKind("SENSOR_FAULT") == static_cast<int>(AlarmKind::SensorFault) &&
+              names::parseKind("GUIDE_PRELOAD_LOW") == static_cast<int>(AlarmKind::GuidePreloadLow) &&
+              names::parseKind("SHAFT_FINGERPRINT") == static_cast<int>(AlarmKind::ShaftFingerprint));
 static_assert(names::parseLevel("CRITICAL") == static_cast<int>(AlarmLevel::Critical));
 static_assert(names::parseEvent("REANNOUNCE") == static_cast<int>(AlarmEventType::Reannounce));
 

@@ -230,6 +230,9 @@ constexpr std::array<SlotRow, AlarmEngine::kSlots> kSlotTable{{
     {AlarmKind::PredictedSlack, AlarmLevel::Warning, Rule::Prediction, nullptr},
     {AlarmKind::ModelMismatch, AlarmLevel::Warning, Rule::Flag, nullptr},
     {AlarmKind::SensorFault, AlarmLevel::Warning, Rule::Flag, nullptr},
+    {AlarmKind::GuidePreloadLow, AlarmLevel::Warning, Rule::Flag, nullptr},
+    {AlarmKind::GuidePreloadLow, AlarmLevel::Critical, Rule::LatchedFlag, nullptr},
+    {AlarmKind::ShaftFingerprint, AlarmLevel::Warning, Rule::Flag, nullptr},
 }};
 
 /// The slot of (kind, level), or -1 if there is no such alarm.
@@ -270,6 +273,9 @@ constexpr int kPredictedClearance = slot(AlarmKind::PredictedClearance, AlarmLev
 constexpr int kPredictedSlack = slot(AlarmKind::PredictedSlack, AlarmLevel::Warning);
 constexpr int kModelMismatch = slot(AlarmKind::ModelMismatch, AlarmLevel::Warning);
 constexpr int kSensorFault = slot(AlarmKind::SensorFault, AlarmLevel::Warning);
+constexpr int kPreloadLowWarning = slot(AlarmKind::GuidePreloadLow, AlarmLevel::Warning);
+constexpr int kPreloadLowCritical = slot(AlarmKind::GuidePreloadLow, AlarmLevel::Critical);
+constexpr int kShaftFingerprint = slot(AlarmKind::ShaftFingerprint, AlarmLevel::Warning);
 
 /// The settings of `row` under `cfg`.
 AlarmSettings settingsOf(const SlotRow& row, const AlarmConfig& cfg) {
@@ -394,6 +400,21 @@ void AlarmEngine::setModelMismatch(double now, bool mismatch, double statistic, 
 void AlarmEngine::setSensorFault(double now, bool fault, double value, double limit, AlarmEvents& out) {
   if (fault) alarms_[kSensorFault].setDetail(value, limit);
   alarms_[kSensorFault].update(now, fault ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setGuidePreloadLow(double now, AlarmLevel level, double upper95, double warning, double critical,
+                                     AlarmEvents& out) {
+  const bool warn = level != AlarmLevel::None;
+  const bool crit = level == AlarmLevel::Critical;
+  alarms_[kPreloadLowWarning].setDetail(upper95, warning);
+  alarms_[kPreloadLowCritical].setDetail(upper95, critical);
+  alarms_[kPreloadLowWarning].update(now, warn ? 1.0 : 0.0, out);
+  alarms_[kPreloadLowCritical].update(now, crit ? 1.0 : 0.0, out);
+}
+
+void AlarmEngine::setShaftFingerprint(double now, bool active, double z, double limit, AlarmEvents& out) {
+  alarms_[kShaftFingerprint].setDetail(z, limit);
+  alarms_[kShaftFingerprint].update(now, active ? 1.0 : 0.0, out);
 }
 
 void AlarmEngine::poll(double now, AlarmEvents& out) {

@@ -270,6 +270,20 @@ void describeAlarmWhole(const AlarmEvent& e, const AlarmTextContext& ctx, char* 
                       kind, level, verb, ctx.predicted_slack_scenario, ctx.slack_threshold, e.value, e.threshold,
                       state);
       break;
+    case AlarmKind::GuidePreloadLow:
+      // The trend's own text names the estimate, its sigma and the trips.
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: the guide-rope preload's 95 %% upper bound %.3f is back above %.2f: "
+                      "%s%s", kind, level, e.value, e.threshold, ctx.preload_text, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: %s%s", kind, level, verb, ctx.preload_text, state);
+      break;
+    case AlarmKind::ShaftFingerprint:
+      if (e.type == AlarmEventType::Clear)
+        std::snprintf(buf, n, "%s %s cleared: %s%s", kind, level, ctx.fingerprint_text, state);
+      else
+        std::snprintf(buf, n, "%s %s %s: %s%s", kind, level, verb, ctx.fingerprint_text, state);
+      break;
   }
 }
 

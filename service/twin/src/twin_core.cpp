@@ -191,6 +191,13 @@ void TwinCore::setPredictions(bool clearance, double clearance_s, bool slack, do
   out_.alarm_level = alarms_.highestActive();
 }
 
+void TwinCore::setCondition(AlarmLevel preload, double upper95, double warning, double critical, bool fingerprint,
+                            double z, double z_limit) {
+  alarms_.setGuidePreloadLow(t_, preload, upper95, warning, critical, events_);
+  alarms_.setShaftFingerprint(t_, fingerprint, z, z_limit, events_);
+  out_.alarm_level = alarms_.highestActive();
+}
+
 bool TwinCore::finishStep(double t, bool allow_fault_check) {
   (void)allow_fault_check;
   const double h = cfg_.shaft.h;

@@ -16,6 +16,9 @@ namespace hoist::mqtt::sparkplug {
 namespace {
 
 using PbPayload = hoist_sparkplug_Payload;
+// nanopb's 16-bit field offsets: the decoded payload (max_count metrics of
+// sparkplug_b.options) must stay below 64 kB.
+static_assert(sizeof(PbPayload) < 65536, "sparkplug_b.options: too many metrics for nanopb's 16-bit offsets");
 using PbMetric = hoist_sparkplug_Payload_Metric;
 
 void copyString(char* dst, std::size_t cap, const std::string& s, const char* what) {

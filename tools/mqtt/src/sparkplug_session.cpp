@@ -128,7 +128,7 @@ void SparkplugSession::onMessage(const struct mosquitto_message* m) {
     const bool may_log = log_.allow(LogBudget::kCmd, now, suppressed);
     if (c.what == sparkplug::Command::What::Rebirth) {
       // Within kRebirthMinMs of the births a request is held and merged
-      // (sparkplug::Node::acceptRebirth): one NCMD may carry 150 Rebirth
+      // (sparkplug::Node::acceptRebirth): one NCMD may carry 200 Rebirth
       // metrics, and each birth queues NBIRTH and every DBIRTH.
       if (!node_->acceptRebirth(nowMs())) {
         if (may_log)

@@ -17,9 +17,11 @@ enum class AlarmKind : std::uint8_t {
   RopeSlack, RopeOverload,            // live rope-force alarms
   PredictedClearance, PredictedSlack,  // look-ahead forecasts
   ModelMismatch,                      // the load estimator: the shaft does not behave like its model
-  SensorFault                         // a sensor of the estimator refused or not believed (names the sensor and why)
+  SensorFault,                        // a sensor of the estimator refused or not believed (names the sensor and why)
+  GuidePreloadLow,                    // the shaft's memory: the guide-rope preload identified over trips is low
+  ShaftFingerprint                    // the shaft's memory: a depth left its commissioning fingerprint
 };
-inline constexpr int kAlarmKinds = 13;
+inline constexpr int kAlarmKinds = 15;
 
 /// Values match alarm_t.LEVEL_*.
 enum class AlarmLevel : std::int8_t { None = 0, Warning = 1, Critical = 2 };

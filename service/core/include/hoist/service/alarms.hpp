@@ -27,6 +27,9 @@
 //     never latched, raised at once (no on-delay: the forecast itself is the
 //     early warning); MODEL_MISMATCH and SENSOR_FAULT (the load estimator's
 //     model check, and a sensor refused or not believed) are WARNING flags;
+//     GUIDE_PRELOAD_LOW (WARNING and CRITICAL) and SHAFT_FINGERPRINT (WARNING)
+//     are the shaft's memory's verdicts over its recorded trips (flags set
+//     after each trip; the CRITICAL one latches);
 //   * the condition comes on when value >= threshold has held for on_delay
 //     and goes off when value < threshold - deadband has held for off_delay
 //     (so a value hovering at the threshold cannot chatter); a low alarm
@@ -241,7 +244,7 @@ class AlarmEngine {
  public:
   /// The number of binary alarms; which ones, in which order, is the slot
   /// table in alarms.cpp (kSlotTable).
-  static constexpr int kSlots = 16;
+  static constexpr int kSlots = 19;
 
   explicit AlarmEngine(const AlarmConfig& cfg = {});
   const AlarmConfig& config() const { return cfg_; }
@@ -289,6 +292,19 @@ class AlarmEngine {
   /// lastSensorFault()); `value` and `limit` are reported (e.g. the clock
   /// offset and max_clock_offset [s]).
   void setSensorFault(double now, bool fault, double value, double limit, AlarmEvents& out);
+  /// GUIDE_PRELOAD_LOW (the shaft's memory, hoist/preload_trend.hpp): the
+  /// trend's level (None, Warning, Critical) after the last recorded trip.
+  /// The WARNING alarm is active at Warning and Critical (as a clearance's
+  /// WARNING is while its CRITICAL is), the CRITICAL one at Critical (it
+  /// latches with latch_critical).  `upper95` (the combined preload scale's
+  /// 95 % upper bound) is reported against `warning` / `critical`.
+  void setGuidePreloadLow(double now, AlarmLevel level, double upper95, double warning, double critical,
+                          AlarmEvents& out);
+  /// SHAFT_FINGERPRINT (WARNING; hoist/shaft_fingerprint.hpp): `active` while
+  /// a depth bin left the commissioning fingerprint on 2 of the last 3 trips
+  /// of a direction; `z` (the strongest hit's last z) against `limit`
+  /// ([condition] fingerprint_sigma).
+  void setShaftFingerprint(double now, bool active, double z, double limit, AlarmEvents& out);
   /// Runs shelve expiry and re-announcement without a new value.
   void poll(double now, AlarmEvents& out);
 

@@ -51,6 +51,10 @@ struct AlarmTextContext {
   /// SENSOR_FAULT: which sensor and why (TwinCore::lastSensorFault()).
   SensorId sensor = SensorId::CageImu;
   SensorFaultReason sensor_reason = SensorFaultReason::ClockOffset;
+  /// GUIDE_PRELOAD_LOW / SHAFT_FINGERPRINT: the condition's own text (the
+  /// estimate, its sigma and the trips; the depth), as the trip room said it.
+  const char* preload_text = "";
+  const char* fingerprint_text = "";
 };
 
 /// A readable one-line description of an alarm event into buf[0..n)

@@ -206,6 +206,13 @@ class TwinCore {
   /// and PREDICTED_SLACK (seconds to the crossing, horizon), at model time now.
   void setPredictions(bool clearance, double clearance_s, bool slack, double slack_s, double horizon,
                       bool from_estimate = false);
+  /// The shaft's memory's verdicts over its recorded trips (the daemon's
+  /// trip room, after each trip and once at start): GUIDE_PRELOAD_LOW at
+  /// `preload` (the combined scale's 95 % upper bound `upper95` against the
+  /// `warning` / `critical` limits) and SHAFT_FINGERPRINT (`z` against
+  /// `z_limit`), at model time now.  Allocation-free.
+  void setCondition(AlarmLevel preload, double upper95, double warning, double critical, bool fingerprint,
+                    double z, double z_limit);
   /// Alarm events since the last clearEvents() (the caller publishes them).
   const AlarmEvents& events() const { return events_; }
   void clearEvents() { events_.clear(); }

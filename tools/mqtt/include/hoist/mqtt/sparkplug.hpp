@@ -15,7 +15,7 @@
 namespace hoist::mqtt::sparkplug {
 
 /// The payload's protobuf encoding.  Throws std::length_error if it does not
-/// fit the static sizes (sparkplug_b.options: 150 metrics, names of 63 bytes).
+/// fit the static sizes (sparkplug_b.options: 200 metrics, names of 63 bytes).
 std::string encode(const Payload& p);
 
 /// Decodes at most `max_bytes` (larger: nullopt, why = "oversized ...").

@@ -98,7 +98,7 @@ class Node {
   /// kRebirthMinMs of the last births it is held instead (false), and any
   /// further requests merge into the held one, which rebirthDue() releases
   /// when the interval has passed: a host that missed the births still gets
-  /// them, and a flood (one NCMD may carry 150 Rebirth metrics, each birth
+  /// them, and a flood (one NCMD may carry 200 Rebirth metrics, each birth
   /// queues NBIRTH and every DBIRTH) costs at most two births per interval.
   /// Held and merged requests are counted (rebirthsCoalesced()).
   bool acceptRebirth(std::uint64_t now_ms);
