@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "hoist/bus/lcm_util.hpp"
+#include "trip_room.hpp"
 
 namespace hoist::svc {
 
@@ -71,6 +72,16 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   m.sensor_clock_refused = tc.clock_refused;
   m.sensor_time_backwards = tc.time_backwards;
   m.sensor_dropped = tc.too_late + tc.superseded;
+  if (const TripRoom* room = ctx_.trips) {  // relaxed reads of the room's atomics: no lock
+    const TripCounters& c = room->counters();
+    m.history_open = c.store_open.load(std::memory_order_relaxed);
+    m.trips_recorded = c.trips.load(std::memory_order_relaxed);
+    m.trips_stored = c.stored.load(std::memory_order_relaxed);
+    m.trips_queued = c.queued.load(std::memory_order_relaxed);
+    m.trips_failed = c.failed.load(std::memory_order_relaxed);
+    m.trip_ticks_dropped = c.dropped.load(std::memory_order_relaxed);
+    m.trip_cpu_ms_last = static_cast<double>(c.cpu_ns_last.load(std::memory_order_relaxed)) * 1e-6;
+  }
   m.alarms_active = al.activeCount();
   m.alarms_unacked = al.unackedCount();
   m.alarms_shelved = al.shelvedCount();

@@ -90,7 +90,7 @@ class TripRing {
 };
 
 /// The room's figures (atomics: the loop and the worker write, the final
-/// log line and the tests read; not in HOIST_HEALTH yet).
+/// log line and HOIST_HEALTH read them: shaft_health.cpp).
 struct TripCounters {
   std::atomic<std::int64_t> ticks{0};        ///< ticks copied into the ring (loop side)
   std::atomic<std::int64_t> trips{0};        ///< trips recorded (records built)

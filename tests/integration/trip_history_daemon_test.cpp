@@ -81,6 +81,13 @@ class TripHistoryDaemon : public LcmProcessTest {
                  std::string::npos;
         },
         60s));
+    // ... and counted in HOIST_HEALTH (published about once a second).
+    EXPECT_TRUE(listener_->waitFor(
+        [&] {
+          const auto h = listener_->decoded<hoist::health_t>("HOIST_HEALTH");
+          return !h.empty() && h.back().trips_recorded >= 2;
+        },
+        15s));
     stopDaemonCleanly(d, path("twind.log"));
   }
 };
@@ -98,6 +105,17 @@ TEST_F(TripHistoryDaemon, EveryTripIsOneRowLiveAsOffline) {
   EXPECT_NE(log.find("trip history: 2 trips recorded, 2 stored, 0 queued, 0 failed, 0 ticks dropped"),
             std::string::npos)
       << log;
+  // HOIST_HEALTH carries the same counters (the last message before the stop).
+  const auto health = listener_->decoded<hoist::health_t>("HOIST_HEALTH");
+  ASSERT_FALSE(health.empty());
+  EXPECT_TRUE(health.back().history_open);
+  EXPECT_EQ(health.back().trips_recorded, 2);
+  EXPECT_EQ(health.back().trips_stored, 2);
+  EXPECT_EQ(health.back().trips_failed, 0);
+  EXPECT_EQ(health.back().trip_ticks_dropped, 0);
+  EXPECT_GT(health.back().trip_cpu_ms_last, 0.0);
+  EXPECT_LT(health.back().trip_cpu_ms_last, 5000.0);
+  std::printf("the trip worker's CPU for the last trip's record: %.1f ms\n", health.back().trip_cpu_ms_last);
 
   auto live = hoist::history::openSqliteStore(db, true);
   hoist::history::ListFilter f;
