@@ -52,6 +52,14 @@ struct AlarmCause {
   std::array<char, 240> fingerprint_text{};
 };
 
+/// The last recorded trip's detectability (TripRoom's ConditionState, copied
+/// by the loop; estimate_t.detect_trip, loss30_separation, loss30_visible).
+struct TripDetectability {
+  std::int64_t trip = 0;
+  double loss30_separation = -1.0;
+  bool loss30_visible = false;
+};
+
 struct ShaftContext {
   using Clock = std::chrono::steady_clock;
 
@@ -80,6 +88,7 @@ struct ShaftContext {
   TwinCore core;                  ///< the model, input validation, alarms (no I/O)
   ShaftStats stats;               ///< every counter and histogram of this shaft
   AlarmCause cause;               ///< what the next alarm events' text names besides the event
+  TripDetectability detect;       ///< the last recorded trip's detectability (loop thread)
   Clock::time_point start{};      ///< the loop's start: wall times are measured from it
   /// --clock input: wall time spent in synchronous forecasts, not counted as
   /// time passing for this shaft's staleness and health windows (the inputs

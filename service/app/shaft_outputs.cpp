@@ -177,6 +177,9 @@ void ShaftOutputs::publishEstimate(std::int64_t utime, bool batch) {
   toEstimateMessage(*e, c, ctx_.core.publishedTime(e->t), st.last_imu_wall < 0.0 ? -1.0 : wall - st.last_imu_wall,
                     st.last_rope_wall < 0.0 ? -1.0 : wall - st.last_rope_wall, ctx_.core.estimateGate(),
                     ctx_.core.modelTime(), ctx_.core.calibrating(), estimate_msg_);
+  estimate_msg_.detect_trip = ctx_.detect.trip;
+  estimate_msg_.loss30_separation = ctx_.detect.loss30_separation;
+  estimate_msg_.loss30_visible = ctx_.detect.loss30_visible;
   encodeAndPublish(ctx_.ch.estimate, estimate_msg_, estimate_buf_, batch);
   logGateEvents();
 }

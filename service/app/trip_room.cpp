@@ -80,6 +80,9 @@ struct TripRoom::Worker {
   TripTick tick;                 // the tick being taken
   std::int64_t cpu_trip0 = 0;    // thread CPU at the trip's first tick
   bool moving = false;
+  std::int64_t detect_trip = 0;     // the last recorded trip (ConditionState)
+  double loss30_separation = -1.0;
+  bool loss30_visible = false;
 };
 
 TripRoom::TripRoom(const TwinConfig& cfg, const TripHistoryConfig& hist, std::string shaft_name, std::size_t capacity)
@@ -193,6 +196,9 @@ void TripRoom::publishCondition() {
   c.z = f.hits.empty() ? 0.0 : f.hits.front().z_last;
   c.z_limit = w.cond_settings.fingerprint_sigma;
   c.trips = w.judge.trips();
+  c.detect_trip = w.detect_trip;
+  c.loss30_separation = w.loss30_separation;
+  c.loss30_visible = w.loss30_visible;
   std::snprintf(c.preload_text.data(), c.preload_text.size(), "%s", p.text.c_str());
   std::snprintf(c.fingerprint_text.data(), c.fingerprint_text.size(), "%s", f.text.c_str());
   condition_.publish();
@@ -278,6 +284,9 @@ void TripRoom::finishTrip() {
   const ConditionLevel before = w.judge.preload().level;
   const bool finger_before = w.judge.fingerprint().active;
   w.judge.judge(r);
+  w.detect_trip = r.trip;
+  w.loss30_separation = r.id.attempted ? r.id.loss30_separation : 0.0;
+  w.loss30_visible = r.id.informative;
   publishCondition();
   if (w.judge.preload().level != before || w.judge.fingerprint().active != finger_before)
     log->warn("{}shaft condition changed after trip {}: {}", tag, r.trip, w.judge.summary());

@@ -68,6 +68,11 @@ struct ConditionState {
   bool fingerprint = false;               ///< SHAFT_FINGERPRINT active
   double z = 0.0, z_limit = 4.0;          ///< the strongest hit's last z; fingerprint_sigma
   std::int64_t trips = 0;                 ///< the trips judged (stored ones included)
+  /// The last trip recorded by this run (estimate_t.detect_trip etc.):
+  /// its number (0: none yet), 0.3 / sigma(s), informative.
+  std::int64_t detect_trip = 0;
+  double loss30_separation = -1.0;
+  bool loss30_visible = false;
   std::array<char, 240> preload_text{};   ///< the trend's text (cut to fit)
   std::array<char, 240> fingerprint_text{};
 };

@@ -91,6 +91,11 @@ int main(int argc, char** argv) {
     e.accepted = 1000 + k;
     e.gated = 2;
     e.implausible = 1;
+    // The last recorded trip's detectability: trip 12 could see a 30 %
+    // preload loss (5.2 sigma); with the rope load cell gone, trip 13 not.
+    e.detect_trip = 12;
+    e.loss30_separation = 5.2;
+    e.loss30_visible = 1;
     if (mode == "mismatch") {
       e.nis_window = 450.0;
       e.mismatch = 1;
@@ -109,6 +114,9 @@ int main(int argc, char** argv) {
       e.sensors = 3;  // the IMU only
       e.rope_load_age = -1.0;
       e.fa_observed = 0;
+      e.detect_trip = 13;
+      e.loss30_separation = 1.6;
+      e.loss30_visible = 0;
     }
     if (mode == "inuse") {
       e.in_use = 1;

@@ -25,6 +25,7 @@
 #include <thread>
 
 #include "hoist/alarm_t.hpp"
+#include "hoist/estimate_t.hpp"
 #include "hoist/history/condition_judge.hpp"
 #include "hoist/history/sqlite_store.hpp"
 #include "hoist/health_t.hpp"
@@ -95,7 +96,7 @@ class TripHistoryDaemon : public LcmProcessTest {
 }  // namespace
 
 TEST_F(TripHistoryDaemon, EveryTripIsOneRowLiveAsOffline) {
-  start(7955, "TripHistoryLive", {"HOIST_HEALTH"});
+  start(7955, "TripHistoryLive", {"HOIST_HEALTH", "HOIST_ESTIMATE"});
   const std::string db = path("live.sqlite"), offline = path("offline.sqlite");
   makeRun(db);
   std::vector<std::string> argv{HOIST_TWIND, "--lcm-url", url_, "--config", path("shaft7.toml"), "--clock", "input"};
@@ -138,6 +139,14 @@ TEST_F(TripHistoryDaemon, EveryTripIsOneRowLiveAsOffline) {
   // identified, and the truth (the nominal preload, s = 1) lies within 3 sigma.
   ASSERT_GT(rows[1].id.sigma_scale, 0.0) << rows[1].id.note;
   EXPECT_LT(std::abs(rows[1].id.scale - 1.0), 3.0 * rows[1].id.sigma_scale);
+  // HOIST_ESTIMATE states the last trip's detectability (as the record does).
+  const auto est = listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE");
+  ASSERT_FALSE(est.empty());
+  EXPECT_EQ(est.front().detect_trip, 0);  // no trip recorded yet
+  EXPECT_EQ(est.back().detect_trip, 2);
+  EXPECT_DOUBLE_EQ(est.back().loss30_separation, rows[1].id.loss30_separation);
+  EXPECT_EQ(est.back().loss30_visible, rows[1].id.informative);
+  std::printf("trip 2: %s\n", rows[1].id.note.c_str());
 
   // The sqlite3 CLI agrees (a real database, not our reader's view of it).
   const auto cli = runCaptured("/usr/bin/sqlite3", {db, "PRAGMA integrity_check; SELECT count(*) FROM trips;"});

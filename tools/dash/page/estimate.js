@@ -11,7 +11,8 @@ import { chartSize, spanAtLeast, splits, ticks, renderTilt } from "./trends.js";
 export const SENSOR_IMU_ACCEL = 1, SENSOR_IMU_RATE = 2, SENSOR_ROPE_LOAD = 4;  // estimate_t.SENSOR_*
 export const EST_ROWS = [["Fa", "payload Fa"], ["b", "offset b"], ["moment", "moment M = Fa b"], ["y_c", "sway y_c"],
                   ["theta", "tilt θ"], ["nis", "NIS window / bound"], ["sensors", "sensors in use"],
-                  ["counts", "updates / gated / refused"], ["in_use", "alarms judge"]];
+                  ["counts", "updates / gated / refused"], ["in_use", "alarms judge"],
+                  ["detect", "preload loss visible"]];
 
 export function makeEstimateCard() {
   const dl = el("dl", { "data-role": "estimate-values" });
@@ -94,11 +95,23 @@ export function renderEstimate(s, e, mismatchInInterval) {
   const inUse = $('[data-field="est-in_use"]', box);
   inUse.previousSibling.hidden = inUse.hidden = typeof e.in_use !== "boolean";
   inUse.textContent = e.in_use === true ? "the estimate" : e.in_use === false ? "the open-loop twin" : "";
+  // The last recorded trip's detectability (estimate_t.detect_trip, newer
+  // daemons with [history] on): could this IMU see a 30 % preload loss?
+  const det = $('[data-field="est-detect"]', box);
+  det.previousSibling.hidden = det.hidden = !num(e.detect_trip);
+  det.textContent = detectText(e);
   const badge = $('[data-field="est-mismatch"]', box);
   const on = Boolean(e.mismatch) || mismatchInInterval;
   badge.dataset.state = on ? "mismatch" : "ok";
   const why = [e.nis_exceeded ? "NIS" : "", e.drift_exceeded ? "load drift" : ""].filter(Boolean).join(", ");
   badge.textContent = on ? `MODEL_MISMATCH${why ? " (" + why + ")" : ""}` : "";
+}
+
+// One plain sentence for estimate_t's detectability fields.
+export function detectText(e) {
+  if (!num(e.detect_trip) || e.detect_trip <= 0) return "no trip recorded yet (the twin identifies the preload per trip)";
+  const sep = num(e.loss30_separation) && e.loss30_separation > 0 ? `: ${fix(e.loss30_separation, 1)} σ` : "";
+  return `this IMU ${e.loss30_visible ? "can" : "cannot"} see a 30 % preload loss (trip ${e.detect_trip}${sep})`;
 }
 
 export function makeEstimateCharts(s) {

@@ -64,7 +64,7 @@ const panel = () => page.evaluate((sel) => {
   const f = (k) => b.querySelector(`[data-field="est-${k}"]`).textContent;
   const pts = (role) => ({ ...b.querySelector(`[data-role="${role}"]`).dataset });
   return { hidden: b.hidden, state: b.dataset.state, Fa: f("Fa"), b: f("b"), moment: f("moment"), theta: f("theta"),
-           nis: f("nis"), sensors: f("sensors"), badge: f("mismatch"),
+           nis: f("nis"), sensors: f("sensors"), badge: f("mismatch"), detect: f("detect"),
            badgeState: b.querySelector('[data-field="est-mismatch"]').dataset.state,
            badgeVisible: getComputedStyle(b.querySelector('[data-field="est-mismatch"]')).display !== "none",
            theta_pts: pts("estimate-theta"), nis_pts: pts("estimate-nis") };
@@ -86,6 +86,7 @@ check(/^0\.6[4-6] ± 0\.01 mrad \(open loop 0\.830 mrad\)$/.test(p.theta), `thet
 check(/^IMU, \d+ ms ago; rope load, \d+ ms ago$/.test(p.sensors), `sensors in use with their ages: "${p.sensors}"`);
 check(/^3\d\d\.\d \/ 372\.0 \(300 dof; 95 %: 253\.9 … 349\.9\)$/.test(p.nis), `NIS against its bound: "${p.nis}"`);
 check(p.badgeState === "ok" && !p.badgeVisible, "no MODEL_MISMATCH badge while the model matches");
+check(p.detect === "this IMU can see a 30 % preload loss (trip 12: 5.2 σ)", `the last trip's detectability: "${p.detect}"`);
 const tp = p.theta_pts, np = p.nis_pts;
 check(Number(tp.points_th) >= 20 && Number(tp.points_hi) >= 20 && Number(tp.points_lo) >= 20 && Number(tp.points_open) >= 20,
       `theta trend has points: estimate ${tp.points_th}, +2 sigma ${tp.points_hi}, -2 sigma ${tp.points_lo}, open loop ${tp.points_open}`);
@@ -133,6 +134,7 @@ p = await panel();
 check(p.Fa === "n/a" && p.b === "n/a", `not observed: Fa "${p.Fa}", b "${p.b}"`);
 check(/^IMU, \d+ ms ago$/.test(p.sensors), `only the IMU in use: "${p.sensors}"`);
 check(p.badgeState === "ok", "the badge clears with the mismatch");
+check(p.detect === "this IMU cannot see a 30 % preload loss (trip 13: 1.6 σ)", `a trip that could not tell: "${p.detect}"`);
 
 // 4. The headline tilt shows what the alarms judge: while the estimate is in
 // use, the estimate's theta (0.65 mrad) with the open-loop twin's (0.830) beside it.
