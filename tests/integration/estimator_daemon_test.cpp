@@ -147,6 +147,13 @@ class EstimatorDaemon : public LcmProcessTest {
     EXPECT_EQ(health.sensor_accepted, 2 * 1001);
     EXPECT_EQ(health.sensor_rejected, 2);
     EXPECT_TRUE(health.estimate_in_use);
+    // The start-up log says whether the moment's sigma carries the offset.
+    const std::string log = readFile((dir_ / "twind.log").string());
+    const bool free = sensors_toml.find("imu_accel_offset_sigma = 0\n") == std::string::npos;
+    EXPECT_NE(log.find(free ? "the accelerometer's offset is estimated (uncalibrated"
+                            : "the accelerometer is declared calibrated"),
+              std::string::npos)
+        << log;
     return live;
   }
 };
