@@ -256,6 +256,20 @@ void Daemon::logStarted() {
                toString(c.service.clock), c.service.rate, bus::describeLcmUrl(opt_.lcm_url),
                lcm_out_ ? ", outputs to " : "", lcm_out_ ? bus::describeLcmUrl(opt_.lcm_url_out) : std::string(),
                ins, outs, c.shaft.n, c.shaft.L, c.shaft.h, c.shaft.l0, instance_id_);
+    // Whether the moment's sigma carries the accelerometer's unknown offset
+    // (docs/estimation.md, "The accelerometer's offset").
+    if (est) {
+      const double prior = c.estimator.settings.accel_offset_sigma;
+      if (prior > 0.0)
+        out_->info("{}load estimator: the accelerometer's offset is estimated (uncalibrated, [sensors] "
+                   "imu_accel_offset_sigma = {} m/s^2): the moment's sigma includes it until a calibration "
+                   "(hoist-alarm-ack --calibrate FA,B,SECONDS with a known load)",
+                   s.tag(), prior);
+      else
+        out_->info("{}load estimator: the accelerometer is declared calibrated ([sensors] imu_accel_offset_sigma "
+                   "= 0): its offset is not estimated",
+                   s.tag());
+    }
   }
   if (n > 1) out_->info("hoist-twind started: {} shafts on one loop, {} schedule(s)", n, groups_.size());
 }

@@ -165,6 +165,50 @@ TEST(SensorTiming, DelayedJitteredStreamGivesTheUndelayedEstimate) {
   EXPECT_FALSE(raised(late.events(), AlarmKind::SensorFault, AlarmEventType::Raise));
 }
 
+// Samples stamped with their winder sample's utime (what hoist-replay
+// --measurements sends) give hoist-estimate's numbers to the bit, with the
+// accelerometer's offset a state (imu_accel_offset_sigma 0.005: nearly
+// singular at rest, it carries a rounding difference to M's 12th digit).
+// The sensors' model time is computed exactly as the winder's: the old
+// (utime - base) * 1e-6 put 30 % of the samples one ulp before their step.
+TEST(SensorTiming, OnTimeSamplesGiveHoistEstimatesNumbersToTheBit) {
+  TwinConfig cfg = estimatorConfig();
+  cfg.estimator.settings.accel_offset_sigma = 0.005;
+  const HoistProfile trip = HoistProfile::trapezoid(50.0, 2.0, 1.0, 12.0, 12.0);
+  const Motion prof{&trip};
+  const long n = 600;
+  const auto z = truthReadings(cfg.shaft, prof, 1500.0, 0.6, n, 4);
+  TwinCore core(cfg, ClockMode::Input);
+  std::vector<MeasurementSample> rows(static_cast<std::size_t>(n));
+  std::vector<LoadEstimate> live;
+  for (long k = 0; k < n; ++k) {
+    const WinderSample w = winderAt(prof, k);
+    ASSERT_EQ(core.onCageImu(w.utime, z[k].f_y, z[k].omega, 0.0, 0), SensorVerdict::Queued);
+    ASSERT_EQ(core.onRopeLoad(w.utime, z[k].rope_load, 0.0, 0), SensorVerdict::Queued);
+    ASSERT_TRUE(core.onInput(w, 0.0).stepped);
+    live.push_back(*core.estimate());
+    MeasurementSample& m = rows[static_cast<std::size_t>(k)];
+    m.t = static_cast<double>(w.utime - kT0) / 1e6;  // the model time of the utime, as a recording has it
+    m.k = Kinematics{w.length, w.v, w.a};
+    m.z = z[k];
+    m.present = kSensorImuAccel | kSensorImuRate | kSensorRopeLoad;
+  }
+  std::size_t i = 0;
+  estimateRecorded(cfg.shaft, cfg.estimator.settings, cfg.service.max_step, rows,
+                   [&](const LoadEstimate& e, const EstimatorCounters&) {
+                     ASSERT_LT(i, live.size());
+                     const LoadEstimate& a = live[i++];
+                     ASSERT_EQ(a.t, e.t) << "row " << i - 1;
+                     ASSERT_EQ(a.moment, e.moment) << "t = " << e.t;
+                     ASSERT_EQ(a.sigma_moment, e.sigma_moment) << "t = " << e.t;
+                     ASSERT_EQ(a.accel_offset, e.accel_offset) << "t = " << e.t;
+                     ASSERT_EQ(a.Fa, e.Fa) << "t = " << e.t;
+                     ASSERT_EQ(a.theta, e.theta) << "t = " << e.t;
+                   });
+  EXPECT_EQ(i, live.size());
+  EXPECT_EQ(core.sensorTiming().applied, 2 * n);
+}
+
 TEST(SensorTiming, AClockTwoSecondsOffIsRefusedAndReported) {
   const TwinConfig cfg = estimatorConfig();
   const HoistProfile trip = HoistProfile::trapezoid(50.0, 2.0, 1.0, 12.0, 12.0);

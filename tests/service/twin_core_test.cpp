@@ -351,7 +351,7 @@ TEST(TwinCoreWall, CalibrateHandsTheKnownLoadToTheEstimator) {
   // learns the accelerometer's offset from it (a 1 mg offset at rest).
   TwinConfig cfg = smallConfig();
   cfg.estimator.enabled = true;
-  cfg.estimator.settings.accel_offset_sigma = 0.005;  // an uncalibrated IMU (the default is 0: calibrated)
+  cfg.estimator.settings.accel_offset_sigma = 0.005;  // an uncalibrated IMU (the default, said here: the test needs it)
   TwinCore core(cfg, ClockMode::Wall);
   WinderSample s;
   s.utime = kT0;

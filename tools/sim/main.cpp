@@ -21,7 +21,9 @@
 // Gaussian noise), in the measurement CSV of hoist-estimate
 // (t,l,v,a,f_y,omega,rope_load; hoist/io/estimator_config.hpp).  The run's
 // load is the config's: a "truth" config with another [load] makes data for
-// hoist-estimate run with the real config.
+// hoist-estimate run with the real config.  Its t is rounded to the whole
+// microsecond (a sensor clock's utime), so that hoist-replay --measurements
+// gives hoist-twind the very times hoist-estimate reads.
 // Exit status: 0 done, 2 bad input (config, profile, options), 1 the run
 // failed (non-finite or implausible state -- the message names the time, the
 // quantity and its value --, write error, out of memory).

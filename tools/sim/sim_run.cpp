@@ -326,7 +326,11 @@ int run(const Options& o) {
           if (meas_file.isOpen()) {
             // The sensor model on this response plus noise, drawn in a fixed order (reproducible by --seed).
             const hoist::SensorValues z = hoist::sensorModel(r, p.g);
-            meas.t = r.t;
+            // Stamped as a sensor clock stamps it, in whole microseconds:
+            // hoist-replay's utime then carries this very t to hoist-twind,
+            // so the live estimator sees the times hoist-estimate reads (r.t
+            // is a sum of steps, 0.35000000000000003 for 0.35 s).
+            meas.t = std::round(r.t * 1e6) / 1e6;
             meas.k = r.kin;
             meas.z.f_y = z.f_y + noise.imu_accel * n01(rng);
             meas.z.omega = z.omega + noise.imu_rate * n01(rng);

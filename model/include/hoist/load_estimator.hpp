@@ -113,10 +113,8 @@ struct EstimatorSettings {
   /// Prior sigma of the accelerometer's constant offset on f_y ([sensors]
   /// imu_accel_offset_sigma) [m/s^2]; 0 declares it calibrated (the offset
   /// is then the one setAccelOffset() gave, 0 by default, and not estimated).
-  /// Default 0 for now: with the offset free the live daemon's estimate does
-  /// not yet equal hoist-estimate's (docs/estimation.md); 0.005 (about
-  /// 0.5 mg) is the prior of an uncalibrated industrial accelerometer.
-  double accel_offset_sigma = 0.0;
+  /// Default 0.005 (about 0.5 mg): an uncalibrated industrial accelerometer.
+  double accel_offset_sigma = 0.005;
   double fa_walk = 5.0;         ///< random walk of Fa at rest [N/sqrt(s)]
   double moment_walk = 5.0;     ///< random walk of M at rest [N m/sqrt(s)]
   double moving_walk_scale = 0.01;  ///< factor on both walks while the cage moves (loads do not change then)

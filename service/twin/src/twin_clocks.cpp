@@ -31,8 +31,7 @@ class InputClock final : public ClockPolicy {
       k = Kinematics{s.has_length ? s.length : c.cfg_.shaft.l0, s.v, s.a};
     } else {
       // A restarted stream continues model time one nominal period later.
-      t = new_stream ? c.t_ + 1.0 / c.cfg_.service.rate
-                     : t_base_ + static_cast<double>(s.utime - utime_base_) / 1e6;
+      t = new_stream ? c.t_ + 1.0 / c.cfg_.service.rate : modelTime(s.utime);
       if (!(t > c.t_)) return reject(c, res, RejectReason::TimeBackwards);
       k = s.has_length ? Kinematics{s.length, s.v, s.a} : c.integrate(c.kin_, s.v, s.a, t - c.t_);
     }
@@ -72,10 +71,18 @@ class InputClock final : public ClockPolicy {
       return -std::numeric_limits<double>::infinity();
     }
     offset = static_cast<double>(utime - c.last_.utime) * 1e-6;
-    return t_base_ + static_cast<double>(utime - utime_base_) * 1e-6;
+    return modelTime(utime);
   }
 
  private:
+  // The model time of a utime: one formula for the winder's samples and the
+  // sensors', so that a sensor sample stamped with a winder sample's utime
+  // lands exactly on that step (a division, not * 1e-6: the two differ in
+  // the last bit for 30 % of the utimes; the sample was then aligned from
+  // an instant one ulp before its step, and the estimate drifted from
+  // hoist-estimate's by rounding).
+  double modelTime(std::int64_t utime) const { return t_base_ + static_cast<double>(utime - utime_base_) / 1e6; }
+
   static InputResult reject(TwinCore& c, InputResult& res, RejectReason r) {
     c.counters_.reject(r);
     res.accepted = false;
