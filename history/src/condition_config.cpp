@@ -22,6 +22,11 @@ ConditionSettings conditionSettingsFromToml(const toml::table& root, const std::
   r.number("preload_critical", c.preload_critical);
   r.number("trend_walk", c.trend_walk);
   detail::runValidated(r, source, [&c] { c.validate(); });
+  // The preload fit carries the accelerometer's offset as the estimator
+  // does: [sensors] imu_accel_offset_sigma of the same file (default 0.005;
+  // 0 = calibrated), so every trip record -- hoist-twind's, hoist-trips
+  // ingest's, Python's -- fits it alike.
+  c.accel_offset_sigma = io::estimatorConfigFromToml(root, source).settings.accel_offset_sigma;
   return c;
 }
 

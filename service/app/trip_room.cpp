@@ -35,6 +35,9 @@ std::shared_ptr<spdlog::logger> logger() {
 /// [condition] plus what the daemon's other sections say ([alarms] gaps).
 ConditionSettings conditionFor(const TwinConfig& cfg, const TripHistoryConfig& h) {
   ConditionSettings c = h.condition;
+  // The preload fit carries the accelerometer's offset as the twin's
+  // estimator does (its [sensors] imu_accel_offset_sigma).
+  c.accel_offset_sigma = cfg.estimator.settings.accel_offset_sigma;
   c.clearance.gap_pos_y = cfg.alarms.gap_pos_y;
   c.clearance.gap_neg_y = cfg.alarms.gap_neg_y;
   c.clearance.guide_rope_gap = cfg.alarms.guide_rope_gap;

@@ -14,9 +14,11 @@
 //
 // Every key optional (ConditionSettings{} defaults).  Errors: io::ConfigError
 // "file:line: condition.key: why" (unknown keys with "did you mean", wrong
-// types, what ConditionSettings::validate() refuses).  The clearance gaps
-// and the accelerometer's offset prior are not [condition] keys (they stay
-// at their defaults here; the daemon copies its [alarms] and [sensors]).
+// types, what ConditionSettings::validate() refuses).  The accelerometer's
+// offset prior is [sensors] imu_accel_offset_sigma of the same file (read
+// here too: the preload fit carries the offset as the estimator does).  The
+// clearance gaps are not [condition] keys (they stay at their defaults here;
+// the daemon copies its [alarms]).
 // Who calls: hoist-trips (ingest, trend); the daemon's configuration later.
 #pragma once
 
