@@ -2,9 +2,13 @@
 #include "hoist/history/condition_config.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 #include <stdexcept>
 
+#include "hoist/io/error.hpp"
 #include "hoist/io/estimator_config.hpp"
+#include "hoist/load_estimator.hpp"
 #include "hoist/io/toml_section.hpp"
 #include "section.hpp"
 
@@ -26,7 +30,21 @@ ConditionSettings conditionSettingsFromToml(const toml::table& root, const std::
   // does: [sensors] imu_accel_offset_sigma of the same file (default 0.005;
   // 0 = calibrated), so every trip record -- hoist-twind's, hoist-trips
   // ingest's, Python's -- fits it alike.
-  c.accel_offset_sigma = io::estimatorConfigFromToml(root, source).settings.accel_offset_sigma;
+  // Only that key: the whole [sensors]/[estimator] is validated by whoever
+  // reads the estimator (the daemon adds keys of its own to [estimator]).
+  c.accel_offset_sigma = EstimatorSettings{}.accel_offset_sigma;
+  if (const toml::table* sensors = root["sensors"].as_table()) {
+    const toml::node* v = sensors->get("imu_accel_offset_sigma");
+    if (v) {
+      const std::optional<double> x = v->value<double>();
+      if (!x || !std::isfinite(*x) || *x < 0.0 || *x > 1.0) {
+        const auto& where = v->source().begin;
+        throw io::ConfigError(source, static_cast<int>(where.line), "sensors.imu_accel_offset_sigma",
+                              "must be a number in [0, 1] m/s^2");
+      }
+      c.accel_offset_sigma = *x;
+    }
+  }
   return c;
 }
 

@@ -31,6 +31,13 @@ EstimatorConfig estimatorConfigFromToml(const toml::table& tbl, const std::strin
     if (f.real) r.number(std::string(f.key), *f.real(c.settings));
     else r.integer(std::string(f.key), *f.integer(c.settings));
   }
+  // hoist-twind's own keys of these sections (it reads them itself:
+  // service/cfg/src/config_file.cpp).  A tool reading the daemon's file
+  // (hoist-estimate, hoist-trips, Python) accepts them, type-checked, and has
+  // no use for them: the same file serves live and offline.
+  double daemon_only = 0.0;
+  sensors.number("max_clock_offset", daemon_only);
+  est.number("clear_hold", daemon_only);
   sensors.run();
   est.run();
   try {

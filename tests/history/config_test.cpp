@@ -187,3 +187,19 @@ TEST(ConditionConfig, KeysDefaultsAndErrorsWithTheLine) {
   EXPECT_NE(std::find(sections.begin(), sections.end(), "condition"), sections.end());
   EXPECT_NO_THROW(io::shaftParamsFromToml(io::parseToml("[history]\nkeep_days = 1\n[condition]\n"), "c.toml", sections));
 }
+
+// The preload fit's offset prior is [sensors] imu_accel_offset_sigma of the
+// same file (the estimator's default without it); only that key is read, so
+// the daemon's own [estimator] keys (clear_hold) are no error here.
+TEST(ConditionConfig, OffsetPriorComesFromSensors) {
+  EXPECT_EQ(conditionSettingsFromToml(io::parseToml("[condition]\n"), "c.toml").accel_offset_sigma, 0.005);
+  const auto c = conditionSettingsFromToml(
+      io::parseToml("[sensors]\nimu_accel_offset_sigma = 0.0\n[estimator]\nclear_hold = 3.0\n"), "c.toml");
+  EXPECT_EQ(c.accel_offset_sigma, 0.0);
+  try {
+    conditionSettingsFromToml(io::parseToml("[sensors]\n\nimu_accel_offset_sigma = -1.0\n", "c.toml"), "c.toml");
+    ADD_FAILURE() << "a negative prior was accepted";
+  } catch (const io::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("c.toml:3: sensors.imu_accel_offset_sigma"), std::string::npos) << e.what();
+  }
+}

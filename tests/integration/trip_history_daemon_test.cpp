@@ -63,7 +63,7 @@ class TripHistoryDaemon : public LcmProcessTest {
                          path("sim.log"), 120s),
               0)
         << readFile(path("sim.log"));
-    std::ofstream(path("shaft7.toml")) << "[model]\nmodes = 8\n[estimator]\nenabled = true\n[condition]\ndepth_bin = 20.0\n"
+    std::ofstream(path("shaft7.toml")) << "[model]\nmodes = 8\n[estimator]\nenabled = true\nclear_hold = 2.0\n[condition]\ndepth_bin = 20.0\n"
                                        << more_condition << "[history]\nurl = \"sqlite://" << db << "\"\n" << more_history;
   }
   /// hoist-replay feeds meas.csv to the daemon `d` (twind.log); the second

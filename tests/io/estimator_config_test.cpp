@@ -120,12 +120,16 @@ TEST(EstimatorConfig, ErrorsNameFileLineAndKey) {
 TEST(EstimatorConfig, DaemonConfigurationIsAcceptedByTheShaftReader) {
   const std::string text =
       "[load]\neccentric_force = 1500.0\n[service]\nmax_step = 0.001\n[alarms]\n[forecast]\n"
-      "[sensors]\nimu_accel_noise = 0.003\n[estimator]\nenabled = true\n";
+      "[sensors]\nimu_accel_noise = 0.003\nmax_clock_offset = 0.3\n[estimator]\nenabled = true\nclear_hold = 1.5\n";
   const toml::table tbl = hoist::io::parseToml(text, "d.toml");
   EXPECT_THROW(hoist::io::shaftParamsFromToml(tbl, "d.toml"), ConfigError);  // the shaft alone refuses them
   const hoist::ShaftParams p = hoist::io::shaftParamsFromToml(tbl, "d.toml", hoist::io::daemonSections());
   EXPECT_EQ(p.Fa, 1500.0);
+  // The daemon's own keys (max_clock_offset, clear_hold) are no error for
+  // the offline tools reading the same file, but still type-checked.
   EXPECT_EQ(hoist::io::estimatorConfigFromToml(tbl, "d.toml").settings.noise.imu_accel, 0.003);
+  EXPECT_NE(errorOf("[estimator]\nclear_hold = \"long\"\n").find("cfg.toml:2: estimator.clear_hold: must be a number"),
+            std::string::npos);
   EXPECT_EQ(hoist::io::serviceMaxStep(tbl, "d.toml", 0.0025), 0.001);
   EXPECT_EQ(hoist::io::serviceMaxStep(hoist::io::parseToml("[load]\n", "x"), "x", 0.0025), 0.0025);
   try {
