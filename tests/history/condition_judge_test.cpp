@@ -16,12 +16,9 @@ using hoist::history::ConditionJudge;
 namespace {
 
 hoist::TripRecord identified(std::int64_t trip, double s, const std::string& shaft) {
-  hoist::TripRecord r = hoist::test::sampleRecord(trip, shaft, 0);
+  hoist::TripRecord r = hoist::test::identifiedRecord(trip, s, shaft, 0);
   r.alarms.clear();
   r.mismatch = false;
-  r.id.scale = s;
-  r.id.sigma_scale = 0.03;
-  r.id.informative = true;
   return r;
 }
 

@@ -71,6 +71,16 @@ inline TripRecord sampleRecord(std::int64_t trip, const std::string& shaft = "",
 }
 
 /// Field by field, written out by hand (independent of history/schema.cpp).
+/// sampleRecord with the preload identified: s +- 0.03, informative (for
+/// the trend's tests: hoist/preload_trend.hpp).
+inline TripRecord identifiedRecord(std::int64_t trip, double s, const std::string& shaft = "", int bins = 4) {
+  TripRecord r = sampleRecord(trip, shaft, bins);
+  r.id.scale = s;
+  r.id.sigma_scale = 0.03;
+  r.id.informative = true;
+  return r;
+}
+
 inline void expectSameRecord(const TripRecord& a, const TripRecord& b) {
   EXPECT_EQ(a.shaft, b.shaft);
   EXPECT_EQ(a.trip, b.trip);

@@ -264,14 +264,11 @@ TEST_F(TripHistoryDaemon, ConditionAlarmsComeFromTheStoredTripsAndJudgeEachNewOn
   {
     auto s = hoist::history::openSqliteStore(db);
     for (int t = 1; t <= 12; ++t) {
-      hoist::TripRecord r = sampleRecord(t, "shaft7", 0);
+      hoist::TripRecord r = identifiedRecord(t, t <= 8 ? 1.0 : 0.6, "shaft7", 0);
       r.alarms.clear();
       r.mismatch = false;
       r.wall_start_us = now_us - (13 - t) * 600'000'000LL;
       r.wall_end_us = r.wall_start_us + 60'000'000LL;
-      r.id.scale = t <= 8 ? 1.0 : 0.6;
-      r.id.sigma_scale = 0.03;
-      r.id.informative = true;
       s->put(r);
     }
   }

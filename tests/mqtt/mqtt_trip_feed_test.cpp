@@ -17,26 +17,16 @@
 
 using hoist::mqtt::TripFeed;
 
-namespace {
-
-hoist::TripRecord rec(std::int64_t trip, double s, const std::string& shaft = "") {
-  hoist::TripRecord r = hoist::test::sampleRecord(trip, shaft, 4);
-  r.id.scale = s;
-  r.id.sigma_scale = 0.03;
-  r.id.informative = true;
-  return r;
-}
-
-}  // namespace
+using hoist::test::identifiedRecord;
 
 TEST(MqttTripFeed, SummaryAndConditionFromTheStore) {
   const auto dir = hoist::test::testDir("trip_feed_read");
   auto s = hoist::history::openSqliteStore((dir / "h.sqlite").string());
   for (int t = 1; t <= 8; ++t) {
-    auto r = rec(t, t <= 4 ? 1.0 : 0.6, "north");
+    auto r = identifiedRecord(t, t <= 4 ? 1.0 : 0.6, "north");
     s->put(r);
   }
-  auto bad = rec(9, 50.0, "north");
+  auto bad = identifiedRecord(9, 50.0, "north");
   s->put(bad);
   std::int64_t rejected = 0;
   const auto u = TripFeed::read(*s, "north", hoist::ConditionSettings{}, &rejected);
@@ -66,7 +56,7 @@ TEST(MqttTripFeed, SummaryAndConditionFromTheStore) {
   EXPECT_NE(j["condition"]["text"].get<std::string>().find("0.6"), std::string::npos) << j.dump();
   EXPECT_EQ(j["wall_end"].get<std::string>().size(), 24u);
   // Another shaft, and one without trips.
-  auto d = rec(1, 1.0);
+  auto d = identifiedRecord(1, 1.0);
   s->put(d);
   EXPECT_EQ(TripFeed::read(*s, "default", hoist::ConditionSettings{}).cond.guide_preload_low, 0);
   EXPECT_TRUE(TripFeed::read(*s, "south", hoist::ConditionSettings{}).shaft.empty());
@@ -103,7 +93,7 @@ TEST(MqttTripFeed, WorkerReportsTheLastTripThenEachNewOne) {
   {
     auto s = hoist::history::openSqliteStore(db.string());
     for (int t = 1; t <= 3; ++t) {
-      auto r = rec(t, 1.0);
+      auto r = identifiedRecord(t, 1.0);
       s->put(r);
       // Longer than a poll: the worker sees trips 1 and 2 on their own.
       std::this_thread::sleep_for(std::chrono::milliseconds(120));
@@ -113,7 +103,7 @@ TEST(MqttTripFeed, WorkerReportsTheLastTripThenEachNewOne) {
   EXPECT_EQ(u.last["trip"], 3);
   {
     auto s = hoist::history::openSqliteStore(db.string());
-    auto r = rec(4, 0.9);
+    auto r = identifiedRecord(4, 0.9);
     s->put(r);
   }
   u = waitFor(4);
