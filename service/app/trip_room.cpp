@@ -284,15 +284,20 @@ void TripRoom::finishTrip() {
     }
   }
   r.trip = number > 0 ? number : w.judge.lastTrip() + 1;
-  const ConditionLevel before = w.judge.preload().level;
-  const bool finger_before = w.judge.fingerprint().active;
-  w.judge.judge(r);
-  w.detect_trip = r.trip;
-  w.loss30_separation = r.id.attempted ? r.id.loss30_separation : 0.0;
-  w.loss30_visible = r.id.informative;
-  publishCondition();
-  if (w.judge.preload().level != before || w.judge.fingerprint().active != finger_before)
-    log->warn("{}shaft condition changed after trip {}: {}", tag, r.trip, w.judge.summary());
+  try {  // never out of the worker: a record the judge refuses is logged, the trip still stored
+    const ConditionLevel before = w.judge.preload().level;
+    const bool finger_before = w.judge.fingerprint().active;
+    w.judge.judge(r);
+    w.detect_trip = r.trip;
+    w.loss30_separation = r.id.attempted ? r.id.loss30_separation : 0.0;
+    w.loss30_visible = r.id.informative;
+    publishCondition();
+    if (w.judge.preload().level != before || w.judge.fingerprint().active != finger_before)
+      log->warn("{}shaft condition changed after trip {}: {}", tag, r.trip, w.judge.summary());
+  } catch (const std::exception& e) {
+    log->error("{}shaft condition: trip {} could not be judged ({}); the condition alarms stay as they were", tag,
+               r.trip, e.what());
+  }
   if (number <= 0) r.trip = 0;
   if (!w.store) {
     counts_.failed.fetch_add(1, std::memory_order_relaxed);
