@@ -137,11 +137,25 @@ inline std::string urlFor(int port) { return "udpm://239.255.76.67:" + std::to_s
 inline std::unique_ptr<Process> startDaemonAndWait(Listener& listener, const std::vector<std::string>& argv,
                                                    const std::string& log,
                                                    const std::string& health_channel = "HOIST_HEALTH") {
+  // Up = a health report of this process: one published after it started.
+  // A report of a daemon stopped just before may still be on its way to the
+  // listener (a loaded machine): counting reports would take that one, and
+  // what the test publishes next would go out before this daemon listens.
+  // health_t's first field is utime (after LCM's 8-byte fingerprint).
+  const auto started_utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch()).count();
   auto p = std::make_unique<Process>(argv, log);
   EXPECT_TRUE(p->started());
-  const std::size_t before = listener.count(health_channel);
-  EXPECT_TRUE(listener.waitFor([&] { return listener.count(health_channel) > before; }, 10s))
-      << "hoist-twind did not come up; its log:\n" << readFile(log);
+  const auto reportedSinceStart = [&] {
+    for (const Listener::Message& m : listener.messages(health_channel)) {
+      if (m.data.size() < 16) continue;
+      std::uint64_t u = 0;
+      for (std::size_t i = 8; i < 16; ++i) u = (u << 8) | m.data[i];
+      if (static_cast<std::int64_t>(u) >= started_utime) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(listener.waitFor(reportedSinceStart, 10s)) << "hoist-twind did not come up; its log:\n" << readFile(log);
   listener.pump(200ms);
   return p;
 }
