@@ -534,3 +534,72 @@ TEST_F(MqttSparkplug, PrimaryHostGatesBirthsAndStoredDataIsHistorical) {
   const json r = report();
   EXPECT_EQ(r["errors"], json::array()) << r.dump(1);
 }
+
+// A forged STATE "offline" (issue 33) on a broker without the STATE ACL:
+// Sparkplug 3.0 stamps the host's online and its death with one timestamp,
+// so an offline stamped otherwise is no death of the session followed.  It
+// still ends the session (the bridge cannot tell), but costs no data and
+// locks nobody out: not retained, the reconnect reads the host's retained
+// online again and the bridge is live at once; retained (it replaced the
+// host's online on the broker), the host's republished online -- the same
+// timestamp -- brings it back.  Before, both onlines were "older than the
+// last STATE" and ignored until the host started a new session.
+TEST_F(MqttSparkplug, ForgedOfflineCostsTheSessionNeverTheDataNorTheHostsReturn) {
+  ASSERT_NO_FATAL_FAILURE(start(18624, 8064, "primary_host_id = \"scada\"\n"));
+  lcm::LCM pub(lcm_url_);
+  const auto now_ms = [] {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+        .count();
+  };
+  const std::int64_t t0 = now_ms();
+  command("state scada true " + std::to_string(t0));
+  ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 5s)) << tail(host_log_);
+  auto seqSeen = [&](std::int64_t seq) {
+    json alias;  // of Cage/Seq, from the DBIRTH
+    for (const auto& b : ofType("DBIRTH"))
+      for (const auto& x : b["metrics"])
+        if (x["name"] == "Cage/Seq") alias = x["alias"];
+    return waitMsg(
+        [&](const json& m) {
+          if (m.value("type", "") != "DDATA") return false;
+          for (const auto& x : m["metrics"])
+            if (x["alias"] == alias && x["value"] == seq) return true;
+          return false;
+        },
+        8s);
+  };
+  auto hexOf = [](const std::string& s) {
+    std::string h;
+    char b[3];
+    for (unsigned char c : s) std::snprintf(b, sizeof b, "%02x", c), h += b;
+    return h;
+  };
+  const std::string forged = R"({"online": false, "timestamp": )" + std::to_string(now_ms()) + "}";
+  // 1. Not retained: NDEATH, reconnect, the retained online read again: births, live.
+  command("raw spBv1.0/STATE/scada " + hexOf(forged));
+  ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "NDEATH"; }, 5s)) << tail(host_log_);
+  const auto c1 = cage(1);
+  ASSERT_EQ(pub.publish("north/HOIST_CAGE", &c1), 0);
+  ASSERT_TRUE(waitMsg([&](const json&) { return ofType("NBIRTH").size() >= 2; }, 10s))
+      << "the host's own retained online brings the session back\n" << tail(host_log_);
+  EXPECT_TRUE(seqSeen(c1.seq)) << "the sample of the outage is sent";
+  // 2. Retained (the host's online replaced on the broker): stored until the
+  // host republishes its online, with its session's timestamp.
+  command("state scada false " + std::to_string(now_ms()));
+  ASSERT_TRUE(waitMsg([&](const json&) { return ofType("NDEATH").size() >= 2; }, 5s)) << tail(host_log_);
+  std::this_thread::sleep_for(1s);  // reconnected, the forged retained offline read: storing
+  const auto c2 = cage(2);
+  ASSERT_EQ(pub.publish("north/HOIST_CAGE", &c2), 0);
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(ofType("NBIRTH").size(), 2u) << "no births while the broker says offline";
+  command("state scada true " + std::to_string(t0));  // the host republishes: the same session
+  ASSERT_TRUE(waitMsg([&](const json&) { return ofType("NBIRTH").size() >= 3; }, 10s))
+      << "the host's republished online (its session's timestamp) is accepted\n" << tail(host_log_);
+  EXPECT_TRUE(seqSeen(c2.seq)) << "stored meanwhile, sent after the births";
+  const auto h = waitHealth([](const json& j) { return j.contains("sparkplug") && j["sparkplug"].value("session", false) &&
+                                                      j["sparkplug"].value("state_unverified", 0) >= 2; }, 5s);
+  ASSERT_TRUE(h) << tail(host_log_);
+  EXPECT_EQ((*h)["sparkplug"]["state_ignored"], 0) << h->dump(1);
+  const json r = report();
+  EXPECT_EQ(r["errors"], json::array()) << r.dump(1);
+}

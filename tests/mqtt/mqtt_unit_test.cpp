@@ -519,7 +519,7 @@ TEST(MqttSparkplugCore, PrimaryHostState) {
   EXPECT_TRUE(n.hostOnline());
   EXPECT_EQ(state(R"({"online": false, "timestamp": 999})"), In::StateIgnored) << "older than the online STATE";
   EXPECT_TRUE(n.hostOnline());
-  EXPECT_EQ(state(R"({"online": false, "timestamp": 1001})"), In::HostOffline);
+  EXPECT_EQ(state(R"({"online": false, "timestamp": 1001})"), In::HostOfflineUnverified) << "not the session's death";
   EXPECT_EQ(state("not json"), In::StateIgnored);
   EXPECT_EQ(state(R"({"online": "yes", "timestamp": 1})"), In::StateIgnored);
   EXPECT_EQ(n.subscriptions().back(), "spBv1.0/STATE/scada");
@@ -536,6 +536,37 @@ TEST(MqttSparkplugCore, PrimaryHostState) {
   EXPECT_EQ(stateAt(R"({"online": true, "timestamp": )" + std::to_string(now) + "}", now), In::HostOnline)
       << "the genuine host is not locked out";
   EXPECT_EQ(n.stateIgnored(), 5);
+}
+
+// Sparkplug 3.0 stamps a host's online STATE and its death with one
+// timestamp: an offline stamped otherwise is no death of the session
+// followed (counted unverified), and it raises no bar -- the same session's
+// online (retained, read again; or republished) brings the host back.
+TEST(MqttSparkplugCore, AnOfflineNotStampedLikeTheSessionRaisesNoBar) {
+  sp::Node n({"G", "E", "scada", "v", 0.0, {}});
+  std::vector<sp::Command> out;
+  using In = sp::Node::Inbound;
+  auto state = [&](bool online, std::uint64_t ts) {
+    const std::string j = std::string(R"({"online": )") + (online ? "true" : "false") + R"(, "timestamp": )" +
+                          std::to_string(ts) + "}";
+    return n.onMessage("spBv1.0/STATE/scada", j.data(), j.size(), 1024, true, out, 2'000'000);
+  };
+  EXPECT_EQ(state(false, 500), In::HostOffline) << "no session known yet: an offline is just offline";
+  EXPECT_EQ(state(true, 400), In::HostOnline) << "an offline raises no bar, even before a session";
+  EXPECT_EQ(state(true, 1000), In::HostOnline);
+  EXPECT_EQ(state(false, 1'500'000), In::HostOfflineUnverified) << "a forged offline stamped now";
+  EXPECT_FALSE(n.hostOnline()) << "stored as for a death: the bridge cannot tell";
+  EXPECT_EQ(state(true, 1000), In::HostOnline) << "the session's own online, read again, brings it back";
+  EXPECT_TRUE(n.hostOnline());
+  EXPECT_EQ(state(false, 1000), In::HostOffline) << "the session's death: its timestamp";
+  EXPECT_EQ(state(true, 1000), In::HostOnline) << "the host republishes its online (it read an offline on its topic)";
+  EXPECT_EQ(state(true, 999), In::StateIgnored) << "an earlier session's";
+  EXPECT_EQ(state(false, 999), In::StateIgnored) << "an earlier session's death";
+  EXPECT_EQ(state(true, 3000), In::HostOnline) << "a new session";
+  EXPECT_EQ(state(false, 1000), In::StateIgnored) << "the old session's death, late";
+  EXPECT_TRUE(n.hostOnline());
+  EXPECT_EQ(n.stateUnverified(), 1);
+  EXPECT_EQ(n.stateIgnored(), 3);
 }
 
 // A Rebirth request (NCMD) within kRebirthMinMs of the births is held and

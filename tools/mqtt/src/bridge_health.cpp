@@ -79,6 +79,7 @@ json BridgeHealth::build() const {
                       {"rebirths", sp_->rebirths()},
                       {"rebirths_coalesced", node.rebirthsCoalesced()},
                       {"state_ignored", node.stateIgnored()},
+                      {"state_unverified", node.stateUnverified()},
                       {"host_offline", sp_->hostOffline()}};
   }
   j["stale_cage"] = {{"marked", ln.stale_marked}, {"dropped", ln.stale_dropped}};

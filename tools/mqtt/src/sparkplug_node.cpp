@@ -204,16 +204,24 @@ Node::Inbound Node::onMessage(const std::string& topic, const void* data, std::s
   if (waitsForHost() && topic == stateTopic(opt_.primary_host)) {
     bool online = false;
     std::uint64_t ts = 0;
-    // Sparkplug 3.0: an offline STATE older than the last online one is
-    // ignored; so is one from the far future (a forgery would lock the
-    // genuine host out) and anything that is not a STATE.
-    if (!parseState(data, size, online, ts) || ts < host_ts_ || (now_ms > 0 && ts > now_ms + kStateFutureMs)) {
+    // Sparkplug 3.0 (see the header): a STATE older than the session known,
+    // from the far future, or not a STATE at all is ignored.
+    const bool ok = parseState(data, size, online, ts) && !(now_ms > 0 && ts > now_ms + kStateFutureMs);
+    if (!ok || ts < host_ts_) {
       ++state_ignored_;
       return Inbound::StateIgnored;
     }
-    host_ts_ = ts;
-    host_online_ = online;
-    return online ? Inbound::HostOnline : Inbound::HostOffline;
+    if (online) {
+      host_ts_ = ts;
+      have_session_ = true;
+      host_online_ = true;
+      return Inbound::HostOnline;
+    }
+    host_online_ = false;
+    if (!have_session_) return Inbound::HostOffline;  // no session known: nothing to end, nothing to mark
+    if (ts == host_ts_) return Inbound::HostOffline;
+    ++state_unverified_;
+    return Inbound::HostOfflineUnverified;
   }
   const std::string ncmd = nodeTopic(opt_.group, "NCMD", opt_.edge);
   const std::string dcmd = nodeTopic(opt_.group, "DCMD", opt_.edge) + "/";

@@ -109,7 +109,19 @@ void SparkplugSession::onMessage(const struct mosquitto_message* m) {
     }
     return;
   }
-  if (in == In::HostOffline) {
+  if (in == In::HostOfflineUnverified) {
+    // Not the death of the session followed (another timestamp): a forgery
+    // on a broker without the STATE ACL, or a host breaking Sparkplug's
+    // rule.  Stored as for a death; the session's own online brings it back.
+    std::int64_t suppressed = 0;
+    if (log_.allow(LogBudget::kCmd, Clock::now(), suppressed))
+      spdlog::warn("Sparkplug: an offline STATE on {} stamped otherwise than the host's online one (not its death: "
+                   "forged, or a host breaking the Sparkplug 3.0 rule); storing until the host's online STATE is "
+                   "read again (the reconnect reads the broker's retained one). Restrict who may write the topic "
+                   "with the broker's ACL (docs/mqtt.md); {} so far [{} similar suppressed]",
+                   printable(m->topic), node_->stateUnverified(), suppressed);
+  }
+  if (in == In::HostOffline || in == In::HostOfflineUnverified) {
     ++host_offline_;
     if (!link_.sessionOpen()) return;
     // Sparkplug 3.0: end the session (NDEATH, disconnect) and start over; meanwhile, store.

@@ -84,16 +84,32 @@ class Node {
   std::string shaftOf(const std::string& device_id) const;
 
   // ---- inbound -----------------------------------------------------------------
-  enum class Inbound : std::uint8_t { NotOurs, Commands, HostOnline, HostOffline, StateIgnored };
+  enum class Inbound : std::uint8_t { NotOurs, Commands, HostOnline, HostOffline, HostOfflineUnverified, StateIgnored };
   /// Classifies one received message: NCMD/DCMD (commands appended to `out`),
-  /// or the primary host's STATE.  `now_ms` (wall clock; 0 = unchecked): a
-  /// STATE stamped more than kStateFutureMs after it is ignored -- else one
-  /// forged far-future STATE would make every genuine one "older" until a
-  /// restart.  Every ignored STATE is counted (stateIgnored()).
+  /// or the primary host's STATE.  Sparkplug 3.0 stamps a host's online
+  /// STATE and its death (the will) with one timestamp, that of the session's
+  /// CONNECT; a later session has a later one.  A STATE older than the last
+  /// accepted online one (an earlier session's) is ignored.  Else:
+  ///   * online: HostOnline, that session now the one known -- also the
+  ///     same session's online after an offline: the host republishes it
+  ///     when it reads an offline on its own topic, and the broker's
+  ///     retained copy is read again at the reconnect;
+  ///   * offline with the session's timestamp: its death (HostOffline);
+  ///   * offline with a later timestamp: no death of the session known -- a
+  ///     forgery, or a host that breaks the rule.  The caller stores as for
+  ///     a death (HostOfflineUnverified, counted in stateUnverified()),
+  ///     and the bar stays the session's, so its online brings it back.
+  /// Without the broker's ACL on the STATE topic a forger can still end
+  /// sessions (a copied timestamp is a death); never lose the data.
+  /// `now_ms` (wall clock; 0 = unchecked): a STATE stamped more than
+  /// kStateFutureMs after it is ignored -- else one forged far-future online
+  /// STATE would make every genuine one "older" until a restart.  Every
+  /// ignored STATE is counted (stateIgnored()).
   Inbound onMessage(const std::string& topic, const void* data, std::size_t size, std::size_t max_bytes,
                     bool retained, std::vector<Command>& out, std::uint64_t now_ms = 0);
   static constexpr std::uint64_t kStateFutureMs = 600'000;
   std::int64_t stateIgnored() const { return state_ignored_; }
+  std::int64_t stateUnverified() const { return state_unverified_; }
   /// A Rebirth request (NCMD) at `now_ms`: true = do the births now.  Within
   /// kRebirthMinMs of the last births it is held instead (false), and any
   /// further requests merge into the held one, which rebirthDue() releases
@@ -117,10 +133,11 @@ class Node {
   std::int64_t bd_seq_ = -1;
   unsigned seq_ = 0;
   bool host_online_ = false;
+  bool have_session_ = false;  // an online STATE was accepted: host_ts_ is its session's timestamp
   std::uint64_t host_ts_ = 0;
   std::uint64_t births_ms_ = 0;  // wall time of the last births()
   bool born_ = false, rebirth_held_ = false;
-  std::int64_t state_ignored_ = 0, rebirths_coalesced_ = 0;
+  std::int64_t state_ignored_ = 0, state_unverified_ = 0, rebirths_coalesced_ = 0;
   NodeCounters last_counters_;
   struct Dev {
     std::string shaft, id;
