@@ -251,6 +251,8 @@ void LoadEstimator::predict(const CageResponse& twin) {
   const SensorValues zq = stepping_ ? sensorModel(q, twin_.g) : zs;
   h_fy_ = zq.f_y;
   h_om_ = zq.omega;
+  hs_fy_ = zs.f_y;
+  hs_om_ = zs.omega;
   h_rope_ = zq.rope_load;
   base_fy_ = zt.f_y + oM * zs.f_y;
   base_om_ = zt.omega + oM * zs.omega;
@@ -314,12 +316,27 @@ bool LoadEstimator::updateLateral(double f_y, double omega, unsigned which) {
   const double eps = set_.model_error;
   const double ea = std::hypot(eps * (std::abs(pred_fy_ - c_) + env_fy_), step_e_fy_);
   const double ew = std::hypot(eps * env_om_, step_e_om_);
-  const double ra = set_.noise.imu_accel * set_.noise.imu_accel + ea * ea;
-  const double rw = set_.noise.imu_rate * set_.noise.imu_rate + ew * ew;
+  double ra = set_.noise.imu_accel * set_.noise.imu_accel + ea * ea;
+  double rw = set_.noise.imu_rate * set_.noise.imu_rate + ew * ew;
   // The lateral state (M, c), c the accelerometer's offset (on f_y only):
   // innovation, its covariance S = H P H^T + R (1 or 2 rows), in closed form.
   Eigen::Matrix2d H;  // rows f_y, omega; columns M, c
   H << (use_a ? h_fy_ : 0.0), (use_a ? 1.0 : 0.0), (use_w ? h_om_ : 0.0), 0.0;
+  if (stepping_) {
+    // While a load change's transient is followed, M is told from the
+    // steady response only.  The transient rings the lightly damped modes
+    // the n-mode model resolves least: a few per cent off in frequency, its
+    // phase is lost within seconds (n = 25 against 100: 30-60 % of its
+    // amplitude 5-20 s after the change), and read as information it
+    // pulled M 7-35 sigma off on the trip that followed (and, at rest, told
+    // M from the offset, which there are one number).  It stays in the
+    // prediction; what it does with M's error is noise to the update.
+    H(0, 0) = use_a ? hs_fy_ : 0.0;
+    H(1, 0) = use_w ? hs_om_ : 0.0;
+    const double da = h_fy_ - hs_fy_, dw = h_om_ - hs_om_;
+    ra += da * da * Pl_(0, 0);
+    rw += dw * dw * Pl_(0, 0);
+  }
   Eigen::Vector2d nu(use_a ? f_y - pred_fy_ : 0.0, use_w ? omega - pred_om_ : 0.0);
   auto covariance = [&](const Eigen::Matrix2d& P) {
     Eigen::Matrix2d S = H * P * H.transpose();

@@ -118,12 +118,26 @@ class SensorAttack : public LcmProcessTest {
       listener_->pump(2ms);
     }
   }
-  /// The last row's estimate arrived (the daemon has taken every row).
+  /// The daemon has taken every row: the last row's estimate arrived, or
+  /// (should the listener have lost that one) the daemon's newest health
+  /// report -- this daemon's: startDaemonAndWait waited for one of its own --
+  /// has reached the last row's model time.  Only the newest messages are
+  /// decoded: decoding all of them at every poll falls behind a sanitized
+  /// daemon, and LCM then drops what queues up.
   bool lastArrived(std::size_t rows) const {
     const std::int64_t last = kT0 + static_cast<std::int64_t>(rows - 1) * 10'000;
-    for (const auto& e : listener_->decoded<hoist::estimate_t>("HOIST_ESTIMATE"))
-      if (e.utime == last) return true;
-    return false;
+    const auto& est = listener_->messages("HOIST_ESTIMATE");
+    for (std::size_t i = est.size(), seen = 0; i > 0 && seen < 8; --i, ++seen) {
+      hoist::estimate_t e;
+      const auto& m = est[i - 1];
+      if (e.decode(m.data.data(), 0, static_cast<int>(m.data.size())) > 0 && e.utime == last) return true;
+    }
+    const auto& health = listener_->messages("HOIST_HEALTH");
+    if (health.empty()) return false;
+    hoist::health_t h;
+    const auto& m = health.back();
+    return h.decode(m.data.data(), 0, static_cast<int>(m.data.size())) > 0 &&
+           h.t >= static_cast<double>(rows - 1) * 0.01 - 1e-6;
   }
   /// Genuine rows at rest with seeded noise.
   std::vector<Row> genuine(std::size_t n, unsigned seed) {

@@ -71,7 +71,9 @@
 // rest (hoist/change_detector.hpp), on either channel, re-open both Fa and
 // M (one load changed).  At rest the change is a step: a third solver
 // (the unit load from rest at the change's onset) carries its transient for
-// kStepFoldTime (60 s); followingLoadChange() says so.
+// kStepFoldTime (60 s); followingLoadChange() says so.  The transient is in
+// the prediction only: M is told from the steady response (its ringing's
+// phase is not known well enough to learn from; docs/estimation.md).
 // Physical bounds: LoadEstimate::plausible ([load] max_payload, max_offset
 // and hoist/plausibility.hpp).
 // Observability: the rope load alone gives Fa but not b; the IMU alone gives M
@@ -358,6 +360,7 @@ class LoadEstimator {
   CageResponse twin_resp_;                 // the twin's response at this tick
   double pred_fy_ = 0.0, pred_om_ = 0.0, pred_rope_ = 0.0;  // predictions (prior)
   double h_fy_ = 0.0, h_om_ = 0.0, h_rope_ = 0.0;           // sensitivities of the measurements
+  double hs_fy_ = 0.0, hs_om_ = 0.0;  // their steady parts (differ from h_fy_, h_om_ while a step's transient is followed)
   int run_fa_ = 0, run_m_ = 0;             // consecutive gated samples
   double env_fy_ = 0.0, env_om_ = 0.0, env_rope_ = 0.0, env_t_ = 0.0;
   double start_rope_ = 0.0, jump_rope_ = 0.0;  // rope-load model error of the start transient, of a jump of a [N]
