@@ -340,6 +340,20 @@ TEST_F(MqttBridge, StateAlarmsLateSubscriberAckAndBadCommands) {
     std::this_thread::sleep_for(20ms);
   EXPECT_NE(readFile(log("twind.log")).find("operator 'scada-op': acknowledge"), std::string::npos);
 
+  // The load estimator's live calibration (issue 30) goes the same way: the
+  // daemon's own command, its fields as sent.
+  const std::size_t acks_now = lcm.count("north/HOIST_ALARM_ACK");
+  early.publish("hoist/north/cmd/ack",
+                R"({"kind":"","level":0,"action":5,"known_fa":250,"known_b":-0.5,"calibrate_duration":60,"user":"eng"})");
+  ASSERT_TRUE(lcm.waitFor([&] { return lcm.count("north/HOIST_ALARM_ACK") > acks_now; }, 5s))
+      << "no calibrate on LCM; bridge log:\n" << readFile(log("bridge.log"));
+  const hoist::alarm_ack_t cal = lcm.decoded<hoist::alarm_ack_t>("north/HOIST_ALARM_ACK").back();
+  EXPECT_EQ(cal.action, +hoist::alarm_ack_t::ACTION_CALIBRATE);
+  EXPECT_EQ(cal.known_fa, 250.0);
+  EXPECT_EQ(cal.known_b, -0.5);
+  EXPECT_EQ(cal.calibrate_duration, 60.0);
+  EXPECT_EQ(cal.user, "eng");
+
   // Stop: the bridge says it is offline (retained) and exits 0.
   bridge.signal(SIGTERM);
   EXPECT_EQ(bridge.wait(5s), 0) << readFile(log("bridge.log"));

@@ -241,6 +241,37 @@ TEST(MqttCommand, RejectsBadPayloadsByReason) {
   EXPECT_EQ(r.detail.find('\x1b'), std::string::npos);
 }
 
+// The live calibration (alarm_ack_t.ACTION_CALIBRATE, issue 30) through the
+// bridge: the daemon's own validation (hoist::contract), answered with its
+// reason when refused; kind and level are ignored as the daemon ignores them.
+TEST(MqttCommand, CalibrateIsValidatedAsTheDaemonDoes) {
+  auto r = parse(R"({"kind":"","level":0,"action":5,"known_fa":1000,"known_b":0.5,"calibrate_duration":30,"user":"eng"})");
+  ASSERT_EQ(r.reject, CommandReject::None) << r.detail;
+  EXPECT_EQ(r.ack.action, +hoist::alarm_ack_t::ACTION_CALIBRATE);
+  EXPECT_EQ(r.ack.known_fa, 1000.0);
+  EXPECT_EQ(r.ack.known_b, 0.5);
+  EXPECT_EQ(r.ack.calibrate_duration, 30.0);
+  EXPECT_EQ(parse(R"({"kind":"","level":0,"action":5,"known_fa":0,"known_b":0,"calibrate_duration":600})").reject,
+            CommandReject::None) << "the empty conveyance, the longest duration";
+  for (const char* bad : {R"({"kind":"","level":0,"action":5})",  // no load, no duration
+                          R"({"kind":"","level":0,"action":5,"known_fa":1000,"known_b":0.5,"calibrate_duration":0})",
+                          R"({"kind":"","level":0,"action":5,"known_fa":1000,"known_b":0.5,"calibrate_duration":601})",
+                          R"({"kind":"","level":0,"action":5,"known_fa":-1,"known_b":0.5,"calibrate_duration":30})",
+                          R"({"kind":"","level":0,"action":5,"known_fa":2e7,"known_b":0.5,"calibrate_duration":30})",
+                          R"({"kind":"","level":0,"action":5,"known_fa":1000,"known_b":101,"calibrate_duration":30})"}) {
+    const auto b = parse(bad);
+    EXPECT_EQ(b.reject, CommandReject::BadCalibration) << bad;
+    EXPECT_NE(b.detail.find("calibrate needs"), std::string::npos) << b.detail;
+  }
+  EXPECT_STREQ(toString(CommandReject::BadCalibration), "bad_calibration");
+  // The same verdicts as the daemon's.
+  hoist::contract::AlarmCommand c;
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 5, 0.0, 1000.0, 0.5, 30.0, c),
+            hoist::contract::CommandError::None);
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 5, 0.0, 1000.0, 0.5, 0.0, c),
+            hoist::contract::CommandError::BadCalibration);
+}
+
 TEST(MqttCommand, SameValidationAsTheDaemon) {
   // The bridge and hoist-twind share hoist::contract::validateAlarmCommand.
   hoist::contract::AlarmCommand c;

@@ -36,6 +36,7 @@ const char* toString(CommandReject r) {
     case CommandReject::ReadOnly: return "read_only";
     case CommandReject::BadValue: return "bad_value";
     case CommandReject::Disabled: return "disabled";
+    case CommandReject::BadCalibration: return "bad_calibration";
   }
   return "?";
 }
@@ -102,8 +103,8 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
     const bool client_utime = j.contains("utime");
     if (!client_utime) j["utime"] = now_utime;
     if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
-    // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE, which this
-    // gate refuses): absent in every alarm command.
+    // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE only): absent
+    // in every alarm command.
     for (const char* k : {"known_fa", "known_b", "calibrate_duration"})
       if (!j.contains(k)) j[k] = 0.0;
     if (!j.contains("user")) j["user"] = kDefaultCommandUser;
@@ -130,7 +131,8 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
       }
     }
     hoist::contract::AlarmCommand cmd;
-    switch (hoist::contract::validateAlarmCommand(r.ack.kind, r.ack.level, r.ack.action, r.ack.shelve_duration, cmd)) {
+    switch (hoist::contract::validateAlarmCommand(r.ack.kind, r.ack.level, r.ack.action, r.ack.shelve_duration,
+                                                  r.ack.known_fa, r.ack.known_b, r.ack.calibrate_duration, cmd)) {
       case hoist::contract::CommandError::None: break;
       case hoist::contract::CommandError::UnknownKind:
         r.reject = CommandReject::UnknownKind;
@@ -142,12 +144,24 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
         return r;
       case hoist::contract::CommandError::BadAction:
         r.reject = CommandReject::BadAction;
-        r.detail = "action " + std::to_string(int(r.ack.action)) + " (1 ack, 2 shelve, 3 unshelve, 4 re-announce)";
+        r.detail = "action " + std::to_string(int(r.ack.action)) +
+                   " (1 ack, 2 shelve, 3 unshelve, 4 re-announce, 5 calibrate)";
         return r;
       case hoist::contract::CommandError::BadShelveDuration:
         r.reject = CommandReject::BadShelveDuration;
         r.detail = "shelve needs a shelve_duration > 0 s";
         return r;
+      case hoist::contract::CommandError::BadCalibration: {
+        r.reject = CommandReject::BadCalibration;
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "calibrate needs known_fa in [0, %g] N, |known_b| <= %g m and calibrate_duration in (0, %g] s "
+                      "(got %g, %g, %g)",
+                      hoist::contract::kMaxCalibrationForce, hoist::contract::kMaxCalibrationOffset,
+                      hoist::contract::kMaxCalibration, r.ack.known_fa, r.ack.known_b, r.ack.calibrate_duration);
+        r.detail = buf;
+        return r;
+      }
     }
     if (r.ack.utime <= 0) r.ack.utime = now_utime;
     return r;

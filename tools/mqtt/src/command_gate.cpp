@@ -84,6 +84,11 @@ void CommandGate::answer(const Shaft& s, const char* result, const char* reason,
                     {"user", printable(ack->user)},
                     {"utime", ack->utime}};
     if (ack->action == hoist::alarm_ack_t::ACTION_SHELVE) j["command"]["shelve_duration"] = ack->shelve_duration;
+    if (ack->action == hoist::alarm_ack_t::ACTION_CALIBRATE) {
+      j["command"]["known_fa"] = ack->known_fa;
+      j["command"]["known_b"] = ack->known_b;
+      j["command"]["calibrate_duration"] = ack->calibrate_duration;
+    }
   }
   ++n_.results_published;
   link_.publish({s.t.result, j.dump(), 1, false, MsgClass::Health});
@@ -195,7 +200,10 @@ void CommandGate::execute(const Shaft& s, const CommandResult& r, int payloadlen
     spdlog::info("command on {} from '{}': action {} kind '{}' level {}{} -> {}", topic, printable(r.ack.user),
                  int(r.ack.action), r.ack.kind.empty() ? "*" : printable(r.ack.kind, 32), int(r.ack.level),
                  r.ack.action == hoist::alarm_ack_t::ACTION_SHELVE ? fmt::format(" for {} s", r.ack.shelve_duration)
-                                                                   : std::string(),
+                 : r.ack.action == hoist::alarm_ack_t::ACTION_CALIBRATE
+                     ? fmt::format(" (calibrate: Fa {} N at b {} m for {} s)", r.ack.known_fa, r.ack.known_b,
+                                   r.ack.calibrate_duration)
+                     : std::string(),
                  channel);
 }
 

@@ -36,7 +36,7 @@ enum class CommandReject : std::uint8_t {
   BadFields,      ///< missing/unknown keys, wrong types, out-of-range integers (codec fromJson)
   UnknownKind,    ///< kind is not an alarm kind, "" or "*"
   BadLevel,       ///< level not 0, 1 or 2
-  BadAction,      ///< action not 1 (ack), 2 (shelve) or 3 (unshelve)
+  BadAction,      ///< action not 1 (ack), 2 (shelve), 3 (unshelve), 4 (re-announce) or 5 (calibrate)
   BadShelveDuration,  ///< shelve without a finite duration > 0
   DuplicateKey,   ///< a JSON key given twice
   BadUser,        ///< user empty, longer than 64 bytes, or with a control character
@@ -51,8 +51,9 @@ enum class CommandReject : std::uint8_t {
   ReadOnly,         ///< a write to a metric that is not writable
   BadValue,         ///< the value's type or range does not fit the metric
   Disabled,         ///< alarm commands are off (--no-commands, [bridge] commands = false)
+  BadCalibration,   ///< calibrate (action 5) without known_fa in [0, 1e7] N, |known_b| <= 100 m, duration in (0, 600] s
 };
-inline constexpr int kCommandRejects = 21;
+inline constexpr int kCommandRejects = 22;
 const char* toString(CommandReject r);  ///< "ok", "oversized", "not_json", ...
 
 /// The `user` of a payload that names none.
