@@ -263,16 +263,25 @@ void LoadEstimator::predict(const CageResponse& twin) {
   // The step's onset is known to one sample: its response one sample early
   // or late differs by about its change over one tick.  And the transient
   // (the step's response less the steady one) rings the modes the n-mode
-  // model resolves least: kStepModelError of it.  Both allowed as model error.
+  // model resolves least: kStepModelError of it -- of the lateral one's
+  // envelope, growing as its phase is lost (kStepPhaseLoss).  All allowed as
+  // model error.
   if (stepping_) {
-    auto err = [](double d, double now, double prev, double steady) {
-      return std::hypot(d * (now - prev), kStepModelError * d * (now - steady));
-    };
-    if (step_fresh_) step_zq_ = zq;
+    if (step_fresh_) {
+      step_zq_ = zq;
+      step_env_fy_ = step_env_om_ = 0.0;
+      step_env_t_ = twin.t;
+    }
     step_fresh_ = false;
-    step_e_fy_ = err(dM, zq.f_y, step_zq_.f_y, zs.f_y);
-    step_e_om_ = err(dM, zq.omega, step_zq_.omega, zs.omega);
-    step_e_rope_ = err(dFa, zq.rope_load, step_zq_.rope_load, zs.rope_load);
+    const double decay_q = std::exp(-std::max(twin.t - step_env_t_, 0.0) / kEnvelopeTime);
+    step_env_t_ = twin.t;
+    step_env_fy_ = std::max(std::abs(zq.f_y - zs.f_y), step_env_fy_ * decay_q);
+    step_env_om_ = std::max(std::abs(zq.omega - zs.omega), step_env_om_ * decay_q);
+    const double rel = std::min(kStepModelErrorMax, kStepModelError + kStepPhaseLoss * std::max(twin.t - step_t_, 0.0));
+    step_e_fy_ = std::hypot(dM * (zq.f_y - step_zq_.f_y), rel * dM * step_env_fy_);
+    step_e_om_ = std::hypot(dM * (zq.omega - step_zq_.omega), rel * dM * step_env_om_);
+    step_e_rope_ = std::hypot(dFa * (zq.rope_load - step_zq_.rope_load),
+                              kStepModelError * dFa * (zq.rope_load - zs.rope_load));
     step_zq_ = zq;
   } else {
     step_e_fy_ = step_e_om_ = step_e_rope_ = 0.0;

@@ -21,6 +21,11 @@ inline constexpr double kStartTransientError = 0.1;  // rope-load model error af
 inline constexpr double kJumpTransientError = 0.1;   // the same after a jump of a later on ...
 inline constexpr double kStepFoldTime = 60.0;      // a load change's step transient is followed this long [s]
 inline constexpr double kStepModelError = 0.2;     // relative model error of a step's transient (n = 25 against n = 100)
+// ... of its lateral part, growing as its phase is lost: 0.2 + kStepPhaseLoss t
+// of its envelope, at most kStepModelErrorMax (n = 25 against n = 100: 0.3-0.6
+// of it 5-20 s after the change; tests/model/load_estimator_change_test.cpp).
+inline constexpr double kStepPhaseLoss = 0.05;     // [1/s]
+inline constexpr double kStepModelErrorMax = 2.0;  // the phase lost: up to twice the envelope
 inline constexpr double kMaxCatchUp = 2.0;         // the step solver catches up at most this much of the past [s]
 inline constexpr double kJumpTransientTime = 2.5;    // ... decaying faster (the shaft was steady before),
 inline constexpr double kRopeOscillationError = 0.07;  // the rope's oscillation, per N of m x_c'' (frequency error)
