@@ -336,6 +336,44 @@ TEST_F(HubTest, ClientPublishesAlarmAckAfterValidation) {
   EXPECT_EQ((*c.lastStatus())["level"], 2);
 }
 
+// The load estimator's live calibration through the dashboard's protocol (a
+// Foxglove Publish panel, issue 30): the daemon's rule (hoist::contract),
+// published with the server's time; invalid ones refused and counted.
+TEST_F(HubTest, ClientPublishesACalibrationAfterTheDaemonsValidation) {
+  Hub hub = make(false);
+  RecClient c;
+  hub.addClient(c);
+  hub.onClientText(c, Json{{"op", "advertise"},
+                           {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}, {"schemaName", "hoist.alarm_ack_t"}}}}}
+                          .dump());
+  hub.onClientBinary(c, clientMessage(5, {{"kind", ""}, {"level", 0}, {"action", 5}, {"known_fa", 0.0}, {"known_b", 0.0},
+                                          {"calibrate_duration", 60.0}, {"user", "eng"}}));
+  ASSERT_EQ(pub.size(), 1u);
+  alarm_ack_t a{};
+  ASSERT_GE(a.decode(pub[0].bytes.data(), 0, static_cast<int>(pub[0].bytes.size())), 0);
+  EXPECT_EQ(a.action, +alarm_ack_t::ACTION_CALIBRATE);
+  EXPECT_EQ(a.known_fa, 0.0);
+  EXPECT_EQ(a.calibrate_duration, 60.0);
+  EXPECT_EQ(a.user, "eng");
+  EXPECT_EQ(a.utime, 1'700'000'000'000'000LL);
+  ASSERT_NE(c.lastStatus(), nullptr);
+  EXPECT_EQ((*c.lastStatus())["level"], 0);
+  EXPECT_NE((*c.lastStatus())["message"].get<std::string>().find("sent calibrate"), std::string::npos);
+  // No duration, too long, a negative load, no user, an alarm named: refused.
+  hub.onClientBinary(c, clientMessage(5, {{"kind", ""}, {"level", 0}, {"action", 5}, {"user", "eng"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"kind", ""}, {"level", 0}, {"action", 5}, {"known_fa", 0.0}, {"known_b", 0.0},
+                                          {"calibrate_duration", 601.0}, {"user", "eng"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"kind", ""}, {"level", 0}, {"action", 5}, {"known_fa", -1.0}, {"known_b", 0.0},
+                                          {"calibrate_duration", 60.0}, {"user", "eng"}}));
+  hub.onClientBinary(c, clientMessage(5, {{"kind", ""}, {"level", 0}, {"action", 5}, {"known_fa", 0.0}, {"known_b", 0.0},
+                                          {"calibrate_duration", 60.0}, {"user", ""}}));
+  hub.onClientBinary(c, clientMessage(5, {{"kind", ""}, {"level", 0}, {"action", 5}, {"known_fa", 0.0}, {"known_b", 0.0},
+                                          {"calibrate_duration", 60.0}, {"user", "eng"}, {"activation_utime", 5}}));
+  EXPECT_EQ(pub.size(), 1u);
+  EXPECT_EQ(hub.counter("commands_rejected_invalid"), 5u);
+  EXPECT_EQ((*c.lastStatus())["level"], 2);
+}
+
 TEST_F(HubTest, ReadOnlyRefusesEveryCommand) {
   Hub hub = make(true);
   RecClient c;

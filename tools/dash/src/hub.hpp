@@ -25,6 +25,10 @@
 
 #include <nlohmann/json.hpp>
 
+namespace hoist {
+class alarm_ack_t;  // hoist/alarm_ack_t.hpp (lcm-gen)
+}
+
 namespace hoist::dash {
 
 using Json = nlohmann::json;
@@ -194,6 +198,8 @@ class Hub {
   void handleClientAdvertise(Client& c, const Json& j);
   void handleClientUnadvertise(Client& c, const Json& j);
   void handleClientMessage(Client& c, std::uint32_t chan, std::string_view payload);
+  /// ACTION_CALIBRATE from a client: validated as the daemon validates it, then published on `channel`.
+  void sendCalibration(Client& c, const std::string& channel, alarm_ack_t& ack, bool names_an_alarm);
 
   Options opt_;
   bool request_states_ = false;  // requestAlarmStates() was called

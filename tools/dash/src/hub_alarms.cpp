@@ -12,6 +12,7 @@
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/channels.hpp"
+#include "hoist/contract/alarm_command.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hub.hpp"
 
@@ -178,8 +179,8 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
   // shelve_duration matters only for SHELVE (where validation requires it).
   if (!j.contains("utime")) j["utime"] = 0;
   if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
-  // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE, which the page
-  // does not send): absent in every alarm command.
+  // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE only): absent in
+  // every alarm command.
   for (const char* k : {"known_fa", "known_b", "calibrate_duration"})
     if (!j.contains(k)) j[k] = 0.0;
   // The alarm the page drew (its activation): a command for an alarm that
@@ -205,6 +206,7 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
     status(c, 2, "rejected command: " + err);
     return;
   }
+  if (ack.action == alarm_ack_t::ACTION_CALIBRATE) return sendCalibration(c, it->second, ack, expect_activation.has_value());
   if (const std::string why = validateAckFields(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.user);
       !why.empty()) {
     count("commands_rejected_invalid");
@@ -240,6 +242,41 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
   static const char* actions[] = {"", "acknowledge", "shelve", "unshelve"};
   status(c, 0, std::string("sent ") + actions[ack.action] + " " + alarm_name + since + " by " + ack.user + " on " +
                    it->second);
+}
+
+void Hub::sendCalibration(Client& c, const std::string& channel, alarm_ack_t& ack, bool names_an_alarm) {
+  // The load estimator's live calibration (docs/service.md "The live
+  // calibration command"): the daemon's own rule (hoist::contract, the
+  // 8-argument form), the user's as for the alarm commands.
+  contract::AlarmCommand cmd;
+  std::string why;
+  if (names_an_alarm) why = "a calibration names no alarm (no activation_utime)";
+  else if (contract::validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.known_fa,
+                                          ack.known_b, ack.calibrate_duration, cmd) != contract::CommandError::None)
+    why = "calibrate needs known_fa in [0, 1e7] N, |known_b| <= 100 m and calibrate_duration in (0, 600] s";
+  else if (ack.user.empty() || ack.user.size() > 64) why = "user must have 1..64 characters (enter your name)";
+  else
+    for (unsigned char ch : ack.user)
+      if (ch < 0x20 || ch == 0x7f) why = "user may not contain control characters";
+  if (!why.empty()) {
+    count("commands_rejected_invalid");
+    status(c, 2, "rejected command: " + why);
+    return;
+  }
+  ack.kind = "";
+  ack.level = 0;
+  ack.utime = static_cast<std::int64_t>(clock_() / 1000);  // the command's time is the server's
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(ack.getEncodedSize()));
+  if (ack.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0 || !publish_(channel, buf)) {
+    count("commands_publish_failed");
+    status(c, 2, "command not sent: LCM publish failed");
+    return;
+  }
+  count("commands_published");
+  char text[200];
+  std::snprintf(text, sizeof text, "sent calibrate: the load is known, Fa = %g N at b = %g m for %g s, by ",
+                ack.known_fa, ack.known_b, ack.calibrate_duration);
+  status(c, 0, text + ack.user + " on " + channel);
 }
 
 }  // namespace hoist::dash
