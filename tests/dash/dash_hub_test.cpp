@@ -304,13 +304,18 @@ std::string clientMessage(std::uint32_t chan, const Json& j) {
   return f + j.dump();
 }
 
+/// The client advertises HOIST_ALARM_ACK (json) as channel `id`.
+void advertiseAck(Hub& hub, RecClient& c, int id) {
+  hub.onClientText(c, Json{{"op", "advertise"},
+                           {"channels", {{{"id", id}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}, {"schemaName", "hoist.alarm_ack_t"}}}}}
+                          .dump());
+}
+
 TEST_F(HubTest, ClientPublishesAlarmAckAfterValidation) {
   Hub hub = make(false);
   RecClient c;
   hub.addClient(c);
-  hub.onClientText(c, Json{{"op", "advertise"},
-                           {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}, {"schemaName", "hoist.alarm_ack_t"}}}}}
-                          .dump());
+  advertiseAck(hub, c, 5);
   hub.onClientBinary(c, clientMessage(5, {{"utime", 0}, {"kind", "CAGE_POS_Y"}, {"level", 1}, {"action", 2}, {"shelve_duration", 600.0}, {"user", "ann"}}));
   ASSERT_EQ(pub.size(), 1u);
   EXPECT_EQ(pub[0].channel, "HOIST_ALARM_ACK");
@@ -343,9 +348,7 @@ TEST_F(HubTest, ClientPublishesACalibrationAfterTheDaemonsValidation) {
   Hub hub = make(false);
   RecClient c;
   hub.addClient(c);
-  hub.onClientText(c, Json{{"op", "advertise"},
-                           {"channels", {{{"id", 5}, {"topic", "HOIST_ALARM_ACK"}, {"encoding", "json"}, {"schemaName", "hoist.alarm_ack_t"}}}}}
-                          .dump());
+  advertiseAck(hub, c, 5);
   hub.onClientBinary(c, clientMessage(5, {{"kind", ""}, {"level", 0}, {"action", 5}, {"known_fa", 0.0}, {"known_b", 0.0},
                                           {"calibrate_duration", 60.0}, {"user", "eng"}}));
   ASSERT_EQ(pub.size(), 1u);

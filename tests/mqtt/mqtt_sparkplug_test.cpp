@@ -153,6 +153,23 @@ class MqttSparkplug : public ::testing::Test {
     const auto p = t.rfind(marker);
     return json::parse(t.substr(p + marker.size(), t.find('\n', p) - p - marker.size()), nullptr, false);
   }
+  /// The DDATA carrying Cage/Seq = seq (the alias from the DBIRTH); with
+  /// `historical`, only one whose is_historical flag is that.
+  std::optional<json> cageSeqData(std::int64_t seq, std::optional<bool> historical, std::chrono::milliseconds timeout) {
+    json alias;
+    for (const auto& b : ofType("DBIRTH"))
+      for (const auto& x : b["metrics"])
+        if (x["name"] == "Cage/Seq") alias = x["alias"];
+    return waitMsg(
+        [&](const json& m) {
+          if (m.value("type", "") != "DDATA") return false;
+          for (const auto& x : m["metrics"])
+            if (x["alias"] == alias && x["value"] == seq)
+              return !historical || x.value("historical", false) == *historical;
+          return false;
+        },
+        timeout);
+  }
   /// The bridge's latest health (hoist/_bridge/<id>/health) satisfying pred.
   std::optional<json> waitHealth(const std::function<bool(const json&)>& pred, std::chrono::milliseconds timeout) {
     auto m = waitMsg([&](const json& j) { return j.contains("json") && j["json"].is_object() && pred(j["json"]); },
@@ -487,20 +504,7 @@ TEST_F(MqttSparkplug, NoCommandsRefusesAndCountsWrites) {
 TEST_F(MqttSparkplug, PrimaryHostGatesBirthsAndStoredDataIsHistorical) {
   ASSERT_NO_FATAL_FAILURE(start(18623, 8063, "primary_host_id = \"scada\"\n"));
   lcm::LCM pub(lcm_url_);
-  auto cageDdata = [&](std::int64_t seq, bool historical) {
-    json alias;  // of Cage/Seq, from the DBIRTH
-    for (const auto& b : ofType("DBIRTH"))
-      for (const auto& x : b["metrics"])
-        if (x["name"] == "Cage/Seq") alias = x["alias"];
-    return waitMsg(
-        [&](const json& m) {
-          if (m.value("type", "") != "DDATA") return false;
-          for (const auto& x : m["metrics"])
-            if (x["alias"] == alias && x["value"] == seq) return x.value("historical", false) == historical;
-          return false;
-        },
-        5s);
-  };
+  auto cageDdata = [&](std::int64_t seq, bool historical) { return cageSeqData(seq, historical, 5s); };
   // No primary host yet: connected, but nothing is published; data is stored.
   const auto c1 = cage(1);
   std::this_thread::sleep_for(500ms);
@@ -554,20 +558,7 @@ TEST_F(MqttSparkplug, ForgedOfflineCostsTheSessionNeverTheDataNorTheHostsReturn)
   const std::int64_t t0 = now_ms();
   command("state scada true " + std::to_string(t0));
   ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 5s)) << tail(host_log_);
-  auto seqSeen = [&](std::int64_t seq) {
-    json alias;  // of Cage/Seq, from the DBIRTH
-    for (const auto& b : ofType("DBIRTH"))
-      for (const auto& x : b["metrics"])
-        if (x["name"] == "Cage/Seq") alias = x["alias"];
-    return waitMsg(
-        [&](const json& m) {
-          if (m.value("type", "") != "DDATA") return false;
-          for (const auto& x : m["metrics"])
-            if (x["alias"] == alias && x["value"] == seq) return true;
-          return false;
-        },
-        8s);
-  };
+  auto seqSeen = [&](std::int64_t seq) { return cageSeqData(seq, std::nullopt, 8s); };
   auto hexOf = [](const std::string& s) {
     std::string h;
     char b[3];
