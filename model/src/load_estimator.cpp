@@ -260,6 +260,12 @@ void LoadEstimator::predict(const CageResponse& twin) {
   pred_fy_ = base_fy_ + dM * h_fy_ + c_;
   pred_om_ = base_om_ + dM * h_om_;
   pred_rope_ = base_rope_ + dFa * h_rope_;
+  // Envelopes (peak hold, decaying over kEnvelopeTime) of the predicted
+  // oscillations: a model a few per cent off in frequency is off by up to
+  // twice their amplitude a few cycles later, also at a zero crossing.
+  const double dt = std::max(twin.t - env_t_, 0.0);
+  env_t_ = twin.t;
+  const double decay = std::exp(-dt / kEnvelopeTime);
   // The step's onset is known to one sample: its response one sample early
   // or late differs by about its change over one tick.  And the transient
   // (the step's response less the steady one) rings the modes the n-mode
@@ -270,13 +276,10 @@ void LoadEstimator::predict(const CageResponse& twin) {
     if (step_fresh_) {
       step_zq_ = zq;
       step_env_fy_ = step_env_om_ = 0.0;
-      step_env_t_ = twin.t;
     }
     step_fresh_ = false;
-    const double decay_q = std::exp(-std::max(twin.t - step_env_t_, 0.0) / kEnvelopeTime);
-    step_env_t_ = twin.t;
-    step_env_fy_ = std::max(std::abs(zq.f_y - zs.f_y), step_env_fy_ * decay_q);
-    step_env_om_ = std::max(std::abs(zq.omega - zs.omega), step_env_om_ * decay_q);
+    step_env_fy_ = std::max(std::abs(zq.f_y - zs.f_y), step_env_fy_ * decay);
+    step_env_om_ = std::max(std::abs(zq.omega - zs.omega), step_env_om_ * decay);
     const double rel = std::min(kStepModelErrorMax, kStepModelError + kStepPhaseLoss * std::max(twin.t - step_t_, 0.0));
     step_e_fy_ = std::hypot(dM * (zq.f_y - step_zq_.f_y), rel * dM * step_env_fy_);
     step_e_om_ = std::hypot(dM * (zq.omega - step_zq_.omega), rel * dM * step_env_om_);
@@ -286,12 +289,6 @@ void LoadEstimator::predict(const CageResponse& twin) {
   } else {
     step_e_fy_ = step_e_om_ = step_e_rope_ = 0.0;
   }
-  // Envelopes (peak hold, decaying over kEnvelopeTime) of the predicted
-  // oscillations: a model a few per cent off in frequency is off by up to
-  // twice their amplitude a few cycles later, also at a zero crossing.
-  const double dt = std::max(twin.t - env_t_, 0.0);
-  env_t_ = twin.t;
-  const double decay = std::exp(-dt / kEnvelopeTime);
   const double yddot = twin.y_c_ddot + oM * s.y_c_ddot + dM * q.y_c_ddot;
   env_fy_ = std::max(std::abs(yddot), env_fy_ * decay);
   env_om_ = std::max(std::abs(pred_om_), env_om_ * decay);

@@ -361,7 +361,7 @@ class LoadEstimator {
   double pred_fy_ = 0.0, pred_om_ = 0.0, pred_rope_ = 0.0;  // predictions (prior)
   double h_fy_ = 0.0, h_om_ = 0.0, h_rope_ = 0.0;           // sensitivities of the measurements
   double hs_fy_ = 0.0, hs_om_ = 0.0;  // their steady parts (differ from h_fy_, h_om_ while a step's transient is followed)
-  double step_env_fy_ = 0.0, step_env_om_ = 0.0, step_env_t_ = 0.0;  // envelopes of the step's lateral transient
+  double step_env_fy_ = 0.0, step_env_om_ = 0.0;  // envelopes of the step's lateral transient (decay as env_*)
   int run_fa_ = 0, run_m_ = 0;             // consecutive gated samples
   double env_fy_ = 0.0, env_om_ = 0.0, env_rope_ = 0.0, env_t_ = 0.0;
   double start_rope_ = 0.0, jump_rope_ = 0.0;  // rope-load model error of the start transient, of a jump of a [N]

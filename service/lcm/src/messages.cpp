@@ -299,7 +299,7 @@ std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*
     case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce, 5 calibrate)"; break;
     case CommandError::BadShelveDuration: why = "shelve_duration must be a finite number > 0 s"; break;
     case CommandError::BadCalibration:
-      why = "calibrate needs known_fa in [0, 1e7] N, |known_b| <= 100 m and calibrate_duration in (0, 600] s";
+      why = contract::kCalibrationRule;
       break;
   }
   return std::nullopt;

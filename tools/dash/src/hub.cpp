@@ -83,6 +83,10 @@ std::string validateAckFields(const std::string& kind, int level, int action, do
   if (action == alarm_ack_t::ACTION_SHELVE && !(std::isfinite(shelve_duration) && shelve_duration > 0.0 &&
                                                  shelve_duration <= 1e6))
     return "shelve_duration must be in (0, 1e6] s";
+  return validateCommandUser(user);
+}
+
+std::string validateCommandUser(const std::string& user) {
   if (user.empty() || user.size() > 64) return "user must have 1..64 characters (enter your name)";
   for (unsigned char ch : user)
     if (ch < 0x20 || ch == 0x7f) return "user may not contain control characters";

@@ -237,5 +237,8 @@ class Hub {
 /// characters.  Returns "" when valid, else the reason.
 std::string validateAckFields(const std::string& kind, int level, int action, double shelve_duration,
                               const std::string& user);
+/// The user rule of every operator command: 1..64 characters, no control
+/// character.  "" when valid, else the reason.
+std::string validateCommandUser(const std::string& user);
 
 }  // namespace hoist::dash

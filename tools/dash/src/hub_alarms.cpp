@@ -253,11 +253,9 @@ void Hub::sendCalibration(Client& c, const std::string& channel, alarm_ack_t& ac
   if (names_an_alarm) why = "a calibration names no alarm (no activation_utime)";
   else if (contract::validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.known_fa,
                                           ack.known_b, ack.calibrate_duration, cmd) != contract::CommandError::None)
-    why = "calibrate needs known_fa in [0, 1e7] N, |known_b| <= 100 m and calibrate_duration in (0, 600] s";
-  else if (ack.user.empty() || ack.user.size() > 64) why = "user must have 1..64 characters (enter your name)";
+    why = contract::kCalibrationRule;
   else
-    for (unsigned char ch : ack.user)
-      if (ch < 0x20 || ch == 0x7f) why = "user may not contain control characters";
+    why = validateCommandUser(ack.user);
   if (!why.empty()) {
     count("commands_rejected_invalid");
     status(c, 2, "rejected command: " + why);

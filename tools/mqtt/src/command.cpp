@@ -153,13 +153,9 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
         return r;
       case hoist::contract::CommandError::BadCalibration: {
         r.reject = CommandReject::BadCalibration;
-        char buf[200];
-        std::snprintf(buf, sizeof buf,
-                      "calibrate needs known_fa in [0, %g] N, |known_b| <= %g m and calibrate_duration in (0, %g] s "
-                      "(got %g, %g, %g)",
-                      hoist::contract::kMaxCalibrationForce, hoist::contract::kMaxCalibrationOffset,
-                      hoist::contract::kMaxCalibration, r.ack.known_fa, r.ack.known_b, r.ack.calibrate_duration);
-        r.detail = buf;
+        char got[96];
+        std::snprintf(got, sizeof got, " (got %g, %g, %g)", r.ack.known_fa, r.ack.known_b, r.ack.calibrate_duration);
+        r.detail = std::string(hoist::contract::kCalibrationRule) + got;
         return r;
       }
     }

@@ -218,8 +218,8 @@ Node::Inbound Node::onMessage(const std::string& topic, const void* data, std::s
       return Inbound::HostOnline;
     }
     host_online_ = false;
-    if (!have_session_) return Inbound::HostOffline;  // no session known: nothing to end, nothing to mark
-    if (ts == host_ts_) return Inbound::HostOffline;
+    // No session known (nothing to end, nothing to mark), or its own death.
+    if (!have_session_ || ts == host_ts_) return Inbound::HostOffline;
     ++state_unverified_;
     return Inbound::HostOfflineUnverified;
   }

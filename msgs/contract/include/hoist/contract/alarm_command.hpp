@@ -31,6 +31,9 @@ inline constexpr double kMaxCalibration = 600.0;
 /// that against [load]) [N], [m].
 inline constexpr double kMaxCalibrationForce = 1.0e7;
 inline constexpr double kMaxCalibrationOffset = 100.0;
+/// The rule above in words, for the clients' and the daemon's refusals.
+inline constexpr const char* kCalibrationRule =
+    "calibrate needs known_fa in [0, 1e7] N, |known_b| <= 100 m and calibrate_duration in (0, 600] s";
 
 const char* toString(AlarmAction a);   ///< "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE"
 const char* toString(CommandError e);  ///< "ok", "unknown_kind", "bad_level", "bad_action", "bad_shelve_duration"
