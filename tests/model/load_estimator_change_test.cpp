@@ -22,13 +22,15 @@ constexpr double kChange = 62.0, kUp = 67.0;
 /// before the cage moves, and M's band honest on the whole trip up.
 /// `offset_sigma`: [sensors] imu_accel_offset_sigma (0: calibrated);
 /// `useful`: the largest sigma_M before the move, relative to |M|.
-void station(double imu_noise, unsigned seed, double offset_sigma, double useful, bool require_no_mismatch) {
+void station(double imu_noise, unsigned seed, double offset_sigma, double useful, bool require_no_mismatch,
+             double truth_offset = 0.0) {
   const Load before{300.0, 0.2}, after{1800.0, -0.7};
   const double dFa = after.Fa - before.Fa, dM = after.Fa * after.b - before.Fa * before.b;
   static const CleanTruth tr = simulate(config(), stationSequence(10.0), before, 100, kChange, {dFa, dM / dFa});
   SensorErrors err;
   err.white.imu_accel = imu_noise;
   err.vibration = 0.75;
+  err.accel_offset = truth_offset;
   EstimatorSettings set;
   set.noise.imu_accel = imu_noise;
   // The truth has no offset; with offset_sigma > 0 the estimator does not
@@ -111,6 +113,14 @@ TEST(LoadEstimatorChange, StationSequenceCheapImu) {
 TEST(LoadEstimatorChange, StationSequenceOffsetFree) {
   for (unsigned seed : {1u, 2u, 3u}) station(0.002, seed, 0.005, 0.05, true);
   for (unsigned seed : {4u, 5u, 6u}) station(0.01, seed, 0.005, 0.2, true);
+}
+
+// An accelerometer 1 mg off (0.0098 m/s^2, a 0.06-degree mounting tilt;
+// about twice the prior's sigma) that nobody calibrated: the offset the trip
+// down teaches carries M through the station, honestly.
+TEST(LoadEstimatorChange, StationSequenceOneMilliGOffset) {
+  for (unsigned seed : {1u, 2u, 3u}) station(0.002, seed, 0.005, 0.05, true, 0.0098);
+  for (unsigned seed : {4u, 5u, 6u}) station(0.01, seed, 0.005, 0.2, true, 0.0098);
 }
 
 // The CUSUM's false changes at rest: a long rest with no change, with
