@@ -77,9 +77,9 @@ def main():
     configs = [cfg.copy().set("guide_ropes.preload", [15e3 + 45e3 * i / (a.runs - 1 or 1)] * 2)
                for i in range(a.runs)]
     one_s, _ = median_time(lambda: hoist.simulate_batch(configs, "paper", t_end=a.t_end, threads=1),
-                           max(1, a.repeat // 3))
+                           max(3, a.repeat // 3))
     two_s, _ = median_time(lambda: hoist.simulate_batch(configs, "paper", t_end=a.t_end, threads=2),
-                           max(1, a.repeat // 3))
+                           max(3, a.repeat // 3))
 
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs; median of {a.repeat}")
     print("| what | time | ratio |")
