@@ -17,7 +17,9 @@
 //             sensors = IMU only;
 //   inuse     as normal, the daemon's alarms judge the estimate (in_use), and
 //             a cage_state_t of the open-loop twin (theta = theta_open =
-//             8.3e-4 rad, l, y_c) on <prefix>HOIST_CAGE with each estimate.
+//             8.3e-4 rad, l, y_c) on <prefix>HOIST_CAGE with each estimate;
+//   calibrating  as normal, a load an operator declared known is in force
+//             (calibrating, after alarm_ack_t ACTION_CALIBRATE).
 #include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
@@ -34,14 +36,15 @@
 
 int main(int argc, char** argv) {
   if (argc < 5) {
-    std::fprintf(stderr, "usage: hoist-test-estimate-pub LCM_URL PREFIX COUNT PERIOD_MS [normal|mismatch|norope|inuse]\n");
+    std::fprintf(stderr, "usage: hoist-test-estimate-pub LCM_URL PREFIX COUNT PERIOD_MS [normal|mismatch|norope|inuse|calibrating]\n");
     return 2;
   }
   const std::string prefix = argv[2];
   const int count = std::atoi(argv[3]);
   const int period_ms = std::atoi(argv[4]);
   const std::string mode = argc > 5 ? argv[5] : "normal";
-  if (mode != "normal" && mode != "mismatch" && mode != "norope" && mode != "inuse") {
+  if (mode != "normal" && mode != "mismatch" && mode != "norope" && mode != "inuse" &&
+      mode != "calibrating") {
     std::fprintf(stderr, "hoist-test-estimate-pub: unknown MODE '%s'\n", mode.c_str());
     return 2;
   }
@@ -118,6 +121,7 @@ int main(int argc, char** argv) {
       e.loss30_separation = 1.6;
       e.loss30_visible = 0;
     }
+    if (mode == "calibrating") e.calibrating = 1;
     if (mode == "inuse") {
       e.in_use = 1;
       hoist::cage_state_t c{};

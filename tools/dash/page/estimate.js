@@ -2,6 +2,7 @@
 import { KEEP_S, state } from "./state.js";
 import { $, el, fix, num, keepWindow } from "./util.js";
 import { chartSize, spanAtLeast, splits, ticks, renderTilt } from "./trends.js";
+import { makeCalibrationForm, renderCalibrating } from "./calibrate.js";
 
 // ---- load estimate (only when HOIST_ESTIMATE publishes) ----------------------------
 // The estimated payload Fa and its offset b with their sigmas ("n/a" when not
@@ -14,13 +15,14 @@ export const EST_ROWS = [["Fa", "payload Fa"], ["b", "offset b"], ["moment", "mo
                   ["counts", "updates / gated / refused"], ["in_use", "alarms judge"],
                   ["detect", "preload loss visible"]];
 
-export function makeEstimateCard() {
+// `prefix`: the shaft's (its calibration's command channel).
+export function makeEstimateCard(prefix) {
   const dl = el("dl", { "data-role": "estimate-values" });
   for (const [f, k] of EST_ROWS) dl.append(el("dt", {}, k), el("dd", { "data-field": `est-${f}` }, "–"));
   return el("div", { class: "card estimate", "data-role": "estimate", hidden: "" },
     el("h2", {}, "Load estimate ", el("span", { class: "badge", "data-field": "est-mismatch", "data-state": "ok" }, "")),
     dl, el("div", { class: "est-note", "data-field": "est-stale" }, ""),
-    el("div", { class: "trends", "data-role": "estimate-trends" }));
+    el("div", { class: "trends", "data-role": "estimate-trends" }), makeCalibrationForm(prefix));
 }
 
 // Decimals that show a value to its sigma's first digit (0 for sigma >= 1).
@@ -100,6 +102,7 @@ export function renderEstimate(s, e, mismatchInInterval) {
   const det = $('[data-field="est-detect"]', box);
   det.previousSibling.hidden = det.hidden = !num(e.detect_trip);
   det.textContent = detectText(e);
+  renderCalibrating(box, e);
   const badge = $('[data-field="est-mismatch"]', box);
   const on = Boolean(e.mismatch) || mismatchInInterval;
   badge.dataset.state = on ? "mismatch" : "ok";

@@ -202,7 +202,7 @@ export function getShaft(prefix) {
       el("option", { value: "600" }, "10 min"), el("option", { value: "1800" }, "30 min"), el("option", { value: "3600" }, "60 min"))));
   const health = el("div", { class: "card health" }, el("h2", {}, "Health"), el("dl", { "data-role": "health" }, el("dt", {}, "–"), el("dd", {}, "no HOIST_HEALTH yet")));
   const forecast = el("div", { class: "card forecast", "data-role": "forecast", hidden: "" }, el("h2", {}, "Forecasts"), el("div", { "data-role": "forecast-body" }));
-  const estimate = makeEstimateCard();
+  const estimate = makeEstimateCard(prefix);
   const right = el("div", { class: "side" }, alarms, estimate, health, forecast);
   root.append(banner, left, trends, right);
   $("#shafts").append(root);

@@ -12,11 +12,14 @@
 // the NIS trend has points of the window's NIS and of its bounds; a mismatch
 // raises the MODEL_MISMATCH badge naming the NIS, and the MODEL_MISMATCH alarm
 // row shows the NIS against its bound; without the rope load cell
-// Fa and b read "n/a"; the panel says STALE when the estimates stop.
+// Fa and b read "n/a"; the panel says STALE when the estimates stop; the
+// calibration form sends a calibration (confirmed, with the operator's name)
+// that hoist-dash publishes, refuses one outside the daemon's bounds, and
+// shows estimate_t.calibrating.
 import fs from "node:fs";
 import path from "node:path";
 import puppeteer from "puppeteer-core";
-import { check, fail, lcmUrl, sleep, start, startDash, stop, workDir } from "./harness.mjs";
+import { check, fail, lcmUrl, sleep, start, startDash, stats, stop, workDir } from "./harness.mjs";
 
 const args = process.argv.slice(2);
 const lcmPort = Number(args.find((a) => /^\d+$/.test(a)) || 7842);
@@ -37,8 +40,9 @@ const browser = await puppeteer.launch({
   defaultViewport: { width: 1500, height: 1180 },
 });
 const page = await browser.newPage();
-const errors = [];
+const errors = [], dialogs = [];
 page.on("pageerror", (e) => errors.push(String(e)));
+page.on("dialog", async (d) => { dialogs.push(d.message()); await d.accept(); });
 page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
 process.on("uncaughtException", async (e) => {
   console.error(`FAIL: ${e.message}`);
@@ -150,6 +154,42 @@ check(/^0\.6[4-6]\d$/.test(tilt.text) && tilt.sub === "estimate; open loop 0.830
 await page.waitForFunction((sel) => document.querySelector(sel).dataset.state === "stale", { timeout: 4000 }, box);
 p = await panel();
 check(p.state === "stale", "the panel says STALE after the estimates stopped");
+
+// 6. The accelerometer's calibration from the panel's form: confirmed by the
+// operator, checked by hoist-dash with the daemon's rule, sent (counted) or
+// refused with the bounds; estimate_t.calibrating shows while it is in force.
+const form = `${box} [data-role=calibrate]`;
+check(await page.$eval(form, (f) => getComputedStyle(f).display !== "none"), "the calibration form is shown (commands enabled)");
+const toasts = () => page.$$eval("#toast div", (ds) => ds.map((d) => d.textContent));
+const published = async () => (await stats(dash.url)).counters.commands_published || 0;
+const calibrateWith = async (fa, b, duration) => {
+  for (const [f, v] of [["fa", fa], ["b", b], ["duration", duration]]) {
+    await page.$eval(`${form} [data-field="cal-${f}"]`, (i, v) => { i.value = v; }, String(v));
+  }
+  await page.click(`${form} button[data-action=calibrate]`);
+};
+await calibrateWith(0, 0, 20);
+check(dialogs.length === 0 && (await toasts()).some((t) => t.startsWith("Enter your name")),
+      "without an operator name nothing is asked or sent");
+await page.type("#user", "cal-test");
+const pub0 = await published();
+await calibrateWith(0, 0, 20);
+await page.waitForFunction(() => [...document.querySelectorAll("#toast div")].some((d) => d.textContent.startsWith("sent calibrate")),
+                           { timeout: 3000 });
+const sent = (await toasts()).find((t) => t.startsWith("sent calibrate"));
+check(sent === "sent calibrate: the load is known, Fa = 0 N at b = 0 m for 20 s, by cal-test on north/HOIST_ALARM_ACK",
+      `the calibration went out on the shaft's command channel: "${sent}"`);
+check(dialogs.length === 1 && dialogs[0].startsWith("Calibrate the accelerometer of north/: the load is known, Fa = 0 N at b = 0 m, for the next 20 s?"),
+      `the confirmation named the shaft and the load: "${dialogs[0]}"`);
+check(await published() === pub0 + 1, "hoist-dash published it once");
+await calibrateWith(0, 0, 9999);
+await page.waitForFunction(() => [...document.querySelectorAll("#toast div.err")].some((d) => d.textContent.startsWith("rejected command: calibrate needs")),
+                           { timeout: 3000 });
+check(await published() === pub0 + 1, "a calibration outside the daemon's bounds (9999 s) is refused, with the rule, and not published");
+await publish("calibrating", 60);
+p = await page.$eval(`${form} [data-field="est-calibrating"]`, (n) => ({ state: n.dataset.state, text: n.textContent }));
+check(p.state === "calibrating" && p.text.startsWith("CALIBRATING: the declared load is in force"),
+      `estimate_t.calibrating is shown: "${p.text}"`);
 
 await browser.close();
 await stop(dash.proc);
