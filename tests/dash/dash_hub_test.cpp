@@ -986,5 +986,41 @@ TEST_F(HubTest, ForecastIsAdvertisedWithItsNestedSchemaAndForwardedAsJson) {
   EXPECT_EQ(hub.counter("lcm_rejected_wrong_type"), 1u);
 }
 
+// A client flooding valid commands (issue 33): beyond its burst it is refused
+// before anything is parsed, counted, told why; the refill lets it send again
+// at the rate; another client's commands are untouched meanwhile.  At the
+// defaults (2/s, bursts of 10) 64 clients stay inside a daemon's budget.
+TEST_F(HubClockTest, AClientFloodingCommandsIsHeldToItsRateAndOthersAreNot) {
+  Hub hub = makeTimed({""});
+  RecClient flood, other;
+  hub.addClient(flood);
+  hub.addClient(other);
+  advertiseAck(hub, flood, 5);
+  advertiseAck(hub, other, 6);
+  const Json ack = {{"kind", "INPUT_STALE"}, {"level", 0}, {"action", 1}, {"user", "op"}};
+  for (int k = 0; k < 100; ++k) hub.onClientBinary(flood, clientMessage(5, ack));
+  EXPECT_EQ(pub.size(), 10u);  // the burst
+  EXPECT_EQ(hub.counter("commands_rejected_rate"), 90u);
+  ASSERT_NE(flood.lastStatus(), nullptr);
+  EXPECT_EQ((*flood.lastStatus())["level"], 2);
+  EXPECT_NE((*flood.lastStatus())["message"].get<std::string>().find("more than 2 commands a second"), std::string::npos);
+  // Garbage costs a token too (refused before it is parsed).
+  hub.onClientBinary(flood, clientMessage(5, {{"nonsense", 1}}));
+  EXPECT_EQ(hub.counter("commands_rejected_rate"), 91u);
+  EXPECT_EQ(hub.counter("commands_rejected_invalid"), 0u);
+  // The other operator is not held by the flood.
+  hub.onClientBinary(other, clientMessage(6, ack));
+  EXPECT_EQ(pub.size(), 11u);
+  // One second later: two more (the rate), then refused again; a clock
+  // stepping back gives nothing.
+  advance(1.0);
+  for (int k = 0; k < 5; ++k) hub.onClientBinary(flood, clientMessage(5, ack));
+  EXPECT_EQ(pub.size(), 13u);
+  now_ns -= 10'000'000'000ULL;
+  hub.onClientBinary(flood, clientMessage(5, ack));
+  EXPECT_EQ(pub.size(), 13u);
+  EXPECT_EQ(hub.counter("commands_rejected_rate"), 95u);
+}
+
 }  // namespace
 }  // namespace hoist::dash

@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
   double warning_fraction = 0.5, critical_fraction = 0.8;
   double rate = 25.0, duration = 0.0;
   std::size_t max_clients = 64, max_msg = 64 * 1024, max_queue_kb = 2048, max_per_peer = 32;
+  double command_rate = 2.0, command_burst = 10.0;
   double max_peer_rate = 30.0;
   std::string token_credential = "hoist-dash-token";
   std::size_t reserved = 4;
@@ -123,6 +124,12 @@ int main(int argc, char** argv) {
   app.add_option("--reserved-clients", reserved,
                  "WebSockets kept for clients with the token, beyond --max-clients (default 4)")
       ->check(CLI::Range(0, 1000));
+  app.add_option("--command-rate", command_rate,
+                 "operator commands a second from one client (default 2, bursts of --command-burst); beyond "
+                 "it a command is refused and counted (commands_rejected_rate)")
+      ->check(CLI::Range(0.01, 1000.0));
+  app.add_option("--command-burst", command_burst, "commands one client may send at once (default 10)")
+      ->check(CLI::Range(1.0, 10000.0));
   app.add_option("--max-message", max_msg, "largest accepted WebSocket message [bytes] (default 65536)")
       ->check(CLI::Range(64, 16 * 1024 * 1024));
   app.add_option("--max-queue-kb", max_queue_kb, "send queue per client before data is dropped [KiB] (default 2048)")
@@ -160,6 +167,8 @@ int main(int argc, char** argv) {
 
   Hub::Options opt;
   opt.read_only = read_only;
+  opt.command_rate = command_rate;
+  opt.command_burst = command_burst;
   Json meta = Json::object();
   meta["*"] = Json{{"warning_fraction", warning_fraction}, {"critical_fraction", critical_fraction}};
   for (const auto& p : prefixes) {

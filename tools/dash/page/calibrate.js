@@ -7,7 +7,8 @@
 // fields are numbers: hoist-dash applies the daemon's own rule
 // (hoist::contract) before anything is published, and its answer ("sent
 // calibrate: ..." or "rejected command: ..." with the bounds) comes back as
-// a status.  Hidden with --read-only (class "cmd"), as the alarm commands are.
+// a status.  Not made for a read-only server's page (hidden with class "cmd"
+// besides), as the alarm commands are not.
 import { state, userInput } from "./state.js";
 import { $, el, num, setText, toast } from "./util.js";
 import { isOpen } from "./main.js";
@@ -25,13 +26,13 @@ export function makeCalibrationForm(prefix) {
     field("fa", "payload Fa", "0", "N", { min: "0" }),
     field("b", "at offset b", "0", "m"),
     field("duration", "for", "30", "s", { min: "1" }),
-    el("button", { type: "submit", "data-action": "calibrate" }, "Calibrate"),
-    el("div", { class: "est-note", "data-field": "est-calibrating" }, ""));
+    el("button", { type: "submit", "data-action": "calibrate" }, "Calibrate"));
   form.addEventListener("submit", (ev) => { ev.preventDefault(); calibrate(prefix, form); });
   return form;
 }
 
-// estimate_t.calibrating: a declared load is in force.
+// estimate_t.calibrating: a declared load is in force (shown on every page,
+// read-only too: the note is the panel's, not the form's).
 export function renderCalibrating(box, e) {
   const on = e.calibrating === true;
   const note = $('[data-field="est-calibrating"]', box);

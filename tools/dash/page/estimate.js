@@ -22,7 +22,10 @@ export function makeEstimateCard(prefix) {
   return el("div", { class: "card estimate", "data-role": "estimate", hidden: "" },
     el("h2", {}, "Load estimate ", el("span", { class: "badge", "data-field": "est-mismatch", "data-state": "ok" }, "")),
     dl, el("div", { class: "est-note", "data-field": "est-stale" }, ""),
-    el("div", { class: "trends", "data-role": "estimate-trends" }), makeCalibrationForm(prefix));
+    el("div", { class: "trends", "data-role": "estimate-trends" }),
+    el("div", { class: "est-note calibrating", "data-field": "est-calibrating" }, ""),
+    // No command controls at all on a read-only server's page (as the alarm rows' buttons).
+    state.readOnly ? "" : makeCalibrationForm(prefix));
 }
 
 // Decimals that show a value to its sigma's first digit (0 for sigma >= 1).

@@ -18,12 +18,15 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "hoist/rt/token_bucket.hpp"
 
 namespace hoist {
 class alarm_ack_t;  // hoist/alarm_ack_t.hpp (lcm-gen)
@@ -71,6 +74,7 @@ class Client {
   std::map<std::uint32_t, std::uint32_t> subs_;     // subscription id -> channel id
   std::map<std::uint32_t, std::uint32_t> by_chan_;  // channel id -> subscription id
   std::map<std::uint32_t, std::string> published_;  // client channel id -> LCM channel
+  std::optional<rt::TokenBucket> commands_;          // its command rate (Options::command_rate), from the first
 };
 
 class Hub {
@@ -93,6 +97,13 @@ class Hub {
     double history_bucket_s = 0.2;    ///< its resolution (min and max per bucket)
     std::size_t max_lcm_bytes = 1 << 20;  ///< larger LCM messages are dropped (counted)
     Json shaft_meta = Json::object();     ///< prefix -> {warning_fraction, ...} (serverInfo metadata)
+    // Client-published messages (commands) a second per client, in bursts of
+    // `command_burst` (a token bucket; beyond it refused and counted, never
+    // parsed).  64 clients at 2/s stay far inside a daemon's budget
+    // (max_commands_per_tick = 4 at 100 Hz): a client flooding valid
+    // commands cannot take another operator's (--command-rate, --command-burst).
+    double command_rate = 2.0;
+    double command_burst = 10.0;
   };
   /// Publishes encoded bytes on an LCM channel; false on failure.
   using Publisher = std::function<bool(const std::string& channel, const std::vector<std::uint8_t>& bytes)>;

@@ -167,6 +167,19 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
     status(c, 2, "rejected: client channel " + std::to_string(chan) + " was not advertised");
     return;
   }
+  // The client's command rate, before anything is parsed (clock_ is wall
+  // time: a step back counts as no time passed).
+  if (!c.commands_) c.commands_.emplace(opt_.command_rate, opt_.command_burst);
+  if (!c.commands_->take(static_cast<double>(clock_()) * 1e-9)) {
+    count("commands_rejected_rate");
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "rejected: more than %g commands a second (bursts of %g) from this client; nothing was sent -- "
+                  "wait a moment and send again",
+                  opt_.command_rate, opt_.command_burst);
+    status(c, 2, text);
+    return;
+  }
   Json j = Json::parse(payload.begin(), payload.end(), nullptr, false);
   alarm_ack_t ack{};
   std::string err;

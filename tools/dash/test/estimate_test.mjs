@@ -187,7 +187,7 @@ await page.waitForFunction(() => [...document.querySelectorAll("#toast div.err")
                            { timeout: 3000 });
 check(await published() === pub0 + 1, "a calibration outside the daemon's bounds (9999 s) is refused, with the rule, and not published");
 await publish("calibrating", 60);
-p = await page.$eval(`${form} [data-field="est-calibrating"]`, (n) => ({ state: n.dataset.state, text: n.textContent }));
+p = await page.$eval(`${box} [data-field="est-calibrating"]`, (n) => ({ state: n.dataset.state, text: n.textContent }));
 check(p.state === "calibrating" && p.text.startsWith("CALIBRATING: the declared load is in force"),
       `estimate_t.calibrating is shown: "${p.text}"`);
 
