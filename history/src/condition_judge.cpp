@@ -1,6 +1,8 @@
 // The shaft's condition alarms over its trip records: see condition_judge.hpp.
 #include "hoist/history/condition_judge.hpp"
 
+#include "hoist/history/judged_history.hpp"
+
 #include <algorithm>
 
 namespace hoist::history {
@@ -11,18 +13,24 @@ void addOnce(std::vector<std::string>& alarms, const char* name) {
 }
 }  // namespace
 
-ConditionJudge::ConditionJudge(const ConditionSettings& cond) : trend_(cond), finger_(cond) {}
+ConditionJudge::ConditionJudge(const ConditionSettings& cond) : cond_(cond), trend_(cond), finger_(cond) {}
 
 std::int64_t ConditionJudge::seed(Store& db, const std::string& shaft) {
-  ListFilter f;
-  f.shaft = shaft;
-  f.with_bins = true;
-  const auto old = db.list(f);
-  const auto marks = db.baseline(shaft);
-  for (const auto& r : old)
-    if (std::binary_search(marks.begin(), marks.end(), r.trip)) finger_.markBaseline(r);
-  for (const auto& r : old) add(r);
-  return static_cast<std::int64_t>(old.size());
+  JudgedHistory h = readJudgedHistory(db, shaft, cond_);
+  const auto marked = [&](std::int64_t trip) { return std::binary_search(h.marks.begin(), h.marks.end(), trip); };
+  // The baseline before the window feeds the fingerprint only (the trend
+  // forgets it: judged_history.hpp).
+  for (const auto& r : h.baseline) {
+    if (marked(r.trip)) finger_.markBaseline(r);
+    else finger_.add(r);
+  }
+  for (const auto& r : h.trips)
+    if (marked(r.trip)) finger_.markBaseline(r);
+  for (const auto& r : h.trips) add(r);
+  stored_last_ = h.last_trip;
+  windowed_ = h.windowed;
+  trips_ += static_cast<std::int64_t>(h.baseline.size());
+  return static_cast<std::int64_t>(h.baseline.size() + h.trips.size());
 }
 
 void ConditionJudge::judge(TripRecord& r) {

@@ -129,6 +129,7 @@ class PgStore final : public Store {
       if (f.from_trip > 0) p.push_back(std::to_string(f.from_trip)), sql += " AND trip >= $" + std::to_string(p.size());
       if (f.to_trip > 0) p.push_back(std::to_string(f.to_trip)), sql += " AND trip <= $" + std::to_string(p.size());
       sql += " ORDER BY shaft, trip";
+      if (f.limit > 0) p.push_back(std::to_string(f.limit)), sql += " LIMIT $" + std::to_string(p.size());
       Result res(run(sql, p, PGRES_TUPLES_OK));
       std::vector<TripRecord> out;
       for (int row = 0; row < PQntuples(res.r); ++row)

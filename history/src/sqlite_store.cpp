@@ -152,10 +152,12 @@ class SqliteStore final : public Store {
     if (f.from_trip > 0) sql += " AND trip >= ?2";
     if (f.to_trip > 0) sql += " AND trip <= ?3";
     sql += " ORDER BY shaft, trip";
+    if (f.limit > 0) sql += " LIMIT ?4";
     Stmt s(db_, sql, name_);
     if (f.shaft) s.bind(1, *f.shaft);
     if (f.from_trip > 0) s.bind(2, f.from_trip);
     if (f.to_trip > 0) s.bind(3, f.to_trip);
+    if (f.limit > 0) s.bind(4, f.limit);
     std::vector<TripRecord> out;
     while (s.step(name_ + ": list")) out.push_back(detail::readTripRow([&](int i, Kind k) { return s.column(i, k); }, name_));
     if (f.with_bins)

@@ -24,6 +24,8 @@ void ConditionSettings::validate() const {
   if (!(std::isfinite(preload_critical) && preload_critical > 0.0 && preload_critical < preload_warning))
     bad("condition.preload_critical", preload_critical, "must be in (0, preload_warning)");
   if (!(std::isfinite(trend_walk) && trend_walk >= 0.0)) bad("condition.trend_walk", trend_walk, "must be >= 0");
+  if (seed_trips != 0 && seed_trips < 2 * baseline_trips)
+    bad("condition.seed_trips", seed_trips, "must be 0 (every stored trip) or >= 2 x baseline_trips");
   if (!(std::isfinite(accel_offset_sigma) && accel_offset_sigma >= 0.0))
     bad("sensors.imu_accel_offset_sigma", accel_offset_sigma, "must be >= 0 m/s^2");
   clearance.validate();

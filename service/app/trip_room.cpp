@@ -162,7 +162,11 @@ void TripRoom::workerMain() {
   if (w_->store) {
     try {
       const std::int64_t n = w_->judge.seed(*w_->store, shaft_);
-      log->info("{}shaft condition from {} stored trips: {}", tag, n, w_->judge.summary());
+      if (w_->judge.seededWindowed())
+        log->info("{}shaft condition from {} stored trips (the newest [condition] seed_trips up to trip {} and the "
+                  "baseline before them): {}", tag, n, w_->judge.storedLastTrip(), w_->judge.summary());
+      else
+        log->info("{}shaft condition from {} stored trips: {}", tag, n, w_->judge.summary());
     } catch (const std::exception& e) {
       log->error("{}shaft condition: the stored trips cannot be read ({}): GUIDE_PRELOAD_LOW and SHAFT_FINGERPRINT "
                  "are judged from this run's trips only", tag, e.what());

@@ -181,6 +181,11 @@ TEST(ConditionConfig, KeysDefaultsAndErrorsWithTheLine) {
   EXPECT_NE(err("[condition]\ndepth_bin = -1\n").find("c.toml:2: condition.depth_bin: must be > 0"), std::string::npos);
   EXPECT_NE(err("[condition]\ndepth_bins = 5\n").find("did you mean 'depth_bin'"), std::string::npos);
   EXPECT_NE(err("[condition]\nbaseline_trips = 2.5\n").find("condition.baseline_trips"), std::string::npos);
+  // seed_trips: 500 by default, 0 (every trip) or at least two baselines' worth.
+  EXPECT_EQ(c.seed_trips, 500);
+  EXPECT_EQ(conditionSettingsFromToml(io::parseToml("[condition]\nseed_trips = 0\n"), "c.toml").seed_trips, 0);
+  EXPECT_NE(err("[condition]\nseed_trips = 15\n").find("c.toml:2: condition.seed_trips: must be 0 (every stored trip) or >= 2 x baseline_trips"),
+            std::string::npos) << err("[condition]\nseed_trips = 15\n");
   // hoist-twind's configuration may hold [history] and [condition] beside the shaft's sections.
   const auto sections = configSections();
   EXPECT_NE(std::find(sections.begin(), sections.end(), "history"), sections.end());

@@ -36,6 +36,9 @@ struct ConditionSettings {
   double preload_warning = 0.85;    ///< condition.preload_warning: GUIDE_PRELOAD_LOW WARNING below (95 % confidence)
   double preload_critical = 0.70;   ///< condition.preload_critical: ... CRITICAL below (95 % confidence)
   double trend_walk = 0.05;         ///< condition.trend_walk: random walk of s between trips (sigma per trip)
+  /// condition.seed_trips: the newest stored trips a judge reads at start
+  /// (plus the baseline before them; hoist/history/judged_history.hpp); 0: all.
+  int seed_trips = 500;
   /// Prior sigma of the accelerometer's offset [m/s^2] in the preload fit:
   /// not a [condition] key -- the caller copies [sensors] imu_accel_offset_sigma
   /// here (issue 30); 0 declares a calibrated accelerometer (no offset fitted).

@@ -75,7 +75,9 @@ function render(j) {
   setAttr(root, "data-trips", String(j.trips));
   setAttr(root, "data-last-trip", last ? String(last.trip) : "");
   const rej = j.rejected > 0 ? `; ${j.rejected} record(s) rejected (${(j.rejected_notes || [])[0] || ""})` : "";
-  setText($("#cond-status"), `${j.trips} trip(s) of shaft ${j.shaft ? `'${j.shaft}'` : "(default)"} in ${j.db}${rej}`);
+  // A long history is judged from its newest [condition] seed_trips trips (and the baseline before them).
+  const shown = j.windowed ? `the newest ${j.trips} of ${j.stored_last_trip} trips` : `${j.trips} trip(s)`;
+  setText($("#cond-status"), `${shown} of shaft ${j.shaft ? `'${j.shaft}'` : "(default)"} in ${j.db}${rej}`);
   $("#cond-status").className = j.rejected > 0 ? "cond-status warn" : "cond-status";
   renderAlarms(j, last);
   drawTrend($("#cond-trend"), trend, j.thresholds || {});

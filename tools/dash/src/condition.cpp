@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "hoist/history/condition_config.hpp"
+#include "hoist/history/judged_history.hpp"
 #include "hoist/history/plausible.hpp"
 #include "hoist/history/record_json.hpp"
 #include "hoist/history/schema.hpp"
@@ -71,10 +72,9 @@ ConditionOptions conditionOptions(const std::string& history_url, const std::str
 
 Json ConditionView::build(history::Store& store, const std::string& shaft, const ConditionSettings& cond,
                           std::size_t max_trips) {
-  history::ListFilter f;
-  f.shaft = shaft;
-  f.with_bins = true;
-  std::vector<TripRecord> all = store.list(f);
+  // The trips the daemon's judge rests on (a bounded read: the newest
+  // [condition] seed_trips and the baseline before them).
+  history::JudgedHistory h = history::readJudgedHistory(store, shaft, cond);
   Json j;
   j["ok"] = true;
   j["error"] = "";
@@ -83,27 +83,39 @@ Json ConditionView::build(history::Store& store, const std::string& shaft, const
   j["thresholds"] = {{"warning", cond.preload_warning}, {"critical", cond.preload_critical},
                      {"max_sigma", cond.max_sigma}};
   // Validate before anything uses a value.
-  std::vector<TripRecord> recs;
   Json notes = Json::array();
   std::size_t rejected = 0;
-  for (auto& r : all) {
-    if (auto why = history::implausible(r); !why.empty()) {
-      ++rejected;
-      if (notes.size() < 10) notes.push_back("trip " + std::to_string(r.trip) + ": " + why);
-      continue;
+  auto valid = [&](std::vector<TripRecord>& in) {
+    std::vector<TripRecord> out;
+    for (auto& r : in) {
+      if (auto why = history::implausible(r); !why.empty()) {
+        ++rejected;
+        if (notes.size() < 10) notes.push_back("trip " + std::to_string(r.trip) + ": " + why);
+        continue;
+      }
+      out.push_back(std::move(r));
     }
-    recs.push_back(std::move(r));
-  }
+    return out;
+  };
+  const std::vector<TripRecord> base = valid(h.baseline);
+  std::vector<TripRecord> recs = valid(h.trips);
   j["trips"] = recs.size();
+  j["stored_last_trip"] = h.last_trip;
+  j["windowed"] = h.windowed;
   j["rejected"] = rejected;
   j["rejected_notes"] = notes;
 
-  // The daemon's decisions, replayed over the stored trips (as hoist-trips ingest judges them).
+  // The daemon's decisions, replayed over the stored trips (as its judge
+  // seeds them: ConditionJudge::seed).
   PreloadTrend trend(cond);
   ShaftFingerprint finger(cond);
-  const auto marks = store.baseline(shaft);
+  const auto marked = [&](std::int64_t trip) { return std::binary_search(h.marks.begin(), h.marks.end(), trip); };
+  for (const auto& r : base) {
+    if (marked(r.trip)) finger.markBaseline(r);
+    else finger.add(r);
+  }
   for (const auto& r : recs)
-    if (std::binary_search(marks.begin(), marks.end(), r.trip)) finger.markBaseline(r);
+    if (marked(r.trip)) finger.markBaseline(r);
   const std::size_t first = recs.size() > max_trips ? recs.size() - max_trips : 0;
   Json tr = Json::array();
   for (std::size_t i = 0; i < recs.size(); ++i) {

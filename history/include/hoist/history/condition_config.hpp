@@ -11,6 +11,7 @@
 //   preload_warning = 0.85    # GUIDE_PRELOAD_LOW WARNING below (95 % confidence)
 //   preload_critical = 0.70   # ... CRITICAL below
 //   trend_walk = 0.05         # random walk of s between trips (sigma per trip)
+//   seed_trips = 500          # newest stored trips read at start (and the baseline before them); 0: all
 //
 // Every key optional (ConditionSettings{} defaults).  Errors: io::ConfigError
 // "file:line: condition.key: why" (unknown keys with "did you mean", wrong

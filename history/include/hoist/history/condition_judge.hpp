@@ -6,8 +6,10 @@
 // GUIDE_PRELOAD_LOW) and the fingerprint (hoist/shaft_fingerprint.hpp,
 // SHAFT_FINGERPRINT) of one shaft.  seed() reads the shaft's stored trips
 // (with their depth bins) and the operator's baseline marks from a Store, in
-// trip order; judge() adds each new record and appends the condition alarms
-// it raises to the record's `alarms` (each name once).
+// trip order -- at most the newest [condition] seed_trips and the baseline
+// before them (hoist/history/judged_history.hpp: a bounded read) --;
+// judge() adds each new record and appends the condition alarms it raises to
+// the record's `alarms` (each name once).
 //
 // Who calls: one thread (the trip room's worker; hoist-trips).  seed() does
 // database reads (never on the real-time loop) and throws StoreError as the
@@ -27,9 +29,14 @@ class ConditionJudge {
  public:
   /// Throws std::invalid_argument for bad settings (cond.validate()).
   explicit ConditionJudge(const ConditionSettings& cond);
-  /// The shaft's history so far: every stored trip of `shaft` (with bins),
-  /// the marked baseline trips first marked.  Returns how many trips.
+  /// The shaft's history so far (readJudgedHistory: every stored trip of
+  /// `shaft`, or the newest seed_trips and the baseline before them), the
+  /// marked baseline trips first marked.  Returns how many trips were read.
   std::int64_t seed(Store& db, const std::string& shaft);
+  /// After seed(): the newest stored trip number, and whether trips older
+  /// than the window were left out.
+  std::int64_t storedLastTrip() const { return stored_last_; }
+  bool seededWindowed() const { return windowed_; }
   /// The next record (trip order; r.trip set).  Appends MODEL_MISMATCH (when
   /// r.mismatch), GUIDE_PRELOAD_LOW and SHAFT_FINGERPRINT to r.alarms when
   /// they are active after it, each only if not there already.
@@ -44,9 +51,11 @@ class ConditionJudge {
 
  private:
   void add(const TripRecord& r);
+  ConditionSettings cond_;
   PreloadTrend trend_;
   ShaftFingerprint finger_;
-  std::int64_t trips_ = 0, last_trip_ = 0;
+  std::int64_t trips_ = 0, last_trip_ = 0, stored_last_ = 0;
+  bool windowed_ = false;
 };
 
 }  // namespace hoist::history

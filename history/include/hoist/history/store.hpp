@@ -64,6 +64,7 @@ struct ListFilter {
   std::optional<std::string> shaft;  ///< only this shaft (nullopt: every shaft)
   bool with_bins = false;            ///< also read the depth bins
   std::int64_t from_trip = 0, to_trip = 0;  ///< 0: no bound
+  std::int64_t limit = 0;            ///< at most this many trips, the first in (shaft, trip) order (0: all)
 };
 
 class Store {
