@@ -70,6 +70,17 @@ TEST(PgStore, RoundTripCredentialsMigrations) {
       EXPECT_EQ(s->put(r), PutResult::Stored);
     }
     for (int t = 1; t <= 6; ++t) hoist::test::expectSameRecord(sampleRecord(t, t % 2 ? "" : "north"), *s->get(t % 2 ? "" : "north", t));
+    {  // limit: the first rows in (shaft, trip) order within the bounds (the condition judge's paging)
+      ListFilter lf;
+      lf.shaft = "";
+      lf.from_trip = 2;
+      lf.limit = 1;
+      const auto first = s->list(lf);
+      ASSERT_EQ(first.size(), 1u);
+      EXPECT_EQ(first[0].trip, 3);
+      lf.limit = 5;
+      EXPECT_EQ(s->list(lf).size(), 2u);  // trips 3 and 5
+    }
     auto again = sampleRecord(3);
     again.peak_speed = 1.0;
     EXPECT_EQ(s->put(again), PutResult::Duplicate);

@@ -61,6 +61,13 @@ TEST(SqliteStore, EveryFieldRoundTripsWithItsBins) {
   const auto north = again->list(f);
   ASSERT_EQ(north.size(), 4u);
   EXPECT_TRUE(north[0].bins.empty());
+  // limit: the first rows in (shaft, trip) order within the bounds (the condition judge's paging).
+  f.from_trip = north[1].trip;
+  f.limit = 2;
+  const auto page = again->list(f);
+  ASSERT_EQ(page.size(), 2u);
+  EXPECT_EQ(page[0].trip, north[1].trip);
+  EXPECT_EQ(page[1].trip, north[2].trip);
   EXPECT_EQ(sql(dir / "h.sqlite", "PRAGMA journal_mode;"), "wal\n");
 }
 
