@@ -89,6 +89,15 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     g->ids.push_back(static_cast<int>(i));
   }
   for (auto& g : groups_) g->shafts.shrink_to_fit();
+  // The trip rooms: one pool of at most one worker per CPU for every shaft
+  // with [history] enabled (trip_pool.hpp).
+  std::size_t with_history = 0;
+  for (auto& sp : shafts_) with_history += sp->trips() ? 1 : 0;
+  if (with_history > 0) {
+    const int cpus = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    trip_pool_ = std::make_unique<TripPool>(std::min(cpus, static_cast<int>(with_history)));
+    for (auto& sp : shafts_) sp->setTripPool(trip_pool_.get());
+  }
   // Look-ahead forecasts: one pool for the process; the forecasting shafts
   // are staggered over the forecast period (shaft i of N at phase i / N).
   std::vector<ShaftTwin*> fshafts;
@@ -114,6 +123,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
 Daemon::~Daemon() {
   watchdog_.stop();
   if (pool_) pool_->stop();
+  if (trip_pool_) trip_pool_->stop();
   // The descriptor belongs to LCM: never let Asio close it.
   if (lcm_fd_.is_open()) lcm_fd_.release();
   log_.stop();
@@ -127,6 +137,7 @@ bool Daemon::start() {
   armLcm();
   if (lcm_out_) out_watch_.open(opt_.lcm_url_out, shafts_);  // a second publisher of our outputs there
   startForecasts();
+  startTrips();
   // The watchdog thread starts while SIGINT/SIGTERM are still blocked, so it
   // never receives them.
   watchdog_.start();
@@ -208,6 +219,14 @@ void Daemon::startForecasts() {
   out_->info("look-ahead forecasts: {} shaft(s) on one pool of {} worker thread(s) (SCHED_OTHER, nice {}: they "
              "give way to the loop)",
              pool_->jobs(), pool_->workers(), ForecastPool::kWorkerNice);
+}
+
+void Daemon::startTrips() {
+  if (!trip_pool_) return;
+  trip_pool_->start();
+  out_->info("trip history: {} shaft(s) on one pool of {} worker thread(s) (SCHED_OTHER, nice {}: they give way "
+             "to the loop)",
+             trip_pool_->rooms(), trip_pool_->workers(), TripPool::kWorkerNice);
 }
 
 void Daemon::unblockStopSignals() {
@@ -433,6 +452,7 @@ void Daemon::stop(const char* why) {
   stop_reason_ = why;
   log_.info("stopping ({})", why);
   flushOutputs();
+  if (trip_pool_) trip_pool_->stop();  // every room drained and closed before the shafts report them
   for (auto& s : shafts_) {
     s->publishHealth(true);
     s->stopOffsetKeeper();

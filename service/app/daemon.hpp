@@ -137,6 +137,7 @@ class Daemon {
   bool openInput();              ///< own udpm receive path (or LCM's); shafts subscribed
   void openOutput();             ///< own udpm publisher for udpm output URLs
   void startForecasts();         ///< the forecast pool's workers
+  void startTrips();             ///< the trip pool's workers ([history] enabled)
   void unblockStopSignals();     ///< the stop signals, handled on the loop thread
   void startSchedules();         ///< the clock starts; shafts announce themselves; timers armed
   void logStarted();             ///< one start line per shaft
@@ -178,6 +179,9 @@ class Daemon {
   /// [forecast] enabled and --clock wall.  Declared after shafts_ so that it
   /// stops (joins its workers) before the jobs it serves are destroyed.
   std::unique_ptr<ForecastPool> pool_;
+  /// The trip rooms' workers ([history] enabled): a few threads for every
+  /// shaft (trip_pool.hpp); after shafts_ for the same reason.
+  std::unique_ptr<TripPool> trip_pool_;
   Clock::time_point start_{};
   Clock::time_point stop_time_{};
   RealtimeOutcome rt_;

@@ -63,6 +63,12 @@ void ShaftTwin::enableTrips(const TripHistoryConfig& hist) {
   ctx_.trips = trips_.get();
 }
 
+void ShaftTwin::setTripPool(TripPool* pool) {
+  if (!trips_ || !pool) return;
+  pool->add(trips_.get());
+  trips_pooled_ = true;
+}
+
 void ShaftTwin::applyCondition() {
   const ConditionState* c = ctx_.trips->takeCondition();
   if (!c) return;
@@ -110,7 +116,7 @@ void ShaftTwin::stopOffsetKeeper() {
 void ShaftTwin::start(Clock::time_point start, double health_phase) {
   ctx_.start = start;
   if (offsets_) offsets_->start();
-  if (trips_) trips_->start();
+  if (trips_ && !trips_pooled_) trips_->start();
   publishHealth();  // announce ourselves at once
   // Shafts of one daemon spread their later health messages over the period.
   health_.start(health_phase);

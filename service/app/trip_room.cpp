@@ -19,7 +19,6 @@
 namespace hoist::svc {
 
 namespace {
-constexpr auto kDrainPeriod = std::chrono::milliseconds(20);
 
 std::int64_t threadCpuNs() {
   timespec ts{};
@@ -81,7 +80,8 @@ struct TripRoom::Worker {
   std::unique_ptr<history::Store> store;
   std::uint32_t seen = 0;        // alarm kinds already added to the trip under way
   TripTick tick;                 // the tick being taken
-  std::int64_t cpu_trip0 = 0;    // thread CPU at the trip's first tick
+  std::int64_t cpu_trip0 = 0;    // the room's CPU (roomCpu) at the trip's first tick
+  std::int64_t drain_c0 = 0;     // the worker thread's CPU when this drain began
   bool moving = false;
   std::int64_t detect_trip = 0;     // the last recorded trip (ConditionState)
   double loss30_separation = -1.0;
@@ -143,6 +143,17 @@ std::string TripRoom::describeStore() const {
 
 void TripRoom::workerMain() {
   hoist::rt::yieldToRealtimeLoop(kNice);
+  workerOpen();
+  for (;;) {
+    const bool quitting = quit_.load(std::memory_order_acquire);
+    workerDrain();
+    if (quitting) break;
+    std::this_thread::sleep_for(TripPool::kDrainPeriod);
+  }
+  workerClose();
+}
+
+void TripRoom::workerOpen() {
   auto log = logger();
   const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
   try {
@@ -173,21 +184,29 @@ void TripRoom::workerMain() {
     }
   }
   publishCondition();
-  for (;;) {
-    const bool quitting = quit_.load(std::memory_order_acquire);
-    const std::int64_t c0 = threadCpuNs();
-    while (ring_.pop(w_->tick)) take(w_->tick);
-    counts_.cpu_ns.fetch_add(threadCpuNs() - c0, std::memory_order_relaxed);
-    if (quitting) break;
-    std::this_thread::sleep_for(kDrainPeriod);
+}
+
+void TripRoom::workerDrain() {
+  Worker& w = *w_;
+  w.drain_c0 = threadCpuNs();
+  while (ring_.pop(w.tick)) take(w.tick);
+  counts_.cpu_ns.fetch_add(threadCpuNs() - w.drain_c0, std::memory_order_relaxed);
+}
+
+void TripRoom::workerClose() {
+  if (!w_->store) return;
+  try {
+    w_->store->flush();
+  } catch (const std::exception& e) {
+    logger()->warn("{}trip history: flush at stop: {}", shaft_.empty() ? std::string() : "[" + shaft_ + "] ",
+                   e.what());
   }
-  if (w_->store) {
-    try {
-      w_->store->flush();
-    } catch (const std::exception& e) {
-      log->warn("{}trip history: flush at stop: {}", tag, e.what());
-    }
-  }
+}
+
+std::int64_t TripRoom::roomCpu() const {
+  // This room's worker CPU so far, the drain under way included (a pool
+  // thread also serves other rooms: its own clock is not this room's).
+  return counts_.cpu_ns.load(std::memory_order_relaxed) + (threadCpuNs() - w_->drain_c0);
 }
 
 void TripRoom::publishCondition() {
@@ -230,7 +249,7 @@ void TripRoom::take(const TripTick& t) {
   if (!std::isfinite(t.m.t) || !std::isfinite(t.m.k.l) || !std::isfinite(t.m.k.v) || !std::isfinite(t.m.k.a) ||
       !std::isfinite(t.e.y_c) || !std::isfinite(t.e.theta))
     return;
-  if (!w.moving) w.cpu_trip0 = threadCpuNs();
+  if (!w.moving) w.cpu_trip0 = roomCpu();
   bool arrived = false;
   try {
     arrived = w.rec.add(t.m, t.e, t.guide_deflection);
@@ -272,7 +291,7 @@ void TripRoom::finishTrip() {
   r.wall_start_us = wallAt(r.t_start);
   r.wall_end_us = wallAt(r.t_end);
   counts_.trips.fetch_add(1, std::memory_order_relaxed);
-  const std::int64_t cpu = threadCpuNs() - w.cpu_trip0;
+  const std::int64_t cpu = roomCpu() - w.cpu_trip0;
   counts_.cpu_ns_last.store(cpu, std::memory_order_relaxed);
   auto log = logger();
   const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";

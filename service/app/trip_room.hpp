@@ -8,11 +8,11 @@
 // the tick (counted: the trip's record then misses samples) -- the loop
 // never waits.
 //
-// One worker thread per shaft (started by start(), SCHED_OTHER nice 10 as
-// the forecast workers, hoist::rt::yieldToRealtimeLoop) opens the history
-// database (hoist::history::Store) off the loop (pruning trips older than
-// [history] keep_days then and after each trip), drains the ring every
-// kDrainPeriod, runs the trip pipeline (hoist::TripRecorder: TripDetector,
+// A worker -- one of the daemon's TripPool (trip_pool.hpp: a few threads
+// for every shaft), or the room's own thread (start(): a room on its own) --
+// opens the history database (hoist::history::Store) off the loop (pruning
+// trips older than [history] keep_days then and after each trip), drains the
+// ring every kDrainPeriod, runs the trip pipeline (hoist::TripRecorder: TripDetector,
 // TripAccumulator, identifyPreload) and, at each trip's end, fills in the
 // shaft's name, the wall-clock times and the alarms raised during the trip
 // and puts the record into the store.  A store that cannot be opened or a
@@ -30,9 +30,10 @@
 // cannot be read is logged as an error (the alarm cannot be judged) and the
 // judge goes on from the trips this run records.
 //
-// Lifetimes: owned by ShaftTwin; stop() (or the destructor) joins the
-// worker after it has drained the ring (a trip under way at stop is not
-// recorded: it did not end).  counters() may be read from any thread.
+// Lifetimes: owned by ShaftTwin; stop() (or the destructor) joins its own
+// worker after it has drained the ring (a pooled room: TripPool::stop()); a
+// trip under way at stop is not recorded (it did not end).  counters() may
+// be read from any thread.
 #pragma once
 
 #include <array>
@@ -48,6 +49,7 @@
 #include "hoist/service/config.hpp"
 #include "hoist/service/history_config.hpp"
 #include "hoist/service/twin_core.hpp"
+#include "trip_pool.hpp"
 
 namespace hoist::svc {
 
@@ -110,12 +112,12 @@ struct TripCounters {
   std::atomic<bool> judged{false};           ///< the condition has been judged once (after the seeding)
 };
 
-class TripRoom {
+class TripRoom : public TripWork {
  public:
   /// Ring of `capacity` ticks (default: 30 s at the step rate, at least 1024).
   /// Throws std::invalid_argument for bad [condition] settings.
   TripRoom(const TwinConfig& cfg, const TripHistoryConfig& hist, std::string shaft_name, std::size_t capacity = 0);
-  ~TripRoom();
+  ~TripRoom() override;
   TripRoom(const TripRoom&) = delete;
   TripRoom& operator=(const TripRoom&) = delete;
 
@@ -125,10 +127,17 @@ class TripRoom {
   /// Loop thread: the newest condition since the last call, or nullptr.
   /// Valid until the next call.  Allocation-free; never blocks.
   const ConditionState* takeCondition() { return condition_.take(); }
-  /// Start the worker (opens the database on it).
+  /// A room on its own: start its own worker thread (opens the database on
+  /// it).  Not for a room a TripPool serves.
   void start();
-  /// Drain the ring, join the worker.  Idempotent.
+  /// Its own worker: drain the ring, join.  Idempotent; nothing for a pooled room.
   void stop();
+
+  // The worker's side (TripWork; its own thread or its TripPool worker, one
+  // thread for the room's life, never the loop).
+  void workerOpen() override;
+  void workerDrain() override;
+  void workerClose() override;
 
   const TripCounters& counters() const { return counts_; }
   /// The store's description ("sqlite /path"), known once open ("" before).
@@ -140,6 +149,7 @@ class TripRoom {
   void finishTrip();             // worker: the record to the store
   void pruneOld(std::int64_t now_us);  // worker: [history] keep_days (at open and after each trip)
   void publishCondition();             // worker: the judge's verdicts to the loop
+  std::int64_t roomCpu() const;        // worker, inside workerDrain: this room's CPU so far [ns]
 
   TwinConfig cfg_;
   TripHistoryConfig hist_;
