@@ -151,18 +151,10 @@ Server::Admission Server::admit(const std::string& peer) {
     return Admission::Refused;
   };
   Peer& p = peers_[peer];
-  const double burst = 2.0 * limits_.max_attempts_per_s;
-  if (p.refilled.time_since_epoch().count() == 0) {
-    p.tokens = burst;
-  } else {
-    p.tokens = std::min(burst, p.tokens + limits_.max_attempts_per_s *
-                                             std::chrono::duration<double>(now - p.refilled).count());
-  }
-  p.refilled = now;
-  if (p.tokens < 1.0)
+  if (!p.attempts) p.attempts.emplace(limits_.max_attempts_per_s, 2.0 * limits_.max_attempts_per_s);
+  if (!p.attempts->take(std::chrono::duration<double>(now.time_since_epoch()).count()))
     return refuse("http_rejected_peer_rate",
                   fmt::format("more than {} new connections a second from that peer", limits_.max_attempts_per_s));
-  p.tokens -= 1.0;
   if (p.conns >= limits_.max_per_peer) {
     // At its cap: its own oldest idle HTTP connection makes room, else refused.
     if (!evictOldest(peer, false, false))

@@ -26,11 +26,13 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "hoist/rt/token_bucket.hpp"
 #include "hub.hpp"
 #include "static_files.hpp"
 
@@ -137,8 +139,7 @@ class Server {
   std::string overShare(const std::string& newcomer, std::size_t cap, bool ws_only) const;
   struct Peer {
     std::size_t conns = 0;
-    double tokens = 0.0;
-    std::chrono::steady_clock::time_point refilled{};
+    std::optional<rt::TokenBucket> attempts;  // new connections a second (--max-peer-rate), from the first
   };
   std::map<std::string, Peer> peers_;  // unauthenticated connections by peer
   std::size_t authed_ = 0, probation_ = 0;

@@ -4,7 +4,8 @@
 // Pure: no I/O, no clock of its own (the caller passes the time, in seconds
 // of any monotonic clock), no allocation; not thread-safe (one owner).  A
 // bucket starts full at its first take().  Used by hoist-mqtt's command gate
-// (per identity and per shaft) and its command results.
+// (per identity and per shaft) and its command results, and by hoist-dash's
+// per-client command rate and per-peer connection rate.
 #pragma once
 
 #include <algorithm>
