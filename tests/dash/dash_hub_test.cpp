@@ -98,8 +98,17 @@ TEST_F(HubTest, ServerInfoThenAdvertiseOfEveryHoistChannelWithJsonSchema) {
   }
   for (const char* t : {"north/HOIST_WINDER", "north/HOIST_CAGE", "north/HOIST_GUIDE_SHAPE", "north/HOIST_ALARM",
                         "north/HOIST_ALARM_ACK", "north/HOIST_HEALTH", "north/HOIST_CAGE/decimated",
-                        "north/HOIST_ESTIMATE", "north/HOIST_ESTIMATE/decimated"})
+                        "north/HOIST_ESTIMATE", "north/HOIST_ESTIMATE/decimated", "north/HOIST_FORECAST",
+                        "north/HOIST_TRIP_PLAN"})
     EXPECT_NE(std::find(topics.begin(), topics.end(), t), topics.end()) << t;
+  // The sensors' raw inputs are not relayed (the estimate made from them is).
+  for (const char* t : {"north/HOIST_CAGE_IMU", "north/HOIST_ROPE_LOAD"})
+    EXPECT_EQ(std::find(topics.begin(), topics.end(), t), topics.end()) << t;
+  // The suffixes come from msgs/*.lcm's @channel (hoist/msg/names.hpp).
+  EXPECT_EQ(channelSuffixOfType("hoist.trip_plan_t"), "HOIST_TRIP_PLAN");
+  EXPECT_EQ(channelSuffixOfType("hoist.cage_imu_t"), "");
+  EXPECT_EQ(hoistSuffixOf("north/HOIST_ALARM_ACK"), "HOIST_ALARM_ACK");  // the longest match
+  EXPECT_EQ(hoistSuffixOf("north/HOIST_ROPE_LOAD"), "");
 }
 
 TEST_F(HubTest, SubscribeDeliversMessageDataWithTheClientsIdAndUnsubscribeStops) {

@@ -48,7 +48,7 @@ Band run(const CleanTruth& tr, const std::vector<MeasurementSample>& m, const Es
 
 }  // namespace
 
-// The shipped default (INTERFACES.md: 0.005 m/s^2, about 0.5 mg): the runs
+// The shipped default ([sensors] imu_accel_offset_sigma = 0.005 m/s^2, about 0.5 mg): the runs
 // below take EstimatorSettings{} as hoist-twind and hoist-estimate do.
 const double kOffsetPrior = EstimatorSettings{}.accel_offset_sigma;
 

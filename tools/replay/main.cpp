@@ -8,7 +8,7 @@
 // Sources:
 //   * a synthetic profile SPEC (hoist_io): `paper` (the default: the paper's
 //     Fig. 2 trapezoid, 50 m -> 300 m in 60 s), `trapezoid:...`, `scurve:...`,
-//     `estop:...`; or a profile CSV (t, v, a [, l]; INTERFACES.md).  Sampled
+//     `estop:...`; or a profile CSV (t, v, a [, l]; docs/offline.md).  Sampled
 //     at --rate (default 100 Hz) at t_k = t0 + k / rate, k = 0 .. round((t_end -
 //     t0) * rate), exactly the times hoist-sim --dt 1/rate steps to;
 //   * an LCM log (lcm-logger): every event whose channel ends in HOIST_WINDER

@@ -4,7 +4,7 @@
 // docs/estimation.md derives everything stated here and shows the figures.
 //
 // Sensor model (the model's frame: x down, theta > 0 turns the cage's downward
-// axis toward +y; ../shared/spec/INTERFACES.md):
+// axis toward +y; docs/model.md, "Frame and signs"):
 //   f_y       = y_c'' + (g - a) theta     specific force along the cage's lateral
 //                                        axis at its centre [m/s^2]
 //   omega     = theta'                    tilt rate [rad/s]

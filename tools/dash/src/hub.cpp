@@ -14,26 +14,27 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/channels.hpp"
 #include "hoist/msg/codec.hpp"
+#include "hoist/msg/names.hpp"
 
 namespace hoist::dash {
 
 namespace {
 
-// Suffix of the LCM channel of each hoist type (INTERFACES.md).
+// The hoist types hoist-dash relays, and their channel suffixes from the
+// `// @channel` of msgs/*.lcm (hoist/msg/names.hpp, generated: no name is
+// spelled here).  The sensors' raw inputs (cage_imu_t, rope_load_t) are not
+// relayed: the page shows the load estimate made from them.
 const std::vector<std::pair<std::string, std::string>>& typeSuffixes() {
-  using namespace hoist::bus;
-  static const std::vector<std::pair<std::string, std::string>> v{
-      {"hoist.winder_t", std::string(kChannelWinder)},
-      {"hoist.cage_state_t", std::string(kChannelCage)},
-      {"hoist.guide_shape_t", std::string(kChannelGuideShape)},
-      {"hoist.alarm_t", std::string(kChannelAlarm)},
-      {"hoist.alarm_ack_t", std::string(kChannelAlarmAck)},
-      {"hoist.health_t", std::string(kChannelHealth)},
-      // INTERFACES.md "Additions": the forecast's channels, once their types exist.
-      {"hoist.forecast_t", "HOIST_FORECAST"},
-      {"hoist.trip_plan_t", "HOIST_TRIP_PLAN"},
-      // The load estimator's output ([estimator] enabled), at the cage rate.
-      {"hoist.estimate_t", std::string(kChannelEstimate)}};
+  static const std::vector<std::pair<std::string, std::string>> v = [] {
+    constexpr std::string_view kRelayed[] = {"hoist.winder_t", "hoist.cage_state_t", "hoist.guide_shape_t",
+                                             "hoist.alarm_t",  "hoist.alarm_ack_t",  "hoist.health_t",
+                                             "hoist.forecast_t", "hoist.trip_plan_t", "hoist.estimate_t"};
+    std::vector<std::pair<std::string, std::string>> out;
+    for (const msg::ChannelInfo& c : msg::kChannels)
+      if (std::find(std::begin(kRelayed), std::end(kRelayed), c.type) != std::end(kRelayed))
+        out.emplace_back(std::string(c.type), std::string(c.channel));
+    return out;
+  }();
   return v;
 }
 

@@ -1,7 +1,9 @@
-// hoist/bus/channels.hpp -- the LCM channel names of INTERFACES.md (contract:
-// the names are exact).  Every program that publishes or subscribes uses these
-// instead of spelling the strings; a configured prefix ([service]
-// channel_prefix, --channel-prefix) is prepended to every name.
+// hoist/bus/channels.hpp -- the LCM channel names (contract: the names are
+// exact; the same as the `// @channel` of msgs/*.lcm, which the generated
+// hoist/msg/names.hpp carries: CodecGenerated.ChannelsMatchBusChannels).
+// Every program that publishes or subscribes uses these instead of spelling
+// the strings; a configured prefix ([service] channel_prefix,
+// --channel-prefix) is prepended to every name.
 // Part of the hoist_lcm target (msgs/CMakeLists.txt).
 #pragma once
 
