@@ -59,15 +59,21 @@ bool wellFormed(const std::string& c) {
          c[c.size() - 2] == 'd';
 }
 
-}  // namespace
-
-TEST(TripPool, FewThreadsServeManyRoomsEachFromOneThreadOpenFirstCloseLast) {
+/// `n` rooms, each added to `pool`.
+std::vector<std::unique_ptr<FakeRoom>> addRooms(TripPool& pool, int n) {
   std::vector<std::unique_ptr<FakeRoom>> rooms;
-  TripPool pool(3);
-  for (int i = 0; i < 50; ++i) {
+  for (int i = 0; i < n; ++i) {
     rooms.push_back(std::make_unique<FakeRoom>());
     pool.add(rooms.back().get());
   }
+  return rooms;
+}
+
+}  // namespace
+
+TEST(TripPool, FewThreadsServeManyRoomsEachFromOneThreadOpenFirstCloseLast) {
+  TripPool pool(3);
+  const auto rooms = addRooms(pool, 50);
   EXPECT_EQ(pool.workers(), 0);
   pool.start();
   EXPECT_EQ(pool.workers(), 3);
@@ -101,12 +107,8 @@ TEST(TripPool, FewThreadsServeManyRoomsEachFromOneThreadOpenFirstCloseLast) {
 }
 
 TEST(TripPool, AStopBeforeEveryRoomWasOpenedStillOpensDrainsAndClosesEachOnce) {
-  std::vector<std::unique_ptr<FakeRoom>> rooms;
   TripPool pool(1);
-  for (int i = 0; i < 200; ++i) {
-    rooms.push_back(std::make_unique<FakeRoom>());
-    pool.add(rooms.back().get());
-  }
+  const auto rooms = addRooms(pool, 200);
   pool.start();
   pool.stop();  // at once: most rooms not yet opened by the passes
   for (auto& r : rooms) EXPECT_TRUE(wellFormed(r->calls())) << r->calls();
