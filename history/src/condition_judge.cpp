@@ -1,9 +1,9 @@
 // The shaft's condition alarms over its trip records: see condition_judge.hpp.
 #include "hoist/history/condition_judge.hpp"
 
-#include "hoist/history/judged_history.hpp"
-
 #include <algorithm>
+
+#include "hoist/history/judged_history.hpp"
 
 namespace hoist::history {
 

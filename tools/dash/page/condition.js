@@ -76,7 +76,7 @@ function render(j) {
   setAttr(root, "data-last-trip", last ? String(last.trip) : "");
   const rej = j.rejected > 0 ? `; ${j.rejected} record(s) rejected (${(j.rejected_notes || [])[0] || ""})` : "";
   // A long history is judged from its newest [condition] seed_trips trips (and the baseline before them).
-  const shown = j.windowed ? `the newest ${j.trips} of ${j.stored_last_trip} trips` : `${j.trips} trip(s)`;
+  const shown = j.windowed ? `the newest ${j.trips} trips (up to trip ${j.stored_last_trip})` : `${j.trips} trip(s)`;
   setText($("#cond-status"), `${shown} of shaft ${j.shaft ? `'${j.shaft}'` : "(default)"} in ${j.db}${rej}`);
   $("#cond-status").className = j.rejected > 0 ? "cond-status warn" : "cond-status";
   renderAlarms(j, last);
