@@ -1,7 +1,9 @@
 // hoist-twind's own udpm receive path (msgs/udpm/include/hoist/bus/udpm_receiver.hpp),
 // for many shafts per process: the receive buffer it asks for is granted, and the kernel's drop count
 // (SO_RXQ_OVFL) accounts for every datagram that did not fit.  Real UDP
-// multicast on loopback, port 8143.  And its own publisher (hoist/bus/udpm_sender.hpp).
+// multicast on loopback, a port per test (8143-8145: CTest runs them side by
+// side, and the drop count would count another test's datagrams).  And its
+// own publisher (hoist/bus/udpm_sender.hpp).
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -14,7 +16,9 @@ using namespace hoist::bus;
 
 namespace {
 
-const char* kUrl = "udpm://239.255.76.67:8143?ttl=0";
+const char* kUrl = "udpm://239.255.76.67:8143?ttl=0";        // DefaultReceiveBufferIsGranted
+const char* kUrlDrops = "udpm://239.255.76.67:8144?ttl=0";   // KernelDropsAccountForEveryDatagramThatDidNotFit
+const char* kUrlSender = "udpm://239.255.76.67:8145?ttl=0";  // LcmReceivesWhatItSendsAndQueues
 
 long rmemMax() {
   std::ifstream f("/proc/sys/net/core/rmem_max");
@@ -58,7 +62,7 @@ TEST(UdpmReceiver, KernelDropsAccountForEveryDatagramThatDidNotFit) {
   UdpmUrl url;
   std::string why;
   // A tiny buffer (the kernel's minimum): a burst overflows it.
-  ASSERT_TRUE(parseUdpmUrl(std::string(kUrl) + "&recv_buf_size=4096", url, why)) << why;
+  ASSERT_TRUE(parseUdpmUrl(std::string(kUrlDrops) + "&recv_buf_size=4096", url, why)) << why;
   UdpmReceiver rx;
   ASSERT_TRUE(rx.open(url, why)) << why;
   int got = 0;
@@ -66,7 +70,7 @@ TEST(UdpmReceiver, KernelDropsAccountForEveryDatagramThatDidNotFit) {
     EXPECT_EQ(rb->data_size, 200u);
     ++got;
   });
-  lcm::LCM tx(kUrl);
+  lcm::LCM tx(kUrlDrops);
   ASSERT_TRUE(tx.good());
   std::vector<std::uint8_t> payload(200, 0x5a);
   constexpr int kSent = 300;
@@ -96,11 +100,11 @@ TEST(UdpmSender, LcmReceivesWhatItSendsAndQueues) {
   if (!multicastWorks()) GTEST_FAIL() << "UDP multicast on loopback is off";
   UdpmUrl url;
   std::string why;
-  ASSERT_TRUE(parseUdpmUrl(kUrl, url, why)) << why;
+  ASSERT_TRUE(parseUdpmUrl(kUrlSender, url, why)) << why;
   EXPECT_EQ(url.ttl, 0);
   UdpmSender tx;
   ASSERT_TRUE(tx.open(url, why)) << why;
-  lcm::LCM rx(std::string(kUrl) + "&recv_buf_size=4000000");
+  lcm::LCM rx(std::string(kUrlSender) + "&recv_buf_size=4000000");
   ASSERT_TRUE(rx.good());
   std::vector<int> seen;
   struct Sub {
