@@ -1247,6 +1247,33 @@ TEST_F(MqttBridge, PerUserCommandTopicsWithTheExampleAcl) {
   EXPECT_TRUE(bridge.running());
   bridge.signal(SIGTERM);
   EXPECT_EQ(bridge.wait(5s), 0) << readFile(log("bridge.log"));
+
+  // Sparkplug DCMDs carry no host identity: the example ACL is what tells
+  // hosts apart.  Only the primary host's user ("scada") may write DCMD, so
+  // mallory's never reach a Sparkplug bridge behind it (and cannot take the
+  // primary host's command budget); the primary host's own junk DCMD does
+  // (counted bad_payload).
+  std::ofstream(path("sp.toml")) << "[broker]\nurl = \"mqtt://127.0.0.1:" << port << "\"\nusername = \"hoist-bridge\"\n"
+                                 << "password_file = \"" << path("bridge.pw") << "\"\n"
+                                 << "[bridge]\nchannel_prefixes = [\"north/\"]\nhealth_period = 0.3\n"
+                                 << "[sparkplug]\nenabled = true\ngroup_id = \"Mine\"\nedge_node_id = \"Edge1\"\n";
+  Process sp({HOIST_MQTT, "--config", path("sp.toml"), "--lcm-url", url, "--client-id", "bridge-sp"},
+             log("bridge-sp.log"));
+  ASSERT_TRUE(scada.waitJson("hoist/_bridge/bridge-sp/health", [](const json& j, bool) {
+    return j["connection"]["state"] == "connected"; }, 10s)) << readFile(log("bridge-sp.log"));
+  const std::string junk("\xff\xff\xff\xff\xff", 5);
+  for (int i = 0; i < 5; ++i) mallory.publish("spBv1.0/Mine/DCMD/Edge1/north", junk);
+  std::this_thread::sleep_for(300ms);
+  scada.publish("spBv1.0/Mine/DCMD/Edge1/north", junk);
+  auto badPayload = [](const json& j) { return j["commands"]["rejected_by_reason"].value("bad_payload", 0); };
+  ASSERT_TRUE(scada.waitJson("hoist/_bridge/bridge-sp/health", [&](const json& j, bool) { return badPayload(j) >= 1; },
+                             10s)) << readFile(log("bridge-sp.log"));
+  std::this_thread::sleep_for(500ms);
+  auto last = scada.waitJson("hoist/_bridge/bridge-sp/health", [](const json&, bool) { return true; }, 5s);
+  ASSERT_TRUE(last);
+  EXPECT_EQ(badPayload(*last), 1) << "a DCMD of a user who is not the primary host reached the bridge";
+  sp.signal(SIGTERM);
+  EXPECT_EQ(sp.wait(5s), 0) << readFile(log("bridge-sp.log"));
   broker.signal(SIGTERM);
   broker.wait(5s);
 }
