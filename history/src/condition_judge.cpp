@@ -17,15 +17,9 @@ ConditionJudge::ConditionJudge(const ConditionSettings& cond) : cond_(cond), tre
 
 std::int64_t ConditionJudge::seed(Store& db, const std::string& shaft) {
   JudgedHistory h = readJudgedHistory(db, shaft, cond_);
-  const auto marked = [&](std::int64_t trip) { return std::binary_search(h.marks.begin(), h.marks.end(), trip); };
   // The baseline before the window feeds the fingerprint only (the trend
   // forgets it: judged_history.hpp).
-  for (const auto& r : h.baseline) {
-    if (marked(r.trip)) finger_.markBaseline(r);
-    else finger_.add(r);
-  }
-  for (const auto& r : h.trips)
-    if (marked(r.trip)) finger_.markBaseline(r);
+  primeFingerprint(h.baseline, h.trips, h.marks, finger_);
   for (const auto& r : h.trips) add(r);
   stored_last_ = h.last_trip;
   windowed_ = h.windowed;

@@ -54,4 +54,15 @@ JudgedHistory readJudgedHistory(Store& db, const std::string& shaft, const Condi
   return h;
 }
 
+void primeFingerprint(const std::vector<TripRecord>& baseline, const std::vector<TripRecord>& window,
+                      const std::vector<std::int64_t>& marks, ShaftFingerprint& finger) {
+  const auto marked = [&](std::int64_t trip) { return std::binary_search(marks.begin(), marks.end(), trip); };
+  for (const auto& r : baseline) {
+    if (marked(r.trip)) finger.markBaseline(r);
+    else finger.add(r);
+  }
+  for (const auto& r : window)
+    if (marked(r.trip)) finger.markBaseline(r);
+}
+
 }  // namespace hoist::history

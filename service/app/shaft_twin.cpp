@@ -64,9 +64,7 @@ void ShaftTwin::enableTrips(const TripHistoryConfig& hist) {
 }
 
 void ShaftTwin::setTripPool(TripPool* pool) {
-  if (!trips_ || !pool) return;
-  pool->add(trips_.get());
-  trips_pooled_ = true;
+  if (trips_ && pool) pool->add(trips_.get());
 }
 
 void ShaftTwin::applyCondition() {
@@ -80,7 +78,6 @@ void ShaftTwin::applyCondition() {
 
 void ShaftTwin::stopTrips() {
   if (!trips_) return;
-  trips_->stop();
   const TripCounters& c = trips_->counters();
   const std::int64_t trips = c.trips.load();
   ctx_.log.info("{}trip history: {} trips recorded, {} stored, {} queued, {} failed, {} ticks dropped (ring full), "
@@ -116,7 +113,6 @@ void ShaftTwin::stopOffsetKeeper() {
 void ShaftTwin::start(Clock::time_point start, double health_phase) {
   ctx_.start = start;
   if (offsets_) offsets_->start();
-  if (trips_ && !trips_pooled_) trips_->start();
   publishHealth();  // announce ourselves at once
   // Shafts of one daemon spread their later health messages over the period.
   health_.start(health_phase);

@@ -126,10 +126,9 @@ class ShaftTwin {
   /// Throws std::invalid_argument for bad [condition] settings.
   void enableTrips(const TripHistoryConfig& hist);
   /// [history] enabled: the daemon's TripPool serves this shaft's trip room
-  /// (before start(); start() then starts no thread of its own for it).
+  /// (before the pool starts).
   void setTripPool(TripPool* pool);
-  /// Drain and join the trip room's own worker (a pooled room: after
-  /// TripPool::stop()); one log line of its figures.
+  /// After TripPool::stop(): one log line of the trip room's figures.
   void stopTrips();
   /// Loop: the trip room's newest condition verdict into the alarms
   /// (GUIDE_PRELOAD_LOW, SHAFT_FINGERPRINT); nothing when none is new.
@@ -152,7 +151,6 @@ class ShaftTwin {
   ShaftInputs inputs_;                           ///< every input channel
   ShaftHealth health_;                           ///< statistics into HOIST_HEALTH, the report's figures
   std::unique_ptr<TripRoom> trips_;              ///< the shaft's memory (nullptr: [history] off)
-  bool trips_pooled_ = false;                    ///< served by the daemon's TripPool (setTripPool)
   static constexpr int kLogCatchup = 0;          ///< log limiter key: limited catch-up
   LogRateLimiter<1> log_limit_{5};               ///< rate limit of the tick's warning lines
   bool fault_injected_ = false;                  ///< TestHooks::inject_fault_at has fired

@@ -13,7 +13,6 @@
 #include "hoist/history/condition_judge.hpp"
 #include "hoist/history/schema.hpp"
 #include "hoist/history/store.hpp"
-#include "hoist/rt/realtime.hpp"
 #include "hoist/trip_recorder.hpp"
 
 namespace hoist::svc {
@@ -96,7 +95,7 @@ TripRoom::TripRoom(const TwinConfig& cfg, const TripHistoryConfig& hist, std::st
                      : std::max<std::size_t>(1024, static_cast<std::size_t>(30.0 * cfg.service.rate))),
       w_(std::make_unique<Worker>(cfg, conditionFor(cfg, hist))) {}
 
-TripRoom::~TripRoom() { stop(); }
+TripRoom::~TripRoom() = default;
 
 void TripRoom::afterStep(const TwinCore& core, std::int64_t wall_us) {
   TripTick& t = scratch_;
@@ -125,32 +124,8 @@ void TripRoom::afterStep(const TwinCore& core, std::int64_t wall_us) {
   else counts_.dropped.fetch_add(1, std::memory_order_relaxed);
 }
 
-void TripRoom::start() {
-  if (worker_.joinable()) return;
-  quit_.store(false);
-  worker_ = std::thread([this] { workerMain(); });
-}
-
-void TripRoom::stop() {
-  if (!worker_.joinable()) return;
-  quit_.store(true, std::memory_order_release);
-  worker_.join();
-}
-
 std::string TripRoom::describeStore() const {
   return counts_.store_open.load(std::memory_order_acquire) ? store_desc_ : std::string();
-}
-
-void TripRoom::workerMain() {
-  hoist::rt::yieldToRealtimeLoop(kNice);
-  workerOpen();
-  for (;;) {
-    const bool quitting = quit_.load(std::memory_order_acquire);
-    workerDrain();
-    if (quitting) break;
-    std::this_thread::sleep_for(TripPool::kDrainPeriod);
-  }
-  workerClose();
 }
 
 void TripRoom::workerOpen() {

@@ -8,9 +8,8 @@
 // the tick (counted: the trip's record then misses samples) -- the loop
 // never waits.
 //
-// A worker -- one of the daemon's TripPool (trip_pool.hpp: a few threads
-// for every shaft), or the room's own thread (start(): a room on its own) --
-// opens the history database (hoist::history::Store) off the loop (pruning
+// A worker of the daemon's TripPool (trip_pool.hpp: a few threads for
+// every shaft) opens the history database (hoist::history::Store) off the loop (pruning
 // trips older than [history] keep_days then and after each trip), drains the
 // ring every kDrainPeriod, runs the trip pipeline (hoist::TripRecorder: TripDetector,
 // TripAccumulator, identifyPreload) and, at each trip's end, fills in the
@@ -30,9 +29,9 @@
 // cannot be read is logged as an error (the alarm cannot be judged) and the
 // judge goes on from the trips this run records.
 //
-// Lifetimes: owned by ShaftTwin; stop() (or the destructor) joins its own
-// worker after it has drained the ring (a pooled room: TripPool::stop()); a
-// trip under way at stop is not recorded (it did not end).  counters() may
+// Lifetimes: owned by ShaftTwin; outlives the pool's TripPool::stop(), which
+// drains the ring a last time and closes the store (a trip under way at stop
+// is not recorded: it did not end).  counters() may
 // be read from any thread.
 #pragma once
 
@@ -41,7 +40,6 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "hoist/load_estimator.hpp"
@@ -127,14 +125,8 @@ class TripRoom : public TripWork {
   /// Loop thread: the newest condition since the last call, or nullptr.
   /// Valid until the next call.  Allocation-free; never blocks.
   const ConditionState* takeCondition() { return condition_.take(); }
-  /// A room on its own: start its own worker thread (opens the database on
-  /// it).  Not for a room a TripPool serves.
-  void start();
-  /// Its own worker: drain the ring, join.  Idempotent; nothing for a pooled room.
-  void stop();
-
-  // The worker's side (TripWork; its own thread or its TripPool worker, one
-  // thread for the room's life, never the loop).
+  // The worker's side (TripWork: its TripPool worker, one thread for the
+  // room's life, never the loop).
   void workerOpen() override;
   void workerDrain() override;
   void workerClose() override;
@@ -144,7 +136,6 @@ class TripRoom : public TripWork {
   std::string describeStore() const;
 
  private:
-  void workerMain();
   void take(const TripTick& t);  // worker: one tick into the recorder
   void finishTrip();             // worker: the record to the store
   void pruneOld(std::int64_t now_us);  // worker: [history] keep_days (at open and after each trip)
@@ -157,13 +148,10 @@ class TripRoom : public TripWork {
   TripRing ring_;
   TripTick scratch_;  // the loop's staging copy (no stack copy of a large struct per step)
   TripCounters counts_;
-  std::thread worker_;
-  std::atomic<bool> quit_{false};
   struct Worker;                  // the worker's state (recorder, store): worker thread only
   std::unique_ptr<Worker> w_;
   rt::LatestMailbox<ConditionState> condition_{ConditionState{}};  // worker -> loop
   std::string store_desc_;        // written by the worker before store_open is set
-  static constexpr int kNice = 10;
 };
 
 }  // namespace hoist::svc

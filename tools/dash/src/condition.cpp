@@ -109,13 +109,7 @@ Json ConditionView::build(history::Store& store, const std::string& shaft, const
   // seeds them: ConditionJudge::seed).
   PreloadTrend trend(cond);
   ShaftFingerprint finger(cond);
-  const auto marked = [&](std::int64_t trip) { return std::binary_search(h.marks.begin(), h.marks.end(), trip); };
-  for (const auto& r : base) {
-    if (marked(r.trip)) finger.markBaseline(r);
-    else finger.add(r);
-  }
-  for (const auto& r : recs)
-    if (marked(r.trip)) finger.markBaseline(r);
+  history::primeFingerprint(base, recs, h.marks, finger);
   const std::size_t first = recs.size() > max_trips ? recs.size() - max_trips : 0;
   Json tr = Json::array();
   for (std::size_t i = 0; i < recs.size(); ++i) {

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "hoist/history/store.hpp"
+#include "hoist/shaft_fingerprint.hpp"
 #include "hoist/trip_pipeline.hpp"
 
 namespace hoist::history {
@@ -42,5 +43,12 @@ struct JudgedHistory {
 };
 
 JudgedHistory readJudgedHistory(Store& db, const std::string& shaft, const ConditionSettings& cond);
+
+/// The fingerprint's part before the window's trips are added in order: the
+/// baseline trips before the window (marked ones marked, the others added:
+/// they build the automatic baseline), then the window's marked trips.
+/// `baseline` and `window` are JudgedHistory's (or a validated subset).
+void primeFingerprint(const std::vector<TripRecord>& baseline, const std::vector<TripRecord>& window,
+                      const std::vector<std::int64_t>& marks, ShaftFingerprint& finger);
 
 }  // namespace hoist::history
