@@ -13,7 +13,7 @@ namespace hoist {
 
 namespace {
 // The estimate's loads into a record's fields (sigma -1 where not observed).
-void copyLoads(const LoadEstimate& e, double& Fa, double& sFa, double& M, double& sM, double& b, double& sb) {
+void copyLoads(const TripEstimate& e, double& Fa, double& sFa, double& M, double& sM, double& b, double& sb) {
   Fa = e.Fa;
   sFa = e.fa_observed ? e.sigma_Fa : -1.0;
   M = e.moment;
@@ -22,6 +22,26 @@ void copyLoads(const LoadEstimate& e, double& Fa, double& sFa, double& M, double
   sb = e.sigma_b;
 }
 }  // namespace
+
+TripEstimate tripEstimate(const LoadEstimate& e) {
+  TripEstimate t;
+  t.Fa = e.Fa;
+  t.sigma_Fa = e.sigma_Fa;
+  t.moment = e.moment;
+  t.sigma_moment = e.sigma_moment;
+  t.b = e.b;
+  t.sigma_b = e.sigma_b;
+  t.fa_observed = e.fa_observed;
+  t.moment_observed = e.moment_observed;
+  t.mismatch = e.mismatch;
+  t.nis_dof = e.nis_dof;
+  t.nis_window = e.nis_window;
+  t.drift = e.drift;
+  t.y_c = e.y_c;
+  t.theta = e.theta;
+  t.lambda = e.lambda;
+  return t;
+}
 
 double conditionBandHz(const ShaftParams& p, double band_hz) {
   if (band_hz > 0.0) return band_hz;
@@ -40,7 +60,7 @@ TripAccumulator::TripAccumulator(const ShaftParams& twin, const EstimatorSetting
   theta_.reserve(n);
 }
 
-void TripAccumulator::begin(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection) {
+void TripAccumulator::begin(const MeasurementSample& m, const TripEstimate& e, double guide_deflection) {
   samples_.clear();
   y_c_.clear();
   theta_.clear();
@@ -56,7 +76,7 @@ void TripAccumulator::begin(const MeasurementSample& m, const LoadEstimate& e, d
   take(m, e, guide_deflection);
 }
 
-void TripAccumulator::add(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection) {
+void TripAccumulator::add(const MeasurementSample& m, const TripEstimate& e, double guide_deflection) {
   if (active_) take(m, e, guide_deflection);
 }
 
@@ -65,7 +85,7 @@ void TripAccumulator::addAlarm(std::string_view kind) {
   if (std::find(rec_.alarms.begin(), rec_.alarms.end(), kind) == rec_.alarms.end()) rec_.alarms.emplace_back(kind);
 }
 
-void TripAccumulator::take(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection) {
+void TripAccumulator::take(const MeasurementSample& m, const TripEstimate& e, double guide_deflection) {
   samples_.push_back(m);
   y_c_.push_back(e.y_c);
   theta_.push_back(e.theta);

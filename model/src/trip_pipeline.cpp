@@ -49,7 +49,7 @@ void TripRecorder::reset() {
   acc_.abandon();
 }
 
-bool TripRecorder::add(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection) {
+bool TripRecorder::add(const MeasurementSample& m, const TripEstimate& e, double guide_deflection) {
   const TripEvent ev = det_.update(m.t, m.k);
   switch (ev) {
     case TripEvent::Departed:

@@ -101,12 +101,10 @@ void TripRoom::afterStep(const TwinCore& core, std::int64_t wall_us) {
   TripTick& t = scratch_;
   const CageOutput& o = core.output();
   if (const LoadEstimate* e = core.estimate()) {
-    t.e = *e;
+    t.e = tripEstimate(*e);
     t.m = core.lastMeasurement();
   } else {
-    t.e = LoadEstimate{};
-    t.e.t = o.t;
-    t.e.kin = o.kin;
+    t.e = TripEstimate{};
     t.e.y_c = o.y_c;
     t.e.theta = o.theta;
     t.e.lambda = o.lambda;

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "hoist/load_estimator.hpp"
+#include "hoist/trip_accumulator.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/history_config.hpp"
@@ -54,7 +55,7 @@ namespace hoist::svc {
 /// What the loop copies per step.
 struct TripTick {
   MeasurementSample m;             ///< t (model), kinematics, sensors applied, present bits
-  LoadEstimate e;                  ///< the estimate (default with the estimator off)
+  TripEstimate e;                  ///< the record's fields of the estimate (the twin's state with the estimator off)
   double guide_deflection = 0.0;   ///< the guide-rope envelope's deflection [m]
   std::int64_t wall_us = 0;        ///< wall clock of the step [us since the epoch]
   std::uint32_t alarms = 0;        ///< bit k: AlarmKind k active

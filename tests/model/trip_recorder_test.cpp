@@ -92,8 +92,8 @@ TEST(TripAccumulator, FiguresOfAHandMadeTrip) {
     e.nis_dof = 100;
     e.mismatch = i == 2500;
     if (i == 3000) e.Fa = 1400.0;
-    if (i == 0) acc.begin(m, e);
-    else acc.add(m, e);
+    if (i == 0) acc.begin(m, tripEstimate(e));
+    else acc.add(m, tripEstimate(e));
     if (i == 100) acc.addAlarm("CAGE_POS_Y");
     if (i == 200) acc.addAlarm("CAGE_POS_Y");
   }

@@ -3,8 +3,8 @@
 //
 // Fed, in time order, with what the twin knows at each tick: the winder's
 // kinematics and the measured sensors (MeasurementSample) and the load
-// estimate of that tick (LoadEstimate: the loads with sigmas, the state they
-// imply, the model check).  begin() takes the departure sample (at rest),
+// estimate of that tick (TripEstimate, the record's fields of a LoadEstimate:
+// the loads with sigmas, the state they imply, the model check).  begin() takes the departure sample (at rest),
 // add() every later one up to the arrival confirmed (the rest after it
 // included), finish() builds the record:
 //   * kinematics: direction, start and end depth, peak |v| and |a|;
@@ -33,6 +33,7 @@
 // finish() allocates and costs the identification (about 1 s CPU at n = 25).
 #pragma once
 
+#include <array>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,6 +47,21 @@ namespace hoist {
 /// The band split's corner [Hz] for `twin` (band_hz when > 0, else the highest guide-rope mode).
 double conditionBandHz(const ShaftParams& twin, double band_hz);
 
+/// What a trip record takes from one tick's LoadEstimate: the loads with
+/// their sigmas, the state they imply, the model check.  The one list of
+/// those fields -- a third of a LoadEstimate, so that the daemon's per-tick
+/// copy into its trip rooms (service/app/trip_room.hpp) carries no more.
+struct TripEstimate {
+  double Fa = 0.0, sigma_Fa = -1.0, moment = 0.0, sigma_moment = -1.0, b = 0.0, sigma_b = -1.0;
+  bool fa_observed = false, moment_observed = false, mismatch = false;
+  int nis_dof = 0;
+  double nis_window = 0.0, drift = 0.0;
+  double y_c = 0.0, theta = 0.0;
+  std::array<double, 5> lambda{};
+};
+/// The record's fields of `e`.
+TripEstimate tripEstimate(const LoadEstimate& e);
+
 class TripAccumulator {
  public:
   /// Throws std::invalid_argument for bad settings (cond.validate(), est.validate()).
@@ -53,9 +69,9 @@ class TripAccumulator {
                   double max_step, double reserve_seconds = 300.0);
 
   /// Start a trip at its departure sample (at rest).  Forgets the previous trip.
-  void begin(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection = 0.0);
+  void begin(const MeasurementSample& m, const TripEstimate& e, double guide_deflection = 0.0);
   /// The next sample of the trip (after begin()).
-  void add(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection = 0.0);
+  void add(const MeasurementSample& m, const TripEstimate& e, double guide_deflection = 0.0);
   /// An alarm kind raised during the trip (kept once).
   void addAlarm(std::string_view kind);
   /// Drop the trip under way (a motion that was not a trip, a new stream).
@@ -69,7 +85,7 @@ class TripAccumulator {
   TripRecord finish(double t_arrival, const Kinematics& arrival);
 
  private:
-  void take(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection);
+  void take(const MeasurementSample& m, const TripEstimate& e, double guide_deflection);
   ShaftParams twin_;
   EstimatorSettings est_;
   ConditionSettings cond_;
@@ -78,7 +94,7 @@ class TripAccumulator {
   std::vector<MeasurementSample> samples_;
   std::vector<double> y_c_, theta_;
   TripRecord rec_;  // the running part (loads, peaks, model check, clearance)
-  LoadEstimate last_;
+  TripEstimate last_;
 };
 
 }  // namespace hoist

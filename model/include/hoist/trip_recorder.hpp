@@ -25,7 +25,10 @@ class TripRecorder {
   /// Throws std::invalid_argument for bad settings.
   TripRecorder(const ShaftParams& twin, const EstimatorSettings& est, const ConditionSettings& cond,
                double max_step);
-  bool add(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection = 0.0);
+  bool add(const MeasurementSample& m, const TripEstimate& e, double guide_deflection = 0.0);
+  bool add(const MeasurementSample& m, const LoadEstimate& e, double guide_deflection = 0.0) {
+    return add(m, tripEstimate(e), guide_deflection);
+  }
   /// An alarm raised now: recorded in the trip under way (ignored at rest).
   void addAlarm(std::string_view kind) { acc_.addAlarm(kind); }
   TripRecord& record() { return rec_; }
@@ -41,7 +44,7 @@ class TripRecorder {
   TripAccumulator acc_;
   struct Pending {  // one tick since the last still sample, as add() got it
     MeasurementSample m;
-    LoadEstimate e;
+    TripEstimate e;
     double guide_deflection;
   };
   std::vector<Pending> pending_;  // since the last still sample
