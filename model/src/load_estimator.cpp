@@ -71,12 +71,9 @@ LoadEstimator::LoadEstimator(const ShaftParams& twin, const EstimatorSettings& s
     : twin_(twin), set_(settings) {
   set_.validate();
   twin_.validate();
-  ShaftParams unit = twin_;
-  unit.Fa = 1.0;
-  unit.b = 1.0;
-  auto unit_model = std::make_shared<const ShaftModel>(unit);
-  sens_ = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
-  step_ = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
+  Model m = buildModel(twin_);
+  sens_ = std::move(m.sens);
+  step_ = std::move(m.step);
   Fa_c_ = twin_.Fa;
   M_c_ = twin_.Fa * twin_.b;
   bounds_ = plausibilityBounds(twin_, 1.0);
@@ -85,6 +82,32 @@ LoadEstimator::LoadEstimator(const ShaftParams& twin, const EstimatorSettings& s
   ring_nis_.assign(cap, 0.0);
   ring_dof_.assign(cap, 0);
   Pc0_ = set_.accel_offset_sigma * set_.accel_offset_sigma;
+}
+
+LoadEstimator::Model LoadEstimator::buildModel(const ShaftParams& twin) {
+  twin.validate();
+  ShaftParams unit = twin;
+  unit.Fa = 1.0;
+  unit.b = 1.0;
+  auto unit_model = std::make_shared<const ShaftModel>(unit);
+  Model m;
+  m.twin = twin;
+  m.sens = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
+  m.step = std::make_unique<FastSolver>(unit_model, Forcing::LoadOnly);
+  return m;
+}
+
+void LoadEstimator::swapModel(Model& m) {
+  if (!m.sens || !m.step || m.twin.n != twin_.n)
+    throw std::invalid_argument("LoadEstimator::swapModel: a model of the same n with both solvers is needed");
+  // The prior stays the configured load (Fa_c_, M_c_ are kept).
+  std::swap(m.twin.Fa, twin_.Fa);
+  std::swap(m.twin.b, twin_.b);
+  std::swap(twin_, m.twin);
+  std::swap(sens_, m.sens);
+  std::swap(step_, m.step);
+  bounds_ = plausibilityBounds(twin_, 1.0);
+  stepping_ = false;  // a followed step's transient belonged to the old model
 }
 
 void LoadEstimator::initialize(double t0, const Kinematics& k0) {

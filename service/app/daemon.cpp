@@ -25,19 +25,6 @@ using std::chrono::duration_cast;
 using rt::nanos;
 using rt::processCpuNanos;
 
-namespace {
-/// The state file of a shaft's accelerometer offset: "accel_offset", or
-/// "accel_offset.<label>" with several shafts (the label's characters other
-/// than letters, digits, '-' and '_' as '_').
-std::string accelOffsetFileName(const std::string& label) {
-  std::string f = "accel_offset";
-  if (label.empty()) return f;
-  f += '.';
-  for (const char c : label)
-    f += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
-  return f;
-}
-}  // namespace
 
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
@@ -64,7 +51,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     shafts_.push_back(std::make_unique<ShaftTwin>(opt_.shafts[i], opt_.labels[i], lcm_, log_, hooks,
                                                   instance_id_, lcm_out_.get()));
     if (!opt_.state_dir.empty() && opt_.shafts[i].estimator.enabled)
-      shafts_.back()->keepAccelOffset(opt_.state_dir + "/" + accelOffsetFileName(opt_.labels[i]), out_);
+      shafts_.back()->keepAccelOffset(opt_.state_dir + "/" + stateFileName("accel_offset", opt_.labels[i]), out_);
     if (i < opt_.history.size() && opt_.history[i].enabled) shafts_.back()->enableTrips(opt_.history[i]);
     // Shaft i publishes its shapes at phase i of the shape divider.
     shafts_.back()->attachLoop(&split_, &misses_.log(), static_cast<int>(i));
@@ -89,6 +76,9 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     g->ids.push_back(static_cast<int>(i));
   }
   for (auto& g : groups_) g->shafts.shrink_to_fit();
+  std::vector<ShaftTwin*> all;
+  for (auto& sp : shafts_) all.push_back(sp.get());
+  keepers_ = std::make_unique<KeeperWorker>(all, opt_.state_dir, out_);  // operators' preload adoptions
   // The trip rooms: one pool of at most one worker per CPU for every shaft
   // with [history] enabled (trip_pool.hpp).
   std::size_t with_history = 0;
@@ -122,6 +112,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
 
 Daemon::~Daemon() {
   watchdog_.stop();
+  if (keepers_) keepers_->stop();
   if (pool_) pool_->stop();
   if (trip_pool_) trip_pool_->stop();
   // The descriptor belongs to LCM: never let Asio close it.
@@ -222,6 +213,7 @@ void Daemon::startForecasts() {
 }
 
 void Daemon::startTrips() {
+  keepers_->start();
   if (!trip_pool_) return;
   trip_pool_->start();
   out_->info("trip history: {} shaft(s) on one pool of {} worker thread(s) (SCHED_OTHER, nice {}: they give way "
@@ -453,6 +445,7 @@ void Daemon::stop(const char* why) {
   log_.info("stopping ({})", why);
   flushOutputs();
   if (trip_pool_) trip_pool_->stop();  // every room drained and closed before the shafts report them
+  keepers_->stop();
   for (auto& s : shafts_) {
     s->publishHealth(true);
     s->stopOffsetKeeper();

@@ -49,6 +49,7 @@
 #include "shaft_twin.hpp"
 #include "hoist/bus/subscriber.hpp"
 #include "hoist/bus/udpm_sender.hpp"
+#include "keeper_worker.hpp"
 #include "watchdog.hpp"
 
 namespace hoist::svc {
@@ -137,7 +138,7 @@ class Daemon {
   bool openInput();              ///< own udpm receive path (or LCM's); shafts subscribed
   void openOutput();             ///< own udpm publisher for udpm output URLs
   void startForecasts();         ///< the forecast pool's workers
-  void startTrips();             ///< the trip pool's workers ([history] enabled)
+  void startTrips();             ///< the preload keepers' worker; the trip pool's ([history] enabled)
   void unblockStopSignals();     ///< the stop signals, handled on the loop thread
   void startSchedules();         ///< the clock starts; shafts announce themselves; timers armed
   void logStarted();             ///< one start line per shaft
@@ -182,6 +183,9 @@ class Daemon {
   /// The trip rooms' workers ([history] enabled): a few threads for every
   /// shaft (trip_pool.hpp); after shafts_ for the same reason.
   std::unique_ptr<TripPool> trip_pool_;
+  /// The shafts' preload keepers' one worker (keeper_worker.hpp); after
+  /// shafts_ for the same reason.
+  std::unique_ptr<KeeperWorker> keepers_;
   Clock::time_point start_{};
   Clock::time_point stop_time_{};
   RealtimeOutcome rt_;

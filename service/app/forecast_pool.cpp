@@ -31,7 +31,9 @@ ForecastResult resultPrototype() { return ForecastResult{}; }
 ForecastJob::ForecastJob(std::shared_ptr<const ShaftModel> model, const TwinConfig& cfg)
     : fc_(cfg.forecast),
       max_length_(cfg.shaft.maxRopeLength()),
-      ws_(model, optionsFor(cfg)),
+      cfg_(cfg),
+      ws_(std::make_unique<ForecastWorkspace>(model, optionsFor(cfg))),
+      ws_scale_(model->params().Tb1 == cfg.shaft.Tb1 ? 1.0 : model->params().Tb1 / cfg.shaft.Tb1),
       in_(ForecastSnapshot(model->n())),
       out_(resultPrototype()) {}
 
@@ -48,6 +50,14 @@ void ForecastJob::compute(const ForecastSnapshot& s, ForecastResult& r) {
   r.plan_error = PlanError::None;
   r.failed = false;
   try {
+    if (s.preload_scale != ws_scale_) {
+      // An operator adopted another preload: forecast with the twin's model.
+      ShaftParams p = cfg_.shaft;
+      p.Tb1 *= s.preload_scale;
+      p.Tb2 *= s.preload_scale;
+      ws_ = std::make_unique<ForecastWorkspace>(std::make_shared<const ShaftModel>(p), optionsFor(cfg_));
+      ws_scale_ = s.preload_scale;
+    }
     const bool finite = std::isfinite(st.t) && std::isfinite(st.kin.l) && std::isfinite(st.kin.v) &&
                         std::isfinite(st.kin.a);
     if (!finite) {
@@ -59,7 +69,7 @@ void ForecastJob::compute(const ForecastSnapshot& s, ForecastResult& r) {
         f.horizon = fc_.horizon;
       }
     } else {
-      forecast(ws_, st, estopProfile(st.t, st.kin, fc_.estop_decel, fc_.estop_jerk), r.scenario[0]);
+      forecast(*ws_, st, estopProfile(st.t, st.kin, fc_.estop_decel, fc_.estop_jerk), r.scenario[0]);
       bool planned = false;
       if (s.has_plan) {
         const PlanCheck pc = planProfile(st.t, st.kin, s.plan, max_length_, plan_profile_);
@@ -71,9 +81,9 @@ void ForecastJob::compute(const ForecastSnapshot& s, ForecastResult& r) {
         }
       }
       if (planned)
-        forecast(ws_, st, plan_profile_, r.scenario[1]);
+        forecast(*ws_, st, plan_profile_, r.scenario[1]);
       else
-        forecast(ws_, st, continueProfile(st.t, st.kin, fc_.vmax, fc_.amax, max_length_), r.scenario[1]);
+        forecast(*ws_, st, continueProfile(st.t, st.kin, fc_.vmax, fc_.amax, max_length_), r.scenario[1]);
     }
   } catch (const std::exception&) {
     r.failed = true;

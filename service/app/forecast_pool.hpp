@@ -40,6 +40,10 @@ struct ForecastSnapshot {
   std::int64_t utime = 0;       ///< utime of the state (as its HOIST_CAGE)
   double t_published = 0.0;     ///< published time of the state (HOIST_CAGE.t)
   bool from_estimate = false;   ///< `state` is the load estimator's (hoist::addLoadResponse)
+  /// The guide-rope preload scale of the twin's model (TwinCore::preloadScale):
+  /// the worker forecasts with the same model (rebuilt, off the loop, when
+  /// an operator adopted another).
+  double preload_scale = 1.0;
   bool has_plan = false;        ///< a validated trip plan is known
   TripPlan plan;
   std::int64_t plan_seq = -1;
@@ -67,7 +71,9 @@ struct ForecastResult {
 
 class ForecastJob {
  public:
-  /// `dt` is the shaft's tick (1 / [service] rate); allocates everything here.
+  /// `dt` is the shaft's tick (1 / [service] rate); allocates everything
+  /// here, and again (on the worker; on the loop with --clock input) when a
+  /// snapshot's preload_scale differs from the model's.
   ForecastJob(std::shared_ptr<const ShaftModel> model, const TwinConfig& cfg);
   ForecastJob(const ForecastJob&) = delete;
   ForecastJob& operator=(const ForecastJob&) = delete;
@@ -86,14 +92,18 @@ class ForecastJob {
   /// it and post the result.  True if it computed one.
   bool runPending();
 
-  const ForecastOptions& options() const { return ws_.options(); }
+  const ForecastOptions& options() const { return ws_->options(); }
+  /// The preload scale the workspace's model runs (worker; tests).
+  double preloadScale() const { return ws_scale_; }
 
  private:
   void compute(const ForecastSnapshot& s, ForecastResult& r);
 
   ForecastConfig fc_;
   double max_length_;
-  ForecastWorkspace ws_;
+  TwinConfig cfg_;                           ///< the shaft as configured (a new scale rebuilds from it)
+  std::unique_ptr<ForecastWorkspace> ws_;
+  double ws_scale_ = 1.0;                    ///< the preload scale of ws_'s model
   MotionProfile plan_profile_;
   rt::LatestMailbox<ForecastSnapshot> in_;
   rt::LatestMailbox<ForecastResult> out_;

@@ -9,8 +9,8 @@
 namespace hoist::svc {
 
 ForecastScheduler::ForecastScheduler(ShaftContext& ctx, ShaftOutputs& out) : ctx_(ctx), out_(out) {
-  fast_ = dynamic_cast<const FastSolver*>(&ctx_.core.solver());
-  if (!fast_) throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
+  if (ctx_.core.solver().method() != Method::Fast)
+    throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
   job_ = std::make_unique<ForecastJob>(ctx_.core.solver().modelPtr(), ctx_.cfg);
   if (ctx_.core.loadSensitivity()) unit_ = FastSolverState(ctx_.core.solver().model().n());
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
@@ -63,12 +63,15 @@ void ForecastScheduler::afterStep(std::int64_t utime) {
     return;
   }
   ForecastSnapshot& snap = job_->snapshotSlot();
-  fast_->saveState(snap.state);
+  // The twin's solver now (an adopted preload replaces it: never cached;
+  // TwinCore::adoptModel keeps the method, so it is a FastSolver).
+  static_cast<const FastSolver&>(core.solver()).saveState(snap.state);
   // With the load estimator in use, forecast what the estimated load
   // implies: the twin's state plus the estimated load change times the unit
   // load's response (the model is linear in its load), continued under the
   // estimated load.  Else the open-loop twin's state and configured load.
   snap.from_estimate = false;
+  snap.preload_scale = ctx_.core.preloadScale();
   if (const LoadEstimate* e = core.estimate(); e && core.estimateInUse()) {
     core.loadSensitivity()->saveState(unit_);
     snap.from_estimate =

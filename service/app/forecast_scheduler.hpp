@@ -53,7 +53,6 @@ class ForecastScheduler {
   ShaftContext& ctx_;                 ///< the shaft's shared state
   ShaftOutputs& out_;                 ///< publishes HOIST_FORECAST and the PREDICTED_* events
   std::unique_ptr<ForecastJob> job_;  ///< workspace and mailboxes of this shaft's forecasts
-  const FastSolver* fast_ = nullptr;  ///< the twin's solver, for saveState
   FastSolverState unit_;              ///< the estimator's unit-load state (sized once; estimator only)
   ForecastPool* pool_ = nullptr;      ///< the daemon's pool (nullptr: synchronous)
   double phase_ = 0.0;                ///< this shaft's offset in the forecast period, [0, 1)

@@ -20,6 +20,7 @@
 namespace hoist::svc {
 
 class OffsetKeeper;
+class PreloadKeeper;
 class TripRoom;
 
 using rt::RtLog;
@@ -102,6 +103,10 @@ struct ShaftContext {
   /// This shaft's kept accelerometer offset (offset_keeper.hpp): told after
   /// every stepped tick, so it sees a calibration end (nullptr: not kept).
   OffsetKeeper* offsets = nullptr;
+  /// This shaft's adopted guide-rope preload (preload_keeper.hpp): takes
+  /// the operator's adoptions, told after every tick (nullptr: not hosted
+  /// by a Daemon).
+  PreloadKeeper* preload = nullptr;
   /// This shaft's trip room (trip_room.hpp): every model step is copied
   /// into it (nullptr: [history] off).
   TripRoom* trips = nullptr;

@@ -36,6 +36,7 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   m.window = std::max(0.0, wall - std::max(0.0, last_wall_));
   m.ticks = st.ticks;
   m.steps = core.steps();
+  m.preload_scale = core.preloadScale();
   m.deadline_misses = st.deadline_misses;
   m.step_p50_us = st.step_hist.quantile(0.5);
   m.step_p99_us = st.step_hist.quantile(0.99);

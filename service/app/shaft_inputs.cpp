@@ -8,6 +8,7 @@
 
 #include "forecast_scheduler.hpp"
 #include "offset_keeper.hpp"
+#include "preload_keeper.hpp"
 #include "trip_room.hpp"
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/alarm_t.hpp"
@@ -211,6 +212,10 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
     calibrate(*cmd, user);
     return;
   }
+  if (cmd->action == AlarmAction::AdoptPreload) {
+    adoptPreload(*cmd, user, bus::wallUtime());  // the daemon's clock, not the sender's
+    return;
+  }
   const int n = ctx_.core.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
   const char* what = cmd->action == AlarmAction::Ack      ? "acknowledge"
                      : cmd->action == AlarmAction::Shelve ? "shelve"
@@ -254,6 +259,23 @@ void ShaftInputs::calibrate(const AlarmCommand& cmd, const std::string& user) {
   ctx_.log.info("{}AUDIT operator '{}': calibrate: the load is known, Fa = {} N at b = {} m (M = {} N m), for {} s "
                 "from t = {:.2f} s", ctx_.tag, user, cmd.known_fa, cmd.known_b, cmd.known_fa * cmd.known_b,
                 cmd.calibrate_duration, ctx_.core.publishedTime(ctx_.core.modelTime()));
+}
+
+void ShaftInputs::adoptPreload(const AlarmCommand& cmd, const std::string& user, std::int64_t utime) {
+  // A new model for the live twin: built and kept off the loop, swapped in
+  // at rest (preload_keeper.hpp).  Audited now and again when in use.
+  if (!ctx_.preload) {
+    logJunk(fmt::format("preload adoption from '{}' ignored: this twin is not hosted by the daemon", user));
+    return;
+  }
+  if (!ctx_.preload->request(cmd.preload_scale, user, utime)) {
+    logJunk(fmt::format("preload adoption x{} from '{}' refused: an earlier adoption is still being built or waits "
+                        "for the cage to rest", cmd.preload_scale, user));
+    return;
+  }
+  ++ctx_.stats.commands_applied;
+  ctx_.log.warn("{}AUDIT operator '{}': adopt the guide-rope preloads x{} (the live twin runs x{}); built off the "
+                "loop, in use when the cage rests", ctx_.tag, user, cmd.preload_scale, ctx_.core.preloadScale());
 }
 
 void ShaftInputs::requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user) {

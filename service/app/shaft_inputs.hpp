@@ -108,6 +108,9 @@ class ShaftInputs {
   void logJunk(const std::string& what);
   /// A valid calibration command: hand it to the model room, audit it.
   void calibrate(const AlarmCommand& cmd, const std::string& user);
+  /// ACTION_ADOPT_PRELOAD: hands the scale to the shaft's PreloadKeeper
+  /// (`utime`: when, on the daemon's clock).
+  void adoptPreload(const AlarmCommand& cmd, const std::string& user, std::int64_t utime);
   /// A valid re-announce request: honour it now, or merge it into the pending one.
   void requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user);
   /// Honour the pending re-announce request if the interval allows.

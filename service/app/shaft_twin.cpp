@@ -106,6 +106,12 @@ void ShaftTwin::keepAccelOffset(const std::string& path, std::shared_ptr<spdlog:
   ctx_.offsets = offsets_.get();
 }
 
+void ShaftTwin::keepPreload(const std::string& path, std::shared_ptr<spdlog::logger> log) {
+  preload_ = std::make_unique<PreloadKeeper>(ctx_.cfg, path, ctx_.tag, std::move(log), ctx_.log);
+  if (auto m = preload_->loadKept()) ctx_.core.adoptModel(m);  // start-up: the old model is freed here
+  ctx_.preload = preload_.get();
+}
+
 void ShaftTwin::stopOffsetKeeper() {
   if (offsets_) offsets_->stop();
 }
@@ -194,6 +200,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   } else {
     core.housekeeping(wall);
   }
+  if (ctx_.preload) ctx_.preload->afterTick(core);
   inputs_.forgetSilentPublisher(wall);
   if (ctx_.trips) applyCondition();
   outputs_.publishAlarmEvents();

@@ -27,6 +27,7 @@
 #include "hoist/bus/udpm_receiver.hpp"
 #include "shaft_context.hpp"
 #include "offset_keeper.hpp"
+#include "preload_keeper.hpp"
 #include "shaft_health.hpp"
 #include "shaft_inputs.hpp"
 #include "shaft_outputs.hpp"
@@ -122,6 +123,17 @@ class ShaftTwin {
   void keepAccelOffset(const std::string& path, std::shared_ptr<spdlog::logger> log);
   /// Write a pending offset and join the keeper's writer.
   void stopOffsetKeeper();
+  /// Take operators' preload adoptions (preload_keeper.hpp), kept in `path`
+  /// across restarts ("" = not kept); applies a kept one now.  Before
+  /// start().  `log`: the daemon's logger (for the worker's lines).
+  void keepPreload(const std::string& path, std::shared_ptr<spdlog::logger> log);
+  /// Worker (the daemon's keeper thread): build and keep a requested preload,
+  /// release a replaced model.  Nothing before keepPreload().
+  void servePreload() {
+    if (preload_) preload_->serve();
+  }
+  /// Preload adoptions in use since start (any thread).
+  long preloadAdoptions() const { return preload_ ? preload_->adopted() : 0; }
   /// [history] enabled: record every trip (trip_room.hpp); before start().
   /// Throws std::invalid_argument for bad [condition] settings.
   void enableTrips(const TripHistoryConfig& hist);
@@ -148,6 +160,7 @@ class ShaftTwin {
   ShaftOutputs outputs_;                         ///< every outgoing message
   std::unique_ptr<ForecastScheduler> forecast_;  ///< look-ahead forecasts (nullptr without [forecast] enabled)
   std::unique_ptr<OffsetKeeper> offsets_;        ///< the kept accelerometer offset (nullptr: not kept)
+  std::unique_ptr<PreloadKeeper> preload_;       ///< the adopted guide-rope preload (nullptr: keepPreload not called)
   ShaftInputs inputs_;                           ///< every input channel
   ShaftHealth health_;                           ///< statistics into HOIST_HEALTH, the report's figures
   std::unique_ptr<TripRoom> trips_;              ///< the shaft's memory (nullptr: [history] off)

@@ -231,7 +231,7 @@ TEST(Codec, AlarmAckStringLengthAttacks) {
   EXPECT_EQ(checkedDecode(b.data(), b.size(), m), DecodeStatus::bad_string);
   k.user = "abc";
   b = encode(k);
-  b[b.size() - 3 * 8 - 3] = 0;  // the user's "b" (known_fa, known_b, calibrate_duration follow it)
+  b[b.size() - 4 * 8 - 3] = 0;  // the user's "b" (known_fa, known_b, calibrate_duration, preload_scale follow it)
   EXPECT_EQ(checkedDecode(b.data(), b.size(), m), DecodeStatus::bad_string);
   k.user = std::string(4097, 'u');
   b = encode(k);
@@ -312,7 +312,7 @@ TEST(Codec, TerminalSafeEscapesControlSequences) {
 TEST(Codec, FromJsonStrictAlarmAck) {
   const auto ok = nlohmann::json::parse(
       R"({"utime": 1, "kind": "*", "level": 0, "action": 2, "shelve_duration": 60, "user": "op",
-          "known_fa": 0, "known_b": 0, "calibrate_duration": 0})");
+          "known_fa": 0, "known_b": 0, "calibrate_duration": 0, "preload_scale": 0})");
   alarm_ack_t k;
   std::string err;
   ASSERT_TRUE(fromJson(ok, k, err)) << err;

@@ -187,7 +187,7 @@ TEST(ReannounceRequest, HonouredAtOnceThenAtMostOnceASecondAndChangesNothing) {
   Daemon d(std::move(opt), logger);
   struct Seen {
     std::vector<std::pair<hoist::alarm_t, std::chrono::steady_clock::time_point>> events;
-    void on(const lcm::ReceiveBuffer* rb, const std::string&, const hoist::alarm_t* m) {
+    void on(const lcm::ReceiveBuffer*, const std::string&, const hoist::alarm_t* m) {
       events.emplace_back(*m, std::chrono::steady_clock::now());
     }
     int count(std::int8_t type) const {

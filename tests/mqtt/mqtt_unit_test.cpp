@@ -270,6 +270,14 @@ TEST(MqttCommand, CalibrateIsValidatedAsTheDaemonDoes) {
             hoist::contract::CommandError::None);
   EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 5, 0.0, 1000.0, 0.5, 0.0, c),
             hoist::contract::CommandError::BadCalibration);
+  // Adopting a guide-rope preload is a control-room command (hoist-alarm-ack),
+  // refused over MQTT with or without its field.
+  for (const char* adopt : {R"({"kind":"","level":0,"action":6,"preload_scale":0.8,"user":"eng"})",
+                            R"({"kind":"","level":0,"action":6,"user":"eng"})"}) {
+    const auto a = parse(adopt);
+    EXPECT_EQ(a.reject, CommandReject::BadAction) << adopt;
+    EXPECT_NE(a.detail.find("hoist-alarm-ack --adopt-preload"), std::string::npos) << a.detail;
+  }
 }
 
 TEST(MqttCommand, SameValidationAsTheDaemon) {

@@ -26,6 +26,7 @@
 #include <thread>
 
 #include "daemon.hpp"
+#include "hoist/alarm_ack_t.hpp"
 #include "hoist/cage_imu_t.hpp"
 #include "hoist/profile.hpp"
 #include "hoist/trip_plan_t.hpp"
@@ -110,6 +111,14 @@ class Feeder {
         lcm_.publish("HOIST_CAGE_IMU", &imu);
       }
       sent_ = seq;
+      if (k == 1500) {  // an operator adopts a guide-rope preload on A (issue 32): built off the loop, used at rest
+        alarm_ack_t ack{};
+        ack.utime = m.utime;
+        ack.action = alarm_ack_t::ACTION_ADOPT_PRELOAD;
+        ack.preload_scale = 0.8;
+        ack.user = "eng";
+        lcm_.publish("HOIST_ALARM_ACK", &ack);
+      }
       if (k % 100 == 50) {  // a trip plan every 0.1 s (it fits the motion: accepted)
         trip_plan_t p{};
         p.utime = m.utime;
@@ -206,6 +215,7 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   loopFor(1.0s);  // warm-up: first input, re-initialization, first events, first health
   const ShaftRunStats a0 = d.shaft(0).runStats(), b0 = d.shaft(1).runStats(), c0 = d.shaft(2).runStats();
   const std::int64_t trip_ticks0 = d.shaft(0).trips()->counters().ticks.load();
+  const long adoptions0 = d.shaft(0).preloadAdoptions();
   long allocs = 0;
   {
     AllocationWatch watch;
@@ -214,6 +224,7 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   }
   const ShaftRunStats a1 = d.shaft(0).runStats(), b1 = d.shaft(1).runStats(), c1 = d.shaft(2).runStats();
   const std::int64_t trip_ticks1 = d.shaft(0).trips()->counters().ticks.load();
+  const long adoptions1 = d.shaft(0).preloadAdoptions();
   feed.join();
   d.requestStop("test over");
   d.finish();
@@ -249,4 +260,11 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   const std::string log = logs.str();
   EXPECT_NE(log.find("[A] ALARM INPUT_STALE"), std::string::npos) << log;
   EXPECT_NE(log.find("[B] alarm: INPUT_STALE WARNING cleared"), std::string::npos) << log;
+  // The preload adopted in the window: requested while the cage moved (1.5 s),
+  // swapped in at rest (the pause) -- on the loop, without an allocation.
+  EXPECT_EQ(adoptions0, 0);
+  EXPECT_EQ(adoptions1, 1) << log;
+  EXPECT_NE(log.find("[A] AUDIT operator 'eng': adopt the guide-rope preloads x0.8"), std::string::npos) << log;
+  EXPECT_NE(log.find("[A] AUDIT operator 'eng': the live twin now runs the guide-rope preloads x0.8"),
+            std::string::npos) << log;
 }

@@ -268,6 +268,32 @@ TEST(Messages, CalibrationCommandIsValidated) {
   EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 5, 0.0, out), hoist::contract::CommandError::BadCalibration);
 }
 
+TEST(Messages, PreloadAdoptionIsValidated) {
+  hoist::alarm_ack_t a{};
+  a.action = hoist::alarm_ack_t::ACTION_ADOPT_PRELOAD;
+  a.kind = "GUIDE_ROPE";  // ignored, as for the calibration
+  const char* why = "";
+  for (const double s : {0.3, 0.82, 1.0, 1.6}) {
+    a.preload_scale = s;
+    const auto c = validateAck(a, why);
+    ASSERT_TRUE(c) << s << ": " << why;
+    EXPECT_EQ(c->action, AlarmAction::AdoptPreload);
+    EXPECT_EQ(c->preload_scale, s);
+    EXPECT_FALSE(c->kind.has_value());
+  }
+  for (const double s : {0.0, 0.29, 1.61, -1.0, std::nan(""), static_cast<double>(INFINITY)}) {
+    a.preload_scale = s;
+    EXPECT_FALSE(validateAck(a, why)) << s;
+    EXPECT_NE(std::string(why).find("preload_scale in [0.3, 1.6]"), std::string::npos) << why;
+  }
+  // A client without the field (the 8- and 5-argument rules) cannot adopt.
+  hoist::contract::AlarmCommand out;
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 6, 0.0, 0.0, 0.0, 0.0, out),
+            hoist::contract::CommandError::BadPreload);
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 6, 0.0, out), hoist::contract::CommandError::BadPreload);
+  EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 7, 0.0, out), hoist::contract::CommandError::BadAction);
+}
+
 TEST(Messages, SensorFaultTextNamesTheSensorAndWhy) {
   AlarmEvent e;
   e.kind = AlarmKind::SensorFault;

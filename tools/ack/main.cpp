@@ -4,12 +4,20 @@
 //                   [--shelve SECONDS | --unshelve] [--user NAME]
 //                   [--lcm-url URL] [--channel-prefix P]
 //   hoist-alarm-ack --calibrate FA,B,SECONDS [--user NAME] ...
+//   hoist-alarm-ack --adopt-preload S [--user NAME] ...
 //
 // --calibrate declares the load known for the load estimator's live
 // calibration (alarm_ack_t ACTION_CALIBRATE: the empty conveyance at the
 // bank with its own Fa and b, or a test weight) for SECONDS from now; the
 // daemon logs it with the user (AUDIT line) and HOIST_ESTIMATE.calibrating
 // shows it in force.
+//
+// --adopt-preload makes the live twin run both guide-rope preloads times S
+// (alarm_ack_t ACTION_ADOPT_PRELOAD; S in [0.3, 1.6], 1 = back to the
+// config's): the preload the shaft's memory identified (hoist-trips trend,
+// GUIDE_PRELOAD_LOW's text).  The daemon builds the model off its loop,
+// swaps it in when the cage rests, keeps it in its state file and logs both
+// steps with the user; HOIST_HEALTH.preload_scale shows it in use.
 //
 // Default: acknowledge every active alarm ("*", both levels).  The daemon
 // answers on HOIST_ALARM with an ACK / SHELVE / UNSHELVE event (watch it with
@@ -103,6 +111,14 @@ int main(int argc, char** argv) {
             return {};
           },
           "FA,B,SECONDS", "calibration"));
+  double adopt = 0.0;
+  auto* ad = app.add_option("--adopt-preload", adopt,
+                            "S: the live twin runs both guide-rope preloads times S, in [0.3, 1.6] (1 = the config's): "
+                            "the preload the shaft's memory identified (docs/condition.md)")
+                 ->excludes(sh)
+                 ->excludes(un)
+                 ->excludes("--calibrate")
+                 ->check(CLI::Range(hoist::contract::kMinPreloadScale, hoist::contract::kMaxPreloadScale));
   app.add_option("--user", user, "operator name (logged by the daemon; default: $USER)");
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
   app.add_option("--channel-prefix", prefix, "prefix of the daemon's channels");
@@ -116,7 +132,7 @@ int main(int argc, char** argv) {
     const char* u = std::getenv("USER");
     user = u ? u : "operator";
   }
-  hoist::alarm_ack_t m;
+  hoist::alarm_ack_t m{};
   m.utime = std::chrono::duration_cast<std::chrono::microseconds>(
                 std::chrono::system_clock::now().time_since_epoch())
                 .count();
@@ -133,6 +149,13 @@ int main(int argc, char** argv) {
     m.known_fa = known_fa;
     m.known_b = known_b;
     m.calibrate_duration = known_s;
+  }
+  const bool adopting = ad->count() > 0;
+  if (adopting) {
+    m.kind = "";
+    m.level = 0;
+    m.action = hoist::alarm_ack_t::ACTION_ADOPT_PRELOAD;
+    m.preload_scale = adopt;
   }
   m.user = user;
   if (const std::string bad = hoist::bus::lcmUrlUsageError("hoist-alarm-ack", app.count("--lcm-url") > 0, url,
@@ -152,6 +175,11 @@ int main(int argc, char** argv) {
   if (lcm.publish(channel, &m) != 0) {
     std::cerr << "hoist-alarm-ack: publish on " << channel << " failed\n";
     return 1;
+  }
+  if (adopting) {
+    std::cout << "sent ADOPT_PRELOAD x" << adopt << " user=" << user << " on " << channel
+              << " (in use when the cage rests: HOIST_HEALTH.preload_scale)\n";
+    return 0;
   }
   if (cal) {
     std::cout << "sent CALIBRATE Fa=" << known_fa << " N b=" << known_b << " m for " << known_s << " s user=" << user

@@ -20,6 +20,7 @@
 #include "hoist/history/condition_judge.hpp"
 #include "hoist/history/schema.hpp"
 #include "hoist/io/config.hpp"
+#include "hoist/profile.hpp"
 #include "hoist/io/estimator_config.hpp"
 #include "hoist/trip_pipeline.hpp"
 #include "trips.hpp"
@@ -42,7 +43,7 @@ int runIngest(const Options& o) {
   ShaftParams p = io::shaftParamsFromToml(tbl, o.config, history::configSections());
   const io::EstimatorConfig ec = io::estimatorConfigFromToml(tbl, o.config);
   const ConditionSettings cond = history::conditionSettingsFromToml(tbl, o.config);
-  const double max_step = o.max_step >= 0.0 ? o.max_step : io::serviceMaxStep(tbl, o.config, 0.0025);
+  const double max_step = o.max_step >= 0.0 ? o.max_step : io::serviceMaxStep(tbl, o.config, hoist::kDefaultMaxStep);
   if (o.modes != 0) p.n = o.modes;
   try {
     p.validate();

@@ -61,6 +61,16 @@ class GuideRopeEnvelope {
   /// The longest run of deferred bounds in a row since construction (a run
   /// ends at an exact or in-tolerance evaluation).
   int longestDeferral() const { return longest_deferral_; }
+  /// Continue the counts above from `old` (an envelope this one replaces:
+  /// the twin adopted another model; the counters stay monotonic).  The
+  /// bounded evaluations restart from an exact one.
+  void carryCountsFrom(const GuideRopeEnvelope& old) {
+    exact_count_ = old.exact_count_;
+    bounded_count_ = old.bounded_count_;
+    deferred_count_ = old.deferred_count_;
+    longest_deferral_ = old.longest_deferral_;
+    have_ref_ = false;
+  }
   const VectorXd& depths() const { return x_; }
   /// The shapes of the last EXACT evaluation.
   const VectorXd& y1() const { return y1_; }

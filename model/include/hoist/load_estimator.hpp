@@ -250,6 +250,23 @@ class LoadEstimator {
   /// Throws std::invalid_argument for bad settings.
   LoadEstimator(const ShaftParams& twin, const EstimatorSettings& settings);
 
+  /// The estimator's share of a shaft model: the shaft and its unit-load
+  /// solvers.  Built off the real-time loop (it allocates) for swapModel().
+  struct Model {
+    ShaftParams twin;
+    std::unique_ptr<FastSolver> sens, step;
+  };
+  /// Throws ParamError for bad parameters.
+  static Model buildModel(const ShaftParams& twin);
+  /// The twin now runs another model of the same shaft (an operator adopted
+  /// a guide-rope preload): its solvers are swapped in, `m` receives the old
+  /// ones (release them off the loop).  The load prior (twin.Fa, twin.b)
+  /// stays the one given at construction.  Call restart() next: the loads,
+  /// their covariance, the offset and the sensors seen carry over.
+  /// Allocation-free.  Throws std::invalid_argument (nothing changed) for a
+  /// model with another n or without solvers.
+  void swapModel(Model& m);
+
   /// Start (again) at (t0, k0), the twin's initialization: the sensitivity
   /// solver starts as the twin does (its params().initial), the loads return
   /// to the prior.  Call after the twin's initialize().

@@ -14,6 +14,7 @@ const char* toString(AlarmAction a) {
     case AlarmAction::Unshelve: return "UNSHELVE";
     case AlarmAction::Reannounce: return "REANNOUNCE";
     case AlarmAction::Calibrate: return "CALIBRATE";
+    case AlarmAction::AdoptPreload: return "ADOPT_PRELOAD";
   }
   return "?";
 }
@@ -26,6 +27,7 @@ const char* toString(CommandError e) {
     case CommandError::BadAction: return "bad_action";
     case CommandError::BadShelveDuration: return "bad_shelve_duration";
     case CommandError::BadCalibration: return "bad_calibration";
+    case CommandError::BadPreload: return "bad_preload";
   }
   return "?";
 }
@@ -33,12 +35,28 @@ const char* toString(CommandError e) {
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
                                   AlarmCommand& out) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  return validateAlarmCommand(kind, level, action, shelve_duration, nan, nan, nan, out);
+  return validateAlarmCommand(kind, level, action, shelve_duration, nan, nan, nan, nan, out);
 }
 
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
                                   double known_fa, double known_b, double calibrate_duration, AlarmCommand& out) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  return validateAlarmCommand(kind, level, action, shelve_duration, known_fa, known_b, calibrate_duration, nan, out);
+}
+
+CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
+                                  double known_fa, double known_b, double calibrate_duration, double preload_scale,
+                                  AlarmCommand& out) {
   AlarmCommand c;
+  if (action == static_cast<int>(AlarmAction::AdoptPreload)) {
+    // The model, not an alarm: kind and level are ignored.
+    if (!(std::isfinite(preload_scale) && preload_scale >= kMinPreloadScale && preload_scale <= kMaxPreloadScale))
+      return CommandError::BadPreload;
+    c.action = AlarmAction::AdoptPreload;
+    c.preload_scale = preload_scale;
+    out = c;
+    return CommandError::None;
+  }
   if (action == static_cast<int>(AlarmAction::Calibrate)) {
     // The load, not an alarm: kind and level are ignored.
     if (!(std::isfinite(known_fa) && known_fa >= 0.0 && known_fa <= kMaxCalibrationForce) ||

@@ -292,15 +292,18 @@ void describeAlarmWhole(const AlarmEvent& e, const AlarmTextContext& ctx, char* 
 std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*& why) {
   AckCommand c;
   switch (validateAlarmCommand(ack.kind, ack.level, ack.action, ack.shelve_duration, ack.known_fa, ack.known_b,
-                               ack.calibrate_duration, c)) {
+                               ack.calibrate_duration, ack.preload_scale, c)) {
     case CommandError::None: return c;
     case CommandError::UnknownKind: why = "unknown alarm kind"; break;
     case CommandError::BadLevel: why = "bad level (0 both, 1 warning, 2 critical)"; break;
-    case CommandError::BadAction: why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce, 5 calibrate)"; break;
+    case CommandError::BadAction:
+      why = "bad action (1 ack, 2 shelve, 3 unshelve, 4 re-announce, 5 calibrate, 6 adopt preload)";
+      break;
     case CommandError::BadShelveDuration: why = "shelve_duration must be a finite number > 0 s"; break;
     case CommandError::BadCalibration:
       why = contract::kCalibrationRule;
       break;
+    case CommandError::BadPreload: why = contract::kPreloadRule; break;
   }
   return std::nullopt;
 }

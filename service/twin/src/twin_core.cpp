@@ -43,14 +43,6 @@ bool allFinite(const CageOutput& o) {
          std::isfinite(c.clearance_guide);
 }
 
-/// The lateral plausibility limit: plausible_factor x the largest gap, but
-/// never below 1 m (hoist-sim's limit): tiny test gaps must raise clearance
-/// alarms, not model faults.
-double lateralLimit(const TwinConfig& c) {
-  return std::max(1.0, c.service.plausible_factor *
-                           std::max({c.alarms.gap_pos_y, c.alarms.gap_neg_y, c.alarms.guide_rope_gap}));
-}
-
 }  // namespace
 
 // ---- TwinCore -------------------------------------------------------------------
@@ -65,7 +57,7 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
       validator_(limitsFrom(cfg)),
       alarms_(cfg.alarms),
       range_(validLengthRange(cfg.shaft)),
-      bounds_(plausibilityBounds(cfg.shaft, lateralLimit(cfg))),
+      bounds_(twinPlausibilityBounds(cfg, cfg.shaft)),
       // The predictions kept cover max_clock_offset at the step rate, and more.
       timing_(cfg.estimator.max_clock_offset,
               std::max<std::size_t>(64, static_cast<std::size_t>(std::ceil(1.5 * cfg.estimator.max_clock_offset *
@@ -92,6 +84,31 @@ TwinCore::TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solve
     initializeAt(0.0, Kinematics{cfg_.shaft.l0, 0.0, 0.0});
     resets_ = 0;
   }
+}
+
+void TwinCore::adoptModel(std::unique_ptr<TwinModel>& m) {
+  if (!m || !m->solver || m->solver->method() != solver_->method() ||
+      m->solver->model().n() != solver_->model().n() || (est_ && !m->estimator.sens))
+    throw std::invalid_argument("TwinCore::adoptModel: a model of the same method and n (with the estimator's "
+                                "solvers when it is enabled) is needed");
+  if (est_) est_->swapModel(m->estimator);
+  m->envelope.carryCountsFrom(envelope_);
+  std::swap(solver_, m->solver);
+  std::swap(envelope_, m->envelope);
+  std::swap(shape_, m->shape);
+  std::swap(bounds_, m->bounds);
+  std::swap(cfg_.shaft, m->shaft);
+  std::swap(preload_scale_, m->preload_scale);
+  if (!started_) return;  // the first start initializes the new model
+  // The new model's equilibrium at the current kinematics (the caller swaps
+  // at rest, where the state is static); the estimator's loads carry over.
+  solver_->initialize(t_, kin_);
+  if (est_) {
+    est_->restart(t_, kin_);
+    est_synced_ = true;
+    timing_.reset(true);  // the queued samples were predicted by the old model
+  }
+  finishStep(t_);
 }
 
 Kinematics TwinCore::integrate(const Kinematics& k0, double v1, double a1, double dt) const {

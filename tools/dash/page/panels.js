@@ -20,6 +20,9 @@ export function renderHealth(s) {
   (h.reject_reason || []).forEach((r, i) => { if (h.rejected[i] > 0) rows.push([`  rejected: ${r}`, String(h.rejected[i])]); });
   rows.push(["alarms active / unacked / shelved", `${h.alarms_active} / ${h.alarms_unacked} / ${h.alarms_shelved}`],
             ["model faults / resets", `${h.model_faults} / ${h.model_resets}`],
+            ["guide-rope preload (the twin's model)", typeof h.preload_scale !== "number" ? "n/a"
+              : h.preload_scale === 1 ? "as configured"
+              : `x${fix(h.preload_scale, 3)} of the configuration's (adopted by an operator)`],
             ["publish failures", String(h.publish_failures)],
             ["uptime", `${fix(h.uptime, 0)} s`]);
   for (const [k, v] of rows) dl.append(el("dt", {}, k), el("dd", {}, v));

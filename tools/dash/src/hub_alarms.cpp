@@ -194,7 +194,7 @@ void Hub::handleClientMessage(Client& c, std::uint32_t chan, std::string_view pa
   if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
   // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE only): absent in
   // every alarm command.
-  for (const char* k : {"known_fa", "known_b", "calibrate_duration"})
+  for (const char* k : {"known_fa", "known_b", "calibrate_duration", "preload_scale"})
     if (!j.contains(k)) j[k] = 0.0;
   // The alarm the page drew (its activation): a command for an alarm that
   // was cleared and raised again since, or is gone, is refused.

@@ -105,7 +105,7 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
     if (!j.contains("shelve_duration")) j["shelve_duration"] = 0.0;
     // The calibration's fields (alarm_ack_t.ACTION_CALIBRATE only): absent
     // in every alarm command.
-    for (const char* k : {"known_fa", "known_b", "calibrate_duration"})
+    for (const char* k : {"known_fa", "known_b", "calibrate_duration", "preload_scale"})
       if (!j.contains(k)) j[k] = 0.0;
     if (!j.contains("user")) j["user"] = kDefaultCommandUser;
     std::string error;
@@ -158,6 +158,12 @@ CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t ma
         r.detail = std::string(hoist::contract::kCalibrationRule) + got;
         return r;
       }
+      case hoist::contract::CommandError::BadPreload:
+        // The 8-field rule refuses ACTION_ADOPT_PRELOAD: a new model for the
+        // twin is adopted at the control room (hoist-alarm-ack), not over MQTT.
+        r.reject = CommandReject::BadAction;
+        r.detail = "action 6 (adopt preload) is not accepted over MQTT: use hoist-alarm-ack --adopt-preload";
+        return r;
     }
     if (r.ack.utime <= 0) r.ack.utime = now_utime;
     return r;

@@ -77,6 +77,7 @@ std::vector<MetricDef> makeDeviceMetrics() {
   add("Health/Alarms Active", D::Int32, "", H);
   add("Health/Alarms Unacked", D::Int32, "", H);
   add("Health/Alarms Shelved", D::Int32, "", H);
+  add("Health/Preload Scale", D::Double, "", H);
   for (const auto& k : hoist::msg::enums::alarm_t::kKindNames) {
     const std::string base = "Alarms/" + std::string(k) + "/";
     add(base + "Level", D::Int32, "", A);
@@ -327,6 +328,7 @@ void DeviceMetrics::onHealth(const hoist::health_t& m) {
   setI("Health/Alarms Active", m.alarms_active, u);
   setI("Health/Alarms Unacked", m.alarms_unacked, u);
   setI("Health/Alarms Shelved", m.alarms_shelved, u);
+  setD("Health/Preload Scale", m.preload_scale, u);
 }
 
 void DeviceMetrics::onForecast(const hoist::forecast_t& m) {

@@ -17,12 +17,21 @@ namespace hoist::contract {
 /// alarm that has one (a client that just started learns of alarms raised
 /// before it); the daemon honours at most one a second per shaft.
 /// Calibrate declares the load known for a while (the load estimator's live
-/// calibration, alarm_ack_t.ACTION_CALIBRATE).
-enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3, Reannounce = 4, Calibrate = 5 };
+/// calibration, alarm_ack_t.ACTION_CALIBRATE).  AdoptPreload makes the live
+/// twin run the guide-rope preloads scaled by preload_scale
+/// (alarm_ack_t.ACTION_ADOPT_PRELOAD).
+enum class AlarmAction { Ack = 1, Shelve = 2, Unshelve = 3, Reannounce = 4, Calibrate = 5, AdoptPreload = 6 };
 
 /// Why a command was refused.
-enum class CommandError { None, UnknownKind, BadLevel, BadAction, BadShelveDuration, BadCalibration };
-inline constexpr int kCommandErrors = 6;
+enum class CommandError { None, UnknownKind, BadLevel, BadAction, BadShelveDuration, BadCalibration, BadPreload };
+inline constexpr int kCommandErrors = 7;
+
+/// The preload scales an operator may adopt: the range the shaft's memory
+/// identifies s over (hoist/preload_identification.hpp's grid).
+inline constexpr double kMinPreloadScale = 0.3;
+inline constexpr double kMaxPreloadScale = 1.6;
+/// The rule above in words.
+inline constexpr const char* kPreloadRule = "adopt_preload needs preload_scale in [0.3, 1.6] (1 = the config's)";
 
 /// The longest calibration an operator may declare [s].
 inline constexpr double kMaxCalibration = 600.0;
@@ -35,8 +44,10 @@ inline constexpr double kMaxCalibrationOffset = 100.0;
 inline constexpr const char* kCalibrationRule =
     "calibrate needs known_fa in [0, 1e7] N, |known_b| <= 100 m and calibrate_duration in (0, 600] s";
 
-const char* toString(AlarmAction a);   ///< "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE"
-const char* toString(CommandError e);  ///< "ok", "unknown_kind", "bad_level", "bad_action", "bad_shelve_duration"
+const char* toString(AlarmAction a);   ///< "ACK", "SHELVE", "UNSHELVE", "REANNOUNCE", "CALIBRATE", "ADOPT_PRELOAD"
+/// "ok", "unknown_kind", "bad_level", "bad_action", "bad_shelve_duration",
+/// "bad_calibration", "bad_preload"
+const char* toString(CommandError e);
 
 /// A validated command.  kind empty = every kind; level None = both levels.
 struct AlarmCommand {
@@ -47,6 +58,7 @@ struct AlarmCommand {
   double known_fa = 0.0;          ///< Calibrate: the known eccentric force [N]
   double known_b = 0.0;           ///< Calibrate: its offset [m]
   double calibrate_duration = 0.0;  ///< Calibrate: for how long [s]
+  double preload_scale = 1.0;     ///< AdoptPreload: the scale of the guide-rope preloads
 };
 
 /// Validates the fields of an alarm_ack_t: `kind` an alarm kind name
@@ -59,8 +71,13 @@ CommandError validateAlarmCommand(std::string_view kind, int level, int action, 
 /// The same with the calibration fields (alarm_ack_t.known_fa, known_b,
 /// calibrate_duration): for Calibrate, known_fa finite in [0,
 /// kMaxCalibrationForce], |known_b| <= kMaxCalibrationOffset, duration in
-/// (0, kMaxCalibration]; else BadCalibration.  The 5-argument form refuses
-/// Calibrate (a client without the fields cannot calibrate).
+/// (0, kMaxCalibration]; else BadCalibration.  For AdoptPreload,
+/// preload_scale (alarm_ack_t.preload_scale) finite in [kMinPreloadScale,
+/// kMaxPreloadScale]; else BadPreload.  The shorter forms refuse Calibrate
+/// and AdoptPreload (a client without the fields cannot send them).
+CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
+                                  double known_fa, double known_b, double calibrate_duration, double preload_scale,
+                                  AlarmCommand& out);
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
                                   double known_fa, double known_b, double calibrate_duration, AlarmCommand& out);
 

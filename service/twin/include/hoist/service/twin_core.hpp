@@ -51,6 +51,7 @@
 #include "hoist/service/config.hpp"
 #include "hoist/service/estimate_gate.hpp"
 #include "hoist/service/sensor_timing.hpp"
+#include "hoist/service/twin_model.hpp"
 #include "hoist/service/input_validator.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/plausibility.hpp"
@@ -273,6 +274,21 @@ class TwinCore {
   std::int64_t domainErrors() const { return domain_errors_; }
   const Solver& solver() const { return *solver_; }
 
+  // ---- the model ---------------------------------------------------------
+  /// Run `m` from now on (an operator adopted a guide-rope preload;
+  /// hoist/service/twin_model.hpp): the solver, the envelopes, the
+  /// plausibility bounds and the estimator's solvers are swapped, and `m`
+  /// receives the old ones (release them off the loop).  A started twin is
+  /// re-initialized in the new model's equilibrium at the current
+  /// kinematics -- call it at rest -- and the estimator keeps its loads,
+  /// their covariance and the accelerometer's offset (its model check
+  /// starts afresh).  Not a reset: no MODEL_FAULT, no degraded output, no
+  /// count.  Allocation-free.  Throws std::invalid_argument (nothing
+  /// changed) for a model of another method or n.
+  void adoptModel(std::unique_ptr<TwinModel>& m);
+  /// The guide-rope preload scale of the model in use (1: the config's).
+  double preloadScale() const { return preload_scale_; }
+
   // ---- load estimator ([estimator], hoist/load_estimator.hpp) ---------------
   /// A validated cage IMU sample (f_y [m/s^2], omega [rad/s]; NaN = that
   /// channel absent) stamped `utime` [us], arriving at `wall_now` [s] when the
@@ -363,6 +379,7 @@ class TwinCore {
   CageOutput out_;
   LengthRange range_;
   PlausibilityBounds bounds_;
+  double preload_scale_ = 1.0;  // adoptModel()
 
   bool started_ = false;        // model initialized
   double t_ = 0.0;              // model time [s]
