@@ -123,11 +123,10 @@ void ForecastScheduler::onResult(const ForecastResult& r) {
   }
   const ForecastSummary* sc[ForecastResult::kScenarios];
   for (int i = 0; i < ForecastResult::kScenarios; ++i) sc[i] = &r.scenario[i];
-  AlarmCause& cause = ctx_.cause;
-  cause.slack_threshold = slackThreshold(ctx_.cfg, ctx_.core.solver().model(), r.kin.l);
-  const ForecastVerdict v = judgeForecast(sc, ForecastResult::kScenarios, cause.slack_threshold);
-  cause.predicted_clearance_scenario = v.clearance ? ForecastResult::kNames[v.clearance_scenario] : "";
-  cause.predicted_slack_scenario = v.slack ? ForecastResult::kNames[v.slack_scenario] : "";
+  const double slack_threshold = slackThreshold(ctx_.cfg, ctx_.core.solver().model(), r.kin.l);
+  const ForecastVerdict v = judgeForecast(sc, ForecastResult::kScenarios, slack_threshold);
+  out_.setForecastCause(v.clearance ? ForecastResult::kNames[v.clearance_scenario] : "",
+                        v.slack ? ForecastResult::kNames[v.slack_scenario] : "", slack_threshold);
   ctx_.core.setPredictions(v.clearance, v.clearance_s, v.slack, v.slack_s, ctx_.cfg.forecast.horizon,
                            r.from_estimate);
   out_.publishForecast(r);

@@ -39,20 +39,6 @@ struct TestHooks {
   double slow_tick_ms = 0.0;
 };
 
-/// Who or what caused the alarm events about to be published, for their
-/// text (set by the room that causes them, read by ShaftOutputs).
-struct AlarmCause {
-  std::string user;                              ///< operator of the command being applied ("" for the twin itself)
-  double requested_shelve = 0.0;                 ///< that command's requested shelve duration [s]
-  const char* predicted_clearance_scenario = ""; ///< PREDICTED_CLEARANCE: the scenario that predicts it (static string)
-  const char* predicted_slack_scenario = "";     ///< PREDICTED_SLACK: the scenario that predicts it (static string)
-  double slack_threshold = 0.0;                  ///< PREDICTED_SLACK threshold of the latest forecast [N]
-  /// GUIDE_PRELOAD_LOW / SHAFT_FINGERPRINT: the trip room's latest texts
-  /// (copied from its ConditionState; fixed size, no allocation).
-  std::array<char, 240> preload_text{};
-  std::array<char, 240> fingerprint_text{};
-};
-
 /// The last recorded trip's detectability (TripRoom's ConditionState, copied
 /// by the loop; estimate_t.detect_trip, loss30_separation, loss30_visible).
 struct TripDetectability {
@@ -88,7 +74,6 @@ struct ShaftContext {
   bus::Channels ch;               ///< channel names: prefix + HOIST_*
   TwinCore core;                  ///< the model, input validation, alarms (no I/O)
   ShaftStats stats;               ///< every counter and histogram of this shaft
-  AlarmCause cause;               ///< what the next alarm events' text names besides the event
   TripDetectability detect;       ///< the last recorded trip's detectability (loop thread)
   Clock::time_point start{};      ///< the loop's start: wall times are measured from it
   /// --clock input: wall time spent in synchronous forecasts, not counted as

@@ -241,12 +241,7 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   ctx_.log.info("{}AUDIT operator '{}': {} {}/{}{} -> {} alarm(s)", ctx_.tag, user, what,
                 cmd->kind ? toString(*cmd->kind) : "*", cmd->level == AlarmLevel::None ? "*" : toString(cmd->level),
                 for_s, n);
-  AlarmCause& cause = ctx_.cause;
-  cause.user = user;
-  cause.requested_shelve = cmd->action == AlarmAction::Shelve ? cmd->shelve_duration : 0.0;
-  out_.publishAlarmEvents();
-  cause.user.clear();
-  cause.requested_shelve = 0.0;
+  out_.publishAlarmEvents(CommandCause{user, cmd->action == AlarmAction::Shelve ? cmd->shelve_duration : 0.0});
 }
 
 void ShaftInputs::calibrate(const AlarmCommand& cmd, const std::string& user) {

@@ -236,18 +236,18 @@ void ShaftOutputs::publishShape(std::int64_t utime, bool batch) {
   encodeAndPublish(ctx_.ch.shape, shape_msg_, shape_buf_, batch);
 }
 
-void ShaftOutputs::publishAlarmEvents() {
+void ShaftOutputs::publishAlarmEvents(const CommandCause& by) {
   TwinCore& core = ctx_.core;
   const AlarmEvents& ev = core.events();
   if (ev.empty()) return;
   const std::int64_t utime = bus::wallUtime();
-  const AlarmCause& cause = ctx_.cause;
+  const AlarmCause& cause = cause_;
   AlarmTextContext tc;
   tc.alarms = &ctx_.cfg.alarms;
   tc.stale_timeout = core.staleTimeout();
   tc.range = core.validRange();
   tc.fault_what = core.lastFaultWhat();
-  tc.requested_shelve = cause.requested_shelve;
+  tc.requested_shelve = by.requested_shelve;
   tc.predicted_clearance_scenario = cause.predicted_clearance_scenario;
   tc.predicted_slack_scenario = cause.predicted_slack_scenario;
   tc.slack_threshold = cause.slack_threshold;
@@ -257,7 +257,7 @@ void ShaftOutputs::publishAlarmEvents() {
   tc.sensor_reason = core.lastSensorFault().reason;
   tc.preload_text = cause.preload_text.data();
   tc.fingerprint_text = cause.fingerprint_text.data();
-  alarm_msg_.user.assign(cause.user);  // who caused these events ("" for the twin itself)
+  alarm_msg_.user.assign(by.user.data(), by.user.size());  // who caused these events ("" for the twin itself)
   RtLog& log = ctx_.log;
   const std::string& tag = ctx_.tag;
   for (const AlarmEvent& e : ev) {
@@ -285,7 +285,7 @@ void ShaftOutputs::publishAlarmEvents() {
         else log.warn("{}ALARM {} (t = {:.2f} s)", tag, text_, alarm_msg_.t);
         break;
       default:
-        if (!cause.user.empty()) log.info("{}alarm: {} (t = {:.2f} s, by '{}')", tag, text_, alarm_msg_.t, cause.user);
+        if (!by.user.empty()) log.info("{}alarm: {} (t = {:.2f} s, by '{}')", tag, text_, alarm_msg_.t, by.user);
         else log.info("{}alarm: {} (t = {:.2f} s)", tag, text_, alarm_msg_.t);
         break;
     }

@@ -9,9 +9,12 @@
 // into a fixed buffer; the std::string fields of the messages are reserved).
 #pragma once
 
+#include <array>
+
 #include <cstdint>
 #include <lcm/lcm-cpp.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "forecast_pool.hpp"
@@ -27,6 +30,24 @@
 namespace hoist::svc {
 
 using bus::UdpmSender;
+
+/// The operator command behind alarm events about to be published (their
+/// text and alarm_t.user name it).
+struct CommandCause {
+  std::string_view user;          ///< "" for the twin itself
+  double requested_shelve = 0.0;  ///< a shelve's requested duration [s]
+};
+
+/// What the alarm events' texts name besides the event: the latest
+/// forecast's and the shaft's memory's causes (kept by ShaftOutputs, set
+/// by the rooms that find them).
+struct AlarmCause {
+  const char* predicted_clearance_scenario = "";  ///< PREDICTED_CLEARANCE: the scenario that predicts it (static string)
+  const char* predicted_slack_scenario = "";      ///< PREDICTED_SLACK: the scenario that predicts it (static string)
+  double slack_threshold = 0.0;                   ///< PREDICTED_SLACK threshold of the latest forecast [N]
+  std::array<char, 240> preload_text{};           ///< GUIDE_PRELOAD_LOW: the trip room's latest text
+  std::array<char, 240> fingerprint_text{};       ///< SHAFT_FINGERPRINT: the trip room's latest text
+};
 
 class ShaftOutputs {
  public:
@@ -64,9 +85,23 @@ class ShaftOutputs {
   void publishCage(std::int64_t utime, bool batch = false);
   /// HOIST_ESTIMATE ([estimator] enabled), with every HOIST_CAGE.
   void publishEstimate(std::int64_t utime, bool batch = false);
-  /// Publishes and logs the model's pending alarm events (ctx.cause names
-  /// who caused them), then clears them.
-  void publishAlarmEvents();
+  /// Publishes and logs the model's pending alarm events, then clears them.
+  /// `by`: the operator command that caused them (none: the twin itself).
+  void publishAlarmEvents(const CommandCause& by = {});
+  /// What the next PREDICTED_* events name: the latest forecast's scenarios
+  /// (static strings, "" for none) and its slack threshold [N]
+  /// (ForecastScheduler, after each result).
+  void setForecastCause(const char* clearance_scenario, const char* slack_scenario, double slack_threshold) {
+    cause_.predicted_clearance_scenario = clearance_scenario;
+    cause_.predicted_slack_scenario = slack_scenario;
+    cause_.slack_threshold = slack_threshold;
+  }
+  /// What the next GUIDE_PRELOAD_LOW / SHAFT_FINGERPRINT events name: the
+  /// trip room's latest texts (ShaftTwin::applyCondition; copies, no allocation).
+  void setConditionTexts(const std::array<char, 240>& preload, const std::array<char, 240>& fingerprint) {
+    cause_.preload_text = preload;
+    cause_.fingerprint_text = fingerprint;
+  }
   /// HOIST_FORECAST from a forecast result.
   void publishForecast(const ForecastResult& r);
   /// The health message, for ShaftHealth to fill before publishHealth().
@@ -74,6 +109,7 @@ class ShaftOutputs {
   void publishHealth();
 
  private:
+  AlarmCause cause_;  ///< setForecastCause(), setConditionTexts()
   void publishShape(std::int64_t utime, bool batch);
   bool publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len, bool batch);
   template <class Msg>

@@ -70,8 +70,7 @@ void ShaftTwin::setTripPool(TripPool* pool) {
 void ShaftTwin::applyCondition() {
   const ConditionState* c = ctx_.trips->takeCondition();
   if (!c) return;
-  ctx_.cause.preload_text = c->preload_text;
-  ctx_.cause.fingerprint_text = c->fingerprint_text;
+  outputs_.setConditionTexts(c->preload_text, c->fingerprint_text);
   ctx_.detect = TripDetectability{c->detect_trip, c->loss30_separation, c->loss30_visible};
   ctx_.core.setCondition(c->preload, c->upper95, c->warning, c->critical, c->fingerprint, c->z, c->z_limit);
 }
