@@ -25,8 +25,9 @@ class TripRoom;
 
 using rt::RtLog;
 
-/// Operator names (alarm commands) are cut to this many printable characters.
-inline constexpr std::size_t kUserMax = 64;
+/// Operator names (alarm commands) are cut to this many printable
+/// characters: the contract's rule (hoist/contract/alarm_command.hpp).
+inline constexpr std::size_t kUserMax = contract::kMaxOperatorName;
 
 /// Test-only fault injection (hidden command-line options, tests/hardening).
 struct TestHooks {

@@ -11,6 +11,7 @@
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/health_t.hpp"
+#include "hoist/winder_t.hpp"
 #include "lcm_fixtures.hpp"
 
 using namespace hoist::test;
@@ -20,6 +21,22 @@ namespace {
 
 class PreloadAdoption : public LcmProcessTest {
  protected:
+  /// The winder at rest at the initial length for `seconds` (100 Hz): the
+  /// twin has a state, so its forecasts run (from the adopted model's solver
+  /// after the swap).
+  void winderAtRest(double seconds) {
+    for (int k = 0; k < static_cast<int>(seconds * 100); ++k) {
+      hoist::winder_t w{};
+      w.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                    std::chrono::system_clock::now().time_since_epoch()).count();
+      w.seq = seq_++;
+      w.has_length = true;
+      w.length = 50.0;
+      listener_->lcm().publish("HOIST_WINDER", &w);
+      listener_->waitFor([] { return false; }, 10ms);
+    }
+  }
+  std::int64_t seq_ = 0;
   bool healthSays(double scale, std::chrono::milliseconds within) {
     return listener_->waitFor(
         [&] {
@@ -62,6 +79,16 @@ TEST_F(PreloadAdoption, AnOperatorAdoptsAPreloadTheDaemonKeepsItAndRunsItAfterAR
     EXPECT_NE(readFile((dir_ / "ack.log").string()).find("sent ADOPT_PRELOAD x0.8 user=alice"), std::string::npos);
     // The twin rests at its initial length: the model is swapped in at once.
     EXPECT_TRUE(healthSays(0.8, 5s)) << readFile(log);
+    // The forecasts now start from the new solver and run the new model on
+    // their worker (the scheduler used to keep the old solver's address).
+    const std::int64_t forecasts0 = listener_->decoded<hoist::health_t>("HOIST_HEALTH").back().forecasts;
+    winderAtRest(3.0);
+    EXPECT_TRUE(listener_->waitFor(
+        [&] {
+          const auto h = listener_->decoded<hoist::health_t>("HOIST_HEALTH");
+          return !h.empty() && h.back().forecasts >= forecasts0 + 2 && h.back().preload_scale == 0.8;
+        },
+        5s)) << readFile(log);
     old_id = listener_->decoded<hoist::health_t>("HOIST_HEALTH").back().instance_id;
     stopDaemonCleanly(*d, log);
   }

@@ -294,6 +294,17 @@ TEST(Messages, PreloadAdoptionIsValidated) {
   EXPECT_EQ(hoist::contract::validateAlarmCommand("", 0, 7, 0.0, out), hoist::contract::CommandError::BadAction);
 }
 
+TEST(Messages, OneOperatorNameRuleForEveryFrontEnd) {
+  using hoist::contract::operatorNameProblem;
+  EXPECT_EQ(operatorNameProblem("alice"), nullptr);
+  EXPECT_EQ(operatorNameProblem(std::string(64, 'a')), nullptr);
+  EXPECT_EQ(operatorNameProblem("Zo\xc3\xab"), nullptr) << "UTF-8 letters are names";
+  EXPECT_STREQ(operatorNameProblem(""), "user must have 1..64 characters");
+  EXPECT_STREQ(operatorNameProblem(std::string(65, 'a')), "user must have 1..64 characters");
+  for (const char* bad : {"op\x1b[2J", "op\x7f", "op\xc2\x9b", "a\nb"})
+    EXPECT_STREQ(operatorNameProblem(bad), "user may not contain control characters") << bad;
+}
+
 TEST(Messages, SensorFaultTextNamesTheSensorAndWhy) {
   AlarmEvent e;
   e.kind = AlarmKind::SensorFault;

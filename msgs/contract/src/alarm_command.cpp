@@ -90,6 +90,18 @@ CommandError validateAlarmCommand(std::string_view kind, int level, int action, 
   return CommandError::None;
 }
 
+const char* operatorNameProblem(std::string_view user) {
+  if (user.empty() || user.size() > kMaxOperatorName) return "user must have 1..64 characters";
+  for (std::size_t i = 0; i < user.size(); ++i) {
+    const auto ch = static_cast<unsigned char>(user[i]);
+    if (ch < 0x20 || ch == 0x7f) return "user may not contain control characters";
+    // C1 controls U+0080..U+009F are C2 80..C2 9F in UTF-8.
+    if (ch == 0xc2 && i + 1 < user.size() && static_cast<unsigned char>(user[i + 1]) <= 0x9f)
+      return "user may not contain control characters";
+  }
+  return nullptr;
+}
+
 std::string printable(const std::string& s, std::size_t max) {
   std::string o;
   o.reserve(std::min(s.size(), max) + 3);

@@ -13,6 +13,7 @@
 
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/bus/channels.hpp"
+#include "hoist/contract/alarm_command.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/msg/names.hpp"
 
@@ -88,10 +89,10 @@ std::string validateAckFields(const std::string& kind, int level, int action, do
 }
 
 std::string validateCommandUser(const std::string& user) {
-  if (user.empty() || user.size() > 64) return "user must have 1..64 characters (enter your name)";
-  for (unsigned char ch : user)
-    if (ch < 0x20 || ch == 0x7f) return "user may not contain control characters";
-  return "";
+  // The contract's one rule (hoist-mqtt applies the same).
+  const char* why = contract::operatorNameProblem(user);
+  if (!why) return "";
+  return user.empty() || user.size() > contract::kMaxOperatorName ? std::string(why) + " (enter your name)" : why;
 }
 
 // ---- Hub ------------------------------------------------------------------------

@@ -42,15 +42,8 @@ const char* toString(CommandReject r) {
 }
 
 std::string checkUser(const std::string& user) {
-  if (user.empty() || user.size() > 64) return "user must have 1..64 characters";
-  for (std::size_t i = 0; i < user.size(); ++i) {
-    const auto ch = static_cast<unsigned char>(user[i]);
-    if (ch < 0x20 || ch == 0x7f) return "user may not contain control characters";
-    // C1 controls U+0080..U+009F are C2 80..C2 9F in UTF-8 (the JSON parser has checked UTF-8).
-    if (ch == 0xc2 && i + 1 < user.size() && static_cast<unsigned char>(user[i + 1]) <= 0x9f)
-      return "user may not contain control characters";
-  }
-  return "";
+  const char* why = hoist::contract::operatorNameProblem(user);  // the contract's one rule
+  return why ? why : "";
 }
 
 CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime,

@@ -81,6 +81,14 @@ CommandError validateAlarmCommand(std::string_view kind, int level, int action, 
 CommandError validateAlarmCommand(std::string_view kind, int level, int action, double shelve_duration,
                                   double known_fa, double known_b, double calibrate_duration, AlarmCommand& out);
 
+/// The operator-name rule, one for every front end: at most this many
+/// bytes (the daemon cuts a longer name from LCM to it, printable()).
+inline constexpr std::size_t kMaxOperatorName = 64;
+/// Why `user` is not an operator name a front end may send (hoist-mqtt,
+/// hoist-dash), or nullptr: 1..kMaxOperatorName bytes, no control character
+/// (C0, DEL, and the C1 controls U+0080..U+009F in UTF-8).
+const char* operatorNameProblem(std::string_view user);
+
 /// At most `max` characters of `s`, every byte outside printable ASCII
 /// replaced by '?', "..." appended when cut (for network strings in logs).
 std::string printable(const std::string& s, std::size_t max = 64);
