@@ -1,7 +1,6 @@
 // hoist-twind's event loop: see daemon.hpp.
 #include "daemon.hpp"
 
-#include <cctype>
 #include <algorithm>
 #include <csignal>
 #include <limits>
@@ -24,7 +23,6 @@ using std::chrono::duration_cast;
 
 using rt::nanos;
 using rt::processCpuNanos;
-
 
 Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     : opt_(std::move(opt)),
