@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Every command of the README's shell blocks, so that the README cannot drift.
+"""Every command of the README's shell blocks (and docs/deploy.md's), so that they cannot drift.
 
 Each command line of every ```sh block is either RUN (the fast ones: it must
 exit 0, run in a scratch directory with build/bin/ mapped to BIN_DIR and the
@@ -78,8 +78,12 @@ def commands(text):
     return out
 
 
-text = open(readme, encoding="utf-8").read()
-cmds = commands(text)
+# The README and the pages it hands a whole procedure to (docs/deploy.md: the
+# plant's install, units, network and timing test) are checked alike.
+pages = [readme, os.path.join(src_dir, "docs", "deploy.md")]
+texts = {pg: open(pg, encoding="utf-8").read() for pg in pages}
+text = "\n".join(texts.values())
+cmds = [(f"{os.path.basename(pg)}:{ln}", c) for pg, t in texts.items() for ln, c in commands(t)]
 check(len(cmds) >= 20, f"{len(cmds)} README commands found")
 
 shutil.rmtree(work, ignore_errors=True)
@@ -111,11 +115,11 @@ for line, cmd in cmds:
             rc, out = r.returncode, r.stdout[-3000:] + r.stderr[-3000:]
         except subprocess.TimeoutExpired:
             rc, out = -1, "timed out after 180 s"
-        check(rc == 0, f"README:{line}: exit {rc} in {time.monotonic() - t0:.1f} s: {bare}", out)
+        check(rc == 0, f"{line}: exit {rc} in {time.monotonic() - t0:.1f} s: {bare}", out)
         ran += 1
         continue
     why = next((reason for r, reason in SKIP if re.search(r, bare) or re.search(r, cmd)), None)
-    check(why is not None, f"README:{line}: classified: {bare}",
+    check(why is not None, f"{line}: classified: {bare}",
           "a README command no rule of tests/deploy/readme_test.py knows: add it to RUN or SKIP")
     if why:
         print(f"     skipped ({why})")
