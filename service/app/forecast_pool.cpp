@@ -28,12 +28,12 @@ ForecastResult resultPrototype() { return ForecastResult{}; }
 
 }  // namespace
 
-ForecastJob::ForecastJob(std::shared_ptr<const ShaftModel> model, const TwinConfig& cfg)
+ForecastJob::ForecastJob(std::shared_ptr<const ShaftModel> model, const TwinConfig& cfg, double preload_scale)
     : fc_(cfg.forecast),
       max_length_(cfg.shaft.maxRopeLength()),
       cfg_(cfg),
       ws_(std::make_unique<ForecastWorkspace>(model, optionsFor(cfg))),
-      ws_scale_(model->params().Tb1 == cfg.shaft.Tb1 ? 1.0 : model->params().Tb1 / cfg.shaft.Tb1),
+      ws_scale_(preload_scale),
       in_(ForecastSnapshot(model->n())),
       out_(resultPrototype()) {}
 
@@ -52,10 +52,8 @@ void ForecastJob::compute(const ForecastSnapshot& s, ForecastResult& r) {
   try {
     if (s.preload_scale != ws_scale_) {
       // An operator adopted another preload: forecast with the twin's model.
-      ShaftParams p = cfg_.shaft;
-      p.Tb1 *= s.preload_scale;
-      p.Tb2 *= s.preload_scale;
-      ws_ = std::make_unique<ForecastWorkspace>(std::make_shared<const ShaftModel>(p), optionsFor(cfg_));
+      ws_ = std::make_unique<ForecastWorkspace>(
+          std::make_shared<const ShaftModel>(withPreloadScale(cfg_.shaft, s.preload_scale)), optionsFor(cfg_));
       ws_scale_ = s.preload_scale;
     }
     const bool finite = std::isfinite(st.t) && std::isfinite(st.kin.l) && std::isfinite(st.kin.v) &&

@@ -30,6 +30,7 @@
 
 #include "hoist/forecast.hpp"
 #include "hoist/service/config.hpp"
+#include "hoist/service/twin_model.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
 
 namespace hoist::svc {
@@ -73,8 +74,9 @@ class ForecastJob {
  public:
   /// `dt` is the shaft's tick (1 / [service] rate); allocates everything
   /// here, and again (on the worker; on the loop with --clock input) when a
-  /// snapshot's preload_scale differs from the model's.
-  ForecastJob(std::shared_ptr<const ShaftModel> model, const TwinConfig& cfg);
+  /// snapshot's preload_scale differs from the model's.  `model` is `cfg`'s
+  /// shaft with its preloads times `preload_scale` (TwinCore::preloadScale).
+  ForecastJob(std::shared_ptr<const ShaftModel> model, const TwinConfig& cfg, double preload_scale = 1.0);
   ForecastJob(const ForecastJob&) = delete;
   ForecastJob& operator=(const ForecastJob&) = delete;
 

@@ -11,7 +11,7 @@ namespace hoist::svc {
 ForecastScheduler::ForecastScheduler(ShaftContext& ctx, ShaftOutputs& out) : ctx_(ctx), out_(out) {
   if (ctx_.core.solver().method() != Method::Fast)
     throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
-  job_ = std::make_unique<ForecastJob>(ctx_.core.solver().modelPtr(), ctx_.cfg);
+  job_ = std::make_unique<ForecastJob>(ctx_.core.solver().modelPtr(), ctx_.cfg, ctx_.core.preloadScale());
   if (ctx_.core.loadSensitivity()) unit_ = FastSolverState(ctx_.core.solver().model().n());
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
 }

@@ -18,12 +18,16 @@ PlausibilityBounds twinPlausibilityBounds(const TwinConfig& cfg, const ShaftPara
   return plausibilityBounds(shaft, lateral);
 }
 
+ShaftParams withPreloadScale(ShaftParams shaft, double scale) {
+  shaft.Tb1 *= scale;
+  shaft.Tb2 *= scale;
+  return shaft;
+}
+
 std::unique_ptr<TwinModel> buildTwinModel(const TwinConfig& cfg, double scale) {
   if (!(std::isfinite(scale) && scale > 0.0))
     throw std::invalid_argument("preload scale " + std::to_string(scale) + ": must be a finite number > 0");
-  ShaftParams p = cfg.shaft;
-  p.Tb1 *= scale;
-  p.Tb2 *= scale;
+  const ShaftParams p = withPreloadScale(cfg.shaft, scale);
   p.validate();
   auto m = std::make_unique<TwinModel>(scale, makeSolver(Method::Fast, std::make_shared<const ShaftModel>(p)),
                                        cfg.service.envelope_points, cfg.service.shape_points);

@@ -39,6 +39,10 @@ struct TwinModel {
   LoadEstimator::Model estimator;    ///< its unit-load solvers ([estimator] enabled; else empty)
 };
 
+/// `shaft` with both guide-rope preloads (Tb1, Tb2) times `scale`: the one
+/// definition of an adopted preload (the twin's model and the forecasts').
+ShaftParams withPreloadScale(ShaftParams shaft, double scale);
+
 /// The model of `cfg`'s shaft with both guide-rope preloads times `scale`
 /// (> 0; the operator's bounds are the contract's kMinPreloadScale ..
 /// kMaxPreloadScale).  Allocates.  Throws ParamError / std::invalid_argument
