@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 
@@ -22,6 +23,11 @@ void readKeyValueFile(const std::string& path,
                       const std::function<void(int line, const std::string& key, const std::string& value)>& take) {
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "", "cannot open");
+  // A state file is a few lines: its size is checked before a line is read
+  // (getline would grow a string over a file without newlines).
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size > kMaxKeyValueFileBytes) throw InputError(path, 0, "", "larger than 64 KiB: not a state file");
   std::set<std::string> seen;
   std::string line;
   int no = 0;

@@ -255,6 +255,8 @@ TEST(PreloadKeeper, ADamagedOrOutOfRangeStateFileIsIgnoredNamingItsKey) {
   EXPECT_NE(log.str().find("given twice"), std::string::npos) << log.str();
   EXPECT_EQ(tryFile("preload_scale = 0.1\nadopted_utime = 1\nadopted_by = a\n"), nullptr);
   EXPECT_NE(log.str().find("outside [0.3, 1.6]"), std::string::npos) << log.str();
+  EXPECT_EQ(tryFile(std::string(100000, 'x')), nullptr) << "a file without newlines is refused by its size";
+  EXPECT_NE(log.str().find("larger than 64 KiB"), std::string::npos) << log.str();
   EXPECT_NE(tryFile("# ok\npreload_scale = 0.8\nadopted_utime = 1\nadopted_by = a b\n"), nullptr) << log.str();
   // Without a state directory the adoption works and says it is not kept.
   TwinCore core(cfg, ClockMode::Input);
