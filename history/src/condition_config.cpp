@@ -25,6 +25,7 @@ ConditionSettings conditionSettingsFromToml(const toml::table& root, const std::
   r.number("preload_warning", c.preload_warning);
   r.number("preload_critical", c.preload_critical);
   r.number("trend_walk", c.trend_walk);
+  r.number("model_check_sigma", c.model_check_sigma);
   r.integer("seed_trips", c.seed_trips, -1000000, 1000000000);
   detail::runValidated(r, source, [&c] { c.validate(); });
   // The preload fit carries the accelerometer's offset as the estimator

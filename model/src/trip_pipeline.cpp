@@ -19,6 +19,8 @@ void ConditionSettings::validate() const {
   if (baseline_trips < 2) bad("condition.baseline_trips", baseline_trips, "must be >= 2 (a spread needs two trips)");
   if (!(std::isfinite(fingerprint_sigma) && fingerprint_sigma > 0.0))
     bad("condition.fingerprint_sigma", fingerprint_sigma, "must be > 0");
+  if (!(std::isfinite(model_check_sigma) && model_check_sigma >= 2.0))
+    bad("condition.model_check_sigma", model_check_sigma, "must be >= 2 (sigma; below that healthy trips raise it)");
   if (!(std::isfinite(preload_warning) && preload_warning > 0.0 && preload_warning < 1.0))
     bad("condition.preload_warning", preload_warning, "must be in (0, 1)");
   if (!(std::isfinite(preload_critical) && preload_critical > 0.0 && preload_critical < preload_warning))

@@ -252,11 +252,15 @@ void ShaftOutputs::publishAlarmEvents(const CommandCause& by) {
   tc.predicted_slack_scenario = cause.predicted_slack_scenario;
   tc.slack_threshold = cause.slack_threshold;
   if (const LoadEstimate* est = core.estimate())
-    tc.mismatch_test = est->nis_exceeded ? "nis" : est->drift_exceeded ? "drift" : "";
+    tc.mismatch_test = est->nis_exceeded    ? "nis"
+                       : est->drift_exceeded ? "drift"
+                       : core.preloadMismatch() ? "preload"
+                                                : "";
   tc.sensor = core.lastSensorFault().sensor;
   tc.sensor_reason = core.lastSensorFault().reason;
   tc.preload_text = cause.preload_text.data();
   tc.fingerprint_text = cause.fingerprint_text.data();
+  tc.preload_verdict_text = cause.preload_verdict_text.data();
   alarm_msg_.user.assign(by.user.data(), by.user.size());  // who caused these events ("" for the twin itself)
   RtLog& log = ctx_.log;
   const std::string& tag = ctx_.tag;

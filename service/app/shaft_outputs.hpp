@@ -47,6 +47,7 @@ struct AlarmCause {
   double slack_threshold = 0.0;                   ///< PREDICTED_SLACK threshold of the latest forecast [N]
   std::array<char, 240> preload_text{};           ///< GUIDE_PRELOAD_LOW: the trip room's latest text
   std::array<char, 240> fingerprint_text{};       ///< SHAFT_FINGERPRINT: the trip room's latest text
+  std::array<char, 240> preload_verdict_text{};   ///< MODEL_MISMATCH's trip-end preload test: its sentence
 };
 
 class ShaftOutputs {
@@ -102,6 +103,8 @@ class ShaftOutputs {
     cause_.preload_text = preload;
     cause_.fingerprint_text = fingerprint;
   }
+  /// What the next MODEL_MISMATCH event of the trip-end preload test names.
+  void setPreloadVerdictText(const std::array<char, 240>& text) { cause_.preload_verdict_text = text; }
   /// HOIST_FORECAST from a forecast result.
   void publishForecast(const ForecastResult& r);
   /// The health message, for ShaftHealth to fill before publishHealth().

@@ -73,6 +73,15 @@ void ShaftTwin::applyCondition() {
   outputs_.setConditionTexts(c->preload_text, c->fingerprint_text);
   ctx_.detect = TripDetectability{c->detect_trip, c->loss30_separation, c->loss30_visible};
   ctx_.core.setCondition(c->preload, c->upper95, c->warning, c->critical, c->fingerprint, c->z, c->z_limit);
+  // MODEL_MISMATCH's trip-end preload test: each verdict once (an adoption
+  // drops the one in force; a re-publication of it must not raise it again),
+  // and only on the preload it judged (one that arrives after an adoption
+  // judged the replaced model).
+  if (c->verdict_trip != verdict_applied_ && c->verdict_twin_scale == ctx_.core.preloadScale()) {
+    verdict_applied_ = c->verdict_trip;
+    outputs_.setPreloadVerdictText(c->verdict_text);
+    ctx_.core.setPreloadVerdict(c->verdict_mismatch, c->verdict_z, c->verdict_limit);
+  }
 }
 
 void ShaftTwin::stopTrips() {

@@ -168,6 +168,7 @@ class ShaftTwin {
   LogRateLimiter<1> log_limit_{5};               ///< rate limit of the tick's warning lines
   bool fault_injected_ = false;                  ///< TestHooks::inject_fault_at has fired
   bool slow_tick_done_ = false;                  ///< TestHooks::slow_tick_at has fired
+  std::int64_t verdict_applied_ = 0;             ///< ConditionState::verdict_trip last applied
   /// A pending start within the tick's budget (model time t of the tick).
   void startWithinBudget(double t, double wall, int& starts_left);
   bool envelope_budget_ = false;  ///< [service] max_exact_envelopes_per_tick applies (wall clock, > 0)

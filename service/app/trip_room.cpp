@@ -85,6 +85,8 @@ struct TripRoom::Worker {
   std::int64_t detect_trip = 0;     // the last recorded trip (ConditionState)
   double loss30_separation = -1.0;
   bool loss30_visible = false;
+  std::int64_t verdicts = 0;        // trips that judged the twin's preload (ConditionState::verdict_trip)
+  PreloadVerdict verdict;           // the last of them
 };
 
 TripRoom::TripRoom(const TwinConfig& cfg, const TripHistoryConfig& hist, std::string shaft_name, std::size_t capacity)
@@ -118,6 +120,7 @@ void TripRoom::afterStep(const TwinCore& core, std::int64_t wall_us) {
   for (const BinaryAlarm& a : core.alarms().alarms())
     if (a.active()) bits |= 1u << static_cast<unsigned>(a.kind());
   t.alarms = bits;
+  t.twin_preload_scale = core.preloadScale();
   if (ring_.push(t)) counts_.ticks.fetch_add(1, std::memory_order_relaxed);
   else counts_.dropped.fetch_add(1, std::memory_order_relaxed);
 }
@@ -198,6 +201,12 @@ void TripRoom::publishCondition() {
   c.detect_trip = w.detect_trip;
   c.loss30_separation = w.loss30_separation;
   c.loss30_visible = w.loss30_visible;
+  c.verdict_trip = w.verdicts;
+  c.verdict_mismatch = w.verdict.mismatch;
+  c.verdict_z = w.verdict.z;
+  c.verdict_limit = w.verdict.limit;
+  c.verdict_twin_scale = w.verdict.twin_scale;
+  describe(w.verdict, c.verdict_text.data(), c.verdict_text.size());
   std::snprintf(c.preload_text.data(), c.preload_text.size(), "%s", p.text.c_str());
   std::snprintf(c.fingerprint_text.data(), c.fingerprint_text.size(), "%s", f.text.c_str());
   condition_.publish();
@@ -280,6 +289,20 @@ void TripRoom::finishTrip() {
     }
   }
   r.trip = number > 0 ? number : w.judge.lastTrip() + 1;
+  // MODEL_MISMATCH's trip-end test: this trip's preload against the twin's.
+  const PreloadVerdict v = judgeTripPreload(r.id, now.twin_preload_scale, w.cond_settings.model_check_sigma);
+  if (v.judged) {
+    const bool was = w.verdicts > 0 && w.verdict.mismatch;
+    w.verdict = v;
+    ++w.verdicts;
+    char text[320];
+    describe(v, text, sizeof text);
+    if (v.mismatch || was)
+      log->warn("{}trip {}: {}{}", tag, r.trip, text,
+                v.mismatch ? ": MODEL_MISMATCH" : ": MODEL_MISMATCH's trip-end test passes again");
+    else
+      log->info("{}trip {}: {}", tag, r.trip, text);
+  }
   try {  // never out of the worker: a record the judge refuses is logged, the trip still stored
     const ConditionLevel before = w.judge.preload().level;
     const bool finger_before = w.judge.fingerprint().active;
@@ -293,6 +316,7 @@ void TripRoom::finishTrip() {
   } catch (const std::exception& e) {
     log->error("{}shaft condition: trip {} could not be judged ({}); the condition alarms stay as they were", tag,
                r.trip, e.what());
+    if (v.judged) publishCondition();  // the trip-end preload verdict still reaches the loop
   }
   if (number <= 0) r.trip = 0;
   if (!w.store) {

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "hoist/load_estimator.hpp"
+#include "hoist/preload_verdict.hpp"
 #include "hoist/trip_accumulator.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
 #include "hoist/service/config.hpp"
@@ -59,6 +60,7 @@ struct TripTick {
   double guide_deflection = 0.0;   ///< the guide-rope envelope's deflection [m]
   std::int64_t wall_us = 0;        ///< wall clock of the step [us since the epoch]
   std::uint32_t alarms = 0;        ///< bit k: AlarmKind k active
+  double twin_preload_scale = 1.0; ///< the guide-rope preload scale the twin ran (TwinCore::preloadScale)
 };
 
 /// The condition alarms' inputs, from the worker to the loop (fixed size).
@@ -76,6 +78,15 @@ struct ConditionState {
   bool loss30_visible = false;
   std::array<char, 240> preload_text{};   ///< the trend's text (cut to fit)
   std::array<char, 240> fingerprint_text{};
+  /// MODEL_MISMATCH's trip-end preload test (hoist/preload_verdict.hpp): the
+  /// last trip that judged it.  verdict_trip counts the verdicts (0: none
+  /// yet): the loop applies a verdict once, so one it dropped after an
+  /// adoption is not raised again by the next publication.
+  std::int64_t verdict_trip = 0;
+  bool verdict_mismatch = false;
+  double verdict_z = 0.0, verdict_limit = 4.0;
+  double verdict_twin_scale = 1.0;  ///< the twin's preload scale the verdict judged
+  std::array<char, 240> verdict_text{};
 };
 
 /// Fixed-capacity SPSC ring of TripTick (lock-free; one producer thread,

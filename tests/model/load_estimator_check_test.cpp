@@ -11,6 +11,9 @@
 #include <random>
 
 #include "hoist/load_estimator.hpp"
+#include "hoist/preload_identification.hpp"
+#include "hoist/preload_verdict.hpp"
+#include "hoist/trip_pipeline.hpp"
 #include "sensor_truth.hpp"
 
 using namespace hoist;
@@ -119,31 +122,48 @@ TEST(LoadEstimatorCheck, HealthyTripsWithVibrationNeverRaiseMismatch) {
 }
 
 // Both guide-rope preloads 30 % low, an industrial IMU with vibration of half
-// and of once its white noise: MODEL_MISMATCH rises during the trip in at
-// least 8 of 10 seeds at either level (the vibration changes nothing: the
-// misses are the constancy test's power at this white noise, see
-// docs/estimation.md's table).
+// and of once its white noise: MODEL_MISMATCH rises in every seed at either
+// level -- during the trip by the estimator's constancy test in at least 8
+// of 10 (its misses are its power at this white noise, see
+// docs/estimation.md's table; the vibration changes nothing), and at the
+// trip's end by the trip-end preload test (hoist/preload_verdict.hpp, as
+// hoist-twind's trip room runs it) in 9 of 10 (measured: |z| 5.9-11.2 but
+// seed 201's 3.0-3.4, which the constancy test sees at 50.7 s); together,
+// every seed (seeds 205 and 209, which the constancy test misses or sees
+// only at the arrival, have |z| 9.0-10.4 and 6.3-7.3).
 TEST(LoadEstimatorCheck, WeakPreloadsWithVibrationRaiseMismatch) {
   ShaftParams shaft = config();
   shaft.Tb1 = shaft.Tb2 = 0.7 * 30000.0;
   const CleanTruth tr = simulate(shaft, HoistProfile::trapezoid(), {1500.0, 0.6}, 100);
   // A calibrated IMU (imu_accel_offset_sigma = 0, or an offset learned by a
   // calibration): with the offset free the constancy test's short memory
-  // cannot tell M's depth shape from the offset (measured: 0 of 10 seeds).
+  // cannot tell M's depth shape from the offset (measured: 0 of 10 seeds;
+  // the trip-end test then sees 7 of 10: PreloadVerdict.*).
   EstimatorSettings set;
   set.accel_offset_sigma = 0.0;
+  PreloadFitOptions fit;
+  fit.accel_offset_sigma = 0.0;
+  fit.max_step = 0.0025;
+  const double limit = ConditionSettings{}.model_check_sigma;
   for (double vib : {0.5, 1.0}) {
-    int detected = 0, n = 0;
+    int in_trip = 0, raised = 0, n = 0;
     for (unsigned seed = 200; seed < 210; ++seed) {
-      const Outcome o = run(config(), measure(tr, industrial(vib), seed), set);
+      const auto meas = measure(tr, industrial(vib), seed);
+      const Outcome o = run(config(), meas, set);
+      const PreloadVerdict v = judgeTripPreload(identifyPreload(config(), set, fit, meas).id, 1.0, limit);
       ++n;
-      const bool in_trip = o.first_mismatch >= 0.0 && o.first_mismatch < 55.0;
-      if (in_trip) ++detected;
-      std::printf("[ weak preloads, vibration %.1f, seed %u ] MODEL_MISMATCH at %.2f s, drift max %.2f, NIS/dof max %.2f\n",
-                  vib, seed, o.first_mismatch, o.max_drift, o.max_nis_ratio);
+      const bool during = o.first_mismatch >= 0.0 && o.first_mismatch < 55.0;
+      if (during) ++in_trip;
+      if (during || v.mismatch) ++raised;
+      std::printf("[ weak preloads, vibration %.1f, seed %u ] MODEL_MISMATCH at %.2f s, drift max %.2f, NIS/dof max "
+                  "%.2f; trip end: s %.3f +- %.3f, z %+.2f%s\n",
+                  vib, seed, o.first_mismatch, o.max_drift, o.max_nis_ratio, v.scale, v.sigma_scale, v.z,
+                  v.mismatch ? " MODEL_MISMATCH" : "");
     }
-    std::printf("[ weak preloads, vibration %.1f ] detected during the trip in %d of %d seeds\n", vib, detected, n);
-    EXPECT_GE(detected, 8) << "vibration " << vib;
+    std::printf("[ weak preloads, vibration %.1f ] during the trip in %d of %d seeds, by the trip's end in %d\n", vib,
+                in_trip, n, raised);
+    EXPECT_GE(in_trip, 8) << "vibration " << vib;
+    EXPECT_EQ(raised, n) << "vibration " << vib << ": MODEL_MISMATCH in every seed";
   }
 }
 

@@ -109,6 +109,18 @@ TEST(Messages, ModelMismatchTextNamesItsTestAndIsCutAtAWord) {
   t = buf;
   EXPECT_NE(t.find("load drifted 4.2 sigma during the trip (bound 3.5)"), std::string::npos) << t;
   EXPECT_EQ(t.find("NIS"), std::string::npos) << t;
+  // The trip-end preload test: its own sentence after the kind (it fits
+  // alarm_t.message whole).
+  ctx.mismatch_test = "preload";
+  ctx.preload_verdict_text =
+      "whole-trip fit: preload x0.59 +- 0.03, 14.3 sigma from the twin's x1 (bound 4): shaft softer, moment reads high "
+      "(fit: M = 894 +- 34 N m); adopt (hoist-alarm-ack --adopt-preload) or re-tension";
+  e.shelved = e.latched = e.from_estimate = false;
+  describeAlarm(e, ctx, buf, sizeof buf);
+  t = buf;
+  EXPECT_EQ(t, std::string("MODEL_MISMATCH WARNING raised: ") + ctx.preload_verdict_text + " [unacknowledged]") << t;
+  ctx.mismatch_test = "drift";
+  e.shelved = e.latched = e.from_estimate = true;
   // Too long for the buffer: cut at a word, marked "...".
   char small[80];
   describeAlarm(e, ctx, small, sizeof small);

@@ -117,7 +117,7 @@ TEST(TwinModel, ATwinThatAdoptedAPreloadAtRestRunsAsATwinConfiguredWithIt) {
     for (TwinCore* c : {&adopted, &configured, &plain}) Trip::feed(*c, k, nominal.shaft.l0);
     const CageOutput &a = adopted.output(), &b = configured.output(), &p = plain.output();
     ASSERT_DOUBLE_EQ(a.kin.l, b.kin.l);
-    for (const auto [x, y, z] : {std::tuple{a.y_c, b.y_c, p.y_c}, std::tuple{a.theta, b.theta, p.theta},
+    for (const auto& [x, y, z] : {std::tuple{a.y_c, b.y_c, p.y_c}, std::tuple{a.theta, b.theta, p.theta},
                                  std::tuple{a.lambda[1], b.lambda[1], p.lambda[1]},
                                  std::tuple{a.clearance.guide_deflection, b.clearance.guide_deflection,
                                             p.clearance.guide_deflection}}) {
@@ -160,6 +160,48 @@ TEST(TwinModel, TheEstimatorsLoadsAndOffsetCarryOverAnAdoption) {
   EXPECT_THROW(core.adoptModel(wrong), std::invalid_argument);
   EXPECT_EQ(core.preloadScale(), 0.8);
   EXPECT_EQ(wrong->preload_scale, 0.9);
+}
+
+// MODEL_MISMATCH's trip-end preload test (hoist/preload_verdict.hpp) in the
+// twin: a verdict raises MODEL_MISMATCH at the next step, with |z| against
+// its bound, and keeps the estimate out of the alarms; a consistent one
+// clears it; an adoption drops it (it judged the old preload).
+TEST(TwinModel, ATripEndPreloadVerdictRaisesModelMismatchUntilAnAdoption) {
+  const TwinConfig cfg = smallConfig();
+  TwinCore core(cfg, ClockMode::Input);
+  for (int k = 0; k <= 20; ++k) Trip::feed(core, k, cfg.shaft.l0);
+  auto mismatchEvent = [&core](AlarmEventType type) -> const AlarmEvent* {
+    for (const AlarmEvent& e : core.events())
+      if (e.kind == AlarmKind::ModelMismatch && e.type == type) return &e;
+    return nullptr;
+  };
+  core.clearEvents();
+  core.setPreloadVerdict(true, -5.8, 4.0);
+  EXPECT_TRUE(core.preloadMismatch());
+  Trip::feed(core, 21, cfg.shaft.l0);
+  const AlarmEvent* raise = mismatchEvent(AlarmEventType::Raise);
+  ASSERT_NE(raise, nullptr) << "MODEL_MISMATCH rises at the next step";
+  EXPECT_DOUBLE_EQ(raise->value, 5.8);
+  EXPECT_DOUBLE_EQ(raise->threshold, 4.0);
+  EXPECT_FALSE(core.estimateInUse()) << "the estimate does not judge the alarms meanwhile";
+  EXPECT_TRUE(core.estimateGate().notUsed() & kNotUsedMismatch);
+  // Held from step to step (no clear while the verdict stands).
+  core.clearEvents();
+  for (int k = 22; k <= 30; ++k) Trip::feed(core, k, cfg.shaft.l0);
+  EXPECT_EQ(mismatchEvent(AlarmEventType::Clear), nullptr);
+  // A consistent trip clears it.
+  core.setPreloadVerdict(false, -0.4, 4.0);
+  Trip::feed(core, 31, cfg.shaft.l0);
+  EXPECT_NE(mismatchEvent(AlarmEventType::Clear), nullptr);
+  // An adoption drops a verdict in force.
+  core.setPreloadVerdict(true, -5.8, 4.0);
+  Trip::feed(core, 32, cfg.shaft.l0);
+  core.clearEvents();
+  auto m = buildTwinModel(cfg, 0.7);
+  core.adoptModel(m);
+  EXPECT_FALSE(core.preloadMismatch());
+  Trip::feed(core, 33, cfg.shaft.l0);
+  EXPECT_NE(mismatchEvent(AlarmEventType::Clear), nullptr) << "the adoption's model is judged by the next trip";
 }
 
 TEST(PreloadKeeper, AnAdoptionIsBuiltOffTheLoopUsedAtRestKeptAndReadBackAtTheNextStart) {

@@ -312,6 +312,9 @@ TEST_F(EstimateCli, KnownLoadAndOffsetFiles) {
 // -- computed by the daemon's TripRecorder on the same estimates; none with
 // --no-trips or -q.  A config whose sensor noise is far below the data's
 // makes many load changes: the summary lists the first 8 and counts the rest.
+// The same lines carry MODEL_MISMATCH's trip-end preload test
+// (hoist/preload_verdict.hpp): quiet on the healthy trip, firing on one
+// whose guide ropes are at x0.6.
 TEST_F(EstimateCli, EachTripStatesWhetherTheImuCanSeeAPreloadLoss) {
   // 5 s at rest, 150 m down (vmax 5, amax 1), 15 s at rest.
   std::string prof = "t,v,a\n";
@@ -342,6 +345,25 @@ TEST_F(EstimateCli, EachTripStatesWhetherTheImuCanSeeAPreloadLoss) {
                                                 R"(this IMU can(not)? see a 30 % preload loss on this trip)")))
       << all;
   EXPECT_EQ(all.find("trip 2"), std::string::npos) << all;
+  // MODEL_MISMATCH's trip-end preload test on this healthy trip: quiet.
+  EXPECT_EQ(all.find("trip-end preload test fired"), std::string::npos) << all;
+  EXPECT_EQ(all.find(": MODEL_MISMATCH."), std::string::npos) << all;
+  // ... and on the same trip with both guide ropes at x0.6 (a calibrated IMU):
+  // it fires, naming the preload the trip fits.
+  const std::string weak = write("weak.toml", "[guide_ropes]\npreload = [18000.0, 18000.0]\n[load]\n"
+                                              "eccentric_force = 1500.0\noffset = 0.6\n");
+  ASSERT_EQ(sim({"--config", weak, "--profile", path("rest_trip.csv"), "--initial", "static", "--modes", "50",
+                 "--write-measurements", path("weak.csv"), "--seed", "4", "-q"})
+                .status,
+            0);
+  const std::string cal = write("cal.toml", "[model]\nmodes = 25\n[sensors]\nimu_accel_offset_sigma = 0.0\n");
+  const CapturedRun w = estimate({"--config", cal, "--measurements", path("weak.csv"), "--out", path("w.csv")});
+  ASSERT_EQ(w.status, 0) << w.output;
+  EXPECT_TRUE(std::regex_search(w.output, std::regex(R"(trip 1 \(down[^\n]*whole-trip fit: preload x0\.[56][0-9] \+- )"
+                                                     R"([^\n]*shaft softer, moment reads high[^\n]*: MODEL_MISMATCH\.)")))
+      << w.output;
+  EXPECT_NE(w.output.find("MODEL_MISMATCH's trip-end preload test fired on 1 of 1 trips"), std::string::npos)
+      << w.output;
 
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> a = base;

@@ -52,6 +52,7 @@
 #include "hoist/io/results.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/profile.hpp"
+#include "hoist/preload_verdict.hpp"
 #include "hoist/trip_recorder.hpp"
 
 namespace {
@@ -244,11 +245,10 @@ int run(const Options& o) {
   // (identifyPreload: about a second of CPU per trip at n = 25).  Only for
   // the summary: not with -q or --no-trips.
   std::optional<hoist::TripRecorder> trips;
-  if (!o.quiet && !o.no_trips) {
-    hoist::ConditionSettings cond;
-    cond.accel_offset_sigma = set.accel_offset_sigma;
-    trips.emplace(p, set, cond, max_step);
-  }
+  hoist::ConditionSettings trip_cond;
+  trip_cond.accel_offset_sigma = set.accel_offset_sigma;
+  long verdict_mismatches = 0;
+  if (!o.quiet && !o.no_trips) trips.emplace(p, set, trip_cond, max_step);
   std::vector<std::string> trip_lines;
   std::size_t sample_index = 0;  // estimateRecorded reports once per sample, in order
   try {
@@ -257,10 +257,17 @@ int run(const Options& o) {
         [&](const hoist::LoadEstimate& e, const hoist::EstimatorCounters& c) {
           if (trips && sample_index < samples.size() && trips->add(samples[sample_index], e)) {
             const hoist::TripRecord& r = trips->record();
+            // MODEL_MISMATCH's trip-end preload test, as hoist-twind's trip room judges it.
+            const hoist::PreloadVerdict v = hoist::judgeTripPreload(r.id, 1.0, trip_cond.model_check_sigma);
+            char verdict[320];
+            hoist::describe(v, verdict, sizeof verdict);
+            if (v.mismatch) ++verdict_mismatches;
             trip_lines.push_back("trip " + std::to_string(r.trip) + " (" +
                                  (r.direction == hoist::TripDirection::Down ? "down " : "up ") +
                                  fmt("%.0f", r.depth_start) + " -> " + fmt("%.0f", r.depth_end) + " m, t = " +
-                                 fmt("%.1f", r.t_start) + " .. " + fmt("%.1f", r.t_end) + " s): " + r.id.note);
+                                 fmt("%.1f", r.t_start) + " .. " + fmt("%.1f", r.t_end) + " s): " + r.id.note +
+                                 (v.judged ? std::string("; ") + verdict + (v.mismatch ? ": MODEL_MISMATCH" : "")
+                                           : std::string()));
           }
           ++sample_index;
           line.clear();
@@ -350,6 +357,10 @@ int run(const Options& o) {
       if (trip_lines.empty())
         s << "hoist-estimate: no whole trip in the data (rest, motion, rest): no preload detectability to state.\n";
       for (const std::string& t : trip_lines) s << "hoist-estimate: " << t << ".\n";
+      if (verdict_mismatches > 0)
+        s << "hoist-estimate: MODEL_MISMATCH's trip-end preload test fired on " << verdict_mismatches << " of "
+          << trip_lines.size() << " trips (the MODEL_MISMATCH column holds the estimator's own tests only; "
+          << "hoist-twind with [history] raises it after such a trip).\n";
     }
     std::cout << s.str();
   }
@@ -394,8 +405,9 @@ int main(int argc, char** argv) {
   app.add_option("--offset-out", o.offset_out, "write the learned accelerometer offset and its sigma to FILE");
   app.add_flag("--progress", o.progress, "show progress on stderr");
   app.add_flag("--no-trips", o.no_trips,
-               "do not state per trip whether the IMU could see a 30 % guide-rope preload loss (that identifies "
-               "the preload scale of each trip: about 1 s of CPU per trip at n = 25)");
+               "do not state per trip whether the IMU could see a 30 % guide-rope preload loss, nor "
+               "MODEL_MISMATCH's trip-end preload test (both identify the preload scale of each trip: about 1 s "
+               "of CPU per trip at n = 25)");
   app.add_flag("-q,--quiet", o.quiet, "no summary and no warnings");
   try {
     app.parse(argc, argv);

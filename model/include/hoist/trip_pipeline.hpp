@@ -36,6 +36,10 @@ struct ConditionSettings {
   double preload_warning = 0.85;    ///< condition.preload_warning: GUIDE_PRELOAD_LOW WARNING below (95 % confidence)
   double preload_critical = 0.70;   ///< condition.preload_critical: ... CRITICAL below (95 % confidence)
   double trend_walk = 0.05;         ///< condition.trend_walk: random walk of s between trips (sigma per trip)
+  /// condition.model_check_sigma: MODEL_MISMATCH when a trip's whole-trip fit
+  /// puts the preload scale more than this many of its sigmas from the scale
+  /// the twin runs (hoist/preload_verdict.hpp).
+  double model_check_sigma = 4.0;
   /// condition.seed_trips: the newest stored trips a judge reads at start
   /// (plus the baseline before them; hoist/history/judged_history.hpp); 0: all.
   int seed_trips = 500;

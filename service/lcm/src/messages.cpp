@@ -72,7 +72,9 @@ void toEstimateMessage(const LoadEstimate& e, const EstimatorCounters& c, double
   m.nis_upper = e.nis_upper;
   m.nis_bound = e.nis_bound;
   m.drift = e.drift;
-  m.mismatch = e.mismatch;
+  // The estimator's own tests, or the trip-end preload test (TwinCore::
+  // setPreloadVerdict), which keeps the estimate out of the alarms as they do.
+  m.mismatch = e.mismatch || (gate.notUsed() & kNotUsedMismatch) != 0;
   m.nis_exceeded = e.nis_exceeded;
   m.drift_exceeded = e.drift_exceeded;
   m.sensors = static_cast<int32_t>(e.sensors);
@@ -228,6 +230,8 @@ void describeAlarmWhole(const AlarmEvent& e, const AlarmTextContext& ctx, char* 
                       "%.3g sigma during the trip (bound %.3g); check the load, guide-rope preloads and the "
                       "sensors%s",
                       kind, level, verb, e.value, e.threshold, state);
+      else if (std::strcmp(ctx.mismatch_test, "preload") == 0)
+        std::snprintf(buf, n, "%s %s %s: %s%s", kind, level, verb, ctx.preload_verdict_text, state);
       else
         std::snprintf(buf, n, "%s %s %s: the shaft does not behave like its model (statistic %.4g, bound %.4g: "
                       "the windowed NIS or the load drift, see HOIST_ESTIMATE)%s",

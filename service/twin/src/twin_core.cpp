@@ -99,6 +99,7 @@ void TwinCore::adoptModel(std::unique_ptr<TwinModel>& m) {
   std::swap(bounds_, m->bounds);
   std::swap(cfg_.shaft, m->shaft);
   std::swap(preload_scale_, m->preload_scale);
+  preload_mismatch_ = false;  // the trip-end verdict judged the old preload
   if (!started_) return;  // the first start initializes the new model
   // The new model's equilibrium at the current kinematics (the caller swaps
   // at rest, where the state is static); the estimator's loads carry over.
@@ -286,8 +287,11 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
         }
         judged = &gate_.step(t, not_used == 0, not_used, est, open, est_->counters().load_changes, e.Fa, e.moment);
         est_in_use_ = gate_.inUse();
-        alarms_.setModelMismatch(t, e.mismatch, e.nis_exceeded ? e.nis_window : e.drift,
-                                 e.nis_exceeded ? e.nis_bound : est_->settings().drift_sigma, events_);
+        if (e.mismatch)
+          alarms_.setModelMismatch(t, true, e.nis_exceeded ? e.nis_window : e.drift,
+                                   e.nis_exceeded ? e.nis_bound : est_->settings().drift_sigma, events_);
+        else  // the trip-end preload test, or neither
+          alarms_.setModelMismatch(t, preload_mismatch_, std::abs(preload_z_), preload_limit_, events_);
       }
       alarms_.setSensorFault(t, t < sensor_fault_until_, sensor_fault_.value, sensor_fault_.limit, events_);
       out_.clearance = judged->clearance;

@@ -95,7 +95,7 @@ void TwinCore::estimatorStep(const CageResponse& r) {
 unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
   unsigned why = 0;
   if (e.sensors == 0) why |= kNotUsedNoSensors;
-  if (e.mismatch) why |= kNotUsedMismatch;
+  if (e.mismatch || preload_mismatch_) why |= kNotUsedMismatch;
   if (!(std::isfinite(e.y_c) && std::isfinite(e.theta) && std::isfinite(e.lambda[0]) && std::isfinite(e.Fa) &&
         std::isfinite(e.moment)))
     return why | kNotUsedNonFinite;

@@ -46,8 +46,11 @@ struct AlarmTextContext {
   const char* predicted_slack_scenario = "";
   double slack_threshold = 0.0;
   /// MODEL_MISMATCH: which test fired ("nis": the windowed NIS over its
-  /// bound; "drift": a load drifting beyond drift_sigma; "" unknown).
+  /// bound; "drift": a load drifting beyond drift_sigma; "preload": the
+  /// trip-end preload test, whose sentence is preload_verdict_text; ""
+  /// unknown).
   const char* mismatch_test = "";
+  const char* preload_verdict_text = "";
   /// SENSOR_FAULT: which sensor and why (TwinCore::lastSensorFault()).
   SensorId sensor = SensorId::CageImu;
   SensorFaultReason sensor_reason = SensorFaultReason::ClockOffset;

@@ -214,6 +214,20 @@ class TwinCore {
   /// `z_limit`), at model time now.  Allocation-free.
   void setCondition(AlarmLevel preload, double upper95, double warning, double critical, bool fingerprint,
                     double z, double z_limit);
+  /// MODEL_MISMATCH's trip-end preload test (hoist/preload_verdict.hpp; the
+  /// daemon's trip room, after each trip that identified the preload):
+  /// `mismatch` when the trip's preload scale lies |z| > `limit` of its
+  /// sigmas from preloadScale().  It holds until the next verdict, or until
+  /// adoptModel() drops it (the twin's preload changed; the next trip judges
+  /// the new one).  While it holds, MODEL_MISMATCH is active and the estimate
+  /// does not judge the alarms, as with the estimator's own tests (applied at
+  /// the next step).  Allocation-free.
+  void setPreloadVerdict(bool mismatch, double z, double limit) {
+    preload_mismatch_ = mismatch;
+    preload_z_ = z;
+    preload_limit_ = limit;
+  }
+  bool preloadMismatch() const { return preload_mismatch_; }
   /// Alarm events since the last clearEvents() (the caller publishes them).
   const AlarmEvents& events() const { return events_; }
   void clearEvents() { events_.clear(); }
@@ -380,6 +394,8 @@ class TwinCore {
   LengthRange range_;
   PlausibilityBounds bounds_;
   double preload_scale_ = 1.0;  // adoptModel()
+  bool preload_mismatch_ = false;  // setPreloadVerdict()
+  double preload_z_ = 0.0, preload_limit_ = 4.0;
 
   bool started_ = false;        // model initialized
   double t_ = 0.0;              // model time [s]
