@@ -153,7 +153,17 @@ if [[ $sensors -eq 1 ]]; then
   config="$twin_config"
 fi
 clock=wall
-if ! awk -v s="$speed" 'BEGIN { exit !(s == 1) }'; then clock=input; fi
+daemon_url="$url"
+if ! awk -v s="$speed" 'BEGIN { exit !(s == 1) }'; then
+  clock=input
+  # The daemon sizes its input socket for 200 ms of real-time inputs; a
+  # replay X times faster fills it X times sooner, and a loaded machine that
+  # stalls the daemon for a few tens of ms would lose inputs (seen at --speed
+  # 20: winder samples lost, sensors refused, a biased estimate).  Ask for X
+  # times the buffer (the daemon's --lcm-url recv_buf_size; at most 64 MiB).
+  rcvbuf=$(awk -v s="$speed" 'BEGIN { b = int(s * 1048576); if (b < 1048576) b = 1048576; if (b > 67108864) b = 67108864; print b }')
+  daemon_url="${url}&recv_buf_size=${rcvbuf}"
+fi
 if [[ $dash -eq 1 ]]; then
   if [[ -x "$bin/hoist-dash" ]]; then
     # Before the daemon, so that the page sees its first alarms.
@@ -177,8 +187,8 @@ if [[ $dash -eq 1 ]]; then
     echo "demo.sh: $bin/hoist-dash not built; running without the dashboard" >&2
   fi
 fi
-echo "== daemon: $bin/hoist-twind --config $config --clock $clock --lcm-url '$url'"
-"$bin/hoist-twind" --config "$config" --clock "$clock" --lcm-url "$url" 2> "$logdir/hoist-twind.log" &
+echo "== daemon: $bin/hoist-twind --config $config --clock $clock --lcm-url '$daemon_url'"
+"$bin/hoist-twind" --config "$config" --clock "$clock" --lcm-url "$daemon_url" 2> "$logdir/hoist-twind.log" &
 daemon_pid=$!
 "$bin/hoist-monitor" --lcm-url "$url" --no-forecast &   # (as the README's sample: no forecast lines)
 monitor_pid=$!

@@ -18,18 +18,22 @@ demo = os.path.join(src, "scripts", "demo.sh")
 failures = []
 
 
+last_out = ""  # the demo run being checked: printed whole on a failure (the logs' folder is in it)
+
+
 def check(ok, what, detail=""):
     print(("ok: " if ok else "FAIL: ") + what)
     if not ok:
         failures.append(what)
-        if detail:
-            print(detail)
+        print(detail or (last_out[:400] + "\n...\n" + last_out[-4000:]))
 
 
 def run(*args, timeout=90):
+    global last_out
     r = subprocess.run(["bash", demo, "--no-setup", "--no-dash", "--port", port, *args], env=env,
                        stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=timeout)
-    return r.returncode, r.stdout + r.stderr
+    last_out = r.stdout + r.stderr
+    return r.returncode, last_out
 
 
 rc, out = run("--speed", "20")

@@ -33,7 +33,14 @@ class Listener {
   bool good() { return lcm_.good(); }
   lcm::LCM& lcm() { return lcm_; }
 
-  void subscribe(const std::string& regex) { lcm_.subscribe(regex, &Listener::onMessage, this); }
+  /// Every message is kept: LCM's per-subscription queue (30 messages by
+  /// default, dropped beyond) is made unbounded -- at 10x real time the
+  /// daemon publishes 2000 messages/s, and a test thread descheduled for
+  /// 15 ms on a busy machine lost some.
+  void subscribe(const std::string& regex) {
+    lcm::Subscription* s = lcm_.subscribe(regex, &Listener::onMessage, this);
+    if (s) s->setQueueCapacity(0);
+  }
   void logTo(const std::string& path) { log_ = std::make_unique<lcm::LogFile>(path, "w"); }
   void closeLog() { log_.reset(); }
 
@@ -177,7 +184,9 @@ class LcmProcessTest : public ::testing::Test {
     dir_ = testDir(name);
     std::string why;
     if (!loopbackMulticastWorks(url_, why)) FAIL() << why << ".\n" << kMulticastHelp;
-    listener_ = std::make_unique<Listener>(url_);
+    // The listener's socket buffer as the daemon's (2 MiB): a burst while
+    // the test thread waits for a CPU stays in the kernel.
+    listener_ = std::make_unique<Listener>(url_ + "&recv_buf_size=2097152");
     ASSERT_TRUE(listener_->good()) << kMulticastHelp;
     for (const auto& c : channels) listener_->subscribe(c);
   }
