@@ -194,6 +194,12 @@ TEST(ShowEstimate, MonitorPrintsTheEstimateLine) {
   e.nis_exceeded = 1;
   e.sensors = 3;  // the IMU only
   pub.lcm().publish("north/HOIST_ESTIMATE", &e);
+  pub.pump(1000ms);
+  // MODEL_MISMATCH by the trip-end preload test: neither of the estimator's
+  // own tests (estimate_t.mismatch alone).
+  auto v = realisticEstimate(3);
+  v.mismatch = 1;
+  pub.lcm().publish("north/HOIST_ESTIMATE", &v);
   // Another shaft's estimate never reaches a north/ monitor.
   auto other = realisticEstimate(3);
   other.Fa = 9999.0;
@@ -207,6 +213,7 @@ TEST(ShowEstimate, MonitorPrintsTheEstimateLine) {
   EXPECT_TRUE(contains(text, "estimate: Fa n/a b n/a theta 6.5e-04 (open 8.3e-04) NIS 1.50/dof (bound 1.24) "
                              "sensors imu [MISMATCH: NIS]"))
       << text;
+  EXPECT_TRUE(contains(text, "[MISMATCH: the trip's preload fit]")) << text;
   EXPECT_FALSE(contains(text, "9999")) << text;
   // No MISMATCH on the lines of the estimate whose model matched.
   const auto first = text.find("estimate: Fa 1502");

@@ -209,6 +209,7 @@ class Monitor {
       out += " [MISMATCH";
       if (e.nis_exceeded) out += e.drift_exceeded ? ": NIS, drift" : ": NIS";
       else if (e.drift_exceeded) out += ": drift";
+      else out += ": the trip's preload fit";  // the trip-end preload test (docs/estimation.md)
       out += "]";
     }
     const double age = std::chrono::duration<double>(now - last_estimate_).count();

@@ -109,7 +109,9 @@ export function renderEstimate(s, e, mismatchInInterval) {
   const badge = $('[data-field="est-mismatch"]', box);
   const on = Boolean(e.mismatch) || mismatchInInterval;
   badge.dataset.state = on ? "mismatch" : "ok";
-  const why = [e.nis_exceeded ? "NIS" : "", e.drift_exceeded ? "load drift" : ""].filter(Boolean).join(", ");
+  // Neither of the estimator's tests: the trip-end preload test (docs/estimation.md).
+  const why = e.mismatch && !e.nis_exceeded && !e.drift_exceeded ? "the trip's preload fit"
+    : [e.nis_exceeded ? "NIS" : "", e.drift_exceeded ? "load drift" : ""].filter(Boolean).join(", ");
   badge.textContent = on ? `MODEL_MISMATCH${why ? " (" + why + ")" : ""}` : "";
 }
 
