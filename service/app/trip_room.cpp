@@ -158,6 +158,10 @@ void TripRoom::workerOpen() {
       log->error("{}shaft condition: the stored trips cannot be read ({}): GUIDE_PRELOAD_LOW and SHAFT_FINGERPRINT "
                  "are judged from this run's trips only", tag, e.what());
     }
+    // The stored trend against the configuration's preload (the loop uses
+    // the verdict only if its twin runs that scale: not after a kept adoption).
+    if (w_->judge.preload().valid)
+      noteVerdict(PreloadVerdict{}, judgeTrendPreload(w_->judge.preload(), 1.0, w_->cond_settings.model_check_sigma), 0);
   }
   publishCondition();
 }
@@ -211,6 +215,33 @@ void TripRoom::publishCondition() {
   std::snprintf(c.fingerprint_text.data(), c.fingerprint_text.size(), "%s", f.text.c_str());
   condition_.publish();
   counts_.judged.store(true, std::memory_order_release);
+}
+
+bool TripRoom::noteVerdict(const PreloadVerdict& trip, const PreloadVerdict& trend, std::int64_t number) {
+  Worker& w = *w_;
+  // MODEL_MISMATCH when either fires (the stronger one's text); else the
+  // trip's own consistent verdict, else the trend's; else nothing new.
+  const PreloadVerdict* v = nullptr;
+  if (trip.mismatch && trend.mismatch) v = std::abs(trip.z) >= std::abs(trend.z) ? &trip : &trend;
+  else if (trip.mismatch) v = &trip;
+  else if (trend.mismatch) v = &trend;
+  else if (trip.judged) v = &trip;
+  else if (trend.judged) v = &trend;
+  if (!v) return false;
+  const bool was = w.verdicts > 0 && w.verdict.mismatch;
+  w.verdict = *v;
+  ++w.verdicts;
+  char text[320];
+  describe(*v, text, sizeof text);
+  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  auto log = logger();
+  const std::string when = number > 0 ? "trip " + std::to_string(number) : std::string("the stored trips");
+  if (v->mismatch || was)
+    log->warn("{}{}: {}{}", tag, when, text,
+              v->mismatch ? ": MODEL_MISMATCH" : ": MODEL_MISMATCH's trip-end test passes again");
+  else
+    log->info("{}{}: {}", tag, when, text);
+  return true;
 }
 
 void TripRoom::pruneOld(std::int64_t now_us) {
@@ -289,20 +320,10 @@ void TripRoom::finishTrip() {
     }
   }
   r.trip = number > 0 ? number : w.judge.lastTrip() + 1;
-  // MODEL_MISMATCH's trip-end test: this trip's preload against the twin's.
+  // MODEL_MISMATCH's trip-end test: this trip's preload against the twin's
+  // (and, once the judge has it, the shaft's trend: noteVerdict).
   const PreloadVerdict v = judgeTripPreload(r.id, now.twin_preload_scale, w.cond_settings.model_check_sigma);
-  if (v.judged) {
-    const bool was = w.verdicts > 0 && w.verdict.mismatch;
-    w.verdict = v;
-    ++w.verdicts;
-    char text[320];
-    describe(v, text, sizeof text);
-    if (v.mismatch || was)
-      log->warn("{}trip {}: {}{}", tag, r.trip, text,
-                v.mismatch ? ": MODEL_MISMATCH" : ": MODEL_MISMATCH's trip-end test passes again");
-    else
-      log->info("{}trip {}: {}", tag, r.trip, text);
-  }
+  bool noted = false;
   try {  // never out of the worker: a record the judge refuses is logged, the trip still stored
     const ConditionLevel before = w.judge.preload().level;
     const bool finger_before = w.judge.fingerprint().active;
@@ -310,13 +331,17 @@ void TripRoom::finishTrip() {
     w.detect_trip = r.trip;
     w.loss30_separation = r.id.attempted ? r.id.loss30_separation : 0.0;
     w.loss30_visible = r.id.informative;
+    noted = noteVerdict(v, judgeTrendPreload(w.judge.preload(), now.twin_preload_scale,
+                                             w.cond_settings.model_check_sigma),
+                        r.trip);
     publishCondition();
     if (w.judge.preload().level != before || w.judge.fingerprint().active != finger_before)
       log->warn("{}shaft condition changed after trip {}: {}", tag, r.trip, w.judge.summary());
   } catch (const std::exception& e) {
     log->error("{}shaft condition: trip {} could not be judged ({}); the condition alarms stay as they were", tag,
                r.trip, e.what());
-    if (v.judged) publishCondition();  // the trip-end preload verdict still reaches the loop
+    if (!noted && noteVerdict(v, PreloadVerdict{}, r.trip))
+      publishCondition();  // the trip's own verdict still reaches the loop
   }
   if (number <= 0) r.trip = 0;
   if (!w.store) {

@@ -152,6 +152,9 @@ class TripRoom : public TripWork {
   void finishTrip();             // worker: the record to the store
   void pruneOld(std::int64_t now_us);  // worker: [history] keep_days (at open and after each trip)
   void publishCondition();             // worker: the judge's verdicts to the loop
+  /// Worker: MODEL_MISMATCH's trip-end preload verdict from this trip's own
+  /// (`trip`) and the shaft's trend (`trend`), logged; false: neither judged.
+  bool noteVerdict(const PreloadVerdict& trip, const PreloadVerdict& trend, std::int64_t number);
   std::int64_t roomCpu() const;        // worker, inside workerDrain: this room's CPU so far [ns]
 
   TwinConfig cfg_;

@@ -11,7 +11,8 @@
 //   * keep_days prunes after each trip, not only at start-up;
 //   * the condition alarms come from the shaft's memory: a daemon started on
 //     a database whose preload fell to 0.6 raises GUIDE_PRELOAD_LOW WARNING
-//     and CRITICAL at once, naming the estimate; each new trip is judged
+//     and CRITICAL at once, naming the estimate, and MODEL_MISMATCH (its
+//     twin runs x1); each new trip is judged
 //     before it is stored, numbered after the stored ones, and its record
 //     names the condition alarms the rule gives over the whole history;
 //   * a bad [history] or [condition] key is exit 2 naming file, line and key.
@@ -300,6 +301,18 @@ TEST_F(TripHistoryDaemon, ConditionAlarmsComeFromTheStoredTripsAndJudgeEachNewOn
 
   replayBothTripsAndStop(*d, 14);
   const std::string log = readFile(path("twind.log"));
+  // The twin runs the configuration's preload, the shaft's memory says x0.6:
+  // MODEL_MISMATCH's trip-end test (the trend's verdict, judged at start)
+  // rises at the twin's first step.
+  bool mismatch_from_trend = false;
+  for (const auto& a : listener_->decoded<hoist::alarm_t>("HOIST_ALARM"))
+    if (a.kind == "MODEL_MISMATCH" && a.event_type == hoist::alarm_t::EVENT_RAISE) {
+      mismatch_from_trend = a.message.find("preload trend of trips 11-12: x0.60 +- 0.03") != std::string::npos &&
+                            a.message.find("shaft softer") != std::string::npos;
+      EXPECT_TRUE(mismatch_from_trend) << a.message;
+      break;
+    }
+  EXPECT_TRUE(mismatch_from_trend) << log;
   // The new trips follow the stored ones, and each record names the
   // condition alarms the rule gives after it over the whole history.
   hoist::history::ListFilter f;
