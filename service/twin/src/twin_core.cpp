@@ -452,7 +452,8 @@ int TwinCore::command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLe
     case AlarmAction::Shelve: n = alarms_.shelve(t_, kind, level, shelve_duration, events_); break;
     case AlarmAction::Unshelve: n = alarms_.unshelve(t_, kind, level, events_); break;
     case AlarmAction::Reannounce: n = alarms_.reannounce(t_, kind, level, events_); break;
-    case AlarmAction::Calibrate: break;  // not an alarm command: calibrate()
+    case AlarmAction::Calibrate: break;     // not an alarm command: calibrate()
+    case AlarmAction::AdoptPreload: break;  // not an alarm command: adoptModel() (the daemon's PreloadKeeper)
   }
   out_.alarm_level = alarms_.highestActive();
   out_.degraded = degradedNow();
