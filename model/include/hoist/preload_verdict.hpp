@@ -7,7 +7,7 @@
 // stiffness, so theta = M / k reads as a steady, wrong moment: with the
 // accelerometer's offset free (the default) the offset absorbs what little
 // depth shape is left within ten seconds, and the estimate is confidently
-// wrong (a 30 % loss: M 40-60 % high at 15 sigma, no word; issue 30).  The
+// wrong (a 30 % loss: M 50-70 % high at 15 sigma, no word; issue 30).  The
 // whole trip can tell: identifyPreload (hoist/preload_identification.hpp)
 // fits the preload scale s jointly with M and the offset over the depth
 // range, where the offset is one constant and s bends the tilt's depth shape.
