@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <string>
 
 #include "hoist/io/error.hpp"
 
@@ -27,7 +28,8 @@ void readKeyValueFile(const std::string& path,
   // (getline would grow a string over a file without newlines).
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
-  if (ec || size > kMaxKeyValueFileBytes) throw InputError(path, 0, "", "larger than 64 KiB: not a state file");
+  if (ec || size > kMaxKeyValueFileBytes)
+    throw InputError(path, 0, "", "larger than " + std::to_string(kMaxKeyValueFileBytes / 1024) + " KiB: not a state file");
   std::set<std::string> seen;
   std::string line;
   int no = 0;

@@ -51,37 +51,28 @@ void describe(const PreloadVerdict& v, char* buf, std::size_t n) {
     return;
   }
   // Short enough for alarm_t.message (255 bytes) with its prefix and " [unacknowledged]".
-  if (v.trend_trips > 0) {
-    char from[64];
-    if (v.first_trip > 0 && v.last_trip > v.first_trip)
-      std::snprintf(from, sizeof from, "trips %lld-%lld", static_cast<long long>(v.first_trip),
-                    static_cast<long long>(v.last_trip));
-    else if (v.last_trip > 0)
-      std::snprintf(from, sizeof from, "trip %lld", static_cast<long long>(v.last_trip));
-    else
-      std::snprintf(from, sizeof from, "the stored trips");
-    if (v.mismatch)
-      std::snprintf(buf, n,
-                    "preload trend of %s: x%.2f +- %.2f, %.1f sigma from the twin's x%.3g (bound %.3g): shaft %s, "
-                    "moment reads %s; adopt (hoist-alarm-ack --adopt-preload) or re-tension",
-                    from, v.scale, v.sigma_scale, std::abs(v.z), v.twin_scale, v.limit,
-                    v.z < 0.0 ? "softer" : "stiffer", v.z < 0.0 ? "high" : "low");
-    else
-      std::snprintf(buf, n, "preload trend of %s: x%.2f +- %.2f, %.1f sigma from the twin's x%.3g (bound %.3g): consistent",
-                    from, v.scale, v.sigma_scale, std::abs(v.z), v.twin_scale, v.limit);
-    return;
-  }
-  if (v.mismatch)
-    std::snprintf(buf, n,
-                  "whole-trip fit: preload x%.2f +- %.2f, %.1f sigma from the twin's x%.3g (bound %.3g): shaft %s, "
-                  "moment reads %s (fit: M = %.0f +- %.0f N m); adopt (hoist-alarm-ack --adopt-preload) or "
-                  "re-tension",
-                  v.scale, v.sigma_scale, std::abs(v.z), v.twin_scale, v.limit, v.z < 0.0 ? "softer" : "stiffer",
-                  v.z < 0.0 ? "high" : "low", v.moment, std::max(v.sigma_moment, 0.0));
+  // What was judged: one trip's fit, or the trend over the trips it rests on.
+  char head[80];
+  if (v.trend_trips == 0)
+    std::snprintf(head, sizeof head, "whole-trip fit: preload ");
+  else if (v.first_trip > 0 && v.last_trip > v.first_trip)
+    std::snprintf(head, sizeof head, "preload trend of trips %lld-%lld: ", static_cast<long long>(v.first_trip),
+                  static_cast<long long>(v.last_trip));
+  else if (v.last_trip > 0)
+    std::snprintf(head, sizeof head, "preload trend of trip %lld: ", static_cast<long long>(v.last_trip));
   else
-    std::snprintf(buf, n,
-                  "whole-trip fit: preload x%.2f +- %.2f, %.1f sigma from the twin's x%.3g (bound %.3g): consistent",
-                  v.scale, v.sigma_scale, std::abs(v.z), v.twin_scale, v.limit);
+    std::snprintf(head, sizeof head, "preload trend of the stored trips: ");
+  // The verdict: consistent, or what the mismatch means and what to do (a
+  // trip's fit also names its moment).
+  char fit[64] = "";
+  if (v.trend_trips == 0)
+    std::snprintf(fit, sizeof fit, " (fit: M = %.0f +- %.0f N m)", v.moment, std::max(v.sigma_moment, 0.0));
+  char verdict[160] = "consistent";
+  if (v.mismatch)
+    std::snprintf(verdict, sizeof verdict, "shaft %s, moment reads %s%s; adopt (hoist-alarm-ack --adopt-preload) or "
+                  "re-tension", v.z < 0.0 ? "softer" : "stiffer", v.z < 0.0 ? "high" : "low", fit);
+  std::snprintf(buf, n, "%sx%.2f +- %.2f, %.1f sigma from the twin's x%.3g (bound %.3g): %s", head, v.scale,
+                v.sigma_scale, std::abs(v.z), v.twin_scale, v.limit, verdict);
 }
 
 }  // namespace hoist

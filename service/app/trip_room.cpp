@@ -93,6 +93,7 @@ TripRoom::TripRoom(const TwinConfig& cfg, const TripHistoryConfig& hist, std::st
     : cfg_(cfg),
       hist_(hist),
       shaft_(std::move(shaft_name)),
+      tag_(shaft_.empty() ? std::string() : "[" + shaft_ + "] "),
       ring_(capacity ? capacity
                      : std::max<std::size_t>(1024, static_cast<std::size_t>(30.0 * cfg.service.rate))),
       w_(std::make_unique<Worker>(cfg, conditionFor(cfg, hist))) {}
@@ -131,7 +132,7 @@ std::string TripRoom::describeStore() const {
 
 void TripRoom::workerOpen() {
   auto log = logger();
-  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  const std::string& tag = tag_;
   try {
     history::HistoryConfig h = hist_.store;
     const history::StoreOptions o = history::resolveStoreOptions(h, hist_.config_dir);
@@ -178,8 +179,7 @@ void TripRoom::workerClose() {
   try {
     w_->store->flush();
   } catch (const std::exception& e) {
-    logger()->warn("{}trip history: flush at stop: {}", shaft_.empty() ? std::string() : "[" + shaft_ + "] ",
-                   e.what());
+    logger()->warn("{}trip history: flush at stop: {}", tag_, e.what());
   }
 }
 
@@ -233,7 +233,7 @@ bool TripRoom::noteVerdict(const PreloadVerdict& trip, const PreloadVerdict& tre
   ++w.verdicts;
   char text[320];
   describe(*v, text, sizeof text);
-  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  const std::string& tag = tag_;
   auto log = logger();
   const std::string when = number > 0 ? "trip " + std::to_string(number) : std::string("the stored trips");
   if (v->mismatch || was)
@@ -247,7 +247,7 @@ bool TripRoom::noteVerdict(const PreloadVerdict& trip, const PreloadVerdict& tre
 void TripRoom::pruneOld(std::int64_t now_us) {
   const int keep_days = hist_.store.keep_days;
   if (keep_days <= 0 || !w_->store) return;
-  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  const std::string& tag = tag_;
   try {
     const std::int64_t pruned = w_->store->prune(keep_days, now_us);
     if (pruned > 0) logger()->info("{}trip history: {} trips older than history.keep_days = {} pruned", tag, pruned, keep_days);
@@ -269,7 +269,7 @@ void TripRoom::take(const TripTick& t) {
   } catch (const std::exception& e) {
     // A step the identification's solver refused: this trip is lost, the next one starts afresh.
     counts_.failed.fetch_add(1, std::memory_order_relaxed);
-    logger()->warn("{}trip history: a trip's record failed: {}", shaft_.empty() ? "" : "[" + shaft_ + "] ", e.what());
+    logger()->warn("{}trip history: a trip's record failed: {}", tag_, e.what());
     w.rec.reset();
     w.moving = false;
     w.seen = 0;
@@ -307,7 +307,7 @@ void TripRoom::finishTrip() {
   const std::int64_t cpu = roomCpu() - w.cpu_trip0;
   counts_.cpu_ns_last.store(cpu, std::memory_order_relaxed);
   auto log = logger();
-  const std::string tag = shaft_.empty() ? std::string() : "[" + shaft_ + "] ";
+  const std::string& tag = tag_;
   // The condition alarms, judged before the record is stored (its alarms
   // name them).  The judge needs the trip's number: the store's next one.
   std::int64_t number = 0;

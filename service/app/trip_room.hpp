@@ -160,6 +160,7 @@ class TripRoom : public TripWork {
   TwinConfig cfg_;
   TripHistoryConfig hist_;
   std::string shaft_;
+  std::string tag_;  ///< "[shaft] " before the worker's log lines ("" for the default shaft)
   TripRing ring_;
   TripTick scratch_;  // the loop's staging copy (no stack copy of a large struct per step)
   TripCounters counts_;
