@@ -11,6 +11,7 @@
 // The verdict rules without LCM: timing_report_test.cpp.
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <regex>
 
 #include "lcm_fixtures.hpp"
@@ -70,12 +71,22 @@ TEST_F(TimingTest, GenerousBudgetsPass) {
   double secs = 0;
   // Generous for a loaded 2-core CI machine; rejected inputs stay at 0.  Fed
   // at 25 Hz (a 40-ms period): a feeder woken 10-15 ms late by a busy machine
-  // (seen under ASan) is still on time, so the verdict can be PASS.
-  const int rc = timingTest({"--rate", "25", "--duration", "4", "--max-misses", "1000", "--max-late-p99-us", "1e6",
-                             "--max-step-p99-us", "1e6", "--max-e2e-p99-us", "1e6", "--report", report},
-                            out, secs);
+  // (seen under ASan) is still on time, so the verdict can be PASS.  The one
+  // verdict that is not the daemon's is INCONCLUSIVE because this test's own
+  // feeder was late (seen once under TSan on a loaded CI machine: two
+  // wake-ups 55 ms late out of 99): that run is repeated, at most twice; any
+  // other verdict is judged as it comes.
+  int rc = 0;
+  std::string r;
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    rc = timingTest({"--rate", "25", "--duration", "4", "--max-misses", "1000", "--max-late-p99-us", "1e6",
+                     "--max-step-p99-us", "1e6", "--max-e2e-p99-us", "1e6", "--report", report},
+                    out, secs);
+    r = readFile(report);
+    if (firstLine(r) != "VERDICT: INCONCLUSIVE" || r.find("The feeder itself was late") == std::string::npos) break;
+    std::cerr << "attempt " << attempt << ": the feeder was late (a busy machine), so INCONCLUSIVE; again\n";
+  }
   stopDaemon(*d, "twind.log");
-  const std::string r = readFile(report);
   EXPECT_EQ(rc, 0) << out;
   EXPECT_EQ(firstLine(r), "VERDICT: PASS") << r;
   EXPECT_NE(r.find("| deadline misses | "), std::string::npos) << r;
