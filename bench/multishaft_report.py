@@ -15,7 +15,7 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rt_report import cpu_model, fmt_us, verdict  # noqa: E402
+from rt_report import cpu_model, fmt_us, load_report, verdict  # noqa: E402
 
 PHASES = [("model_step", "model step"), ("envelope", "envelope"), ("publish", "LCM publish"),
           ("receive", "LCM receive"), ("tick_other", "rest of the tick"), ("timer_and_rest", "timer, kernel, rest")]
@@ -64,12 +64,11 @@ def main():
     a = ap.parse_args()
     if a.row_summary:
         try:
-            with open(a.row_summary) as f:
-                r = json.load(f)
+            r = load_report(a.row_summary)
         except (OSError, ValueError) as e:
             print(f"no run report ({e})")
             return
-        misses = sum(s["deadline_misses"] for s in r.get("shafts", []))
+        misses = sum(s["health"]["deadline_misses"] for s in r.get("shafts", []))
         print(f"deadline misses {misses}" + (f"; {worst_miss_text(r)}" if worst_miss_text(r) else ""))
         return
     if not a.items:
@@ -80,8 +79,7 @@ def main():
     for i in range(0, len(a.items), 6):
         name, setting, n, js, md, cpu_steal = a.items[i:i + 6]
         try:
-            with open(js) as f:
-                r = json.load(f)
+            r = load_report(js)
         except (OSError, ValueError):
             r = None
         cpu, _, steal = cpu_steal.partition("/")
@@ -124,9 +122,9 @@ def main():
             out.append(f"| {setting} | {x['n']} | {x['name']} | (no report) | | | {x['cpu']:.0f} % | {x['steal']} s | | | | | |")
             continue
         sh = r["shafts"]
-        x["misses"] = sum(s["deadline_misses"] for s in sh)
-        x["gaps"] = sum(s["sequence_gaps"] for s in sh)
-        rejected = sum(s.get("inputs_rejected", 0) for s in sh)
+        x["misses"] = sum(s["health"]["deadline_misses"] for s in sh)
+        x["gaps"] = sum(s["health"]["seq_gaps"] for s in sh)
+        rejected = sum(s["health"].get("rejected_total", 0) for s in sh)
         drops = r.get("input_socket", {}).get("kernel_drops")
         x["drops"] = drops or 0
         lp99 = max(s["late_us"]["p99"] for s in sh)
@@ -140,7 +138,8 @@ def main():
                    f"{'—' if drops is None else drops} | {bare_cell(x['bare'])} | {verdict(x['md'])} "
                    f"([report]({os.path.relpath(x['md'], a.out_dir)})) |")
     out.append("")
-    fc_rows = [x for x in rows if x["r"] and any("forecasts" in s for s in x["r"]["shafts"])]
+    # (A shaft with [forecast] enabled reports forecast_us; an old report, forecasts beside it.)
+    fc_rows = [x for x in rows if x["r"] and any("forecast_us" in s or "forecasts" in s for s in x["r"]["shafts"])]
     if fc_rows:
         out.append("Forecasts (rows with `[forecast] enabled`; from the daemon's run report): done, snapshots the "
                    "workers never took (`dropped`: a newer one replaced it, i.e. the workers fell behind), "
@@ -148,9 +147,9 @@ def main():
         out.append("")
         for x in fc_rows:
             sh = x["r"]["shafts"]
-            done = sum(s.get("forecasts", 0) for s in sh)
-            dropped = sum(s.get("forecasts_dropped", 0) for s in sh)
-            skipped = sum(s.get("forecasts_skipped", 0) for s in sh)
+            done = sum(s["health"].get("forecasts", 0) for s in sh)
+            dropped = sum(s["health"].get("forecasts_dropped", 0) for s in sh)
+            skipped = sum(s["health"].get("forecasts_skipped", 0) for s in sh)
             out.append(f"- {x['n']} twins, `{x['name']}`: {done} done ({done / max(1, len(sh)):.1f} per shaft), "
                        f"{dropped} dropped, {skipped} skipped")
         out.append("")
@@ -191,7 +190,7 @@ def main():
             for x in rows:
                 if x["setting"] != setting or x["name"] != d or not x["r"]:
                     continue
-                ticks = sum(s["ticks"] for s in x["r"]["shafts"])
+                ticks = sum(s["health"]["ticks"] for s in x["r"]["shafts"])
                 if x["gaps"] == 0 and ticks > 0 and x["misses"] < 0.005 * ticks:
                     ok.append(x)
             if not ok:

@@ -25,6 +25,27 @@ def cpu_model():
     return platform.processor() or "unknown"
 
 
+# Reports written before the per-shaft counters moved under "health" (the
+# final HOIST_HEALTH, health_t's names) kept them beside the histograms under
+# other names; load_report() moves them there, so old runs still render.
+_OLD_NAMES = {"ticks": "ticks", "steps": "steps", "deadline_misses": "deadline_misses",
+              "inputs_accepted": "accepted", "inputs_rejected": "rejected_total", "sequence_gaps": "seq_gaps",
+              "alarm_events": "alarm_events", "model_faults": "model_faults", "publish_failures": "publish_failures",
+              "nonfinite_withheld": "nonfinite_blocked", "starts_deferred": "starts_deferred",
+              "forecasts": "forecasts", "forecasts_dropped": "forecasts_dropped",
+              "forecasts_skipped": "forecasts_skipped", "rate_hz": "rate", "clock": "clock"}
+
+
+def load_report(path):
+    """hoist-twind's run report (--report), every shaft with its "health"."""
+    with open(path) as f:
+        r = json.load(f)
+    for s in r.get("shafts", []):
+        if "health" not in s:
+            s["health"] = {new: s[old] for old, new in _OLD_NAMES.items() if old in s}
+    return r
+
+
 def fmt_us(x):
     if x >= 1000:
         return f"{x / 1000:.2f} ms"
@@ -89,8 +110,7 @@ def main():
     points = []
     for i in range(0, len(a.items), 3):
         tag, js, md = a.items[i:i + 3]
-        with open(js) as f:
-            points.append((tag, json.load(f), md))
+        points.append((tag, load_report(js), md))
 
     first = points[0][1]
     out = [f"# {a.title}", ""]
@@ -110,11 +130,11 @@ def main():
     out.append("|---|---|---|---|---|---|---|")
     for tag, r, md in points:
         for s in r["shafts"]:
-            st, lt = s["step_us"], s["late_us"]
+            st, lt, h = s["step_us"], s["late_us"], s["health"]
             label = tag if len(r["shafts"]) == 1 else f"{tag} {s['label']}"
             out.append(
-                f"| {label} ({s['rate_hz']:g} Hz, n = {s['modes']}) | {r['duration_s'] / 60:.1f} min | {s['ticks']} | "
-                f"**{s['deadline_misses']}** | {fmt_us(st['p50'])} / {fmt_us(st['p99'])} / {fmt_us(st['p999'])} / "
+                f"| {label} ({h['rate']:g} Hz, n = {s['modes']}) | {r['duration_s'] / 60:.1f} min | {h['ticks']} | "
+                f"**{h['deadline_misses']}** | {fmt_us(st['p50'])} / {fmt_us(st['p99'])} / {fmt_us(st['p999'])} / "
                 f"{fmt_us(st['max'])} | {fmt_us(lt['p50'])} / {fmt_us(lt['p99'])} / {fmt_us(lt['p999'])} / "
                 f"{fmt_us(lt['max'])} | {verdict(md)} ([report]({os.path.relpath(md, a.out_dir)})) |")
     base_rows = []
@@ -139,7 +159,8 @@ def main():
     out.append("")
     for tag, r, md in points:
         for s in r["shafts"]:
-            out.append(f"## {tag}: {s['rate_hz']:g} Hz, n = {s['modes']}")
+            h = s["health"]
+            out.append(f"## {tag}: {h['rate']:g} Hz, n = {s['modes']}")
             out.append("")
             sp = md.replace(".timing.md", ".steal")
             if os.path.exists(sp):
@@ -149,9 +170,9 @@ def main():
                            f"this virtual CPU's slot to something else): **{steal:.2f} s** "
                            f"({100.0 * steal / max(r['duration_s'], 1e-9):.2f} % of the run).")
                 out.append("")
-            out.append(f"Inputs accepted {s['inputs_accepted']}, rejected {s['inputs_rejected']}, sequence gaps "
-                       f"{s['sequence_gaps']}; alarm events {s['alarm_events']}; model faults {s['model_faults']}; "
-                       f"publish failures {s['publish_failures']}; log lines dropped {r.get('log_lines_dropped', 0)}.")
+            out.append(f"Inputs accepted {h['accepted']}, rejected {h['rejected_total']}, sequence gaps "
+                       f"{h['seq_gaps']}; alarm events {h['alarm_events']}; model faults {h['model_faults']}; "
+                       f"publish failures {h['publish_failures']}; log lines dropped {r.get('log_lines_dropped', 0)}.")
             out.append("")
             out.append("Step time (count per bin, log-scaled bars):")
             out.append("```")

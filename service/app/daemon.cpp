@@ -324,20 +324,14 @@ void Daemon::onLcmReadable(const boost::system::error_code& ec) {
 
 void Daemon::flushOutputs() {
   if (!sender_ || sender_->queued() == 0) return;
-  const auto t0 = Clock::now();
+  const rt::ScopedSpan span(&ns_flush_, &split_.publish);
   sender_->flush();
-  const std::int64_t ns = nanos(Clock::now() - t0);
-  ns_flush_ += ns;
-  split_.publish += ns;
 }
 
 void Daemon::drainInput() {
-  const auto t0 = Clock::now();
+  const rt::ScopedSpan span(&ns_receive_, &split_.receive);
   input_.drain(256);
   if (const UdpmReceiver* rx = input_.udpm()) ignored_ = rx->ignored() + rx->malformed();
-  const std::int64_t ns = nanos(Clock::now() - t0);
-  ns_receive_ += ns;
-  split_.receive += ns;
 }
 
 // ---- timers ------------------------------------------------------------------

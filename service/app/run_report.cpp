@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "hoist/io/checked_file.hpp"
+#include "hoist/msg/codec.hpp"
 #include "hoist/version.hpp"
 
 namespace hoist::svc {
@@ -35,15 +36,16 @@ nlohmann::ordered_json costSplit(const RunFacts& f) {
   std::int64_t model = 0, env = 0, publish = 0, shaft_ticks = 0, exact = 0, bounded = 0, deferred = 0;
   int longest = 0;
   for (const ShaftTwin* sp : f.shafts) {
-    const ShaftRunStats st = sp->runStats();
+    const ShaftStats& st = sp->stats();
+    const TwinCore& core = sp->core();
     model += st.ns_model;
-    env += st.ns_envelope;
+    env += core.envelopeNanos();
     publish += st.ns_publish;
     shaft_ticks += st.ticks;
-    exact += st.envelope_exact;
-    bounded += st.envelope_bounded;
-    deferred += st.envelope_deferred;
-    longest = std::max(longest, st.envelope_longest_deferral);
+    exact += core.envelope().exactEvaluations();
+    bounded += core.envelope().boundedEvaluations();
+    deferred += core.envelope().deferredEvaluations();
+    longest = std::max(longest, core.envelope().longestDeferral());
   }
   const double cpu = static_cast<double>(f.cpu_ns);
   const double per = shaft_ticks > 0 ? 1e-3 / static_cast<double>(shaft_ticks) : 0.0;
@@ -75,7 +77,7 @@ nlohmann::ordered_json splitJson(const MissRecord& r) {
 nlohmann::ordered_json missJson(const MissRecord& r, const RunFacts& f) {
   auto label = [&](int id) -> std::string {
     if (id < 0 || static_cast<std::size_t>(id) >= f.shafts.size()) return "";
-    return f.shafts[static_cast<std::size_t>(id)]->runStats().label;
+    return f.shafts[static_cast<std::size_t>(id)]->reportLabel();
   };
   return {{"seq", r.seq},
           {"utime", r.utime},
@@ -117,35 +119,26 @@ nlohmann::ordered_json missesJson(const RunFacts& f) {
   return o;
 }
 
+/// One shaft: its label, prefix and modes; `health`, the final HOIST_HEALTH
+/// as the generated toJson writes it (every counter under health_t's name,
+/// the one name it has everywhere); then the figures only a whole run has:
+/// the whole-run histograms and the counters HOIST_HEALTH does not carry.
 nlohmann::ordered_json shaftJson(const ShaftTwin& sp) {
-  const ShaftRunStats s = sp.runStats();
+  const ShaftStats& st = sp.stats();
   const TwinConfig& c = sp.config();
   nlohmann::ordered_json o;
-  o["label"] = s.label;
+  o["label"] = sp.reportLabel();
   o["channel_prefix"] = c.service.channel_prefix;
-  o["clock"] = toString(c.service.clock);
-  o["rate_hz"] = c.service.rate;
   o["modes"] = c.shaft.n;
-  o["ticks"] = s.ticks;
-  o["steps"] = s.steps;
-  o["deadline_misses"] = s.deadline_misses;
-  o["inputs_accepted"] = s.accepted;
-  o["inputs_rejected"] = s.rejected;
-  o["sequence_gaps"] = s.seq_gaps;
-  o["alarm_events"] = s.alarm_events;
-  o["model_faults"] = s.model_faults;
-  o["publish_failures"] = s.publish_failures;
-  o["nonfinite_withheld"] = s.nonfinite_blocked;
-  o["starts_deferred"] = s.starts_deferred;
+  o["health"] = nlohmann::ordered_json(hoist::msg::toJson(sp.lastHealth()));
+  o["commands_applied"] = st.commands_applied;
   if (c.forecast.enabled) {
-    // Whether the forecasts kept up: done, snapshots the workers never took
-    // (replaced by a newer one), instants skipped (degraded state).
-    o["forecasts"] = s.forecasts;
-    o["forecasts_dropped"] = s.forecasts_dropped;
-    o["forecasts_skipped"] = s.forecasts_skipped;
+    o["forecasts_from_estimate"] = st.forecasts_from_estimate;
+    o["forecast_failures"] = st.forecast_failures;
+    o["forecast_us"] = histogramJson(st.forecast_total);
   }
-  o["step_us"] = histogramJson(*s.step);
-  o["late_us"] = histogramJson(*s.late);
+  o["step_us"] = histogramJson(st.step_total);
+  o["late_us"] = histogramJson(st.late_total);
   return o;
 }
 

@@ -212,46 +212,4 @@ std::int64_t ShaftHealth::rssKb() const {
   return static_cast<std::int64_t>(resident) * (::sysconf(_SC_PAGESIZE) / 1024);
 }
 
-ShaftRunStats ShaftHealth::runStats() const {
-  ShaftRunStats s;
-  const TwinCore& core = ctx_.core;
-  const ShaftStats& st = ctx_.stats;
-  const InputCounters& c = core.counters();
-  const std::string& prefix = ctx_.cfg.service.channel_prefix;
-  s.label = !ctx_.label.empty() ? ctx_.label : prefix.empty() ? "default" : prefix;
-  s.ticks = st.ticks;
-  s.steps = core.steps();
-  s.deadline_misses = st.deadline_misses;
-  s.accepted = c.accepted;
-  s.rejected = c.rejectedTotal();
-  s.seq_gaps = c.seq_gaps;
-  s.alarm_events = st.alarm_events;
-  s.model_faults = core.modelFaults();
-  s.publish_failures = st.publish_failures;
-  s.nonfinite_blocked = st.nonfinite_blocked;
-  s.step = &st.step_total;
-  s.late = &st.late_total;
-  s.ns_model = st.ns_model;
-  s.ns_envelope = core.envelopeNanos();
-  s.ns_publish = st.ns_publish;
-  s.ns_tick = st.ns_tick;
-  s.envelope_exact = core.envelope().exactEvaluations();
-  s.envelope_bounded = core.envelope().boundedEvaluations();
-  s.envelope_deferred = core.envelope().deferredEvaluations();
-  s.envelope_longest_deferral = core.envelope().longestDeferral();
-  s.forecasts = st.forecasts;
-  s.forecasts_dropped = st.forecasts_dropped;
-  s.forecasts_skipped = st.forecasts_skipped;
-  s.forecasts_from_estimate = st.forecasts_from_estimate;
-  s.plans_accepted = st.plans_accepted;
-  s.plans_rejected = st.plansRejected();
-  s.commands_applied = st.commands_applied;
-  s.commands_dropped = st.commands_dropped;
-  s.commands_invalid = st.commands_invalid;
-  s.forecast = &st.forecast_total;
-  s.starts_deferred = core.startsDeferred();
-  s.ns_start = st.ns_start;
-  return s;
-}
-
 }  // namespace hoist::svc

@@ -25,13 +25,13 @@ ShaftInputs::ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, For
     : ctx_(ctx), in_(in), out_(out), forecast_(forecast) {
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
   decode_budget_ = std::max(kMinDecodesPerTick, static_cast<int>(kDecodesPerSecond / ctx_.cfg.service.rate));
-  routes_[kWinder] = {this, &ctx_.ch.winder, &ShaftInputs::handleWinder, "HOIST_WINDER"};
-  routes_[kAck] = {this, &ctx_.ch.ack, &ShaftInputs::handleAck, "HOIST_ALARM_ACK"};
-  routes_[kTripPlan] = {this, &ctx_.ch.trip_plan, &ShaftInputs::handleTripPlan, "HOIST_TRIP_PLAN"};
-  routes_[kOwnHealth] = {this, &ctx_.ch.health, &ShaftInputs::handleOwnHealth, "HOIST_HEALTH"};
-  routes_[kOwnAlarm] = {this, &ctx_.ch.alarm, &ShaftInputs::handleOwnAlarm, "HOIST_ALARM"};
-  routes_[kCageImu] = {this, &ctx_.ch.cage_imu, &ShaftInputs::handleCageImu, "HOIST_CAGE_IMU"};
-  routes_[kRopeLoad] = {this, &ctx_.ch.rope_load, &ShaftInputs::handleRopeLoad, "HOIST_ROPE_LOAD"};
+  routes_[kWinder] = {this, &ctx_.ch.winder, &ShaftInputs::handleWinder, bus::kChannelWinder.data()};
+  routes_[kAck] = {this, &ctx_.ch.ack, &ShaftInputs::handleAck, bus::kChannelAlarmAck.data()};
+  routes_[kTripPlan] = {this, &ctx_.ch.trip_plan, &ShaftInputs::handleTripPlan, bus::kChannelTripPlan.data()};
+  routes_[kOwnHealth] = {this, &ctx_.ch.health, &ShaftInputs::handleOwnHealth, bus::kChannelHealth.data()};
+  routes_[kOwnAlarm] = {this, &ctx_.ch.alarm, &ShaftInputs::handleOwnAlarm, bus::kChannelAlarm.data()};
+  routes_[kCageImu] = {this, &ctx_.ch.cage_imu, &ShaftInputs::handleCageImu, bus::kChannelCageImu.data()};
+  routes_[kRopeLoad] = {this, &ctx_.ch.rope_load, &ShaftInputs::handleRopeLoad, bus::kChannelRopeLoad.data()};
   text_[0] = '\0';
 }
 

@@ -64,22 +64,22 @@ bool ShaftInputs::sensorSeqNewer(std::int64_t seq, SensorSequence& sq, const cha
 }
 
 void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
-  if (!decodeSensor(rbuf, imu_in_, "HOIST_CAGE_IMU")) return;
+  if (!decodeSensor(rbuf, imu_in_, bus::kChannelCageImu.data())) return;
   const cage_imu_t& m = imu_in_;
   const bool a_ok = std::isfinite(m.f_y) && std::abs(m.f_y) <= kMaxSpecificForce;
   const bool w_ok = std::isfinite(m.omega) && std::abs(m.omega) <= kMaxTiltRate;
   if (!a_ok && !w_ok) {
     std::snprintf(text_, sizeof text_, "f_y %g m/s^2 and omega %g rad/s implausible (|f_y| <= %g, |omega| <= %g)",
                   m.f_y, m.omega, kMaxSpecificForce, kMaxTiltRate);
-    rejectSensor("HOIST_CAGE_IMU", text_);
+    rejectSensor(bus::kChannelCageImu.data(), text_);
     return;
   }
-  if (!sensorSeqNewer(m.seq, ctx_.stats.imu_seq, "HOIST_CAGE_IMU")) return;
+  if (!sensorSeqNewer(m.seq, ctx_.stats.imu_seq, bus::kChannelCageImu.data())) return;
   // A channel that is implausible on its own is left out of this sample.
   const double wall = ctx_.wallNow();
   const SensorVerdict v = ctx_.core.onCageImu(m.utime, a_ok ? m.f_y : NAN, w_ok ? m.omega : NAN, wall,
                                                bus::wallUtime());
-  if (!sensorTimeOk(v, m.utime, "HOIST_CAGE_IMU")) return;
+  if (!sensorTimeOk(v, m.utime, bus::kChannelCageImu.data())) return;
   ctx_.stats.last_imu_wall = wall;
   ++ctx_.stats.sensor_accepted;
 }
@@ -110,17 +110,17 @@ bool ShaftInputs::sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* 
 }
 
 void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
-  if (!decodeSensor(rbuf, rope_in_, "HOIST_ROPE_LOAD")) return;
+  if (!decodeSensor(rbuf, rope_in_, bus::kChannelRopeLoad.data())) return;
   const rope_load_t& m = rope_in_;
   if (!(std::isfinite(m.force) && std::abs(m.force) <= kMaxRopeLoad)) {
     std::snprintf(text_, sizeof text_, "force %g N implausible (|force| <= %g)", m.force, kMaxRopeLoad);
-    rejectSensor("HOIST_ROPE_LOAD", text_);
+    rejectSensor(bus::kChannelRopeLoad.data(), text_);
     return;
   }
-  if (!sensorSeqNewer(m.seq, ctx_.stats.rope_seq, "HOIST_ROPE_LOAD")) return;
+  if (!sensorSeqNewer(m.seq, ctx_.stats.rope_seq, bus::kChannelRopeLoad.data())) return;
   const double wall = ctx_.wallNow();
   const SensorVerdict v = ctx_.core.onRopeLoad(m.utime, m.force, wall, bus::wallUtime());
-  if (!sensorTimeOk(v, m.utime, "HOIST_ROPE_LOAD")) return;
+  if (!sensorTimeOk(v, m.utime, bus::kChannelRopeLoad.data())) return;
   ctx_.stats.last_rope_wall = wall;
   ++ctx_.stats.sensor_accepted;
 }

@@ -109,6 +109,7 @@ class ShaftOutputs {
   void publishForecast(const ForecastResult& r);
   /// The health message, for ShaftHealth to fill before publishHealth().
   hoist::health_t& health() { return health_msg_; }
+  const hoist::health_t& health() const { return health_msg_; }
   void publishHealth();
 
  private:

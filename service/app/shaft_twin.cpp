@@ -9,6 +9,7 @@
 namespace hoist::svc {
 
 using rt::nanos;
+using rt::ScopedSpan;
 using std::chrono::duration;
 
 ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks,
@@ -33,16 +34,14 @@ void ShaftTwin::attachLoop(LoopSplit* split, const MissLog* misses, int phase) {
   outputs_.setPhase(phase);
 }
 
-void ShaftTwin::startWithinBudget(double t, double wall, int& starts_left) {
+void ShaftTwin::startWithinBudget(double t, double wall, int& starts_left, int* envelope_budget) {
   if (starts_left <= 0) return;  // waits for a later tick: "starting"
   --starts_left;
   ShaftStats& st = ctx_.stats;
-  const auto s0 = Clock::now();
-  ctx_.core.completeStart(t - 1.0 / ctx_.cfg.service.rate, wall);
-  const std::int64_t ns = nanos(Clock::now() - s0);
-  st.ns_model += ns;
-  st.ns_start += ns;
-  if (ctx_.split) ctx_.split->start += ns;
+  {
+    const ScopedSpan span(&st.ns_model, &st.ns_start, ctx_.split ? &ctx_.split->start : nullptr);
+    ctx_.core.completeStart(t - 1.0 / ctx_.cfg.service.rate, wall, envelope_budget);
+  }
   ++st.starts;
   st.start_tick = st.ticks;
   st.start_wall = wall;
@@ -159,15 +158,14 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
 
   if (core.clock() == ClockMode::Wall) {
     const double t = static_cast<double>(k) / ctx_.cfg.service.rate;
-    // (The budget is this tick's: held by the core only within it.)
-    core.setEnvelopeBudget(envelope_budget_ ? &left.exact_envelopes : nullptr);
-    if (core.startPending()) startWithinBudget(t, wall, left.starts);
+    // This tick's budget of exact envelopes, shared by the schedule's shafts.
+    int* const envelopes = envelope_budget_ ? &left.exact_envelopes : nullptr;
+    if (core.startPending()) startWithinBudget(t, wall, left.starts, envelopes);
     const auto t0 = Clock::now();
     const std::int64_t env0 = core.envelopeNanos();
     if (ctx_.hooks.slow_tick_at >= 0.0) [[unlikely]] slowTickHook(wall);
-    const TickResult r = core.tick(t, wall);
+    const TickResult r = core.tick(t, wall, envelopes);
     core.housekeeping(wall);
-    core.setEnvelopeBudget(nullptr);
     const auto t1 = Clock::now();
     st.ns_model += nanos(t1 - t0);
     if (split) {
@@ -185,22 +183,20 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
     }
     // Results of earlier snapshots (the worker posts them when done).
     if (forecast_) {
-      const auto f0 = Clock::now();
+      const ScopedSpan span(split ? &split->forecast : nullptr);
       forecast_->pollResult();
-      if (split) split->forecast += nanos(Clock::now() - f0);
     }
     // No HOIST_CAGE before the trip started (no input yet, or the start
     // still waits for the start budget).
     if (r.stepped && core.hasOutput()) {
-      const auto p0 = Clock::now();
       const std::int64_t utime = bus::wallUtime();
-      outputs_.publishTick(k, utime);
-      const auto p1 = Clock::now();
-      st.ns_publish += nanos(p1 - p0);
-      if (split) split->publish += nanos(p1 - p0);
+      {
+        const ScopedSpan span(&st.ns_publish, split ? &split->publish : nullptr);
+        outputs_.publishTick(k, utime);
+      }
       if (forecast_) {
+        const ScopedSpan span(split ? &split->forecast : nullptr);
         forecast_->afterStep(utime);
-        if (split) split->forecast += nanos(Clock::now() - p1);
       }
       if (ctx_.trips) ctx_.trips->afterStep(core, utime);
     }
@@ -214,11 +210,8 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   outputs_.publishAlarmEvents();
 
   if (health_.due(wall)) {
-    const auto p0 = Clock::now();
+    const ScopedSpan span(&st.ns_publish, split ? &split->health : nullptr);
     publishHealth();
-    const std::int64_t ns = nanos(Clock::now() - p0);
-    st.ns_publish += ns;
-    if (split) split->health += ns;
   }
   st.ns_tick += nanos(Clock::now() - now);
 }

@@ -101,7 +101,7 @@ class ShaftTwin {
   /// before k (missed ticks).  `left`: what the tick may still spend across
   /// the schedule's shafts; a pending start (TwinCore::startPending) takes
   /// one start or waits, and each exact guide-rope envelope takes one of
-  /// exact_envelopes (TwinCore::setEnvelopeBudget).
+  /// exact_envelopes (TwinCore::tick's envelope_budget).
   void tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, TickAllowance& left);
   /// The twin's start waits for the start budget (HOIST_HEALTH.starting).
   bool starting() const { return ctx_.core.startPending(); }
@@ -152,7 +152,21 @@ class ShaftTwin {
   const std::string& label() const { return ctx_.label; }
   /// "[label] " for log lines, "" for a daemon with one shaft.
   const std::string& tag() const { return ctx_.tag; }
-  ShaftRunStats runStats() const { return health_.runStats(); }
+  /// "label" in the run report: the label, else the channel prefix, else "default".
+  std::string reportLabel() const {
+    if (!ctx_.label.empty()) return ctx_.label;
+    return ctx_.cfg.service.channel_prefix.empty() ? "default" : ctx_.cfg.service.channel_prefix;
+  }
+  /// Read-only views for the run report and tests, valid while this
+  /// ShaftTwin lives; read them on the loop's thread, or after it stopped.
+  /// The statistics the rooms keep (the run-only figures: cost split,
+  /// whole-run histograms, counters HOIST_HEALTH does not carry):
+  const ShaftStats& stats() const { return ctx_.stats; }
+  /// The model and its counters (inputs, envelope evaluations):
+  const TwinCore& core() const { return ctx_.core; }
+  /// The latest HOIST_HEALTH filled (after stop(): the final report's,
+  /// filled even if its publish failed):
+  const hoist::health_t& lastHealth() const { return outputs_.health(); }
 
  private:
   ShaftContext ctx_;                             ///< what the rooms share (declared first: built first)
@@ -170,7 +184,7 @@ class ShaftTwin {
   bool slow_tick_done_ = false;                  ///< TestHooks::slow_tick_at has fired
   std::int64_t verdict_applied_ = 0;             ///< ConditionState::verdict_trip last applied
   /// A pending start within the tick's budget (model time t of the tick).
-  void startWithinBudget(double t, double wall, int& starts_left);
+  void startWithinBudget(double t, double wall, int& starts_left, int* envelope_budget);
   bool envelope_budget_ = false;  ///< [service] max_exact_envelopes_per_tick applies (wall clock, > 0)
   void slowTickHook(double wall);                ///< TestHooks::slow_tick_at
 };

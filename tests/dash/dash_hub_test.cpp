@@ -897,13 +897,23 @@ TEST(ValidateAckTest, Fields) {
   EXPECT_NE(validateAckFields("", 1, 1, 0, "ann"), "");
   EXPECT_NE(validateAckFields(std::string(65, 'A'), 1, 1, 0, "ann"), "");
   EXPECT_NE(validateAckFields("cage", 1, 1, 0, "ann"), "");
-  EXPECT_NE(validateAckFields("X", 3, 1, 0, "ann"), "");
-  EXPECT_NE(validateAckFields("X", 1, 0, 0, "ann"), "");
-  EXPECT_NE(validateAckFields("X", 1, 2, 0, "ann"), "");        // shelve needs a duration
-  EXPECT_NE(validateAckFields("X", 1, 2, 1e300 * 1e300, "ann"), "");
-  EXPECT_EQ(validateAckFields("X", 1, 2, 600, "ann"), "");
-  EXPECT_NE(validateAckFields("X", 1, 1, 0, ""), "");
-  EXPECT_NE(validateAckFields("X", 1, 1, 0, "a\nb"), "");
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 3, 1, 0, "ann"), "");
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 1, 0, 0, "ann"), "");
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 1, 4, 0, "ann"), "") << "re-announce is not the page's";
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 1, 2, 0, "ann"), "");        // shelve needs a duration
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 1, 2, 1e300 * 1e300, "ann"), "");
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 1, 2, 2e6, "ann"), "");
+  EXPECT_EQ(validateAckFields("GUIDE_ROPE", 1, 2, 600, "ann"), "");
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 1, 1, 0, ""), "");
+  EXPECT_NE(validateAckFields("GUIDE_ROPE", 1, 1, 0, "a\nb"), "");
+  // The daemon's rule under the page's: a kind the daemon does not know is
+  // refused here, named (it was forwarded and refused by the daemon).
+  const std::string why = validateAckFields("NO_SUCH_KIND", 1, 1, 0, "ann");
+  EXPECT_NE(why.find("alarm kind"), std::string::npos) << why;
+  EXPECT_NE(why.find("NO_SUCH_KIND"), std::string::npos) << why;
+  // Every kind of the contract passes, at both levels.
+  for (std::string_view k : hoist::msg::enums::alarm_t::kKindNames)
+    for (int level : {0, 1, 2}) EXPECT_EQ(validateAckFields(std::string(k), level, 1, 0, "ann"), "") << k;
 }
 
 }  // namespace

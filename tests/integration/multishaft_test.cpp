@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
 
 #include "lcm_fixtures.hpp"
 #include "lcm_messages.hpp"
@@ -122,10 +124,27 @@ TEST(MultiShaft, ThreeShaftsOneProcessOwnChannelsAlarmsAndRates) {
   EXPECT_EQ(hn.back().accepted, 0);
   EXPECT_DOUBLE_EQ(hs.back().rate, 200.0);
 
-  // The run report names every shaft, with histograms.
+  // The run report names every shaft, with its whole-run histograms and its
+  // final HOIST_HEALTH under health_t's names (one name per counter: the
+  // report's own spellings of them are gone).
   const std::string r = readFile(report);
   for (const char* s : {"\"north/\"", "\"south/\"", "\"east/\"", "\"p999\"", "\"deadline_misses\"", "\"late_us\""})
     EXPECT_NE(r.find(s), std::string::npos) << s << " missing in\n" << r;
+  for (const char* s : {"inputs_accepted", "nonfinite_withheld", "sequence_gaps", "rate_hz"})
+    EXPECT_EQ(r.find(s), std::string::npos) << s << " in\n" << r;
+  const auto j = nlohmann::json::parse(r);
+  ASSERT_EQ(j["shafts"].size(), 3u) << r;
+  std::map<std::string, nlohmann::json> by_label;
+  for (const auto& s : j["shafts"]) by_label[s["label"].get<std::string>()] = s;
+  ASSERT_EQ(by_label.count("south/"), 1u) << r;
+  const auto& south_health = by_label["south/"]["health"];
+  EXPECT_GE(south_health["accepted"].get<std::int64_t>(), hs.back().accepted) << "the final report counts every input";
+  EXPECT_LE(south_health["accepted"].get<std::int64_t>(), 200);
+  EXPECT_EQ(south_health["seq_gaps"].get<std::int64_t>(), hs.back().seq_gaps);
+  EXPECT_DOUBLE_EQ(south_health["rate"].get<double>(), 200.0);
+  EXPECT_EQ(south_health["reject_reason"].size(), static_cast<std::size_t>(hs.back().n_reasons));
+  EXPECT_EQ(by_label["north/"]["health"]["accepted"].get<std::int64_t>(), 0);
+  EXPECT_GE(by_label["south/"]["step_us"]["count"].get<std::int64_t>(), 190) << "whole-run histogram";
   const std::string log = readFile((dir / "twind.log").string());
   EXPECT_NE(log.find("3 shafts on one loop, 2 schedule(s)"), std::string::npos) << log;
   EXPECT_NE(log.find("[south/] final health"), std::string::npos) << log;

@@ -358,12 +358,12 @@ TEST(DaemonEnvelopes, LockstepShaftsOnAMovingTripShareTheExactEnvelopeBudget) {
 
   std::int64_t deferred[2] = {0, 0}, exact[2] = {0, 0}, bounded[2] = {0, 0};
   for (int i = 0; i < 2 * kPerGroup; ++i) {
-    const ShaftRunStats st = d.shaft(i).runStats();
+    const GuideRopeEnvelope& env = d.shaft(i).core().envelope();
     const int g = i < kPerGroup ? 0 : 1;
-    deferred[g] += st.envelope_deferred;
-    exact[g] += st.envelope_exact;
-    bounded[g] += st.envelope_bounded;
-    EXPECT_EQ(st.envelope_deferred > 0, st.envelope_longest_deferral > 0) << i;
+    deferred[g] += env.deferredEvaluations();
+    exact[g] += env.exactEvaluations();
+    bounded[g] += env.boundedEvaluations();
+    EXPECT_EQ(env.deferredEvaluations() > 0, env.longestDeferral() > 0) << i;
   }
   std::printf("with a budget of 1 per tick: %lld exact, %lld bounded, %lld deferred; without: %lld exact, %lld "
               "bounded, %lld deferred\n",

@@ -10,7 +10,7 @@
 //     thresholds 1 % of the gap lower; so raise times can only be earlier, by
 //     no more than the exact envelope needs to climb 1 % of the gap;
 //   * the cage alarms (no envelope) are identical;
-// and with a per-tick budget of exact evaluations (TwinCore::setEnvelopeBudget)
+// and with a per-tick budget of exact evaluations (the envelope_budget of TwinCore::onInput)
 // the deferred bounds change no alarm and lockstep twins share the budget.
 #include <gtest/gtest.h>
 
@@ -175,7 +175,7 @@ TEST(EnvelopeAlarm, ToleranceIsValidated) {
 }
 
 // The per-tick budget of exact envelopes ([service] max_exact_envelopes_per_tick,
-// TwinCore::setEnvelopeBudget): a twin whose budget is always spent keeps
+// the envelope_budget of TwinCore::onInput): a twin whose budget is always spent keeps
 // the wider bound wherever it lies below the GUIDE_ROPE WARNING alarm's clear
 // level.  Over the same trips and gaps as above, against the exact envelope:
 //   * its guide deflection is never below the exact envelope;
@@ -200,7 +200,6 @@ TEST(EnvelopeAlarm, ASpentBudgetDefersOnlyBelowTheAlarmsClearLevel) {
       TwinCore exact(ce, ClockMode::Input), free(cf, ClockMode::Input), starved(cf, ClockMode::Input),
           lowered(cl, ClockMode::Input);
       int spent = 0;
-      starved.setEnvelopeBudget(&spent);
       const double clear = (cf.alarms.warning_fraction - cf.alarms.deadband) * gap;
       ASSERT_DOUBLE_EQ(starved.envelopeDeferBelow(), clear);
       double worst_over = 0.0, worst_under = 0.0;
@@ -209,7 +208,7 @@ TEST(EnvelopeAlarm, ASpentBudgetDefersOnlyBelowTheAlarmsClearLevel) {
         const WinderSample s = sampleAt(prof, k, 0.01);
         spent = 0;  // every tick's budget is already spent
         for (TwinCore* c : {&exact, &free, &starved, &lowered}) {
-          ASSERT_TRUE(c->onInput(s, 0.01 * k).accepted) << k;
+          ASSERT_TRUE(c->onInput(s, 0.01 * k, c == &starved ? &spent : nullptr).accepted) << k;
           c->clearEvents();
         }
         const double e = exact.output().clearance.guide_deflection;
@@ -269,10 +268,8 @@ TEST(EnvelopeAlarm, LockstepTwinsShareTheBudgetAndEachIsRefreshed) {
     int left = kBudget;
     int exact_this_tick = 0;
     for (auto& t : twins) {
-      t->setEnvelopeBudget(&left);
       const std::int64_t before = t->envelope().exactEvaluations();
-      ASSERT_TRUE(t->onInput(s, dt * k).accepted);
-      t->setEnvelopeBudget(nullptr);
+      ASSERT_TRUE(t->onInput(s, dt * k, &left).accepted);
       exact_this_tick += static_cast<int>(t->envelope().exactEvaluations() - before);
       ASSERT_GE(t->output().clearance.guide_deflection, exact.output().clearance.guide_deflection - 1e-15)
           << "step " << k;

@@ -98,6 +98,7 @@
 #include "hoist/change_detector.hpp"
 #include "hoist/fast_solver.hpp"
 #include "hoist/plausibility.hpp"
+#include "hoist/profile.hpp"
 #include "hoist/sensor_monitor.hpp"
 
 namespace hoist {
@@ -356,7 +357,7 @@ class LoadEstimator {
   bool stepping_ = false;
   double step_t_ = 0.0;                    // the step's onset
   double o_Fa_ = 0.0, o_M_ = 0.0;          // origin of the step part (= the configured load when not stepping)
-  double sub_h_ = 0.0025;                  // the last advance()'s substep [s]
+  double sub_h_ = kDefaultMaxStep;         // the last advance()'s substep [s]
   bool step_fresh_ = false;                // no step sensitivity of the previous tick yet
   SensorValues step_zq_;                   // the step's sensitivities at the previous tick
   double step_e_fy_ = 0.0, step_e_om_ = 0.0, step_e_rope_ = 0.0;  // model error of the onset's one-sample uncertainty

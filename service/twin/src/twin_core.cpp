@@ -242,7 +242,8 @@ bool TwinCore::finishStep(double t, bool allow_fault_check) {
       // The deflection alarm's envelope: exact, or a conservative bound
       // within envelope_tol_ of it (service.envelope_tolerance), or -- with
       // the caller's budget of exact evaluations spent -- a wider bound that
-      // no GUIDE_ROPE alarm can tell from the exact one (setEnvelopeBudget).
+      // no GUIDE_ROPE alarm can tell from the exact one (EnvelopeBudget in
+      // twin_core.hpp).
       const auto e0 = std::chrono::steady_clock::now();
       const bool defer = envelope_budget_ && *envelope_budget_ <= 0;
       double gdef = envelope_.evaluateBounded(*solver_, envelope_tol_,
@@ -361,7 +362,22 @@ void TwinCore::setStale(bool stale) {
   out_.alarm_level = alarms_.highestActive();
 }
 
-InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
+namespace {
+/// The caller's envelope budget, held by the core for one call only.
+class BudgetScope {
+ public:
+  BudgetScope(int*& slot, int* budget) : slot_(slot) { slot_ = budget; }
+  ~BudgetScope() { slot_ = nullptr; }
+  BudgetScope(const BudgetScope&) = delete;
+  BudgetScope& operator=(const BudgetScope&) = delete;
+
+ private:
+  int*& slot_;
+};
+}  // namespace
+
+InputResult TwinCore::onInput(const WinderSample& s, double wall_now, int* envelope_budget) {
+  const BudgetScope budget(envelope_budget_, envelope_budget);
   if (start_wall_ < 0.0) start_wall_ = wall_now;
   const Verdict v = validator_.check(s);
   if (!v.ok) {
@@ -390,7 +406,10 @@ InputResult TwinCore::onInput(const WinderSample& s, double wall_now) {
   return res;
 }
 
-TickResult TwinCore::tick(double t, double wall_now) { return clock_->tick(*this, t, wall_now); }
+TickResult TwinCore::tick(double t, double wall_now, int* envelope_budget) {
+  const BudgetScope budget(envelope_budget_, envelope_budget);
+  return clock_->tick(*this, t, wall_now);
+}
 
 void TwinCore::deferStart(double wall_now, const Kinematics& k, bool first) {
   start_pending_ = true;
@@ -401,8 +420,9 @@ void TwinCore::deferStart(double wall_now, const Kinematics& k, bool first) {
   ++starts_deferred_;
 }
 
-void TwinCore::completeStart(double t_prev, double wall_now) {
+void TwinCore::completeStart(double t_prev, double wall_now, int* envelope_budget) {
   if (!start_pending_) return;
+  const BudgetScope budget(envelope_budget_, envelope_budget);
   start_pending_ = false;
   // At the previous tick's model time, so that the coming tick steps one
   // ordinary period (no catch-up across the ticks the start waited), but

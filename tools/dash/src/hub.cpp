@@ -74,17 +74,26 @@ std::string hoistSuffixOf(const std::string& channel) {
 
 std::string validateAckFields(const std::string& kind, int level, int action, double shelve_duration,
                               const std::string& user) {
-  if (kind.empty() || kind.size() > 64) return "kind must have 1..64 characters";
-  for (char ch : kind)
-    if (!((ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '*'))
-      return "kind may contain only A-Z, 0-9, '_' and '*'";
-  if (level < 0 || level > 2) return "level must be 0 (both), 1 (WARNING) or 2 (CRITICAL)";
+  // The page's policy: a kind named ("*" for all), the three alarm actions
+  // of an operator at the list, a shelve of at most 1e6 s ...
+  if (kind.empty()) return "kind must name an alarm kind, or '*' for all";
   if (action != alarm_ack_t::ACTION_ACK && action != alarm_ack_t::ACTION_SHELVE &&
       action != alarm_ack_t::ACTION_UNSHELVE)
     return "action must be 1 (ACK), 2 (SHELVE) or 3 (UNSHELVE)";
-  if (action == alarm_ack_t::ACTION_SHELVE && !(std::isfinite(shelve_duration) && shelve_duration > 0.0 &&
-                                                 shelve_duration <= 1e6))
-    return "shelve_duration must be in (0, 1e6] s";
+  if (action == alarm_ack_t::ACTION_SHELVE && !(shelve_duration <= 1e6)) return "shelve_duration must be in (0, 1e6] s";
+  // ... on top of the daemon's own rule (hoist::contract, as hoist-mqtt), so
+  // the page never forwards a command the daemon would refuse.
+  contract::AlarmCommand cmd;
+  switch (contract::validateAlarmCommand(kind, level, action, shelve_duration, cmd)) {
+    case contract::CommandError::None: break;
+    case contract::CommandError::UnknownKind:
+      return "kind must name an alarm kind, or '*' for all (\"" + contract::printable(kind) + "\" is none)";
+    case contract::CommandError::BadLevel: return "level must be 0 (both), 1 (WARNING) or 2 (CRITICAL)";
+    case contract::CommandError::BadShelveDuration: return "shelve_duration must be in (0, 1e6] s";
+    case contract::CommandError::BadAction:
+    case contract::CommandError::BadCalibration:
+    case contract::CommandError::BadPreload: return "action must be 1 (ACK), 2 (SHELVE) or 3 (UNSHELVE)";
+  }
   return validateCommandUser(user);
 }
 
@@ -143,7 +152,7 @@ void Hub::addPrefix(const std::string& prefix) {
     ch.schema = schemaText(t.schema);
     auto& stored = channels_[ch.topic] = std::move(ch);
     by_id_[stored.id] = &stored;
-    if (suffix == "HOIST_ALARM" && !pending.empty()) {
+    if (suffix == bus::kChannelAlarm && !pending.empty()) {
       // Kept from before the shaft was confirmed: only the confirmed daemon
       // instance's alarm events (issue 33).
       const auto d = disc_.find(prefix);
@@ -183,9 +192,9 @@ void Hub::addPrefix(const std::string& prefix) {
       by_id_[sd.id] = &sd;
       added.push_back(&sd);
     };
-    if (suffix == bus::kChannelEstimate) addDecimated(kEstimateDecimatedSuffix, "hoist_dash.estimate_decimated", "HOIST_ESTIMATE");
-    if (suffix == "HOIST_CAGE") {
-      addDecimated(kDecimatedSuffix, "hoist_dash.cage_decimated", "HOIST_CAGE");
+    if (suffix == bus::kChannelEstimate) addDecimated(kEstimateDecimatedSuffix, "hoist_dash.estimate_decimated", std::string(bus::kChannelEstimate));
+    if (suffix == bus::kChannelCage) {
+      addDecimated(kDecimatedSuffix, "hoist_dash.cage_decimated", std::string(bus::kChannelCage));
       // The trend history: sent whole on subscribe, then nothing (the
       // decimated channel carries the rest).
       Channel hc;
@@ -302,19 +311,19 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
     return;
   }
   const std::string prefix = channel.substr(0, channel.size() - suffix.size());
-  if (opt_.discover && suffix == "HOIST_HEALTH") onDiscoveryHealth(prefix, j);
-  if (suffix == "HOIST_HEALTH" && channelFor(channel) != nullptr) {
+  if (opt_.discover && suffix == bus::kChannelHealth) onDiscoveryHealth(prefix, j);
+  if (suffix == bus::kChannelHealth && channelFor(channel) != nullptr) {
     if (!noteInstance(prefix, j)) return;
     maybeRequestAlarmStates(prefix, j);
   }
-  if (suffix != "HOIST_HEALTH" && channelFor(channel) != nullptr && !fromFollowedInstance(prefix, suffix, j)) return;
-  if (suffix == "HOIST_ALARM" && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
+  if (suffix != bus::kChannelHealth && channelFor(channel) != nullptr && !fromFollowedInstance(prefix, suffix, j)) return;
+  if (suffix == bus::kChannelAlarm && (channelFor(channel) != nullptr || opt_.discover)) annotateAlarm(prefix, j);
   Channel* ch = channelFor(channel);
   if (ch == nullptr) {
     if (ch == nullptr) {
       // An alarm of a shaft not announced yet (its first HOIST_HEALTH is up
       // to a second away): keep it for the alarm list, bounded.
-      if (opt_.discover && suffix == "HOIST_ALARM" &&
+      if (opt_.discover && suffix == bus::kChannelAlarm &&
           (pending_alarms_.count(prefix) || pending_alarms_.size() < opt_.max_prefixes)) {
         pending_since_.emplace(prefix, clock_());
         auto& t = pending_alarms_[prefix];
@@ -327,15 +336,15 @@ void Hub::onLcm(const std::string& channel, const void* data, std::size_t size) 
   }
   count("lcm_decoded");
   const auto payload = std::make_shared<const std::string>(j.dump());
-  if (suffix == "HOIST_HEALTH" || suffix == "HOIST_GUIDE_SHAPE" || suffix == "HOIST_FORECAST" ||
-      suffix == "HOIST_TRIP_PLAN")
+  if (suffix == bus::kChannelHealth || suffix == bus::kChannelGuideShape || suffix == bus::kChannelForecast ||
+      suffix == bus::kChannelTripPlan)
     ch->latest = payload;  // sent on subscribe (the trip plan: the speed axis's vmax)
-  if (suffix == "HOIST_ALARM") {
+  if (suffix == bus::kChannelAlarm) {
     const std::string key = j.value("kind", std::string()) + "/" + std::to_string(j.value("level", 0));
     if (ch->table.size() < 64 || ch->table.count(key)) ch->table[key] = payload;
     else count("alarm_table_full");
   }
-  if (suffix == "HOIST_CAGE") decimators_[prefix].add(j);
+  if (suffix == bus::kChannelCage) decimators_[prefix].add(j);
   if (suffix == bus::kChannelEstimate) estimate_decimators_[prefix].add(j);
   broadcast(*ch, payload);
 }

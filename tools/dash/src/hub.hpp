@@ -242,10 +242,12 @@ class Hub {
   std::string session_id_;
 };
 
-/// Checks an operator command before it is published: kind is 1..64
-/// characters of [A-Z0-9_*], level 0..2, action ACK/SHELVE/UNSHELVE,
-/// shelve_duration finite in (0, 1e6] for SHELVE, user 1..64 printable
-/// characters.  Returns "" when valid, else the reason.
+/// Checks an operator command before it is published: the page's policy
+/// (a kind named, "*" for all; action ACK, SHELVE or UNSHELVE; a shelve of
+/// at most 1e6 s) on top of the daemon's own rule
+/// (hoist::contract::validateAlarmCommand: a known kind, level 0..2, a
+/// finite shelve_duration > 0), then the operator-name rule
+/// (validateCommandUser).  Returns "" when valid, else the reason.
 std::string validateAckFields(const std::string& kind, int level, int action, double shelve_duration,
                               const std::string& user);
 /// The user rule of every operator command: 1..64 characters, no control

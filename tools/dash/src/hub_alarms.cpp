@@ -38,7 +38,7 @@ bool Hub::fromFollowedInstance(const std::string& prefix, const std::string& suf
   if (!j.contains("instance_id")) return true;  // a type without a sender (trip plans, guide shape)
   const std::int64_t instance = j.value("instance_id", std::int64_t{0});
   const auto it = instance_.find(prefix);
-  if (it != instance_.end() ? it->second == instance : suffix != "HOIST_ALARM") return true;
+  if (it != instance_.end() ? it->second == instance : suffix != bus::kChannelAlarm) return true;
   count(suffix + "_foreign_instance");
   if (logAllowed())
     spdlog::warn("shaft '{}': dropped {} of daemon instance {}: the dashboard follows instance {}",

@@ -5,6 +5,7 @@
 // by the server (server.hpp) on the hub's thread for a Client it owns; the
 // rest of the hub is hub.cpp.
 
+#include "hoist/bus/channels.hpp"
 #include "hub.hpp"
 
 namespace hoist::dash {
@@ -128,7 +129,7 @@ void Hub::handleClientAdvertise(Client& c, const Json& j) {
     }
     const std::string topic = ch["topic"].get<std::string>();
     const Channel* target = channelFor(topic);
-    if (target == nullptr || target->suffix != "HOIST_ALARM_ACK") {
+    if (target == nullptr || target->suffix != bus::kChannelAlarmAck) {
       count("commands_rejected_topic");
       status(c, 2, "rejected advertise: clients may publish only on <prefix>HOIST_ALARM_ACK of a known shaft, not \"" +
                        topic.substr(0, 128) + "\"");

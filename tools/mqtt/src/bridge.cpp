@@ -89,17 +89,17 @@ struct Bridge::Impl final : ShaftDirectory::Events, MqttLink::Events {
     // Data of another daemon instance than the shaft's (an impostor under its
     // prefix) is dropped and counted: ShaftData::admit.
     lcm.route<hoist::cage_state_t>(hoist::bus::kChannelCage, [this](const Shaft& s, const hoist::cage_state_t& m) {
-      if (data.admit(s, m.instance_id, "HOIST_CAGE", false)) data.onCage(s, m);
+      if (data.admit(s, m.instance_id, hoist::bus::kChannelCage.data(), false)) data.onCage(s, m);
     });
     lcm.route<hoist::health_t>(hoist::bus::kChannelHealth,
                                [this](const Shaft& s, const hoist::health_t& m) { onHealth(s, m); });
     lcm.route<hoist::alarm_t>(hoist::bus::kChannelAlarm,
                               [this](const Shaft& s, const hoist::alarm_t& m) { data.onAlarm(s, m); });
     lcm.route<hoist::forecast_t>(hoist::bus::kChannelForecast, [this](const Shaft& s, const hoist::forecast_t& m) {
-      if (data.admit(s, m.instance_id, "HOIST_FORECAST", false)) data.onForecast(s, m);
+      if (data.admit(s, m.instance_id, hoist::bus::kChannelForecast.data(), false)) data.onForecast(s, m);
     });
     lcm.route<hoist::estimate_t>(hoist::bus::kChannelEstimate, [this](const Shaft& s, const hoist::estimate_t& m) {
-      if (data.admit(s, m.instance_id, "HOIST_ESTIMATE", false)) data.onEstimate(s, m);
+      if (data.admit(s, m.instance_id, hoist::bus::kChannelEstimate.data(), false)) data.onEstimate(s, m);
     });
     if (!cfg.history_url.empty()) {
       history::HistoryConfig hc;

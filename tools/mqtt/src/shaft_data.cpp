@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "hoist/mqtt/command.hpp"
+#include "hoist/bus/channels.hpp"
 #include "hoist/msg/codec.hpp"
 #include "sparkplug_session.hpp"
 
@@ -103,7 +104,7 @@ bool ShaftData::admit(const Shaft& s, std::int64_t instance, const char* channel
 void ShaftData::onAlarm(const Shaft& s, const hoist::alarm_t& m) {
   // Only the daemon whose health this shaft follows changes what SCADA sees
   // (issue 33: one forged CLEAR turned the retained alarm inactive).
-  if (!admit(s, m.instance_id, "HOIST_ALARM", true)) return;
+  if (!admit(s, m.instance_id, hoist::bus::kChannelAlarm.data(), true)) return;
   if (!validKind(m.kind) || m.level < 1 || m.level > 2) {
     ++alarm_rejected_;
     std::int64_t suppressed = 0;

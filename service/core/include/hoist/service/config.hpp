@@ -88,7 +88,7 @@ struct ServiceConfig {
   /// Once they are spent, a twin whose bounded envelope has drifted past
   /// envelope_tolerance keeps that wider, still rigorous bound for a tick or
   /// more -- only while it lies below the GUIDE_ROPE WARNING alarm's clear
-  /// level, so no alarm decides differently (TwinCore::setEnvelopeBudget);
+  /// level, so no alarm decides differently (EnvelopeBudget in hoist/service/twin_core.hpp);
   /// near a threshold it is exact regardless.  Hundreds of twins in lockstep
   /// then refresh over a few ticks instead of in one.  The smallest value
   /// among a schedule's shafts; 0 = no budget, [0, 100000].

@@ -134,8 +134,10 @@ class TwinCore {
   /// Throws ParamError / std::invalid_argument for a bad configuration.
   TwinCore(const TwinConfig& cfg, ClockMode clock, std::unique_ptr<Solver> solver = nullptr);
 
-  /// A winder sample received at wall time `wall_now` [s].
-  InputResult onInput(const WinderSample& s, double wall_now);
+  /// A winder sample received at wall time `wall_now` [s].  `envelope_budget`:
+  /// the caller's budget of exact envelope evaluations for this call (see
+  /// EnvelopeBudget below; nullptr, the default: none).
+  InputResult onInput(const WinderSample& s, double wall_now, int* envelope_budget = nullptr);
   /// An undecodable message (garbage, truncated, wrong fingerprint).
   void rejectUndecodable() {
     counters_.reject(RejectReason::Decode);
@@ -152,7 +154,8 @@ class TwinCore {
   void injectFault() { inject_fault_ = true; }
   /// Wall clock: step the model to model time t (> current).  Input clock: no-op.
   /// While a deferred start is pending (see deferStarts) it does not step.
-  TickResult tick(double t, double wall_now);
+  /// `envelope_budget`: as for onInput().
+  TickResult tick(double t, double wall_now, int* envelope_budget = nullptr);
 
   // ---- deferred starts (wall clock; the daemon's start budget) ---------------
   /// With --clock wall, the first input (and a new stream whose encoder
@@ -172,7 +175,8 @@ class TwinCore {
   /// (so that the next tick(t) steps one ordinary period) but never before
   /// the input that asked for it; the kinematics are the stream's latest,
   /// carried forward to that time.  No-op without a pending start.
-  void completeStart(double t_prev, double wall_now);
+  /// `envelope_budget`: as for onInput().
+  void completeStart(double t_prev, double wall_now, int* envelope_budget = nullptr);
   /// Starts (first inputs and new streams) deferred since construction.
   std::int64_t startsDeferred() const { return starts_deferred_; }
   /// Staleness, shelve expiry and re-announcement; call at least a few times
@@ -239,9 +243,10 @@ class TwinCore {
   /// The deflection alarm's envelope (service.envelope_tolerance: exact or
   /// bounded evaluations, GuideRopeEnvelope::evaluateBounded).
   const GuideRopeEnvelope& envelope() const { return envelope_; }
-  /// The caller's budget of exact envelope evaluations (the daemon's per-tick
-  /// [service] max_exact_envelopes_per_tick across a schedule's shafts), or
-  /// null: no budget (the default).  Each exact evaluation decrements
+  /// EnvelopeBudget: the `envelope_budget` of onInput(), tick() and
+  /// completeStart() is the caller's budget of exact envelope evaluations
+  /// (the daemon's per-tick [service] max_exact_envelopes_per_tick across a
+  /// schedule's shafts), or null: no budget.  Each exact evaluation decrements
   /// *left; while *left <= 0 an evaluation whose bound has grown wider than
   /// envelope_tolerance is deferred (GuideRopeEnvelope::evaluateBounded with
   /// defer_below) if that wider bound is below envelopeDeferBelow(): the
@@ -249,8 +254,7 @@ class TwinCore {
   /// values are under the WARNING alarm's clear level), and the published
   /// guide_deflection is still never below the exact envelope, only looser
   /// than the tolerance for those steps.  Anything else is exact regardless.
-  /// The pointer is held until set again; the caller owns the int.
-  void setEnvelopeBudget(int* left) { envelope_budget_ = left; }
+  /// The core holds the pointer only within that call.
   /// The deflection below which an envelope evaluation may be deferred [m]:
   /// (alarms.warning_fraction - alarms.deadband) x alarms.guide_rope_gap, the
   /// GUIDE_ROPE WARNING alarm's clear level (below it neither GUIDE_ROPE
@@ -383,7 +387,7 @@ class TwinCore {
   GuideRopeEnvelope envelope_;
   double envelope_tol_ = 0.0;  // [m]: service.envelope_tolerance x alarms.guide_rope_gap
   double envelope_defer_below_ = 0.0;  // [m]: envelopeDeferBelow()
-  int* envelope_budget_ = nullptr;     // setEnvelopeBudget()
+  int* envelope_budget_ = nullptr;     // the envelope_budget of the onInput()/tick()/completeStart() under way
   std::int64_t envelope_ns_ = 0;
   GuideRopeEnvelope shape_;
   InputValidator validator_;
