@@ -8,11 +8,13 @@
 
 namespace hoist::svc {
 
-ForecastScheduler::ForecastScheduler(ShaftContext& ctx, ShaftOutputs& out) : ctx_(ctx), out_(out) {
-  if (ctx_.core.solver().method() != Method::Fast)
+ForecastScheduler::ForecastScheduler(const ShaftContext& ctx, TwinCore& core, ShaftClock& clock, ForecastStats& stats,
+                                     ShaftOutputs& out)
+    : ctx_(ctx), core_(core), clock_(clock), stats_(stats), out_(out) {
+  if (core_.solver().method() != Method::Fast)
     throw std::invalid_argument("forecast.enabled: the forecasts need the fast solver");
-  job_ = std::make_unique<ForecastJob>(ctx_.core.solver().modelPtr(), ctx_.cfg, ctx_.core.preloadScale());
-  if (ctx_.core.loadSensitivity()) unit_ = FastSolverState(ctx_.core.solver().model().n());
+  job_ = std::make_unique<ForecastJob>(core_.solver().modelPtr(), ctx_.cfg, core_.preloadScale());
+  if (core_.loadSensitivity()) unit_ = FastSolverState(core_.solver().model().n());
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
 }
 
@@ -44,7 +46,7 @@ bool ForecastScheduler::acceptPlan(const TripPlan& plan, std::int64_t seq, doubl
 }
 
 void ForecastScheduler::afterStep(std::int64_t utime) {
-  TwinCore& core = ctx_.core;
+  TwinCore& core = core_;
   const ForecastConfig& fc = ctx_.cfg.forecast;
   const double tp = core.output().t;
   const double period = 1.0 / fc.rate;
@@ -58,7 +60,7 @@ void ForecastScheduler::afterStep(std::int64_t utime) {
     // edge, a limited catch-up: not a state to forecast from.  The
     // predictions are withdrawn (MODEL_FAULT / INPUT_STALE / MODEL_DOMAIN
     // say what is wrong).
-    ++ctx_.stats.forecasts_skipped;
+    ++stats_.forecasts_skipped;
     core.setPredictions(false, 0.0, false, 0.0, fc.horizon);
     return;
   }
@@ -71,7 +73,7 @@ void ForecastScheduler::afterStep(std::int64_t utime) {
   // load's response (the model is linear in its load), continued under the
   // estimated load.  Else the open-loop twin's state and configured load.
   snap.from_estimate = false;
-  snap.preload_scale = ctx_.core.preloadScale();
+  snap.preload_scale = core_.preloadScale();
   if (const LoadEstimate* e = core.estimate(); e && core.estimateInUse()) {
     core.loadSensitivity()->saveState(unit_);
     snap.from_estimate =
@@ -87,11 +89,11 @@ void ForecastScheduler::afterStep(std::int64_t utime) {
     // is published before the next input is read.
     const auto c0 = ShaftContext::Clock::now();
     const ForecastResult& r = job_->runNow();
-    ctx_.sync_pause += ShaftContext::Clock::now() - c0;
+    clock_.pause(ShaftContext::Clock::now() - c0);
     onResult(r);
     return;
   }
-  if (job_->postSnapshot()) ++ctx_.stats.forecasts_dropped;
+  if (job_->postSnapshot()) ++stats_.forecasts_dropped;
   pool_->notify();
 }
 
@@ -100,7 +102,7 @@ void ForecastScheduler::pollResult() {
 }
 
 void ForecastScheduler::onResult(const ForecastResult& r) {
-  ShaftStats& st = ctx_.stats;
+  ForecastStats& st = stats_;
   if (r.failed) {
     ++st.forecast_failures;
     return;
@@ -108,8 +110,7 @@ void ForecastScheduler::onResult(const ForecastResult& r) {
   ++st.forecasts;
   if (r.from_estimate) ++st.forecasts_from_estimate;
   const double us = r.compute_s * 1e6;
-  st.forecast_hist.add(us);
-  st.forecast_total.add(us);
+  st.compute.add(us);
   if (r.plan_error != PlanError::None) {
     // The plan was valid when it came, but no longer fits the motion (e.g.
     // braking already, the target closer than the plan's stopping distance):
@@ -123,11 +124,11 @@ void ForecastScheduler::onResult(const ForecastResult& r) {
   }
   const ForecastSummary* sc[ForecastResult::kScenarios];
   for (int i = 0; i < ForecastResult::kScenarios; ++i) sc[i] = &r.scenario[i];
-  const double slack_threshold = slackThreshold(ctx_.cfg, ctx_.core.solver().model(), r.kin.l);
+  const double slack_threshold = slackThreshold(ctx_.cfg, core_.solver().model(), r.kin.l);
   const ForecastVerdict v = judgeForecast(sc, ForecastResult::kScenarios, slack_threshold);
   out_.setForecastCause(v.clearance ? ForecastResult::kNames[v.clearance_scenario] : "",
                         v.slack ? ForecastResult::kNames[v.slack_scenario] : "", slack_threshold);
-  ctx_.core.setPredictions(v.clearance, v.clearance_s, v.slack, v.slack_s, ctx_.cfg.forecast.horizon,
+  core_.setPredictions(v.clearance, v.clearance_s, v.slack, v.slack_s, ctx_.cfg.forecast.horizon,
                            r.from_estimate);
   out_.publishForecast(r);
   out_.publishAlarmEvents();

@@ -16,13 +16,19 @@
 #include "hoist/fast_solver.hpp"
 #include "shaft_context.hpp"
 #include "shaft_outputs.hpp"
+#include "shaft_stats.hpp"
 
 namespace hoist::svc {
 
 class ForecastScheduler {
  public:
   /// Throws std::invalid_argument when the twin does not run the fast solver.
-  ForecastScheduler(ShaftContext& ctx, ShaftOutputs& out);
+  /// Writes `stats` (its own), the forecasts' predictions into `core` (the
+  /// PREDICTED_* alarms) and pauses `clock` while it forecasts synchronously
+  /// (--clock input).  Every reference must outlive this room (all are
+  /// ShaftTwin's, as this room is).
+  ForecastScheduler(const ShaftContext& ctx, TwinCore& core, ShaftClock& clock, ForecastStats& stats,
+                    ShaftOutputs& out);
   ForecastScheduler(const ForecastScheduler&) = delete;
   ForecastScheduler& operator=(const ForecastScheduler&) = delete;
 
@@ -50,7 +56,10 @@ class ForecastScheduler {
  private:
   void onResult(const ForecastResult& r);
 
-  ShaftContext& ctx_;                 ///< the shaft's shared state
+  const ShaftContext& ctx_;           ///< the shaft's shared, read-only state
+  TwinCore& core_;                    ///< the model: snapshots from it, predictions into it
+  ShaftClock& clock_;                 ///< paused while a synchronous forecast runs
+  ForecastStats& stats_;              ///< this room's statistics
   ShaftOutputs& out_;                 ///< publishes HOIST_FORECAST and the PREDICTED_* events
   std::unique_ptr<ForecastJob> job_;  ///< workspace and mailboxes of this shaft's forecasts
   FastSolverState unit_;              ///< the estimator's unit-load state (sized once; estimator only)

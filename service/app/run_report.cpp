@@ -36,7 +36,7 @@ nlohmann::ordered_json costSplit(const RunFacts& f) {
   std::int64_t model = 0, env = 0, publish = 0, shaft_ticks = 0, exact = 0, bounded = 0, deferred = 0;
   int longest = 0;
   for (const ShaftTwin* sp : f.shafts) {
-    const ShaftStats& st = sp->stats();
+    const TickStats& st = sp->stats().tick;
     const TwinCore& core = sp->core();
     model += st.ns_model;
     env += core.envelopeNanos();
@@ -124,21 +124,25 @@ nlohmann::ordered_json missesJson(const RunFacts& f) {
 /// the one name it has everywhere); then the figures only a whole run has:
 /// the whole-run histograms and the counters HOIST_HEALTH does not carry.
 nlohmann::ordered_json shaftJson(const ShaftTwin& sp) {
-  const ShaftStats& st = sp.stats();
+  const ShaftStatsView st = sp.stats();
   const TwinConfig& c = sp.config();
   nlohmann::ordered_json o;
   o["label"] = sp.reportLabel();
   o["channel_prefix"] = c.service.channel_prefix;
   o["modes"] = c.shaft.n;
   o["health"] = nlohmann::ordered_json(hoist::msg::toJson(sp.lastHealth()));
-  o["commands_applied"] = st.commands_applied;
+  o["commands_applied"] = st.in.commands_applied;
   if (c.forecast.enabled) {
-    o["forecasts_from_estimate"] = st.forecasts_from_estimate;
-    o["forecast_failures"] = st.forecast_failures;
-    o["forecast_us"] = histogramJson(st.forecast_total);
+    o["forecasts_from_estimate"] = st.forecast.forecasts_from_estimate;
+    o["forecast_failures"] = st.forecast.forecast_failures;
+    o["forecast_us"] = histogramJson(st.forecast.compute.total);
   }
-  o["step_us"] = histogramJson(st.step_total);
-  o["late_us"] = histogramJson(st.late_total);
+  // The model step time of the tick (--clock wall) or of the inputs
+  // (--clock input): one of them is empty.
+  LatencyHistogram step = st.tick.step.total;
+  step.merge(st.in.step.total);
+  o["step_us"] = histogramJson(step);
+  o["late_us"] = histogramJson(st.tick.late.total);
   return o;
 }
 

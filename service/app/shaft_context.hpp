@@ -1,7 +1,7 @@
-// ShaftContext: what every room of one hosted shaft shares (the rooms:
-// docs/architecture.md): the configuration, the names, the log, the model
-// (TwinCore), the statistics and the shaft's wall clock.  Plain data plus
-// two clock helpers; the rooms hold a reference to it.
+// ShaftContext: what every room of one hosted shaft shares, read-only (the
+// rooms: docs/architecture.md): the configuration, the names, the log, the
+// model (TwinCore) and the shaft's wall clock.  Each room's own state is
+// the room's (its statistics: shaft_stats.hpp).
 #pragma once
 
 #include <array>
@@ -14,14 +14,8 @@
 #include "hoist/rt/rt_log.hpp"
 #include "hoist/service/config.hpp"
 #include "hoist/service/twin_core.hpp"
-#include "miss_record.hpp"
-#include "shaft_stats.hpp"
 
 namespace hoist::svc {
-
-class OffsetKeeper;
-class PreloadKeeper;
-class TripRoom;
 
 using rt::RtLog;
 
@@ -48,61 +42,82 @@ struct TripDetectability {
   bool loss30_visible = false;
 };
 
-struct ShaftContext {
+class OffsetKeeper;
+class PreloadKeeper;
+class TripRoom;
+
+/// The optional rooms of a shaft (nullptr: not hosted), set by ShaftTwin as
+/// they are enabled (before the loop starts).  The rooms that hand them
+/// work hold a const reference: they call the rooms, never re-seat them.
+struct ShaftPeers {
+  OffsetKeeper* offsets = nullptr;  ///< the kept accelerometer offset (offset_keeper.hpp)
+  PreloadKeeper* preload = nullptr; ///< the adopted guide-rope preload (preload_keeper.hpp)
+  TripRoom* trips = nullptr;        ///< the shaft's memory ([history]; trip_room.hpp)
+};
+
+/// One shaft's wall clock: seconds since the loop started, less the time
+/// spent in synchronous forecasts (--clock input: the inputs wait in the
+/// socket meanwhile; they are not late).  ShaftTwin starts it; the
+/// ForecastScheduler pauses it; every room reads it.
+class ShaftClock {
+ public:
   using Clock = std::chrono::steady_clock;
+  /// The loop's start (ShaftTwin::start, rebase).
+  void start(Clock::time_point t) { start_ = t; }
+  /// `d` of wall time that does not count (ForecastScheduler).
+  void pause(Clock::duration d) { paused_ += d; }
+  /// Wall time of `t` [s].
+  double wallAt(Clock::time_point t) const { return std::chrono::duration<double>(t - start_ - paused_).count(); }
+  /// Wall time now [s].
+  double wallNow() const { return wallAt(Clock::now()); }
+
+ private:
+  Clock::time_point start_{};
+  Clock::duration paused_{};
+};
+
+/// What the rooms of one shaft share, read-only: the configuration, the
+/// names, the log, the clock and the model.  ShaftTwin owns it and hands
+/// each room a const reference (for as long as the ShaftTwin lives); a room
+/// that writes the model or the clock is given that part by reference of
+/// its own (see the rooms' constructors), so what a room may change is in
+/// its constructor's signature.
+struct ShaftContext {
+  using Clock = ShaftClock::Clock;
 
   ShaftContext(const TwinConfig& config, std::string shaft_label, RtLog& rt_log, TestHooks test_hooks,
                std::int64_t instance)
-      : cfg(config),
+      : cfg(validated(config)),
         label(std::move(shaft_label)),
         tag(label.empty() ? std::string() : "[" + label + "] "),
         log(rt_log),
         hooks(test_hooks),
         instance_id(instance),
         ch(cfg.service.channel_prefix),
-        core(cfg, cfg.service.clock) {
-    if (cfg.forecast.enabled) cfg.forecast.validate(cfg.service.rate);
-  }
+        core(cfg, cfg.service.clock) {}
   ShaftContext(const ShaftContext&) = delete;
   ShaftContext& operator=(const ShaftContext&) = delete;
 
-  TwinConfig cfg;                 ///< this shaft's effective configuration
-  std::string label;              ///< as given ("" for a daemon with one shaft)
-  std::string tag;                ///< log-line prefix: "[label] " or ""
-  RtLog& log;                     ///< the daemon's real-time log ring (never blocks)
-  TestHooks hooks;                ///< test-only fault injection
-  std::int64_t instance_id = 0;   ///< this process's random id (HOIST_CAGE/HOIST_HEALTH/HOIST_FORECAST)
-  bus::Channels ch;               ///< channel names: prefix + HOIST_*
-  TwinCore core;                  ///< the model, input validation, alarms (no I/O)
-  ShaftStats stats;               ///< every counter and histogram of this shaft
-  TripDetectability detect;       ///< the last recorded trip's detectability (loop thread)
-  Clock::time_point start{};      ///< the loop's start: wall times are measured from it
-  /// --clock input: wall time spent in synchronous forecasts, not counted as
-  /// time passing for this shaft's staleness and health windows (the inputs
-  /// wait in the socket meanwhile; they are not late).
-  Clock::duration sync_pause{};
-  /// The daemon's loop-time split (miss_record.hpp): the rooms add their
-  /// phases' time to it (nullptr: not hosted by a Daemon).
-  LoopSplit* split = nullptr;
-  /// The daemon's miss record, for HOIST_HEALTH (nullptr: none).
-  const MissLog* misses = nullptr;
-  /// This shaft's kept accelerometer offset (offset_keeper.hpp): told after
-  /// every stepped tick, so it sees a calibration end (nullptr: not kept).
-  OffsetKeeper* offsets = nullptr;
-  /// This shaft's adopted guide-rope preload (preload_keeper.hpp): takes
-  /// the operator's adoptions, told after every tick (nullptr: not hosted
-  /// by a Daemon).
-  PreloadKeeper* preload = nullptr;
-  /// This shaft's trip room (trip_room.hpp): every model step is copied
-  /// into it (nullptr: [history] off).
-  TripRoom* trips = nullptr;
+  const TwinConfig cfg;           ///< this shaft's effective configuration
+  const std::string label;        ///< as given ("" for a daemon with one shaft)
+  const std::string tag;          ///< log-line prefix: "[label] " or ""
+  RtLog& log;                     ///< the daemon's real-time log ring (never blocks; a sink every room writes)
+  const TestHooks hooks;          ///< test-only fault injection
+  const std::int64_t instance_id = 0;  ///< this process's random id (HOIST_CAGE/HOIST_HEALTH/HOIST_FORECAST)
+  const bus::Channels ch;         ///< channel names: prefix + HOIST_*
+  TwinCore core;                  ///< the model, input validation, alarms (no I/O): the model room
+  ShaftClock clock;               ///< the shaft's wall clock
 
   /// Wall time of `t` [s] on this shaft's clock.
-  double wallAt(Clock::time_point t) const {
-    return std::chrono::duration<double>(t - start - sync_pause).count();
-  }
+  double wallAt(Clock::time_point t) const { return clock.wallAt(t); }
   /// Wall time now [s] on this shaft's clock.
-  double wallNow() const { return wallAt(Clock::now()); }
+  double wallNow() const { return clock.wallNow(); }
+
+ private:
+  static const TwinConfig& validated(const TwinConfig& c) {
+    if (c.forecast.enabled) c.forecast.validate(c.service.rate);
+    return c;
+  }
 };
 
 }  // namespace hoist::svc

@@ -12,7 +12,8 @@
 
 namespace hoist::svc {
 
-ShaftHealth::ShaftHealth(ShaftContext& ctx) : ctx_(ctx) {
+ShaftHealth::ShaftHealth(const ShaftContext& ctx, ShaftStatsView stats, const ShaftPeers& peers)
+    : ctx_(ctx), st_(stats), peers_(peers) {
   statm_fd_ = ::open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
 }
 
@@ -27,41 +28,46 @@ bool ShaftHealth::due(double wall) const {
 
 void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   const TwinCore& core = ctx_.core;
-  const ShaftStats& st = ctx_.stats;
+  const TickStats& tk = st_.tick;
+  const InputStats& in = st_.in;
+  const OutputStats& out = st_.out;
+  const ForecastStats& fc = st_.forecast;
   const InputCounters& c = core.counters();
   const AlarmEngine& al = core.alarms();
   m.utime = bus::wallUtime();
   m.uptime = std::max(0.0, wall);
   m.t = core.publishedTime(core.modelTime());
   m.window = std::max(0.0, wall - std::max(0.0, last_wall_));
-  m.ticks = st.ticks;
+  m.ticks = tk.ticks;
   m.steps = core.steps();
   m.preload_scale = core.preloadScale();
-  m.deadline_misses = st.deadline_misses;
-  m.step_p50_us = st.step_hist.quantile(0.5);
-  m.step_p99_us = st.step_hist.quantile(0.99);
-  m.step_max_us = st.step_hist.max();
-  m.late_p50_us = st.late_hist.quantile(0.5);
-  m.late_p99_us = st.late_hist.quantile(0.99);
-  m.late_max_us = st.late_hist.max();
+  m.deadline_misses = tk.deadline_misses;
+  const LatencyHistogram& step = st_.stepWindow();
+  m.step_p50_us = step.quantile(0.5);
+  m.step_p99_us = step.quantile(0.99);
+  m.step_max_us = step.max();
+  m.late_p50_us = tk.late.window.quantile(0.5);
+  m.late_p99_us = tk.late.window.quantile(0.99);
+  m.late_max_us = tk.late.window.max();
   m.input_age = core.inputAge(wall);
   m.accepted = c.accepted;
   m.seq_gaps = c.seq_gaps;
   m.rejected_total = c.rejectedTotal();
   for (int i = 0; i < kRejectReasons; ++i) m.rejected[i] = c.rejected[i];
-  m.rejected[kRejectReasons] = st.command_decode_rejects;
-  m.rejected[kRejectReasons + 1] = st.handler_exceptions;
+  m.rejected[kRejectReasons] = in.command_decode_rejects;
+  m.rejected[kRejectReasons + 1] = in.handler_exceptions;
   for (int i = 0; i < kPlanRejectReasons; ++i)
-    m.rejected[kRejectReasons + 2 + i] = st.plan_rejects[static_cast<std::size_t>(i)];
-  m.forecast_p50_us = st.forecast_hist.count() > 0 ? st.forecast_hist.quantile(0.5) : 0.0;
-  m.forecast_p99_us = st.forecast_hist.count() > 0 ? st.forecast_hist.quantile(0.99) : 0.0;
-  m.forecasts = st.forecasts;
-  m.forecasts_dropped = st.forecasts_dropped;
-  m.forecasts_skipped = st.forecasts_skipped;
-  m.plans_accepted = st.plans_accepted;
-  m.plans_rejected = st.plansRejected();
-  m.sensor_accepted = st.sensor_accepted;
-  m.sensor_rejected = st.sensor_rejected;
+    m.rejected[kRejectReasons + 2 + i] = in.plan_rejects[static_cast<std::size_t>(i)];
+  const LatencyHistogram& fh = fc.compute.window;
+  m.forecast_p50_us = fh.count() > 0 ? fh.quantile(0.5) : 0.0;
+  m.forecast_p99_us = fh.count() > 0 ? fh.quantile(0.99) : 0.0;
+  m.forecasts = fc.forecasts;
+  m.forecasts_dropped = fc.forecasts_dropped;
+  m.forecasts_skipped = fc.forecasts_skipped;
+  m.plans_accepted = in.plans_accepted;
+  m.plans_rejected = in.plansRejected();
+  m.sensor_accepted = in.sensor_accepted;
+  m.sensor_rejected = in.sensor_rejected;
   if (const EstimatorCounters* ec = ctx_.core.estimatorCounters()) {
     m.sensor_gated = ec->gated;
     m.estimator_load_changes = ec->load_changes;
@@ -73,7 +79,7 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   m.sensor_clock_refused = tc.clock_refused;
   m.sensor_time_backwards = tc.time_backwards;
   m.sensor_dropped = tc.too_late + tc.superseded;
-  if (const TripRoom* room = ctx_.trips) {  // relaxed reads of the room's atomics: no lock
+  if (const TripRoom* room = peers_.trips) {  // relaxed reads of the room's atomics: no lock
     const TripCounters& c = room->counters();
     m.history_open = c.store_open.load(std::memory_order_relaxed);
     m.trips_recorded = c.trips.load(std::memory_order_relaxed);
@@ -86,36 +92,36 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   m.alarms_active = al.activeCount();
   m.alarms_unacked = al.unackedCount();
   m.alarms_shelved = al.shelvedCount();
-  m.alarm_events = st.alarm_events;
+  m.alarm_events = out.alarm_events;
   m.model_faults = core.modelFaults();
   m.model_resets = core.modelResets();
-  m.publish_failures = st.publish_failures;
-  m.nonfinite_blocked = st.nonfinite_blocked;
+  m.publish_failures = out.publish_failures;
+  m.nonfinite_blocked = out.nonfinite_blocked;
   m.degraded = core.degraded();
   m.rss_kb = rssKb();
-  m.commands_dropped = st.commands_dropped;
-  m.commands_invalid = st.commands_invalid;
+  m.commands_dropped = in.commands_dropped;
+  m.commands_invalid = in.commands_invalid;
   m.catchup_limited = core.catchupLimited();
   m.datagrams_ignored = ignored_counter_ ? *ignored_counter_ : 0;
   fillStartsAndMisses(m);
 }
 
 void ShaftHealth::fillStartsAndMisses(hoist::health_t& m) const {
-  static_assert(ShaftStats::kMissesNoted == hoist::health_t::MAX_MISSES, "one noted miss per health_t slot");
+  static_assert(TickStats::kMissesNoted == hoist::health_t::MAX_MISSES, "one noted miss per health_t slot");
   const TwinCore& core = ctx_.core;
-  const ShaftStats& st = ctx_.stats;
+  const TickStats& st = st_.tick;
   m.starting = core.startPending();
   m.starts_deferred = core.startsDeferred();
-  const MissLog* log = ctx_.misses;
+  const MissLog* log = misses_;
   m.misses_recorded = log ? log->total() : 0;
   // This shaft's latest misses whose records the ring still keeps, oldest first.
   int n = 0;
   if (log) {
     const std::int64_t noted = st.misses_noted;
-    const std::int64_t from = std::max<std::int64_t>(0, noted - ShaftStats::kMissesNoted);
+    const std::int64_t from = std::max<std::int64_t>(0, noted - TickStats::kMissesNoted);
     const std::int64_t oldest_kept = log->total() - static_cast<std::int64_t>(log->kept());
     for (std::int64_t j = from; j < noted; ++j) {
-      const auto slot = static_cast<std::size_t>(j % ShaftStats::kMissesNoted);
+      const auto slot = static_cast<std::size_t>(j % TickStats::kMissesNoted);
       const std::int64_t seq = st.miss_seq[slot];
       if (seq < oldest_kept || seq >= log->total()) continue;
       const MissRecord& r = log->at(static_cast<std::size_t>(seq - oldest_kept));
@@ -141,29 +147,28 @@ void ShaftHealth::fillStartsAndMisses(hoist::health_t& m) const {
 }
 
 void ShaftHealth::endWindow(const hoist::health_t& m, double wall, bool final_report) {
-  ShaftStats& st = ctx_.stats;
   const InputCounters& c = ctx_.core.counters();
   if (!final_report)
     ctx_.log.debug("{}health: t={:.2f} s steps={} step p50/p99/max={:.0f}/{:.0f}/{:.0f} us late "
                    "p50/p99/max={:.0f}/{:.0f}/{:.0f} us misses={} inputs ok={} rejected={} gaps={} "
                    "alarms active={} faults={} publish failures={}{}",
                    ctx_.tag, m.t, m.steps, m.step_p50_us, m.step_p99_us, m.step_max_us, m.late_p50_us,
-                   m.late_p99_us, m.late_max_us, st.deadline_misses, c.accepted, c.rejectedTotal(), c.seq_gaps,
-                   m.alarms_active, m.model_faults, st.publish_failures, m.degraded ? " DEGRADED" : "");
-  // The whole-run histograms take each window at its end (one add per
-  // value per tick instead of two: with hundreds of shafts every histogram
-  // bin touched is a cache miss).
-  st.step_total.merge(st.step_hist);
-  st.late_total.merge(st.late_hist);
-  st.step_hist.reset();
-  st.late_hist.reset();
-  st.forecast_hist.reset();
+                   m.late_p99_us, m.late_max_us, st_.tick.deadline_misses, c.accepted, c.rejectedTotal(), c.seq_gaps,
+                   m.alarms_active, m.model_faults, st_.out.publish_failures, m.degraded ? " DEGRADED" : "");
   last_wall_ = wall;
 }
 
 void ShaftHealth::logFinal() const {
   const TwinCore& core = ctx_.core;
-  const ShaftStats& st = ctx_.stats;
+  const TickStats& tk = st_.tick;
+  const InputStats& in = st_.in;
+  const OutputStats& out = st_.out;
+  const ForecastStats& fc = st_.forecast;
+  // The whole run's model step time: the tick's (--clock wall) and the
+  // inputs' (--clock input); one of them is empty.  (At stop: a copy.)
+  LatencyHistogram step = tk.step.total;
+  step.merge(in.step.total);
+  const LatencyHistogram& late = tk.late.total;
   const InputCounters& c = core.counters();
   const std::string& tag = ctx_.tag;
   RtLog& log = ctx_.log;
@@ -172,30 +177,30 @@ void ShaftHealth::logFinal() const {
            "deadline misses={}; inputs accepted={} rejected={} sequence gaps={}; alarms "
            "active={} events={}; model faults={} resets={}; publish failures={} withheld "
            "(non-finite)={}{}",
-           tag, core.modelTime(), st.ticks, core.steps(), st.step_total.quantile(0.5), st.step_total.quantile(0.99),
-           st.step_total.quantile(0.999), st.step_total.max(), st.late_total.quantile(0.5),
-           st.late_total.quantile(0.99), st.late_total.quantile(0.999), st.late_total.max(), st.deadline_misses,
-           c.accepted, c.rejectedTotal(), c.seq_gaps, core.alarms().activeCount(), st.alarm_events,
-           core.modelFaults(), core.modelResets(), st.publish_failures, st.nonfinite_blocked,
+           tag, core.modelTime(), tk.ticks, core.steps(), step.quantile(0.5), step.quantile(0.99),
+           step.quantile(0.999), step.max(), late.quantile(0.5),
+           late.quantile(0.99), late.quantile(0.999), late.max(), tk.deadline_misses,
+           c.accepted, c.rejectedTotal(), c.seq_gaps, core.alarms().activeCount(), out.alarm_events,
+           core.modelFaults(), core.modelResets(), out.publish_failures, out.nonfinite_blocked,
            core.degraded() ? " DEGRADED" : "");
   for (int i = 0; i < kRejectReasons; ++i)
     if (c.rejected[i] > 0) log.info("{}  rejected {}: {}", tag, toString(static_cast<RejectReason>(i)), c.rejected[i]);
-  if (st.command_decode_rejects > 0)
-    log.info("{}  rejected alarm commands (command_decode): {}", tag, st.command_decode_rejects);
-  if (st.handler_exceptions > 0) log.info("{}  exceptions caught in LCM handlers: {}", tag, st.handler_exceptions);
-  if (st.reannounce_requests > 0)
+  if (in.command_decode_rejects > 0)
+    log.info("{}  rejected alarm commands (command_decode): {}", tag, in.command_decode_rejects);
+  if (in.handler_exceptions > 0) log.info("{}  exceptions caught in LCM handlers: {}", tag, in.handler_exceptions);
+  if (in.reannounce_requests > 0)
     log.info("{}  alarm re-announce requests: {} ({} honoured, {} merged into a pending one)", tag,
-             st.reannounce_requests, st.reannounces, st.reannounce_merged);
+             in.reannounce_requests, in.reannounces, in.reannounce_merged);
   if (ctx_.cfg.forecast.enabled) {
     log.info("{}forecasts: {} done (compute p50/p99/max {:.1f}/{:.1f}/{:.1f} ms), {} dropped (worker late), {} "
              "skipped (degraded), {} failed; trip plans accepted {}, no longer fitting the motion {}",
-             tag, st.forecasts, st.forecast_total.quantile(0.5) / 1e3, st.forecast_total.quantile(0.99) / 1e3,
-             st.forecast_total.max() / 1e3, st.forecasts_dropped, st.forecasts_skipped, st.forecast_failures,
-             st.plans_accepted, st.plan_unusable);
+             tag, fc.forecasts, fc.compute.total.quantile(0.5) / 1e3, fc.compute.total.quantile(0.99) / 1e3,
+             fc.compute.total.max() / 1e3, fc.forecasts_dropped, fc.forecasts_skipped, fc.forecast_failures,
+             in.plans_accepted, fc.plan_unusable);
     for (int i = 0; i < kPlanRejectReasons; ++i)
-      if (st.plan_rejects[static_cast<std::size_t>(i)] > 0)
+      if (in.plan_rejects[static_cast<std::size_t>(i)] > 0)
         log.info("{}  rejected trip plans {}: {}", tag, toString(static_cast<PlanReject>(i)),
-                 st.plan_rejects[static_cast<std::size_t>(i)]);
+                 in.plan_rejects[static_cast<std::size_t>(i)]);
   }
 }
 

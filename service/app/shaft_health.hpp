@@ -12,17 +12,24 @@
 #include <string>
 
 #include "hoist/health_t.hpp"
+#include "miss_record.hpp"
 #include "shaft_context.hpp"
+#include "shaft_stats.hpp"
 
 namespace hoist::svc {
 
 class ShaftHealth {
  public:
-  explicit ShaftHealth(ShaftContext& ctx);
+  /// Reads the statistics in `stats` and the trip room in `peers` (never
+  /// writes them: each slice's owner ends its own window); every reference
+  /// must outlive this room (all are ShaftTwin's, as this room is).
+  ShaftHealth(const ShaftContext& ctx, ShaftStatsView stats, const ShaftPeers& peers);
   ~ShaftHealth();
   ShaftHealth(const ShaftHealth&) = delete;
   ShaftHealth& operator=(const ShaftHealth&) = delete;
 
+  /// The daemon's miss record, for HOIST_HEALTH (nullptr: none).
+  void setMissLog(const MissLog* misses) { misses_ = misses; }
   /// Process-wide count of ignored datagrams, reported in HOIST_HEALTH.
   void setIgnoredCounter(const std::int64_t* n) { ignored_counter_ = n; }
   /// The loop starts: the next report is due `phase` s earlier than a full
@@ -32,8 +39,8 @@ class ShaftHealth {
   bool due(double wall) const;
   /// Fills `m` for wall time `wall` (this window's figures).
   void fill(hoist::health_t& m, double wall) const;
-  /// After `m` was published: the debug line (unless final), the window's
-  /// histograms merged into the whole run and reset.
+  /// After `m` was published: the debug line (unless final); the next
+  /// window starts.  (The slices' owners end their histograms' windows.)
   void endWindow(const hoist::health_t& m, double wall, bool final_report);
   /// The final health line and per-reason rejection counts, in the log.
   void logFinal() const;
@@ -44,7 +51,10 @@ class ShaftHealth {
   /// shaft took part in, from the daemon's miss record).
   void fillStartsAndMisses(hoist::health_t& m) const;
 
-  ShaftContext& ctx_;                           ///< the shaft's shared state
+  const ShaftContext& ctx_;                     ///< the shaft's shared, read-only state
+  ShaftStatsView st_;                           ///< every statistics slice of the shaft, read-only
+  const ShaftPeers& peers_;                     ///< the trip room, if any (its counters)
+  const MissLog* misses_ = nullptr;             ///< setMissLog()
   double last_wall_ = 0.0;                      ///< wall time of the last report [s]
   int statm_fd_ = -1;                           ///< /proc/self/statm, open for the run
   const std::int64_t* ignored_counter_ = nullptr;  ///< the daemon's ignored-datagram count

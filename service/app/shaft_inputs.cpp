@@ -21,8 +21,9 @@ namespace hoist::svc {
 
 using std::chrono::duration;
 
-ShaftInputs::ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast)
-    : ctx_(ctx), in_(in), out_(out), forecast_(forecast) {
+ShaftInputs::ShaftInputs(const ShaftContext& ctx, TwinCore& core, InputStats& stats, const ShaftPeers& peers,
+                         lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast)
+    : ctx_(ctx), core_(core), stats_(stats), peers_(peers), in_(in), out_(out), forecast_(forecast) {
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
   decode_budget_ = std::max(kMinDecodesPerTick, static_cast<int>(kDecodesPerSecond / ctx_.cfg.service.rate));
   routes_[kWinder] = {this, &ctx_.ch.winder, &ShaftInputs::handleWinder, bus::kChannelWinder.data()};
@@ -66,7 +67,7 @@ void ShaftInputs::subscribe(bus::InputRouter* router, bool own_health) {
     add(router, routes_[kOwnHealth]);
     add(router, routes_[kOwnAlarm]);
   }
-  if (ctx_.core.estimatorEnabled()) {
+  if (core_.estimatorEnabled()) {
     add(router, routes_[kCageImu]);
     add(router, routes_[kRopeLoad]);
   }
@@ -80,7 +81,7 @@ void ShaftInputs::watchOwnOutputs(bus::InputRouter* router) {
 void ShaftInputs::forgetSilentPublisher(double wall) {
   if (other_seen_wall_ >= 0.0 && wall - other_seen_wall_ > 3.0 / ctx_.cfg.service.health_rate) {
     other_seen_wall_ = -1.0;
-    ctx_.core.setDuplicatePublisher(false, 0.0);
+    core_.setDuplicatePublisher(false, 0.0);
   }
 }
 
@@ -97,7 +98,7 @@ void ShaftInputs::logReject(RejectReason r, const char* detail) {
 }
 
 void ShaftInputs::handlerFailed(const char* what, const char* channel) {
-  ++ctx_.stats.handler_exceptions;
+  ++stats_.handler_exceptions;
   std::int64_t suppressed = 0;
   if (log_limit_.allow(kLogHandlerException, ctx_.wallNow(), suppressed))
     ctx_.log.error("{}exception in the {} handler caught (message dropped): {} [{} similar suppressed]", ctx_.tag,
@@ -112,7 +113,7 @@ void ShaftInputs::logJunk(const std::string& what) {
 }
 
 void ShaftInputs::rejectPlan(PlanReject r, const char* detail) {
-  ++ctx_.stats.plan_rejects[static_cast<std::size_t>(r)];
+  ++stats_.plan_rejects[static_cast<std::size_t>(r)];
   std::int64_t suppressed = 0;
   if (!log_limit_.allow(kLogPlan, ctx_.wallNow(), suppressed)) return;
   ctx_.log.warn("{}rejected trip plan ({}): {} [{} similar suppressed]", ctx_.tag, toString(r), detail, suppressed);
@@ -121,7 +122,7 @@ void ShaftInputs::rejectPlan(PlanReject r, const char* detail) {
 // ---- HOIST_WINDER ----------------------------------------------------------------
 
 void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
-  TwinCore& core = ctx_.core;
+  TwinCore& core = core_;
   const double wall = ctx_.wallNow();
   WinderSample s;
   const WinderDecode dec = decodeWinder(rbuf->data, rbuf->data_size, winder_in_, s);
@@ -147,11 +148,11 @@ void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
                   core.startPending() ? " (at the next tick within the start budget)" : "");
   if (res.republish) out_.publishCage(s.utime);  // the held state, flagged degraded
   if (res.stepped) {
-    ctx_.stats.step_hist.add(duration<double, std::micro>(t1 - t0).count());
+    stats_.step.add(duration<double, std::micro>(t1 - t0).count());
     out_.publishStep(s.utime);
     if (forecast_) forecast_->afterStep(s.utime);
-    if (ctx_.offsets) ctx_.offsets->afterTick(core);
-    if (ctx_.trips) ctx_.trips->afterStep(core, s.utime);
+    if (peers_.offsets) peers_.offsets->afterTick(core);
+    if (peers_.trips) peers_.trips->afterStep(core, s.utime);
   }
   out_.publishAlarmEvents();
 }
@@ -171,7 +172,7 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
   //   * junk is logged under a rate limit; every EFFECTIVE command is audited
   //     (log line and the HOIST_ALARM events it causes carry the user) and
   //     never rate-limited.
-  ShaftStats& st = ctx_.stats;
+  InputStats& st = stats_;
   if (++decodes_this_tick_ > decode_budget_) {
     ++st.commands_dropped;
     ++st.command_decodes_dropped;
@@ -216,7 +217,7 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
     adoptPreload(*cmd, user, bus::wallUtime());  // the daemon's clock, not the sender's
     return;
   }
-  const int n = ctx_.core.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
+  const int n = core_.command(cmd->action, cmd->kind, cmd->level, cmd->shelve_duration);
   const char* what = cmd->action == AlarmAction::Ack      ? "acknowledge"
                      : cmd->action == AlarmAction::Shelve ? "shelve"
                                                           : "unshelve";
@@ -246,35 +247,35 @@ void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
 
 void ShaftInputs::calibrate(const AlarmCommand& cmd, const std::string& user) {
   // The live calibration: no alarm changes; audited as an effective command.
-  if (!ctx_.core.calibrate(cmd.known_fa, cmd.known_b, cmd.calibrate_duration)) {
+  if (!core_.calibrate(cmd.known_fa, cmd.known_b, cmd.calibrate_duration)) {
     logJunk(fmt::format("calibration from '{}' ignored: [estimator] is not enabled", user));
     return;
   }
-  ++ctx_.stats.commands_applied;
+  ++stats_.commands_applied;
   ctx_.log.info("{}AUDIT operator '{}': calibrate: the load is known, Fa = {} N at b = {} m (M = {} N m), for {} s "
                 "from t = {:.2f} s", ctx_.tag, user, cmd.known_fa, cmd.known_b, cmd.known_fa * cmd.known_b,
-                cmd.calibrate_duration, ctx_.core.publishedTime(ctx_.core.modelTime()));
+                cmd.calibrate_duration, core_.publishedTime(core_.modelTime()));
 }
 
 void ShaftInputs::adoptPreload(const AlarmCommand& cmd, const std::string& user, std::int64_t utime) {
   // A new model for the live twin: built and kept off the loop, swapped in
   // at rest (preload_keeper.hpp).  Audited now and again when in use.
-  if (!ctx_.preload) {
+  if (!peers_.preload) {
     logJunk(fmt::format("preload adoption from '{}' ignored: this twin is not hosted by the daemon", user));
     return;
   }
-  if (!ctx_.preload->request(cmd.preload_scale, user, utime)) {
+  if (!peers_.preload->request(cmd.preload_scale, user, utime)) {
     logJunk(fmt::format("preload adoption x{} from '{}' refused: an earlier adoption is still being built or waits "
                         "for the cage to rest", cmd.preload_scale, user));
     return;
   }
-  ++ctx_.stats.commands_applied;
+  ++stats_.commands_applied;
   ctx_.log.warn("{}AUDIT operator '{}': adopt the guide-rope preloads x{} (the live twin runs x{}); built off the "
-                "loop, in use when the cage rests", ctx_.tag, user, cmd.preload_scale, ctx_.core.preloadScale());
+                "loop, in use when the cage rests", ctx_.tag, user, cmd.preload_scale, core_.preloadScale());
 }
 
 void ShaftInputs::requestReannounce(std::optional<AlarmKind> kind, AlarmLevel level, const std::string& user) {
-  ShaftStats& st = ctx_.stats;
+  InputStats& st = stats_;
   ++st.reannounce_requests;
   if (reannounce_pending_) {
     ++st.reannounce_merged;
@@ -297,8 +298,8 @@ void ShaftInputs::serviceReannounce() {
   if (reannounce_wall_ >= 0.0 && wall - reannounce_wall_ < kReannounceInterval) return;
   reannounce_pending_ = false;
   reannounce_wall_ = wall;
-  ++ctx_.stats.reannounces;
-  ctx_.core.command(AlarmAction::Reannounce, reannounce_kind_, reannounce_level_, 0.0);
+  ++stats_.reannounces;
+  core_.command(AlarmAction::Reannounce, reannounce_kind_, reannounce_level_, 0.0);
   out_.publishAlarmEvents();
 }
 
@@ -314,7 +315,7 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   const trip_plan_t& m = plan_in_;
-  const double t = ctx_.core.modelTime();
+  const double t = core_.modelTime();
   const double timeout = ctx_.cfg.forecast.plan_timeout;
   // The sequence rule is per sender (hoist/service/plan_senders.hpp): another
   // sender's seq, however large, never makes this sender's plans old.
@@ -330,8 +331,8 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   const TripPlan p{m.target_length, m.vmax, m.amax, m.jerk};
-  const CageOutput& o = ctx_.core.output();
-  const PlanCheck pc = checkPlan(p, ctx_.core.modelTime(), o.kin, ctx_.cfg.shaft, plan_scratch_);
+  const CageOutput& o = core_.output();
+  const PlanCheck pc = checkPlan(p, core_.modelTime(), o.kin, ctx_.cfg.shaft, plan_scratch_);
   if (!pc.ok()) {
     // describe() allocates: plans are rare, off the tick (as alarm commands).
     const std::string why = describe(pc);
@@ -352,7 +353,7 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
     rejectPlan(PlanReject::AboveLimits, text_);
     return;
   }
-  ++ctx_.stats.plans_accepted;
+  ++stats_.plans_accepted;
   plan_senders_.accept(m.sender_id, m.seq, t, timeout);
   forecast_->hasPlan(t);  // expire (and log) the plan in force first
   const bool other_sender = plan_sender_ != m.sender_id;
@@ -451,7 +452,7 @@ void ShaftInputs::otherPublisher(std::int64_t id, std::uint64_t ut, const std::s
   }
   other_id_ = id;
   other_seen_wall_ = wall;
-  ctx_.core.setDuplicatePublisher(true, static_cast<double>(id));
+  core_.setDuplicatePublisher(true, static_cast<double>(id));
   out_.publishAlarmEvents();
 }
 

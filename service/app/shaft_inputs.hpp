@@ -33,6 +33,7 @@
 #include "hoist/winder_t.hpp"
 #include "shaft_context.hpp"
 #include "shaft_outputs.hpp"
+#include "shaft_stats.hpp"
 
 namespace hoist::svc {
 
@@ -42,7 +43,12 @@ class ShaftInputs {
  public:
   /// `in` receives when the daemon has no own receive path; `forecast` is
   /// nullptr without [forecast] enabled (trip plans are then not subscribed).
-  ShaftInputs(ShaftContext& ctx, lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast);
+  /// Writes `stats` (its own) and feeds `core` (samples, commands); hands
+  /// work to `out`, `forecast` and the optional rooms in `peers` (read at
+  /// each use: ShaftTwin sets them before the loop starts).  Every reference
+  /// must outlive this room (all are ShaftTwin's, as this room is).
+  ShaftInputs(const ShaftContext& ctx, TwinCore& core, InputStats& stats, const ShaftPeers& peers, lcm::LCM& in,
+              ShaftOutputs& out, ForecastScheduler* forecast);
   ShaftInputs(const ShaftInputs&) = delete;
   ShaftInputs& operator=(const ShaftInputs&) = delete;
 
@@ -117,7 +123,10 @@ class ShaftInputs {
   void serviceReannounce();
   void add(bus::InputRouter* router, Route& r);
 
-  ShaftContext& ctx_;               ///< the shaft's shared state
+  const ShaftContext& ctx_;         ///< the shaft's shared, read-only state
+  TwinCore& core_;                  ///< the model: fed the samples and commands
+  InputStats& stats_;               ///< this room's statistics
+  const ShaftPeers& peers_;         ///< the optional rooms (offset and preload keepers, trip room)
   lcm::LCM& in_;                    ///< LCM's receive path (when the daemon has none of its own)
   ShaftOutputs& out_;               ///< publishes what an input causes (cage, shape, alarm events)
   ForecastScheduler* forecast_;     ///< the forecast room (nullptr without forecasts)

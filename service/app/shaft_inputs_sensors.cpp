@@ -25,7 +25,7 @@ constexpr double kMaxRopeLoad = 1.0e8;       // |force| [N]
 }  // namespace
 
 void ShaftInputs::rejectSensor(const char* channel, const char* detail) {
-  ++ctx_.stats.sensor_rejected;
+  ++stats_.sensor_rejected;
   std::int64_t suppressed = 0;
   if (log_limit_.allow(kLogSensor, ctx_.wallNow(), suppressed))
     ctx_.log.warn("{}rejected {} sample: {} [{} similar suppressed]", ctx_.tag, channel, detail, suppressed);
@@ -74,20 +74,20 @@ void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
     rejectSensor(bus::kChannelCageImu.data(), text_);
     return;
   }
-  if (!sensorSeqNewer(m.seq, ctx_.stats.imu_seq, bus::kChannelCageImu.data())) return;
+  if (!sensorSeqNewer(m.seq, stats_.imu_seq, bus::kChannelCageImu.data())) return;
   // A channel that is implausible on its own is left out of this sample.
   const double wall = ctx_.wallNow();
-  const SensorVerdict v = ctx_.core.onCageImu(m.utime, a_ok ? m.f_y : NAN, w_ok ? m.omega : NAN, wall,
+  const SensorVerdict v = core_.onCageImu(m.utime, a_ok ? m.f_y : NAN, w_ok ? m.omega : NAN, wall,
                                                bus::wallUtime());
   if (!sensorTimeOk(v, m.utime, bus::kChannelCageImu.data())) return;
-  ctx_.stats.last_imu_wall = wall;
-  ++ctx_.stats.sensor_accepted;
+  stats_.last_imu_wall = wall;
+  ++stats_.sensor_accepted;
 }
 
 bool ShaftInputs::sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* channel) {
   // Refused by its time: counted (HOIST_HEALTH), logged (rate-limited), and
   // SENSOR_FAULT raised by the model room (published here).
-  const double off = ctx_.core.lastSensorOffset();
+  const double off = core_.lastSensorOffset();
   switch (v) {
     case SensorVerdict::Queued: return true;
     case SensorVerdict::NoClock: return false;  // no model time yet (--clock input before the winder)
@@ -95,7 +95,7 @@ bool ShaftInputs::sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* 
       std::snprintf(text_, sizeof text_, "utime %lld is %+.3f s from the daemon's clock (%s), beyond "
                     "sensors.max_clock_offset = %g s: the sensor's clock is off; not used (SENSOR_FAULT)",
                     static_cast<long long>(utime), off,
-                    ctx_.core.clock() == ClockMode::Wall ? "wall clock" : "the winder's utime",
+                    core_.clock() == ClockMode::Wall ? "wall clock" : "the winder's utime",
                     ctx_.cfg.estimator.max_clock_offset);
       break;
     case SensorVerdict::TimeBackwards:
@@ -117,12 +117,12 @@ void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
     rejectSensor(bus::kChannelRopeLoad.data(), text_);
     return;
   }
-  if (!sensorSeqNewer(m.seq, ctx_.stats.rope_seq, bus::kChannelRopeLoad.data())) return;
+  if (!sensorSeqNewer(m.seq, stats_.rope_seq, bus::kChannelRopeLoad.data())) return;
   const double wall = ctx_.wallNow();
-  const SensorVerdict v = ctx_.core.onRopeLoad(m.utime, m.force, wall, bus::wallUtime());
+  const SensorVerdict v = core_.onRopeLoad(m.utime, m.force, wall, bus::wallUtime());
   if (!sensorTimeOk(v, m.utime, bus::kChannelRopeLoad.data())) return;
-  ctx_.stats.last_rope_wall = wall;
-  ++ctx_.stats.sensor_accepted;
+  stats_.last_rope_wall = wall;
+  ++stats_.sensor_accepted;
 }
 
 }  // namespace hoist::svc

@@ -19,14 +19,16 @@ int divider(double rate, double sub_rate) {
 
 }  // namespace
 
-ShaftOutputs::ShaftOutputs(ShaftContext& ctx, lcm::LCM& out) : ctx_(ctx), out_(out) {
+ShaftOutputs::ShaftOutputs(const ShaftContext& ctx, TwinCore& core, OutputStats& stats, const InputStats& inputs,
+                           lcm::LCM& out)
+    : ctx_(ctx), core_(core), stats_(stats), inputs_(inputs), out_(out) {
   const ServiceConfig& s = ctx_.cfg.service;
   cage_div_ = divider(s.rate, s.cage_rate);
   shape_div_ = divider(s.rate, s.shape_rate);
   log_limit_.setLimit(s.log_rate_limit);
 
   // Preallocate every outgoing message and its buffer.
-  const GuideRopeEnvelope& sh = ctx_.core.shape();
+  const GuideRopeEnvelope& sh = core_.shape();
   shape_msg_.n = static_cast<int32_t>(sh.depths().size());
   shape_msg_.x.assign(sh.depths().data(), sh.depths().data() + sh.depths().size());
   shape_msg_.y1.assign(shape_msg_.n, 0.0);
@@ -96,7 +98,7 @@ ShaftOutputs::ShaftOutputs(ShaftContext& ctx, lcm::LCM& out) : ctx_(ctx), out_(o
 
 bool ShaftOutputs::publishBytes(const std::string& channel, const std::vector<std::uint8_t>& buf, int len,
                                 bool batch) {
-  ShaftStats& st = ctx_.stats;
+  OutputStats& st = stats_;
   const int every = ctx_.hooks.fail_publish_every;
   const bool injected = every > 0 && ++st.publish_attempts % every == 0;
   const auto n = static_cast<std::size_t>(len);
@@ -118,7 +120,7 @@ bool ShaftOutputs::publishBytes(const std::string& channel, const std::vector<st
 template <class Msg>
 bool ShaftOutputs::encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
                                     bool batch) {
-  ShaftStats& st = ctx_.stats;
+  OutputStats& st = stats_;
   if (!hoist::msg::allFinite(msg)) {  // generated from the .lcm files (hoist/msg/codec.hpp)
     ++st.nonfinite_blocked;
     std::int64_t suppressed = 0;
@@ -152,7 +154,7 @@ void ShaftOutputs::publishStep(std::int64_t utime) {
   publishCage(utime);
   publishEstimate(utime, false);
   const double rate = ctx_.cfg.service.shape_rate;
-  const double t = ctx_.core.modelTime();
+  const double t = core_.modelTime();
   if (rate > 0.0 && t - last_shape_t_ >= 1.0 / rate - 1e-9) {
     last_shape_t_ = t;
     publishShape(utime, false);
@@ -162,30 +164,30 @@ void ShaftOutputs::publishStep(std::int64_t utime) {
 void ShaftOutputs::publishCage(std::int64_t utime, bool batch) {
   cage_msg_.utime = utime;
   cage_msg_.seq = cage_seq_++;
-  toCageMessage(ctx_.core.output(), cage_msg_);
+  toCageMessage(core_.output(), cage_msg_);
   encodeAndPublish(ctx_.ch.cage, cage_msg_, cage_buf_, batch);
 }
 
 void ShaftOutputs::publishEstimate(std::int64_t utime, bool batch) {
-  const LoadEstimate* e = ctx_.core.estimate();
+  const LoadEstimate* e = core_.estimate();
   if (!e) return;  // [estimator] disabled, or not stepped since the last refused step
   estimate_msg_.utime = utime;
   estimate_msg_.seq = estimate_seq_++;
-  const EstimatorCounters& c = *ctx_.core.estimatorCounters();
+  const EstimatorCounters& c = *core_.estimatorCounters();
   const double wall = ctx_.wallNow();
-  const ShaftStats& st = ctx_.stats;
-  toEstimateMessage(*e, c, ctx_.core.publishedTime(e->t), st.last_imu_wall < 0.0 ? -1.0 : wall - st.last_imu_wall,
-                    st.last_rope_wall < 0.0 ? -1.0 : wall - st.last_rope_wall, ctx_.core.estimateGate(),
-                    ctx_.core.modelTime(), ctx_.core.calibrating(), estimate_msg_);
-  estimate_msg_.detect_trip = ctx_.detect.trip;
-  estimate_msg_.loss30_separation = ctx_.detect.loss30_separation;
-  estimate_msg_.loss30_visible = ctx_.detect.loss30_visible;
+  const InputStats& st = inputs_;
+  toEstimateMessage(*e, c, core_.publishedTime(e->t), st.last_imu_wall < 0.0 ? -1.0 : wall - st.last_imu_wall,
+                    st.last_rope_wall < 0.0 ? -1.0 : wall - st.last_rope_wall, core_.estimateGate(),
+                    core_.modelTime(), core_.calibrating(), estimate_msg_);
+  estimate_msg_.detect_trip = detect_.trip;
+  estimate_msg_.loss30_separation = detect_.loss30_separation;
+  estimate_msg_.loss30_visible = detect_.loss30_visible;
   encodeAndPublish(ctx_.ch.estimate, estimate_msg_, estimate_buf_, batch);
   logGateEvents();
 }
 
 void ShaftOutputs::logGateEvents() {
-  const EstimateGate& g = ctx_.core.estimateGate();
+  const EstimateGate& g = core_.estimateGate();
   const std::int64_t n = g.events();
   if (n - gate_seen_ > EstimateGate::kEvents) {
     ctx_.log.warn("{}{} estimate switch/load-change log lines lost (more than {} between two steps)", ctx_.tag,
@@ -195,7 +197,7 @@ void ShaftOutputs::logGateEvents() {
   const double hold = ctx_.cfg.estimator.clear_hold;
   for (; gate_seen_ < n; ++gate_seen_) {
     const GateEvent& e = g.event(gate_seen_);
-    const double t = ctx_.core.publishedTime(e.t);
+    const double t = core_.publishedTime(e.t);
     switch (e.type) {
       case GateEvent::Type::Switch:
         if (e.to_estimate)
@@ -223,7 +225,7 @@ void ShaftOutputs::logGateEvents() {
 }
 
 void ShaftOutputs::publishShape(std::int64_t utime, bool batch) {
-  TwinCore& core = ctx_.core;
+  TwinCore& core = core_;
   core.evaluateShape();
   const GuideRopeEnvelope& sh = core.shape();
   shape_msg_.utime = utime;
@@ -237,7 +239,7 @@ void ShaftOutputs::publishShape(std::int64_t utime, bool batch) {
 }
 
 void ShaftOutputs::publishAlarmEvents(const CommandCause& by) {
-  TwinCore& core = ctx_.core;
+  TwinCore& core = core_;
   const AlarmEvents& ev = core.events();
   if (ev.empty()) return;
   const std::int64_t utime = bus::wallUtime();
@@ -281,7 +283,7 @@ void ShaftOutputs::publishAlarmEvents(const CommandCause& by) {
     alarm_msg_.shelved_for = e.shelved_for;
     alarm_msg_.from_estimate = e.from_estimate;
     alarm_msg_.message.assign(text_);
-    if (encodeAndPublish(ctx_.ch.alarm, alarm_msg_, alarm_buf_)) ++ctx_.stats.alarm_events;
+    if (encodeAndPublish(ctx_.ch.alarm, alarm_msg_, alarm_buf_)) ++stats_.alarm_events;
     switch (e.type) {
       case AlarmEventType::Reannounce: log.debug("{}alarm: {} (t = {:.2f} s)", tag, text_, alarm_msg_.t); break;
       case AlarmEventType::Raise:

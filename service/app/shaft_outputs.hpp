@@ -25,6 +25,7 @@
 #include "hoist/guide_shape_t.hpp"
 #include "hoist/health_t.hpp"
 #include "shaft_context.hpp"
+#include "shaft_stats.hpp"
 #include "hoist/bus/udpm_sender.hpp"
 
 namespace hoist::svc {
@@ -56,8 +57,12 @@ class ShaftOutputs {
   /// instance published has a smaller one: ShaftInputs tells forged events
   /// with a copied instance id by it).
   std::int64_t nextAlarmId() const { return alarm_id_; }
-  /// Publishes through `out` unless setSender() gives the daemon's own publisher.
-  ShaftOutputs(ShaftContext& ctx, lcm::LCM& out);
+  /// Publishes through `out` unless setSender() gives the daemon's own
+  /// publisher.  Writes `stats` (its own) and, through `core`, the shape
+  /// evaluation and the taken alarm events; reads `inputs` (the sensors'
+  /// latest sample times).  Every reference must outlive this room (all are
+  /// ShaftTwin's, as this room is).
+  ShaftOutputs(const ShaftContext& ctx, TwinCore& core, OutputStats& stats, const InputStats& inputs, lcm::LCM& out);
   ShaftOutputs(const ShaftOutputs&) = delete;
   ShaftOutputs& operator=(const ShaftOutputs&) = delete;
 
@@ -103,6 +108,9 @@ class ShaftOutputs {
     cause_.preload_text = preload;
     cause_.fingerprint_text = fingerprint;
   }
+  /// The last recorded trip's detectability, carried by every HOIST_ESTIMATE
+  /// (ShaftTwin::applyCondition).
+  void setDetectability(const TripDetectability& d) { detect_ = d; }
   /// What the next MODEL_MISMATCH event of the trip-end preload test names.
   void setPreloadVerdictText(const std::array<char, 240>& text) { cause_.preload_verdict_text = text; }
   /// HOIST_FORECAST from a forecast result.
@@ -120,7 +128,11 @@ class ShaftOutputs {
   bool encodeAndPublish(const std::string& channel, const Msg& msg, std::vector<std::uint8_t>& buf,
                         bool batch = false);
 
-  ShaftContext& ctx_;            ///< the shaft's shared state
+  const ShaftContext& ctx_;      ///< the shaft's shared, read-only state
+  TwinCore& core_;               ///< the model: its outputs, shape and alarm events
+  OutputStats& stats_;           ///< this room's statistics
+  const InputStats& inputs_;     ///< the inputs' statistics (the sensors' latest sample times)
+  TripDetectability detect_;     ///< setDetectability()
   lcm::LCM& out_;                ///< publishes (lcm_url_out, or the input instance) unless sender_ is set
   UdpmSender* sender_ = nullptr; ///< the daemon's own publisher, or nullptr
   int cage_div_ = 1;             ///< --clock wall: HOIST_CAGE every cage_div_ ticks

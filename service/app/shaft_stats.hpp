@@ -1,7 +1,11 @@
-// ShaftStats: every counter and histogram of one hosted shaft, in one plain
-// struct.  Each room of the shaft (shaft_twin.hpp) increments the fields
-// marked with its name; ShaftHealth (shaft_health.hpp) reads them all for
-// HOIST_HEALTH, the final log lines and the run report.  No logic here.
+// The statistics of one hosted shaft, as one slice per room that writes
+// them: the tick (ShaftTwin), the inputs (ShaftInputs), the outputs
+// (ShaftOutputs) and the forecasts (ForecastScheduler).  ShaftTwin holds
+// the slices; each room gets its own slice writable and the others', where
+// it reads them, const (ShaftHealth reads them all for HOIST_HEALTH and the
+// final log lines; the run report and the tests read them through
+// ShaftTwin).  Each counter has one writer.  Plain data: no logic but the
+// window's end, which the owner calls (ShaftTwin::publishHealth).
 #pragma once
 
 #include <array>
@@ -19,19 +23,30 @@ namespace hoist::svc {
 /// exceptions caught in an input handler, then one per PlanReject.
 inline constexpr int kExtraReasons = 2 + kPlanRejectReasons;
 
-struct ShaftStats {
-  // ---- the tick (ShaftTwin) ----
+/// A figure measured per health window and over the whole run: samples go
+/// into `window`; at the window's end it is merged into `total` and reset.
+struct WindowedHistogram {
+  LatencyHistogram window;  ///< this health window
+  LatencyHistogram total;   ///< the whole run, up to the last window's end
+  void add(double us) { window.add(us); }
+  /// (The whole-run histogram takes each window at its end: one add per
+  /// value instead of two; with hundreds of shafts every bin touched is a
+  /// cache miss.)
+  void endWindow() {
+    total.merge(window);
+    window.reset();
+  }
+};
+
+/// The tick's (ShaftTwin): --clock wall steps, lateness, starts, misses.
+struct TickStats {
   std::int64_t ticks = 0;            ///< ticks run
   std::int64_t deadline_misses = 0;  ///< deadlines the schedule skipped
   std::int64_t ns_model = 0;         ///< steady-clock ns in the model (core tick + housekeeping)
   std::int64_t ns_publish = 0;       ///< steady-clock ns publishing from the tick (encode + send)
   std::int64_t ns_tick = 0;          ///< steady-clock ns in whole tick() calls
-  LatencyHistogram step_hist;        ///< model step time [us], this health window
-  LatencyHistogram late_hist;        ///< tick lateness [us], this health window
-  LatencyHistogram step_total;       ///< model step time [us], whole run (windows merged at each health report)
-  LatencyHistogram late_total;       ///< tick lateness [us], whole run
-
-  // ---- starts and misses (ShaftTwin, the Daemon's miss record) ----
+  WindowedHistogram step;            ///< model step time [us] (--clock wall)
+  WindowedHistogram late;            ///< tick lateness [us]
   double last_late_us = 0.0;         ///< this tick's lateness [us] (the miss record reads it)
   std::int64_t starts = 0;           ///< deferred starts completed in a tick (within the start budget)
   std::int64_t start_tick = -1;      ///< `ticks` at the latest deferred start (-1: none yet)
@@ -49,8 +64,14 @@ struct ShaftStats {
     miss_late_us[j] = late_us;
     ++misses_noted;
   }
+  void endWindow() {
+    step.endWindow();
+    late.endWindow();
+  }
+};
 
-  // ---- inputs (ShaftInputs) ----
+/// The inputs' (ShaftInputs): commands, trip plans, sensors, --clock input steps.
+struct InputStats {
   std::int64_t command_decode_rejects = 0;  ///< undecodable alarm commands
   std::int64_t handler_exceptions = 0;      ///< exceptions caught in an input handler
   std::int64_t command_decodes_dropped = 0; ///< command datagrams beyond the tick's decode bound (not decoded)
@@ -61,27 +82,12 @@ struct ShaftStats {
   std::int64_t reannounces = 0;             ///< ... honoured (at most one a second)
   std::int64_t reannounce_merged = 0;       ///< ... merged into a pending one (arrived within the interval)
   std::int64_t plans_accepted = 0;          ///< trip plans accepted
+  std::array<std::int64_t, kPlanRejectReasons> plan_rejects{};  ///< trip plans rejected, per reason
   std::int64_t sensor_accepted = 0;         ///< cage IMU and rope-load samples handed to the estimator
   std::int64_t sensor_rejected = 0;         ///< ... refused (undecodable, implausible, old seq)
   SensorSequence imu_seq, rope_seq;         ///< each sensor's sequence rule (hoist/service/sensor_sequence.hpp)
   double last_imu_wall = -1.0, last_rope_wall = -1.0;  ///< when (wall clock [s]; < 0: never)
-  std::array<std::int64_t, kPlanRejectReasons> plan_rejects{};  ///< trip plans rejected, per reason
-
-  // ---- outputs (ShaftOutputs) ----
-  std::int64_t publish_failures = 0;   ///< publishes that failed (socket, encode, buffer size)
-  std::int64_t nonfinite_blocked = 0;  ///< messages withheld because a field was not finite
-  std::int64_t alarm_events = 0;       ///< HOIST_ALARM events published
-  std::int64_t publish_attempts = 0;   ///< publishes tried (TestHooks::fail_publish_every counts them)
-
-  // ---- forecasts (ForecastScheduler) ----
-  std::int64_t forecasts = 0;          ///< forecasts done
-  std::int64_t forecasts_dropped = 0;  ///< snapshots replaced before the worker took them
-  std::int64_t forecasts_skipped = 0;  ///< forecast instants skipped (degraded state)
-  std::int64_t forecasts_from_estimate = 0;  ///< forecasts started from the load estimate's state
-  std::int64_t forecast_failures = 0;  ///< forecasts whose engine threw (nothing published)
-  std::int64_t plan_unusable = 0;      ///< forecasts whose accepted plan no longer fit the motion
-  LatencyHistogram forecast_hist;      ///< forecast compute time [us], this health window
-  LatencyHistogram forecast_total;     ///< forecast compute time [us], whole run
+  WindowedHistogram step;                   ///< model step time [us] (--clock input: the inputs step the model)
 
   /// Trip plans rejected, all reasons.
   std::int64_t plansRejected() const {
@@ -89,6 +95,38 @@ struct ShaftStats {
     for (auto v : plan_rejects) n += v;
     return n;
   }
+  void endWindow() { step.endWindow(); }
+};
+
+/// The outputs' (ShaftOutputs).
+struct OutputStats {
+  std::int64_t publish_failures = 0;   ///< publishes that failed (socket, encode, buffer size)
+  std::int64_t nonfinite_blocked = 0;  ///< messages withheld because a field was not finite
+  std::int64_t alarm_events = 0;       ///< HOIST_ALARM events published
+  std::int64_t publish_attempts = 0;   ///< publishes tried (TestHooks::fail_publish_every counts them)
+};
+
+/// The forecasts' (ForecastScheduler; all zero without [forecast] enabled).
+struct ForecastStats {
+  std::int64_t forecasts = 0;          ///< forecasts done
+  std::int64_t forecasts_dropped = 0;  ///< snapshots replaced before the worker took them
+  std::int64_t forecasts_skipped = 0;  ///< forecast instants skipped (degraded state)
+  std::int64_t forecasts_from_estimate = 0;  ///< forecasts started from the load estimate's state
+  std::int64_t forecast_failures = 0;  ///< forecasts whose engine threw (nothing published)
+  std::int64_t plan_unusable = 0;      ///< forecasts whose accepted plan no longer fit the motion
+  WindowedHistogram compute;           ///< forecast compute time [us]
+  void endWindow() { compute.endWindow(); }
+};
+
+/// Every slice of one shaft, read-only (ShaftHealth, the run report, tests).
+struct ShaftStatsView {
+  const TickStats& tick;
+  const InputStats& in;
+  const OutputStats& out;
+  const ForecastStats& forecast;
+  /// Model step time [us] this window: the tick's (--clock wall) or the
+  /// inputs' (--clock input); one of them is empty.
+  const LatencyHistogram& stepWindow() const { return in.step.window.count() > 0 ? in.step.window : tick.step.window; }
 };
 
 }  // namespace hoist::svc

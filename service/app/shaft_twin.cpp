@@ -16,10 +16,12 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
                      std::int64_t instance_id, lcm::LCM* lcm_out)
     : ctx_(cfg, std::move(label), log, hooks, instance_id),
       in_(lcm),
-      outputs_(ctx_, lcm_out ? *lcm_out : lcm),
-      forecast_(ctx_.cfg.forecast.enabled ? std::make_unique<ForecastScheduler>(ctx_, outputs_) : nullptr),
-      inputs_(ctx_, lcm, outputs_, forecast_.get()),
-      health_(ctx_) {
+      outputs_(ctx_, ctx_.core, output_stats_, input_stats_, lcm_out ? *lcm_out : lcm),
+      forecast_(ctx_.cfg.forecast.enabled ? std::make_unique<ForecastScheduler>(ctx_, ctx_.core, ctx_.clock,
+                                                                                  forecast_stats_, outputs_)
+                                          : nullptr),
+      inputs_(ctx_, ctx_.core, input_stats_, peers_, lcm, outputs_, forecast_.get()),
+      health_(ctx_, stats(), peers_) {
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
   // Wall clock: the first input's (and a new stream's) static solve waits
   // for the daemon's per-tick start budget ([service] max_starts_per_tick).
@@ -29,17 +31,17 @@ ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, Rt
 }
 
 void ShaftTwin::attachLoop(LoopSplit* split, const MissLog* misses, int phase) {
-  ctx_.split = split;
-  ctx_.misses = misses;
+  split_ = split;
+  health_.setMissLog(misses);
   outputs_.setPhase(phase);
 }
 
 void ShaftTwin::startWithinBudget(double t, double wall, int& starts_left, int* envelope_budget) {
   if (starts_left <= 0) return;  // waits for a later tick: "starting"
   --starts_left;
-  ShaftStats& st = ctx_.stats;
+  TickStats& st = tick_stats_;
   {
-    const ScopedSpan span(&st.ns_model, &st.ns_start, ctx_.split ? &ctx_.split->start : nullptr);
+    const ScopedSpan span(&st.ns_model, &st.ns_start, split_ ? &split_->start : nullptr);
     ctx_.core.completeStart(t - 1.0 / ctx_.cfg.service.rate, wall, envelope_budget);
   }
   ++st.starts;
@@ -59,7 +61,7 @@ void ShaftTwin::slowTickHook(double wall) {
 
 void ShaftTwin::enableTrips(const TripHistoryConfig& hist) {
   trips_ = std::make_unique<TripRoom>(ctx_.cfg, hist, hist.shaft);
-  ctx_.trips = trips_.get();
+  peers_.trips = trips_.get();
 }
 
 void ShaftTwin::setTripPool(TripPool* pool) {
@@ -67,10 +69,10 @@ void ShaftTwin::setTripPool(TripPool* pool) {
 }
 
 void ShaftTwin::applyCondition() {
-  const ConditionState* c = ctx_.trips->takeCondition();
+  const ConditionState* c = trips_->takeCondition();
   if (!c) return;
   outputs_.setConditionTexts(c->preload_text, c->fingerprint_text);
-  ctx_.detect = TripDetectability{c->detect_trip, c->loss30_separation, c->loss30_visible};
+  outputs_.setDetectability(TripDetectability{c->detect_trip, c->loss30_separation, c->loss30_visible});
   ctx_.core.setCondition(c->preload, c->upper95, c->warning, c->critical, c->fingerprint, c->z, c->z_limit);
   // MODEL_MISMATCH's trip-end preload test: each verdict once (an adoption
   // drops the one in force; a re-publication of it must not raise it again),
@@ -110,13 +112,13 @@ void ShaftTwin::keepAccelOffset(const std::string& path, std::shared_ptr<spdlog:
       ctx_.log.warn("{}accelerometer offset: {} holds a value the estimator refused ({} +- {} m/s^2): ignored",
                     ctx_.tag, path, r->offset, r->sigma);
   }
-  ctx_.offsets = offsets_.get();
+  peers_.offsets = offsets_.get();
 }
 
 void ShaftTwin::keepPreload(const std::string& path, std::shared_ptr<spdlog::logger> log) {
   preload_ = std::make_unique<PreloadKeeper>(ctx_.cfg, path, ctx_.tag, std::move(log), ctx_.log);
   if (auto m = preload_->loadKept()) ctx_.core.adoptModel(m);  // start-up: the old model is freed here
-  ctx_.preload = preload_.get();
+  peers_.preload = preload_.get();
 }
 
 void ShaftTwin::stopOffsetKeeper() {
@@ -124,7 +126,7 @@ void ShaftTwin::stopOffsetKeeper() {
 }
 
 void ShaftTwin::start(Clock::time_point start, double health_phase) {
-  ctx_.start = start;
+  ctx_.clock.start(start);
   if (offsets_) offsets_->start();
   publishHealth();  // announce ourselves at once
   // Shafts of one daemon spread their later health messages over the period.
@@ -137,15 +139,19 @@ void ShaftTwin::publishHealth(bool final_report) {
   health_.fill(m, wall);
   outputs_.publishHealth();
   health_.endWindow(m, wall, final_report);
+  // Each slice's owner ends its window (the whole-run histograms take it).
+  tick_stats_.endWindow();
+  input_stats_.endWindow();
+  forecast_stats_.endWindow();
 }
 
 void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t skipped, TickAllowance& left) {
-  ShaftStats& st = ctx_.stats;
+  TickStats& st = tick_stats_;
   TwinCore& core = ctx_.core;
-  LoopSplit* split = ctx_.split;
+  LoopSplit* split = split_;
   const auto now = Clock::now();
   st.last_late_us = std::max(0.0, duration<double, std::micro>(now - deadline).count());
-  st.late_hist.add(st.last_late_us);
+  st.late.add(st.last_late_us);
   ++st.ticks;
   st.deadline_misses += skipped;
   inputs_.beginTick();
@@ -173,7 +179,7 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
       split->envelope += env;
       split->step += nanos(t1 - t0) - env;
     }
-    if (r.stepped) st.step_hist.add(duration<double, std::micro>(t1 - t0).count());
+    if (r.stepped) st.step.add(duration<double, std::micro>(t1 - t0).count());
     if (r.catchup_limited) {
       std::int64_t suppressed = 0;
       if (log_limit_.allow(kLogCatchup, wall, suppressed))
@@ -198,15 +204,15 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
         const ScopedSpan span(split ? &split->forecast : nullptr);
         forecast_->afterStep(utime);
       }
-      if (ctx_.trips) ctx_.trips->afterStep(core, utime);
+      if (trips_) trips_->afterStep(core, utime);
     }
-    if (r.stepped && ctx_.offsets) ctx_.offsets->afterTick(core);
+    if (r.stepped && offsets_) offsets_->afterTick(core);
   } else {
     core.housekeeping(wall);
   }
-  if (ctx_.preload) ctx_.preload->afterTick(core);
+  if (preload_) preload_->afterTick(core);
   inputs_.forgetSilentPublisher(wall);
-  if (ctx_.trips) applyCondition();
+  if (trips_) applyCondition();
   outputs_.publishAlarmEvents();
 
   if (health_.due(wall)) {

@@ -88,7 +88,7 @@ class ShaftTwin {
   void start(Clock::time_point start, double health_phase);
   /// Wall times are measured from `start` from now on (the daemon's schedule
   /// starts after the shafts announced themselves).
-  void rebase(Clock::time_point start) { ctx_.start = start; }
+  void rebase(Clock::time_point start) { ctx_.clock.start(start); }
   /// The daemon's loop-time split and miss record (miss_record.hpp), and
   /// this shaft's publication phase: with shape_rate (cage_rate) below the
   /// step rate, HOIST_GUIDE_SHAPE (HOIST_CAGE) goes out on the ticks k with
@@ -106,13 +106,13 @@ class ShaftTwin {
   /// The twin's start waits for the start budget (HOIST_HEALTH.starting).
   bool starting() const { return ctx_.core.startPending(); }
   /// This shaft took part in miss record `seq`, `late_us` late.
-  void noteMiss(std::int64_t seq, double late_us) { ctx_.stats.noteMiss(seq, late_us); }
+  void noteMiss(std::int64_t seq, double late_us) { tick_stats_.noteMiss(seq, late_us); }
   /// The latest tick's lateness [us].
-  double lastLateUs() const { return ctx_.stats.last_late_us; }
+  double lastLateUs() const { return tick_stats_.last_late_us; }
   /// Ticks run, and the tick count / wall time of the latest deferred start (-1: none).
-  std::int64_t ticks() const { return ctx_.stats.ticks; }
-  std::int64_t startTick() const { return ctx_.stats.start_tick; }
-  double startWall() const { return ctx_.stats.start_wall; }
+  std::int64_t ticks() const { return tick_stats_.ticks; }
+  std::int64_t startTick() const { return tick_stats_.start_tick; }
+  double startWall() const { return tick_stats_.start_wall; }
   void publishHealth(bool final_report = false);
   /// The final health line and per-reason rejection counts, in the log.
   void logFinal() const { health_.logFinal(); }
@@ -161,7 +161,7 @@ class ShaftTwin {
   /// ShaftTwin lives; read them on the loop's thread, or after it stopped.
   /// The statistics the rooms keep (the run-only figures: cost split,
   /// whole-run histograms, counters HOIST_HEALTH does not carry):
-  const ShaftStats& stats() const { return ctx_.stats; }
+  ShaftStatsView stats() const { return {tick_stats_, input_stats_, output_stats_, forecast_stats_}; }
   /// The model and its counters (inputs, envelope evaluations):
   const TwinCore& core() const { return ctx_.core; }
   /// The latest HOIST_HEALTH filled (after stop(): the final report's,
@@ -169,7 +169,15 @@ class ShaftTwin {
   const hoist::health_t& lastHealth() const { return outputs_.health(); }
 
  private:
-  ShaftContext ctx_;                             ///< what the rooms share (declared first: built first)
+  ShaftContext ctx_;                             ///< what the rooms share, read-only (declared first: built first)
+  // Each room's statistics (shaft_stats.hpp): declared before the rooms,
+  // which hold references to them; each slice has one writer.
+  TickStats tick_stats_;                         ///< this class's: the tick
+  InputStats input_stats_;                       ///< ShaftInputs'
+  OutputStats output_stats_;                     ///< ShaftOutputs'
+  ForecastStats forecast_stats_;                 ///< ForecastScheduler's (zero without forecasts)
+  ShaftPeers peers_;                             ///< the optional rooms below, for the rooms that call them
+  LoopSplit* split_ = nullptr;                   ///< the daemon's loop-time split (attachLoop; nullptr: none)
   lcm::LCM& in_;                                 ///< receives (LCM's path) and, without lcm_out, publishes
   ShaftOutputs outputs_;                         ///< every outgoing message
   std::unique_ptr<ForecastScheduler> forecast_;  ///< look-ahead forecasts (nullptr without [forecast] enabled)

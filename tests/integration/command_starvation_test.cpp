@@ -111,24 +111,23 @@ TEST_P(CommandStarvation, GenuineCommandsAreAppliedWithinATickUnderAJunkFlood) {
   for (int i = 0; i < kCommands; ++i) {
     // Shelve all, then unshelve all, ...: each one changes state (effective).
     const auto b = encode(command(i % 2 == 0 ? hoist::alarm_ack_t::ACTION_SHELVE : hoist::alarm_ack_t::ACTION_UNSHELVE, "*"));
-    const ShaftStats before = d.shaft(0).stats();
+    const ShaftTwin& shaft = d.shaft(0);
+    const std::int64_t applied0 = shaft.stats().in.commands_applied, ticks0 = shaft.ticks();
     ASSERT_EQ(genuine.publish("HOIST_ALARM_ACK", b.data(), static_cast<unsigned>(b.size())), 0);
     const auto deadline = std::chrono::steady_clock::now() + 1s;
-    ShaftStats now = before;
     while (std::chrono::steady_clock::now() < deadline) {
       d.poll();
-      now = d.shaft(0).stats();
-      if (now.commands_applied > before.commands_applied) break;
+      if (shaft.stats().in.commands_applied > applied0) break;
       std::this_thread::sleep_for(50us);
     }
-    if (now.commands_applied > before.commands_applied) {
+    if (shaft.stats().in.commands_applied > applied0) {
       ++applied;
-      max_ticks = std::max(max_ticks, now.ticks - before.ticks);
+      max_ticks = std::max(max_ticks, shaft.ticks() - ticks0);
     }
     // One genuine command per tick (the budget is for valid commands: more
     // than max_commands_per_tick of them in one tick are dropped by design).
-    const std::int64_t tick = now.ticks;
-    while (d.shaft(0).stats().ticks == tick) {
+    const std::int64_t tick = shaft.ticks();
+    while (shaft.ticks() == tick) {
       d.poll();
       std::this_thread::sleep_for(50us);
     }
@@ -138,7 +137,7 @@ TEST_P(CommandStarvation, GenuineCommandsAreAppliedWithinATickUnderAJunkFlood) {
   loopFor(0.1s);  // the junk still in the socket is counted
   flooding = false;
   flood.join();
-  const ShaftStats end = d.shaft(0).stats();
+  const InputStats end = d.shaft(0).stats().in;
   d.requestStop("test over");
   d.finish();
 
@@ -233,7 +232,7 @@ TEST(ReannounceRequest, HonouredAtOnceThenAtMostOnceASecondAndChangesNothing) {
   // first; the margin is for a loaded machine delaying the first delivery.)
   EXPECT_LT(std::chrono::duration<double>(answers[0] - t_sent).count(), 0.9) << "the first is answered at once";
   EXPECT_GE(std::chrono::duration<double>(answers[1] - answers[0]).count(), 0.8) << "at most one a second";
-  const ShaftStats st = d.shaft(0).stats();
+  const InputStats st = d.shaft(0).stats().in;
   EXPECT_EQ(st.commands_applied, 0) << "a re-announce changes nothing (no AUDIT)";
   d.requestStop("test over");
   d.finish();

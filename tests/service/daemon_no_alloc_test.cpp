@@ -216,12 +216,16 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   // What the checks below read: the rooms' statistics plus the model's input
   // and envelope counters (the run report's sources).
   struct Snap {
-    ShaftStats st;
+    TickStats tick;
+    InputStats in;
+    OutputStats out;
+    ForecastStats fc;
     std::int64_t accepted, envelope_exact, envelope_bounded;
   };
   auto snap = [&](int i) {
     const ShaftTwin& s = d.shaft(i);
-    return Snap{s.stats(), s.core().counters().accepted, s.core().envelope().exactEvaluations(),
+    const ShaftStatsView v = s.stats();
+    return Snap{v.tick, v.in, v.out, v.forecast, s.core().counters().accepted, s.core().envelope().exactEvaluations(),
                 s.core().envelope().boundedEvaluations()};
   };
   const Snap a0 = snap(0), b0 = snap(1), c0 = snap(2);
@@ -250,24 +254,24 @@ TEST(DaemonNoAlloc, LoopWithTwoShaftsAlarmsAndStaleInputAllocatesNothing) {
   // The watched window did the real work.
   // (3.3 s at 1 kHz and 100 Hz: 3300 and 330 ticks on an idle machine; a
   // loaded one skips some -- the point is that the loop ran, alarms and all)
-  EXPECT_GT(a1.st.ticks - a0.st.ticks, 1000);
-  EXPECT_GT(b1.st.ticks - b0.st.ticks, 100);
+  EXPECT_GT(a1.tick.ticks - a0.tick.ticks, 1000);
+  EXPECT_GT(b1.tick.ticks - b0.tick.ticks, 100);
   EXPECT_GT(a1.accepted - a0.accepted, 1500);
   EXPECT_GT(b1.accepted - b0.accepted, 1500);
-  EXPECT_GT(a1.st.alarm_events - a0.st.alarm_events, 4) << logs.str();
-  EXPECT_GT(b1.st.alarm_events - b0.st.alarm_events, 4) << logs.str();
-  EXPECT_EQ(a1.st.publish_failures, 0);
+  EXPECT_GT(a1.out.alarm_events - a0.out.alarm_events, 4) << logs.str();
+  EXPECT_GT(b1.out.alarm_events - b0.out.alarm_events, 4) << logs.str();
+  EXPECT_EQ(a1.out.publish_failures, 0);
   EXPECT_GT(c1.envelope_bounded - c0.envelope_bounded, 250) << "the bounded envelope ran in the window";
   EXPECT_GT(a1.envelope_exact - a0.envelope_exact, 0);
-  EXPECT_GT(a1.st.ns_model - a0.st.ns_model, 0) << "cost split measured";
-  EXPECT_GT(a1.st.ns_publish - a0.st.ns_publish, 0);
+  EXPECT_GT(a1.tick.ns_model - a0.tick.ns_model, 0) << "cost split measured";
+  EXPECT_GT(a1.tick.ns_publish - a0.tick.ns_publish, 0);
   // Forecasts ran and came back through the loop in the window (5 Hz).
-  EXPECT_GE(a1.st.forecasts - a0.st.forecasts, 8) << logs.str();
+  EXPECT_GE(a1.fc.forecasts - a0.fc.forecasts, 8) << logs.str();
   // ... some of them from the load estimate (its state shifted in the loop).
-  EXPECT_GE(a1.st.forecasts_from_estimate - a0.st.forecasts_from_estimate, 4) << logs.str();
-  EXPECT_GE(b1.st.forecasts - b0.st.forecasts, 8) << logs.str();
-  EXPECT_GE(a1.st.plans_accepted - a0.st.plans_accepted, 20);
-  EXPECT_EQ(a1.st.plansRejected(), 0) << logs.str();
+  EXPECT_GE(a1.fc.forecasts_from_estimate - a0.fc.forecasts_from_estimate, 4) << logs.str();
+  EXPECT_GE(b1.fc.forecasts - b0.fc.forecasts, 8) << logs.str();
+  EXPECT_GE(a1.in.plans_accepted - a0.in.plans_accepted, 20);
+  EXPECT_EQ(a1.in.plansRejected(), 0) << logs.str();
   const std::string log = logs.str();
   EXPECT_NE(log.find("[A] ALARM INPUT_STALE"), std::string::npos) << log;
   EXPECT_NE(log.find("[B] alarm: INPUT_STALE WARNING cleared"), std::string::npos) << log;
