@@ -15,7 +15,11 @@
 #      and history/ nothing from service/ (as rule 3);
 #   5. no tool includes "hoist/bus/udpm_receiver.hpp" itself: the choice
 #      between our udpm receive path and LCM's is made once, by
-#      hoist::bus::Subscriber ("hoist/bus/subscriber.hpp").
+#      hoist::bus::Subscriber ("hoist/bus/subscriber.hpp");
+#   6. service's own libraries follow their links (core <- cfg, core <-
+#      twin <- lcm <- app): each includes the hoist/service/ headers of
+#      itself and of what it links, none of service/app, and core and twin
+#      nothing of LCM (hoist/bus/, hoist/msg/, <lcm/...>, hoist/<type>_t.hpp).
 # Also: model/ includes only its own headers and system/Eigen headers.
 #   cmake -DROOT=<source dir> -DMODEL_LINKS='Eigen3::Eigen' -P check_layers.cmake
 # Prints "LAYER VIOLATION: ..." for each broken rule and fails.
@@ -153,6 +157,43 @@ foreach(f IN LISTS _files)
   endforeach()
 endforeach()
 
+# ---- rule 6: service's own libraries ----------------------------------------
+# service/CMakeLists.txt links core <- cfg, core <- twin <- lcm <- app: a
+# library includes the hoist/service/ headers of itself and of the
+# libraries it links, never a header of service/app; and core and twin (the
+# model's shell: "the math knows nothing of LCM") include nothing of LCM:
+# no hoist/bus/, hoist/msg/ or <lcm/...>, no generated hoist/<type>_t.hpp.
+set(_svc_libs core cfg twin lcm)
+set(_svc_may_core core)
+set(_svc_may_cfg core cfg)
+set(_svc_may_twin core twin)
+set(_svc_may_lcm core twin lcm)
+file(GLOB _app_headers LIST_DIRECTORIES false RELATIVE "${ROOT}/service/app" "${ROOT}/service/app/*.hpp")
+foreach(lib IN LISTS _svc_libs)
+  file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/service/${lib}/*.hpp" "${ROOT}/service/${lib}/*.cpp")
+  foreach(f IN LISTS _files)
+    file(RELATIVE_PATH _rel "${ROOT}" "${f}")
+    get_filename_component(_dir "${f}" DIRECTORY)
+    _includes("${f}" _incs)
+    foreach(inc IN LISTS _incs)
+      if(inc MATCHES "^hoist/service/")
+        foreach(owner IN LISTS _svc_libs)
+          if(EXISTS "${ROOT}/service/${owner}/include/${inc}" AND NOT owner IN_LIST _svc_may_${lib})
+            string(REPLACE ";" ", " _may "${_svc_may_${lib}}")
+            _violation("${_rel} includes \"${inc}\" of service/${owner} (service/${lib} may include service/{${_may}})")
+          endif()
+        endforeach()
+      endif()
+      if(inc IN_LIST _app_headers AND NOT EXISTS "${_dir}/${inc}")
+        _violation("${_rel} includes \"${inc}\", a header of service/app")
+      endif()
+      if(lib MATCHES "^(core|twin)$" AND inc MATCHES "^(hoist/bus/|hoist/msg/|lcm/|hoist/[a-z0-9_]+_t\\.hpp$)")
+        _violation("${_rel} includes \"${inc}\": service/${lib} knows nothing of LCM")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+
 # ---- model/ includes only itself (and Eigen / the standard library) --------
 file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/model/*.hpp" "${ROOT}/model/*.cpp")
 foreach(f IN LISTS _files)
@@ -170,4 +211,5 @@ if(_violations GREATER 0)
   message(FATAL_ERROR "check_layers: ${_violations} layer violation(s); see README.md, Development")
 endif()
 message("check_layers: OK (hoist_model links: ${MODEL_LINKS}; no tools/ header in service/, io/, msgs/ or rt/; "
-        "no service/ header in tools/, msgs/ or rt/; tools receive through hoist/bus/subscriber.hpp)")
+        "no service/ header in tools/, msgs/ or rt/; tools receive through hoist/bus/subscriber.hpp; "
+        "service's libraries follow their links, core and twin free of LCM)")

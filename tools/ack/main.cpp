@@ -23,7 +23,7 @@
 // answers on HOIST_ALARM with an ACK / SHELVE / UNSHELVE event (watch it with
 // hoist-monitor).  Exit status: 0 sent, 1 LCM failure, 2 bad usage (options, LCM URL,
 // a shelve longer than the daemon's limit).
-#include "hoist/version.hpp"
+#include "hoist/cli/app.hpp"
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -42,9 +42,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"hoist-alarm-ack: acknowledge, shelve or unshelve hoist-twind alarms (one HOIST_ALARM_ACK message)",
                "hoist-alarm-ack"};
-  app.name("hoist-alarm-ack");  // usage lines name the program, not the path it was run by
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-alarm-ack ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-alarm-ack");  // usage, errors and --version name the program
   std::string kind = "*", level = "both", user, url, prefix;
   double shelve = 0.0;
   bool unshelve = false;
@@ -122,12 +120,7 @@ int main(int argc, char** argv) {
   app.add_option("--user", user, "operator name (logged by the daemon; default: $USER)");
   app.add_option("--lcm-url", url, "LCM URL; default: $LCM_DEFAULT_URL, else LCM's default");
   app.add_option("--channel-prefix", prefix, "prefix of the daemon's channels");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   if (user.empty()) {
     const char* u = std::getenv("USER");
     user = u ? u : "operator";

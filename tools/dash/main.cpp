@@ -7,7 +7,7 @@
 //
 // One thread, one Asio loop: the LCM file descriptor, the HTTP/WebSocket
 // server (Boost.Beast) and the 25 Hz decimation timer.
-#include "hoist/version.hpp"
+#include "hoist/cli/app.hpp"
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
@@ -73,9 +73,7 @@ int main(int argc, char** argv) {
       "(subprotocol foxglove.websocket.v1) on one port, with every hoist LCM channel of every shaft\n"
       "advertised under its LCM channel name in JSON encoding.  Binds loopback by default: anyone who\n"
       "can reach the port can acknowledge and shelve alarms unless --read-only (docs/security.md)."};
-  app.name("hoist-dash");  // usage lines name the program, not the path it was run by
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-dash ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-dash");  // usage, errors and --version name the program
   std::string bind = "127.0.0.1", url, web_root, log_level = "info";
   int port = 8080;
   bool read_only = false;
@@ -155,12 +153,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.1, 3600.0));
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error (default info)")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   spdlog::set_default_logger(spdlog::stderr_color_mt("hoist-dash"));
   spdlog::set_level(spdlog::level::from_str(log_level));
   spdlog::set_pattern("%Y-%m-%d %H:%M:%S.%e [%^%l%$] hoist-dash: %v");

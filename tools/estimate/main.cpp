@@ -28,7 +28,7 @@
 // A one-paragraph summary goes to stdout (not with -q).
 // Exit status: 0 done, 2 bad input (naming file, line, column or option),
 // 1 the run failed (model domain, write error).
-#include "hoist/version.hpp"
+#include "hoist/cli/app.hpp"
 
 #include <unistd.h>
 
@@ -379,9 +379,7 @@ int main(int argc, char** argv) {
       "column: no such sensor; an empty field: no sample in that row); hoist-sim --write-measurements\n"
       "writes such files.",
       "hoist-estimate"};
-  app.name("hoist-estimate");
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
-  app.set_version_flag("--version", std::string("hoist-estimate ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-estimate");  // usage, errors and --version name the program
   app.add_option("--config", o.config,
                  "shaft TOML or hoist-twind's configuration: the twin's shaft, [sensors] noise and [estimator] "
                  "tuning (enabled is not needed here); required")
@@ -409,12 +407,7 @@ int main(int argc, char** argv) {
                "MODEL_MISMATCH's trip-end preload test (both identify the preload scale of each trip: about 1 s "
                "of CPU per trip at n = 25)");
   app.add_flag("-q,--quiet", o.quiet, "no summary and no warnings");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   // Required, but checked after parsing: CLI11 reports a missing option
   // before an unknown one, and an unknown option must be named.
   for (const auto& [given, what] : {std::pair{!o.config.empty(), "--config"},

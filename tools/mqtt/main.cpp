@@ -8,7 +8,7 @@
 // Exit status: 0 after SIGINT/SIGTERM, 1 if LCM cannot be opened, 2 bad
 // options or configuration.  A broker that is down or goes away is never
 // fatal: the bridge retries with backoff.
-#include "hoist/version.hpp"
+#include "hoist/cli/app.hpp"
 #include <mosquitto.h>
 
 #include <csignal>
@@ -33,8 +33,7 @@ int main(int argc, char** argv) {
   CLI::App app{"hoist-mqtt: bridge the twin's LCM channels (cage state, health, alarms) to an MQTT broker, and "
                "operator alarm commands back (docs/mqtt.md)",
                "hoist-mqtt"};
-  app.set_version_flag("--version", std::string("hoist-mqtt ") + hoist::kVersionString);
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });  // errors name the program
+  hoist::cli::nameProgram(app, "hoist-mqtt");  // usage, errors and --version name the program
   std::string config_path, broker, client_id, lcm_url, sparkplug;
   std::vector<std::string> prefixes;
   bool no_commands = false, quiet = false;
@@ -56,12 +55,7 @@ int main(int argc, char** argv) {
                  "Sparkplug B mode as edge node EDGE of group GROUP (spBv1.0/GROUP/...; each shaft is a device) "
                  "instead of the JSON topics; or [sparkplug] in the configuration (docs/mqtt.md)");
   app.add_flag("-q,--quiet", quiet, "log warnings and errors only");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   spdlog::set_default_logger(spdlog::stderr_color_mt("hoist-mqtt"));  // logs on stderr (journal under systemd)
   spdlog::set_pattern("%Y-%m-%d %H:%M:%S.%e [%l] %v");
   if (quiet) spdlog::set_level(spdlog::level::warn);

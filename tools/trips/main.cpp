@@ -14,7 +14,7 @@
 //
 // Exit status: 0 done, 2 bad input (an option, naming it; a bad file,
 // naming file, line and key), 1 the database or a write failed.
-#include "hoist/version.hpp"
+#include "hoist/cli/app.hpp"
 
 #include <ctime>
 #include <filesystem>
@@ -81,9 +81,7 @@ int main(int argc, char** argv) {
       "identified guide-rope preload) in the history database, listed, plotted, exported; recorded runs\n"
       "ingested through the daemon's trip pipeline (docs/condition.md).",
       "hoist-trips"};
-  app.name("hoist-trips");
-  app.failure_message([](const CLI::App* a, const CLI::Error& e) { return a->get_name() + ": " + CLI::FailureMessage::simple(a, e); });
-  app.set_version_flag("--version", std::string("hoist-trips ") + hoist::kVersionString);
+  hoist::cli::nameProgram(app, "hoist-trips");  // usage, errors and --version name the program
   app.require_subcommand(0, 1);  // none is checked after parsing, so that an unknown option is named first
   app.footer(
       "Examples:\n"
@@ -171,12 +169,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
-  }
+  if (const auto rc = hoist::cli::parse(app, argc, argv)) return *rc;
   if (app.get_subcommands().empty()) {
     std::cerr << "hoist-trips: a subcommand is required (list, show, trend, depth-map, baseline, export, ingest)\n"
                  "Run with --help for more information.\n";

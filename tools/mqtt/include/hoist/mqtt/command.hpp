@@ -70,8 +70,8 @@ struct CommandResult {
 CommandResult parseAckCommand(const void* data, std::size_t size, std::size_t max_bytes, std::int64_t now_utime,
                               double max_age_s = 0.0);
 
-/// hoist-dash's rule for an operator name (tools/dash validateAckFields),
-/// plus the C1 controls: "" if valid, else why.
+/// The contract's one operator-name rule (hoist::contract::operatorNameProblem,
+/// as hoist-dash's): "" if valid, else why.
 std::string checkUser(const std::string& user);
 
 /// printable(): the daemon's own, hoist/contract/alarm_command.hpp.
