@@ -6,7 +6,7 @@
 //     built from a git checkout: hoist/version.hpp);
 //   * --help and --version exit 0; a usage error exits 2 after CLI11 printed
 //     the message naming the option (the project's rule: exit 2 = bad input).
-// Called by the mains of tools/ (header only; the target hoist_cli links
+// Called by every program's main, hoist-twind's too (header only; the target hoist_cli links
 // CLI11 and the version header).  Nothing here outlives the call.
 #pragma once
 
