@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "condition_text.hpp"
 #include "forecast_pool.hpp"
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
@@ -46,9 +47,9 @@ struct AlarmCause {
   const char* predicted_clearance_scenario = "";  ///< PREDICTED_CLEARANCE: the scenario that predicts it (static string)
   const char* predicted_slack_scenario = "";      ///< PREDICTED_SLACK: the scenario that predicts it (static string)
   double slack_threshold = 0.0;                   ///< PREDICTED_SLACK threshold of the latest forecast [N]
-  std::array<char, 240> preload_text{};           ///< GUIDE_PRELOAD_LOW: the trip room's latest text
-  std::array<char, 240> fingerprint_text{};       ///< SHAFT_FINGERPRINT: the trip room's latest text
-  std::array<char, 240> preload_verdict_text{};   ///< MODEL_MISMATCH's trip-end preload test: its sentence
+  ConditionText preload_text{};           ///< GUIDE_PRELOAD_LOW: the trip room's latest text
+  ConditionText fingerprint_text{};       ///< SHAFT_FINGERPRINT: the trip room's latest text
+  ConditionText preload_verdict_text{};   ///< MODEL_MISMATCH's trip-end preload test: its sentence
 };
 
 class ShaftOutputs {
@@ -104,7 +105,7 @@ class ShaftOutputs {
   }
   /// What the next GUIDE_PRELOAD_LOW / SHAFT_FINGERPRINT events name: the
   /// trip room's latest texts (ShaftTwin::applyCondition; copies, no allocation).
-  void setConditionTexts(const std::array<char, 240>& preload, const std::array<char, 240>& fingerprint) {
+  void setConditionTexts(const ConditionText& preload, const ConditionText& fingerprint) {
     cause_.preload_text = preload;
     cause_.fingerprint_text = fingerprint;
   }
@@ -112,7 +113,7 @@ class ShaftOutputs {
   /// (ShaftTwin::applyCondition).
   void setDetectability(const TripDetectability& d) { detect_ = d; }
   /// What the next MODEL_MISMATCH event of the trip-end preload test names.
-  void setPreloadVerdictText(const std::array<char, 240>& text) { cause_.preload_verdict_text = text; }
+  void setPreloadVerdictText(const ConditionText& text) { cause_.preload_verdict_text = text; }
   /// HOIST_FORECAST from a forecast result.
   void publishForecast(const ForecastResult& r);
   /// The health message, for ShaftHealth to fill before publishHealth().
@@ -162,7 +163,7 @@ class ShaftOutputs {
   std::vector<std::uint8_t> alarm_buf_;     ///< encode buffer of alarm_msg_
   std::vector<std::uint8_t> health_buf_;    ///< encode buffer of health_msg_
   std::vector<std::uint8_t> forecast_buf_;  ///< encode buffer of forecast_msg_ (empty without forecasts)
-  char text_[256];                          ///< the alarm text being published
+  char text_[kConditionTextChars + 112];    ///< the alarm text being published (a ConditionText and its frame)
 };
 
 }  // namespace hoist::svc

@@ -42,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "condition_text.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/preload_verdict.hpp"
 #include "hoist/trip_accumulator.hpp"
@@ -76,8 +77,8 @@ struct ConditionState {
   std::int64_t detect_trip = 0;
   double loss30_separation = -1.0;
   bool loss30_visible = false;
-  std::array<char, 240> preload_text{};   ///< the trend's text (cut to fit)
-  std::array<char, 240> fingerprint_text{};
+  ConditionText preload_text{};   ///< the trend's text (cut to fit)
+  ConditionText fingerprint_text{};
   /// MODEL_MISMATCH's trip-end preload test (hoist/preload_verdict.hpp): the
   /// last trip that judged it.  verdict_trip counts the verdicts (0: none
   /// yet): the loop applies a verdict once, so one it dropped after an
@@ -86,7 +87,7 @@ struct ConditionState {
   bool verdict_mismatch = false;
   double verdict_z = 0.0, verdict_limit = 4.0;
   double verdict_twin_scale = 1.0;  ///< the twin's preload scale the verdict judged
-  std::array<char, 240> verdict_text{};
+  ConditionText verdict_text{};
 };
 
 /// Fixed-capacity SPSC ring of TripTick (lock-free; one producer thread,

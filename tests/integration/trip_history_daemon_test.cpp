@@ -297,6 +297,10 @@ TEST_F(TripHistoryDaemon, ConditionAlarmsComeFromTheStoredTripsAndJudgeEachNewOn
   EXPECT_NE(crit.message.find("guide-rope preload scale 0.6"), std::string::npos) << crit.message;
   EXPECT_NE(crit.message.find("from trips"), std::string::npos) << crit.message;
   EXPECT_NE(crit.message.find("tensioning weights"), std::string::npos) << crit.message;
+  // The whole advice and the alarm's state fit (the text once was cut at
+  // 255 characters: its end and "[unacknowledged]" were lost).
+  EXPECT_NE(crit.message.find("then survey the guide ropes"), std::string::npos) << crit.message;
+  EXPECT_NE(crit.message.find("[unacknowledged]"), std::string::npos) << crit.message;
   EXPECT_NE(readFile(path("twind.log")).find("shaft condition from 12 stored trips"), std::string::npos);
 
   replayBothTripsAndStop(*d, 14);
