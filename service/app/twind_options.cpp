@@ -84,7 +84,7 @@ void loadTwindShafts(const TwindCommandLine& cl, DaemonOptions& opt, std::string
       if (!cl.clock.empty()) cfg.service.clock = cl.clock == "input" ? ClockMode::Input : ClockMode::Wall;
       if (cl.rate > 0.0) {
         cfg.service.rate = cl.rate;
-        // Publish rates follow a lower --cl.rate rather than failing validation.
+        // Publish rates follow a lower --rate rather than failing validation.
         cfg.service.cage_rate = std::min(cfg.service.cage_rate, cl.rate);
         cfg.service.shape_rate = std::min(cfg.service.shape_rate, cl.rate);
       } else if (cl.rate_given) {
@@ -99,11 +99,11 @@ void loadTwindShafts(const TwindCommandLine& cl, DaemonOptions& opt, std::string
         throw std::invalid_argument(what);
       }
       cfg.shaft.validate();
-      // [forecast] against the effective [service] cl.rate (--cl.rate may have lowered it).
+      // [forecast] against the effective [service] rate (--rate may have lowered it).
       try {
         cfg.forecast.validate(cfg.service.rate);
       } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(where + ": " + e.what() + (cl.rate > 0.0 ? " (with --cl.rate)" : ""));
+        throw std::invalid_argument(where + ": " + e.what() + (cl.rate > 0.0 ? " (with --rate)" : ""));
       }
       if (!prefixes.insert(cfg.service.channel_prefix).second)
         throw std::invalid_argument(where + ": service.channel_prefix: \"" + cfg.service.channel_prefix +
