@@ -50,7 +50,8 @@ void describe(const PreloadVerdict& v, char* buf, std::size_t n) {
     std::snprintf(buf, n, "the trip did not identify the guide-rope preload: nothing judged");
     return;
   }
-  // Short enough for alarm_t.message (255 bytes) with its prefix and " [unacknowledged]".
+  // One sentence (at most about 260 characters): an alarm text carries it
+  // whole with its prefix and state.
   // What was judged: one trip's fit, or the trend over the trips it rests on.
   char head[80];
   if (v.trend_trips == 0)

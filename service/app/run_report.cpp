@@ -137,11 +137,7 @@ nlohmann::ordered_json shaftJson(const ShaftTwin& sp) {
     o["forecast_failures"] = st.forecast.forecast_failures;
     o["forecast_us"] = histogramJson(st.forecast.compute.total);
   }
-  // The model step time of the tick (--clock wall) or of the inputs
-  // (--clock input): one of them is empty.
-  LatencyHistogram step = st.tick.step.total;
-  step.merge(st.in.step.total);
-  o["step_us"] = histogramJson(step);
+  o["step_us"] = histogramJson(st.stepTotal());
   o["late_us"] = histogramJson(st.tick.late.total);
   return o;
 }

@@ -164,10 +164,7 @@ void ShaftHealth::logFinal() const {
   const InputStats& in = st_.in;
   const OutputStats& out = st_.out;
   const ForecastStats& fc = st_.forecast;
-  // The whole run's model step time: the tick's (--clock wall) and the
-  // inputs' (--clock input); one of them is empty.  (At stop: a copy.)
-  LatencyHistogram step = tk.step.total;
-  step.merge(in.step.total);
+  const LatencyHistogram step = st_.stepTotal();
   const LatencyHistogram& late = tk.late.total;
   const InputCounters& c = core.counters();
   const std::string& tag = ctx_.tag;

@@ -127,6 +127,13 @@ struct ShaftStatsView {
   /// Model step time [us] this window: the tick's (--clock wall) or the
   /// inputs' (--clock input); one of them is empty.
   const LatencyHistogram& stepWindow() const { return in.step.window.count() > 0 ? in.step.window : tick.step.window; }
+  /// Model step time [us] over the whole run: both merged (a copy: at stop,
+  /// for the final log line and the run report, never in the loop).
+  LatencyHistogram stepTotal() const {
+    LatencyHistogram h = tick.step.total;
+    h.merge(in.step.total);
+    return h;
+  }
 };
 
 }  // namespace hoist::svc

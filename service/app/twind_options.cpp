@@ -15,6 +15,12 @@
 namespace hoist::svc {
 
 namespace {
+/// The error line of a configuration that cannot run: "hoist-twind:
+/// configuration error: " and what (which names the option or key).
+TwindConfigError configError(const std::string& what) {
+  return TwindConfigError("hoist-twind: configuration error: " + what);
+}
+
 /// The --config files ("" for the paper's shaft when none is given).
 std::vector<std::string> configPaths(const TwindCommandLine& cl) {
   return cl.config_paths.empty() ? std::vector<std::string>{""} : cl.config_paths;
@@ -132,7 +138,7 @@ void loadTwindShafts(const TwindCommandLine& cl, DaemonOptions& opt, std::string
     }
     if (!cl.cpus.empty()) opt.realtime.cpus = parseCpuList(cl.cpus, "--cpus");
   } catch (const std::exception& e) {
-    throw TwindConfigError(std::string("hoist-twind: configuration error: ") + e.what());
+    throw configError(e.what());
   }
 }
 
@@ -149,15 +155,13 @@ void checkTwindRun(const TwindCommandLine& cl, const std::string& shaft_url, int
                              : (env && *env)           ? "LCM_DEFAULT_URL: "
                              : config_paths[0].empty() ? ""
                                                        : config_paths[0] + ": service.lcm_url: ";
-    throw TwindConfigError("hoist-twind: configuration error: " + from + bad);
+    throw configError(from + bad);
   }
   for (std::size_t i = 1; i < opt.shafts.size(); ++i)
-    if (opt.shafts[i].service.lcm_url_out != opt.shafts[0].service.lcm_url_out) {
-      throw TwindConfigError("hoist-twind: configuration error: " + config_paths[i] + ": service.lcm_url_out: \"" +
-                             opt.shafts[i].service.lcm_url_out + "\" differs from \"" +
-                             opt.shafts[0].service.lcm_url_out + "\" in " + config_paths[0] +
-                             " (one process has one output URL)");
-    }
+    if (opt.shafts[i].service.lcm_url_out != opt.shafts[0].service.lcm_url_out)
+      throw configError(config_paths[i] + ": service.lcm_url_out: \"" + opt.shafts[i].service.lcm_url_out +
+                        "\" differs from \"" + opt.shafts[0].service.lcm_url_out + "\" in " + config_paths[0] +
+                        " (one process has one output URL)");
   opt.lcm_url_out = opt.shafts[0].service.lcm_url_out;
 
   opt.duration = cl.duration;
@@ -179,15 +183,12 @@ void checkTwindRun(const TwindCommandLine& cl, const std::string& shaft_url, int
   }
   if (!state_dir.empty()) {
     std::error_code ec;
-    if (!std::filesystem::is_directory(state_dir, ec)) {
-      throw TwindConfigError("hoist-twind: configuration error: --state-dir " + state_dir + ": not a directory");
-    }
+    if (!std::filesystem::is_directory(state_dir, ec)) throw configError("--state-dir " + state_dir + ": not a directory");
   }
   opt.state_dir = state_dir;
   if (const std::string bad = cl.report.empty() ? "" : hoist::io::outputPathError(cl.report, "--report"); !bad.empty())
-    throw TwindConfigError("hoist-twind: configuration error: " + bad);
+    throw configError(bad);
   for (int i = 0; i < argc; ++i) opt.command_line += (i ? " " : "") + std::string(argv[i]);
-
 }
 
 }  // namespace hoist::svc
