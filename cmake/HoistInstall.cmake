@@ -60,6 +60,9 @@ file(GLOB _hoist_lcm_files ${PROJECT_SOURCE_DIR}/msgs/*.lcm)
 install(FILES ${_hoist_lcm_files} DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/hoist-twin/lcm COMPONENT dev)
 install(DIRECTORY ${CMAKE_BINARY_DIR}/msgs/generated/hoist/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/hoist
         COMPONENT dev FILES_MATCHING PATTERN "*.hpp")
+# hoist::lcm's generated channel names (msgs/codec: from the `// @channel` annotations).
+install(FILES ${HOIST_BUS_GEN_INCLUDE}/hoist/bus/channels.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/hoist/bus
+        COMPONENT dev)
 
 # ---- configuration, unit, docs ----------------------------------------------------
 install(FILES ${PROJECT_SOURCE_DIR}/service/config/example.toml DESTINATION ${HOIST_CONFIG_DIR} COMPONENT runtime)

@@ -16,6 +16,9 @@ arrays of either, strings, consts) and writes
   OUT/names/include/hoist/msg/names.hpp
                                     the name tables and channels alone
                                     (header-only, no LCM or JSON)
+  OUT/bus/include/hoist/bus/channels.hpp
+                                    the channel names for C++ (kChannel*,
+                                    bus::Channels; header-only)
   OUT/js/hoist_msgs.js              the same for the dashboard page (ES module)
 
 The steps live in lcmgen/ (parse.py, fingerprint.py, sizes.py, schema.py,
@@ -43,6 +46,7 @@ or the fingerprint):
                        COLUMN_FIRST, COLUMN_FIRST+1, ...; FIRST default 0)
   // @csvfirst A,B,... these members' CSV columns come first, in this order
   // @channel NAME     the type's LCM channel without the prefix (kChannels,
+                       bus::kChannel<Name> and bus::Channels::<name>,
                        CHANNELS of hoist_msgs.js)
 
 Usage: lcm_codec_gen.py --out DIR FILE.lcm...

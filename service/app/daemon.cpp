@@ -256,7 +256,7 @@ void Daemon::logStarted() {
     // Every channel the shaft uses (the optional ones only when configured).
     const bus::Channels& ch = s.channels();
     const bool est = c.estimator.enabled, fc = c.forecast.enabled;
-    std::string ins = ch.winder + " " + ch.ack, outs = ch.cage + " " + ch.shape + " " + ch.alarm + " " + ch.health;
+    std::string ins = ch.winder + " " + ch.alarm_ack, outs = ch.cage + " " + ch.guide_shape + " " + ch.alarm + " " + ch.health;
     if (fc) ins += " " + ch.trip_plan, outs += " " + ch.forecast;
     if (est) ins += " " + ch.cage_imu + " " + ch.rope_load, outs += " " + ch.estimate;
     out_->info("{}hoist-twind {}: clock={} rate={} Hz, LCM {}{}{}, inputs {}, outputs {}, "

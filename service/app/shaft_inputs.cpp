@@ -27,7 +27,7 @@ ShaftInputs::ShaftInputs(const ShaftContext& ctx, TwinCore& core, InputStats& st
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
   decode_budget_ = std::max(kMinDecodesPerTick, static_cast<int>(kDecodesPerSecond / ctx_.cfg.service.rate));
   routes_[kWinder] = {this, &ctx_.ch.winder, &ShaftInputs::handleWinder, bus::kChannelWinder.data()};
-  routes_[kAck] = {this, &ctx_.ch.ack, &ShaftInputs::handleAck, bus::kChannelAlarmAck.data()};
+  routes_[kAck] = {this, &ctx_.ch.alarm_ack, &ShaftInputs::handleAck, bus::kChannelAlarmAck.data()};
   routes_[kTripPlan] = {this, &ctx_.ch.trip_plan, &ShaftInputs::handleTripPlan, bus::kChannelTripPlan.data()};
   routes_[kOwnHealth] = {this, &ctx_.ch.health, &ShaftInputs::handleOwnHealth, bus::kChannelHealth.data()};
   routes_[kOwnAlarm] = {this, &ctx_.ch.alarm, &ShaftInputs::handleOwnAlarm, bus::kChannelAlarm.data()};

@@ -235,7 +235,7 @@ void ShaftOutputs::publishShape(std::int64_t utime, bool batch) {
     shape_msg_.y1[i] = sh.y1()(i);
     shape_msg_.y2[i] = sh.y2()(i);
   }
-  encodeAndPublish(ctx_.ch.shape, shape_msg_, shape_buf_, batch);
+  encodeAndPublish(ctx_.ch.guide_shape, shape_msg_, shape_buf_, batch);
 }
 
 void ShaftOutputs::publishAlarmEvents(const CommandCause& by) {

@@ -16,7 +16,7 @@ for f in usr/bin/hoist-twind usr/bin/hoist-sim usr/bin/hoist-study usr/bin/hoist
          usr/bin/hoist-alarm-ack usr/bin/hoist-log2csv usr/bin/hoist-wakeup-latency \
          etc/hoist-twin/example.toml usr/lib/systemd/system/hoist-twind@.service \
          usr/share/hoist-twin/lcm/cage_state_t.lcm usr/include/hoist/cage_state_t.hpp usr/include/hoist/params.hpp \
-         usr/include/hoist/io/config.hpp usr/share/doc/hoist-twin/README.md usr/share/doc/hoist-twin/examples/demo.toml; do
+         usr/include/hoist/io/config.hpp usr/include/hoist/bus/channels.hpp usr/include/hoist/bus/lcm_util.hpp usr/share/doc/hoist-twin/README.md usr/share/doc/hoist-twin/examples/demo.toml; do
   [ -e "$root/$f" ] || fail "not installed: /$f"
 done
 cfg=$(find "$root/usr/lib" -name hoistConfig.cmake | head -1)

@@ -291,7 +291,17 @@ TEST(CodecGenerated, NameTablesMatchTheLcmConstants) {
 }
 
 TEST(CodecGenerated, ChannelsMatchBusChannels) {
-  // `// @channel` in the .lcm files against the names the programs use.
+  // The channel names are a contract (exact): `// @channel` in the .lcm files
+  // (kChannels) and the generated C++ names the programs use
+  // (hoist/bus/channels.hpp) against the names clients have been told.  A
+  // renamed or added annotation fails here until the contract says so.
+  const std::map<std::string_view, std::string_view> contract = {
+      {"hoist.winder_t", "HOIST_WINDER"},          {"hoist.cage_state_t", "HOIST_CAGE"},
+      {"hoist.guide_shape_t", "HOIST_GUIDE_SHAPE"}, {"hoist.alarm_t", "HOIST_ALARM"},
+      {"hoist.alarm_ack_t", "HOIST_ALARM_ACK"},    {"hoist.health_t", "HOIST_HEALTH"},
+      {"hoist.forecast_t", "HOIST_FORECAST"},      {"hoist.trip_plan_t", "HOIST_TRIP_PLAN"},
+      {"hoist.cage_imu_t", "HOIST_CAGE_IMU"},      {"hoist.rope_load_t", "HOIST_ROPE_LOAD"},
+      {"hoist.estimate_t", "HOIST_ESTIMATE"}};
   const std::map<std::string_view, std::string_view> bus = {
       {"hoist.winder_t", bus::kChannelWinder},         {"hoist.cage_state_t", bus::kChannelCage},
       {"hoist.guide_shape_t", bus::kChannelGuideShape}, {"hoist.alarm_t", bus::kChannelAlarm},
@@ -304,5 +314,9 @@ TEST(CodecGenerated, ChannelsMatchBusChannels) {
     EXPECT_NE(findByName(c.type), nullptr) << c.type;
     gen[c.type] = c.channel;
   }
-  EXPECT_EQ(gen, bus);
+  EXPECT_EQ(gen, contract);
+  EXPECT_EQ(bus, contract);
+  // bus::Channels holds one prefixed name per channel (and nothing else).
+  EXPECT_EQ(sizeof(bus::Channels), kChannels.size() * sizeof(std::string));
+  EXPECT_EQ(bus::Channels("P/").estimate, "P/HOIST_ESTIMATE");
 }

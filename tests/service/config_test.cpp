@@ -136,9 +136,9 @@ TEST(Channels, Prefix) {
   const hoist::bus::Channels ch("A_");
   EXPECT_EQ(ch.winder, "A_HOIST_WINDER");
   EXPECT_EQ(ch.cage, "A_HOIST_CAGE");
-  EXPECT_EQ(ch.shape, "A_HOIST_GUIDE_SHAPE");
+  EXPECT_EQ(ch.guide_shape, "A_HOIST_GUIDE_SHAPE");
   EXPECT_EQ(ch.alarm, "A_HOIST_ALARM");
-  EXPECT_EQ(ch.ack, "A_HOIST_ALARM_ACK");
+  EXPECT_EQ(ch.alarm_ack, "A_HOIST_ALARM_ACK");
   EXPECT_EQ(ch.health, "A_HOIST_HEALTH");
   EXPECT_EQ(hoist::bus::channel("north/", hoist::bus::kChannelCage), "north/HOIST_CAGE");
   EXPECT_EQ(hoist::bus::Channels().winder, "HOIST_WINDER");

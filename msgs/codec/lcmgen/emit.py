@@ -1,5 +1,6 @@
-"""Step 3: Structs -> OUT/include/hoist/msg/codec.hpp, OUT/src/codec.cpp and
-OUT/names/include/hoist/msg/names.hpp and OUT/js/hoist_msgs.js,
+"""Step 3: Structs -> OUT/include/hoist/msg/codec.hpp, OUT/src/codec.cpp,
+OUT/names/include/hoist/msg/names.hpp, OUT/bus/include/hoist/bus/channels.hpp
+and OUT/js/hoist_msgs.js,
 rendered from the Jinja2 templates in msgs/codec/templates/.  This module
 only prepares what the templates read (TypeView, MemberView); the C++ is in
 the templates."""
@@ -51,6 +52,13 @@ class TypeView:
         self.max_size = max_size(st)
         self.schema = schema(st)
         self.channel = st.channel
+        # hoist/bus/channels.hpp's names: HOIST_GUIDE_SHAPE -> kChannelGuideShape,
+        # Channels::guide_shape (the package's prefix dropped).
+        words = (st.channel or "").split("_")
+        if words and words[0] == st.package.upper() and len(words) > 1:
+            words = words[1:]
+        self.channel_stem = "".join(w.capitalize() for w in words)
+        self.channel_member = "_".join(w.lower() for w in words)
         counts = {m.dims[0][1] for m in st.members if m.var_array}
         self.members = [MemberView(st, m, counts) for m in st.members]
         self.enums = [EnumView(e) for e in st.enums]
@@ -151,6 +159,8 @@ def render(structs):
     channels = [t for t in types if t.channel]
     if len({t.channel for t in channels}) != len(channels):
         raise GenError("two types name the same @channel")
+    if len({t.channel_member for t in channels}) != len(channels):
+        raise GenError("two @channel names give the same C++ name (hoist/bus/channels.hpp)")
     ctx = {"banner": BANNER, "types": types, "channels": channels,
            "enums": [(t, e) for t in types for e in t.enums]}
     env = environment()
@@ -158,6 +168,8 @@ def render(structs):
         os.path.join("include", "hoist", "msg", "codec.hpp"): env.get_template("codec.hpp.j2").render(ctx),
         os.path.join("src", "codec.cpp"): env.get_template("codec.cpp.j2").render(ctx),
         os.path.join("names", "include", "hoist", "msg", "names.hpp"): env.get_template("names.hpp.j2").render(ctx),
+        os.path.join("bus", "include", "hoist", "bus", "channels.hpp"):
+            env.get_template("channels.hpp.j2").render(ctx),
         os.path.join("js", "hoist_msgs.js"): env.get_template("hoist_msgs.js.j2").render(ctx),
     }
 

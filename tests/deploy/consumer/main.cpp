@@ -1,6 +1,7 @@
 // Uses each exported target of find_package(hoist) once: a shaft from TOML
 // (hoist::io), its static equilibrium (hoist::model), and the result as an
-// LCM message (hoist::msgs), encoded and decoded.  The decode check also
+// LCM message (hoist::msgs), encoded and decoded, on its channel's name
+// (hoist::lcm's generated hoist/bus/channels.hpp).  The decode check also
 // catches LCM 1.3.1's strict-aliasing bug (lcm_coretypes.h writes doubles
 // through int64_t*: at -O2 GCC drops them) if hoist::msgs stopped carrying
 // -fno-strict-aliasing to its users.
@@ -9,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include <hoist/bus/channels.hpp>
 #include <hoist/cage_state_t.hpp>
 #include <hoist/fast_solver.hpp>
 #include <hoist/io/config.hpp>
@@ -34,7 +36,9 @@ int main() {
   const int decoded = back.decode(buf.data(), 0, static_cast<int>(buf.size()));
   const bool ok = encoded == static_cast<int>(buf.size()) && decoded == encoded && back.y_c == r.y_c &&
                   back.lambdas[1] == r.lambda[1] && std::isfinite(r.y_c) && r.y_c > 0.004 && r.y_c < 0.006;
-  std::printf("hoist-consumer: n=%d l=%.1f m static y_c=%.4f mm, cage_state_t %zu bytes: %s\n", p.n, m.l,
-              r.y_c * 1e3, buf.size(), ok ? "ok" : "FAIL");
-  return ok ? 0 : 1;
+  const hoist::bus::Channels ch("north/");
+  const bool named = ch.cage == "north/HOIST_CAGE" && hoist::bus::kChannelCage == "HOIST_CAGE";
+  std::printf("hoist-consumer: n=%d l=%.1f m static y_c=%.4f mm, cage_state_t %zu bytes on %s: %s\n", p.n, m.l,
+              r.y_c * 1e3, buf.size(), ch.cage.c_str(), ok && named ? "ok" : "FAIL");
+  return ok && named ? 0 : 1;
 }
