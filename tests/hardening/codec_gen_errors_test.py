@@ -38,6 +38,8 @@ run("badform_t", "struct badform_t {\n  int8_t level;  // @enum level\n}\n", 2, 
 run("csvunknown_t", "struct csvunknown_t {\n  int8_t a;  // @csv b c\n}\n", 2, "@csv names unknown member 'b'")
 run("csvdup_t", "struct csvdup_t {\n  int8_t a;  // @csv a b\n  int8_t b;\n}\n", 2, "two CSV columns named b")
 run("csvfirst_t", "struct csvfirst_t {\n  // @csvfirst a,zz\n  int8_t a;\n}\n", 2, "@csvfirst names unknown member 'zz'")
+run("enumid_t", "struct enumid_t {\n  int8_t n;  // @enum n N_\n  const int8_t N_1 = 0;\n}\n", 2,
+    "no distinct C++ enumerators")
 run("chan_t", "struct chan_t  // @channel lower\n{\n  int8_t a;\n}\n", 2, "malformed annotation")
 run("good_t", "struct good_t  // @channel GOOD\n{\n  // @csvfirst b\n  int8_t a;  // @enum a A_\n"
     "  double b[2];  // @csv b bee 1\n  string k;  // @enum k K_\n"
@@ -47,7 +49,11 @@ names = open(os.path.join(work, "out_good_t", "names", "include", "hoist", "msg"
 for what, ok in [('columns bee_1, bee_2, a in that order', good.find('{"bee_1", [') < good.find('{"bee_2", [') < good.find('{"a", [')),
                  ("A_ table starts at -1", "kAFirst = -1" in names and '"X", "Y"' in names),
                  ("K_ table for a string member", '"ONE", "TWO"' in names),
-                 ("channel GOOD", '{"hoist.good_t", "GOOD"}' in names)]:
+                 ("channel GOOD", '{"hoist.good_t", "GOOD"}' in names),
+                 ("enum class A : std::int8_t {X = -1, Y = 0}",
+                  "enum class A : std::int8_t {\n  X = -1,\n  Y = 0\n};" in names),
+                 ("bus::kChannelGood", 'kChannelGood = "GOOD"' in open(os.path.join(
+                     work, "out_good_t", "bus", "include", "hoist", "bus", "channels.hpp")).read())]:
     print(f"{'ok  ' if ok else 'FAIL'} good_t: {what}")
     passed, failed = passed + ok, failed + (not ok)
 print(f"{passed} passed, {failed} failed")

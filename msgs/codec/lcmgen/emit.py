@@ -78,6 +78,8 @@ class EnumView:
         self.names = e.names
         self.stem = e.stem
         self.lower = e.stem[0].lower() + e.stem[1:]
+        self.camel = e.camel
+        self.ctype = e.ctype
 
 
 class FiniteCheck:

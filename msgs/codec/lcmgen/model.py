@@ -47,11 +47,17 @@ class Enum:
     """The consts PREFIX_<NAME> of a struct that name the values of one of its
     members (`// @enum MEMBER PREFIX_`): names[i] is the value first + i."""
 
-    def __init__(self, member, prefix, first, names):
+    def __init__(self, member, prefix, first, names, ctype="int64_t"):
         self.member = member      # member name
+        self.ctype = ctype        # the consts' C integer type (the widest of them)
         self.prefix = prefix      # "LEVEL_"
         self.first = first        # value of names[0]
         self.names = names        # ["NONE", "WARNING", "CRITICAL"]
+
+    @property
+    def camel(self):
+        """The enumerators of enum class <Stem>: CAGE_POS_Y -> CagePosY."""
+        return ["".join(w.capitalize() for w in n.split("_")) for n in self.names]
 
     @property
     def stem(self):

@@ -269,7 +269,7 @@ def check_struct(st):
 def enum_of(st, member, prefix, consts, where):
     """The consts PREFIX_* of st as an Enum: integer consts whose values are
     distinct and consecutive (a name table indexed by value - first)."""
-    items = []
+    items, types = [], set()
     for t, n, v in st.consts:
         if not n.startswith(prefix):
             continue
@@ -277,6 +277,7 @@ def enum_of(st, member, prefix, consts, where):
             raise GenError(f"{where}: @enum {member} {prefix}: const {n} is not an integer const "
                            f"named {prefix}<NAME>")
         items.append((int(v, 0), n[len(prefix):]))
+        types.add(t)
     if not items:
         raise GenError(f"{where}: @enum {member} {prefix}: the struct has no const {prefix}<NAME>")
     items.sort()
@@ -285,7 +286,14 @@ def enum_of(st, member, prefix, consts, where):
     if values != list(range(first, first + len(items))):
         raise GenError(f"{where}: @enum {member} {prefix}: the values {values} are not distinct "
                        "and consecutive")
-    return Enum(member, prefix, first, [n for _, n in items])
+    ctype = max(types, key=lambda t: INT_RANGE[t][1] - INT_RANGE[t][0])
+    if ctype == "byte":
+        ctype = "uint8_t"
+    e = Enum(member, prefix, first, [n for _, n in items], ctype)
+    if len(set(e.camel)) != len(e.camel) or any(not c[:1].isalpha() for c in e.camel):
+        raise GenError(f"{where}: @enum {member} {prefix}: the names {e.names} give no distinct C++ "
+                       "enumerators (CAGE_POS_Y -> CagePosY)")
+    return e
 
 
 def resolve(structs):

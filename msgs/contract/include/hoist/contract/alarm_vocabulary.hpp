@@ -9,27 +9,22 @@
 #include <optional>
 #include <string_view>
 
+#include "hoist/msg/names.hpp"  // generated from alarm_t.lcm; standard library only (no LCM)
+
 namespace hoist::contract {
 
-/// Every alarm kind the daemon raises; the name is toString(kind).
-enum class AlarmKind : std::uint8_t {
-  CagePosY, CageNegY, GuideRope, InputStale, ModelFault, ModelDomain, DuplicatePublisher,
-  RopeSlack, RopeOverload,            // live rope-force alarms
-  PredictedClearance, PredictedSlack,  // look-ahead forecasts
-  ModelMismatch,                      // the load estimator: the shaft does not behave like its model
-  SensorFault,                        // a sensor of the estimator refused or not believed (names the sensor and why)
-  GuidePreloadLow,                    // the shaft's memory: the guide-rope preload identified over trips is low
-  ShaftFingerprint                    // the shaft's memory: a depth left its commissioning fingerprint
-};
-inline constexpr int kAlarmKinds = 15;
+/// Every alarm kind the daemon raises (alarm_t.KIND_*: KIND_CAGE_POS_Y is
+/// AlarmKind::CagePosY); the name is toString(kind).  Generated from the
+/// `// @enum kind KIND_` of msgs/alarm_t.lcm: a new kind is its const there
+/// (and the daemon's code that raises it).
+using AlarmKind = hoist::msg::enums::alarm_t::Kind;
+inline constexpr int kAlarmKinds = static_cast<int>(hoist::msg::enums::alarm_t::kKindNames.size());
 
-/// Values match alarm_t.LEVEL_*.
-enum class AlarmLevel : std::int8_t { None = 0, Warning = 1, Critical = 2 };
+/// alarm_t.LEVEL_* (None, Warning, Critical), generated likewise.
+using AlarmLevel = hoist::msg::enums::alarm_t::Level;
 
-/// Values match alarm_t.EVENT_*.
-enum class AlarmEventType : std::int8_t {
-  Raise = 1, Clear = 2, Ack = 3, Shelve = 4, Unshelve = 5, Reannounce = 6
-};
+/// alarm_t.EVENT_* (Raise, Clear, Ack, Shelve, Unshelve, Reannounce), generated likewise.
+using AlarmEventType = hoist::msg::enums::alarm_t::Event;
 
 /// The default of [alarms] max_shelve: the longest shelve an operator may set [s].
 inline constexpr double kDefaultMaxShelve = 3600.0;
