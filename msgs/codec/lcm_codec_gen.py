@@ -10,6 +10,8 @@ arrays of either, strings, consts) and writes
                                     fromJson, jsonSchema, TypeInfo, allTypes,
                                     allFinite, csvColumns/csvHeader/csvRow,
                                     allEnums)
+  OUT/include/hoist/msg/groups.hpp  one struct per `@group` of a type, with
+                                    fillInto(msg)
   OUT/src/codec.cpp                 one byte walker, one JSON converter pair,
                                     one JSON Schema, one all-finite check and
                                     one CSV column table per type
@@ -48,6 +50,9 @@ or the fingerprint):
   // @channel NAME     the type's LCM channel without the prefix (kChannels,
                        bus::kChannel<Name> and bus::Channels::<name>,
                        CHANNELS of hoist_msgs.js)
+  // @group name       (in a scalar member's own line) the member is one of the
+                       figures one writer keeps: struct groups::<type>::<Name>
+                       with those members and fillInto(msg)
 
 Usage: lcm_codec_gen.py --out DIR FILE.lcm...
        lcm_codec_gen.py --fingerprints FILE.lcm...   (prints name and hash)

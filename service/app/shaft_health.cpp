@@ -34,14 +34,17 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   const ForecastStats& fc = st_.forecast;
   const InputCounters& c = core.counters();
   const AlarmEngine& al = core.alarms();
+  // Each room's counters of health_t (its `@group`), under health_t's names.
+  tk.fillInto(m);
+  in.fillInto(m);
+  out.fillInto(m);
+  fc.fillInto(m);
   m.utime = bus::wallUtime();
   m.uptime = std::max(0.0, wall);
   m.t = core.publishedTime(core.modelTime());
   m.window = std::max(0.0, wall - std::max(0.0, last_wall_));
-  m.ticks = tk.ticks;
   m.steps = core.steps();
   m.preload_scale = core.preloadScale();
-  m.deadline_misses = tk.deadline_misses;
   const LatencyHistogram& step = st_.stepWindow();
   m.step_p50_us = step.quantile(0.5);
   m.step_p99_us = step.quantile(0.99);
@@ -61,13 +64,7 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   const LatencyHistogram& fh = fc.compute.window;
   m.forecast_p50_us = fh.count() > 0 ? fh.quantile(0.5) : 0.0;
   m.forecast_p99_us = fh.count() > 0 ? fh.quantile(0.99) : 0.0;
-  m.forecasts = fc.forecasts;
-  m.forecasts_dropped = fc.forecasts_dropped;
-  m.forecasts_skipped = fc.forecasts_skipped;
-  m.plans_accepted = in.plans_accepted;
   m.plans_rejected = in.plansRejected();
-  m.sensor_accepted = in.sensor_accepted;
-  m.sensor_rejected = in.sensor_rejected;
   if (const EstimatorCounters* ec = ctx_.core.estimatorCounters()) {
     m.sensor_gated = ec->gated;
     m.estimator_load_changes = ec->load_changes;
@@ -92,15 +89,10 @@ void ShaftHealth::fill(hoist::health_t& m, double wall) const {
   m.alarms_active = al.activeCount();
   m.alarms_unacked = al.unackedCount();
   m.alarms_shelved = al.shelvedCount();
-  m.alarm_events = out.alarm_events;
   m.model_faults = core.modelFaults();
   m.model_resets = core.modelResets();
-  m.publish_failures = out.publish_failures;
-  m.nonfinite_blocked = out.nonfinite_blocked;
   m.degraded = core.degraded();
   m.rss_kb = rssKb();
-  m.commands_dropped = in.commands_dropped;
-  m.commands_invalid = in.commands_invalid;
   m.catchup_limited = core.catchupLimited();
   m.datagrams_ignored = ignored_counter_ ? *ignored_counter_ : 0;
   fillStartsAndMisses(m);

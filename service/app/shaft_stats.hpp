@@ -6,11 +6,19 @@
 // final log lines; the run report and the tests read them through
 // ShaftTwin).  Each counter has one writer.  Plain data: no logic but the
 // window's end, which the owner calls (ShaftTwin::publishHealth).
+//
+// The counters HOIST_HEALTH carries as they are come from health_t.lcm: a
+// slice derives from the generated group of its room (`@group tick`, ...:
+// hoist::msg::groups::health_t::Tick, ...), which holds them under
+// health_t's names and copies them into the message (fillInto, called by
+// ShaftHealth::fill).  A new such counter is its line in health_t.lcm and
+// its increment.
 #pragma once
 
 #include <array>
 #include <cstdint>
 
+#include "hoist/msg/groups.hpp"
 #include "hoist/service/forecast_rules.hpp"
 #include "hoist/service/health.hpp"
 #include "hoist/service/input_validator.hpp"
@@ -38,10 +46,9 @@ struct WindowedHistogram {
   }
 };
 
-/// The tick's (ShaftTwin): --clock wall steps, lateness, starts, misses.
-struct TickStats {
-  std::int64_t ticks = 0;            ///< ticks run
-  std::int64_t deadline_misses = 0;  ///< deadlines the schedule skipped
+/// The tick's (ShaftTwin): --clock wall steps, lateness, starts, misses;
+/// ticks and deadline_misses from health_t's `@group tick`.
+struct TickStats : msg::groups::health_t::Tick {
   std::int64_t ns_model = 0;         ///< steady-clock ns in the model (core tick + housekeeping)
   std::int64_t ns_publish = 0;       ///< steady-clock ns publishing from the tick (encode + send)
   std::int64_t ns_tick = 0;          ///< steady-clock ns in whole tick() calls
@@ -70,21 +77,20 @@ struct TickStats {
   }
 };
 
-/// The inputs' (ShaftInputs): commands, trip plans, sensors, --clock input steps.
-struct InputStats {
+/// The inputs' (ShaftInputs): commands, trip plans, sensors, --clock input
+/// steps; commands_dropped (valid commands beyond max_commands_per_tick,
+/// plus decode-bound drops), commands_invalid, plans_accepted,
+/// sensor_accepted (handed to the estimator) and sensor_rejected from
+/// health_t's `@group inputs`.
+struct InputStats : msg::groups::health_t::Inputs {
   std::int64_t command_decode_rejects = 0;  ///< undecodable alarm commands
   std::int64_t handler_exceptions = 0;      ///< exceptions caught in an input handler
   std::int64_t command_decodes_dropped = 0; ///< command datagrams beyond the tick's decode bound (not decoded)
-  std::int64_t commands_dropped = 0;        ///< valid commands beyond max_commands_per_tick, plus decode-bound drops
-  std::int64_t commands_invalid = 0;        ///< undecodable or invalid commands
   std::int64_t commands_applied = 0;        ///< effective commands (audited)
   std::int64_t reannounce_requests = 0;     ///< valid re-announce requests (alarm_ack_t ACTION_REANNOUNCE)
   std::int64_t reannounces = 0;             ///< ... honoured (at most one a second)
   std::int64_t reannounce_merged = 0;       ///< ... merged into a pending one (arrived within the interval)
-  std::int64_t plans_accepted = 0;          ///< trip plans accepted
   std::array<std::int64_t, kPlanRejectReasons> plan_rejects{};  ///< trip plans rejected, per reason
-  std::int64_t sensor_accepted = 0;         ///< cage IMU and rope-load samples handed to the estimator
-  std::int64_t sensor_rejected = 0;         ///< ... refused (undecodable, implausible, old seq)
   SensorSequence imu_seq, rope_seq;         ///< each sensor's sequence rule (hoist/service/sensor_sequence.hpp)
   double last_imu_wall = -1.0, last_rope_wall = -1.0;  ///< when (wall clock [s]; < 0: never)
   WindowedHistogram step;                   ///< model step time [us] (--clock input: the inputs step the model)
@@ -98,19 +104,16 @@ struct InputStats {
   void endWindow() { step.endWindow(); }
 };
 
-/// The outputs' (ShaftOutputs).
-struct OutputStats {
-  std::int64_t publish_failures = 0;   ///< publishes that failed (socket, encode, buffer size)
-  std::int64_t nonfinite_blocked = 0;  ///< messages withheld because a field was not finite
-  std::int64_t alarm_events = 0;       ///< HOIST_ALARM events published
+/// The outputs' (ShaftOutputs); publish_failures (socket, encode, buffer
+/// size), nonfinite_blocked and alarm_events from health_t's `@group outputs`.
+struct OutputStats : msg::groups::health_t::Outputs {
   std::int64_t publish_attempts = 0;   ///< publishes tried (TestHooks::fail_publish_every counts them)
 };
 
-/// The forecasts' (ForecastScheduler; all zero without [forecast] enabled).
-struct ForecastStats {
-  std::int64_t forecasts = 0;          ///< forecasts done
-  std::int64_t forecasts_dropped = 0;  ///< snapshots replaced before the worker took them
-  std::int64_t forecasts_skipped = 0;  ///< forecast instants skipped (degraded state)
+/// The forecasts' (ForecastScheduler; all zero without [forecast] enabled);
+/// forecasts, forecasts_dropped and forecasts_skipped from health_t's
+/// `@group forecasts`.
+struct ForecastStats : msg::groups::health_t::Forecasts {
   std::int64_t forecasts_from_estimate = 0;  ///< forecasts started from the load estimate's state
   std::int64_t forecast_failures = 0;  ///< forecasts whose engine threw (nothing published)
   std::int64_t plan_unusable = 0;      ///< forecasts whose accepted plan no longer fit the motion

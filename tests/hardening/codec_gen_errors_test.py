@@ -40,10 +40,15 @@ run("csvdup_t", "struct csvdup_t {\n  int8_t a;  // @csv a b\n  int8_t b;\n}\n",
 run("csvfirst_t", "struct csvfirst_t {\n  // @csvfirst a,zz\n  int8_t a;\n}\n", 2, "@csvfirst names unknown member 'zz'")
 run("enumid_t", "struct enumid_t {\n  int8_t n;  // @enum n N_\n  const int8_t N_1 = 0;\n}\n", 2,
     "no distinct C++ enumerators")
+run("grouparr_t", "struct grouparr_t {\n  int8_t a[2];  // @group g\n}\n", 2,
+    "@group is for scalar numbers and booleans only")
+run("groupline_t", "struct groupline_t {\n  // @group g\n  int8_t a;\n}\n", 2, "@group belongs in its member's own line")
+run("groupcase_t", "struct groupcase_t {\n  int8_t a;  // @group G\n}\n", 2, "malformed annotation")
 run("chan_t", "struct chan_t  // @channel lower\n{\n  int8_t a;\n}\n", 2, "malformed annotation")
 run("good_t", "struct good_t  // @channel GOOD\n{\n  // @csvfirst b\n  int8_t a;  // @enum a A_\n"
     "  double b[2];  // @csv b bee 1\n  string k;  // @enum k K_\n"
-    "  const int8_t A_X = -1, A_Y = 0, K_ONE = 0, K_TWO = 1;\n}\n", 0)
+    "  const int8_t A_X = -1, A_Y = 0, K_ONE = 0, K_TWO = 1;\n"
+    "  int64_t n;  // @group my_room counted things\n  boolean up;  // @group my_room\n}\n", 0)
 good = open(os.path.join(work, "out_good_t", "src", "codec.cpp")).read()
 names = open(os.path.join(work, "out_good_t", "names", "include", "hoist", "msg", "names.hpp")).read()
 for what, ok in [('columns bee_1, bee_2, a in that order', good.find('{"bee_1", [') < good.find('{"bee_2", [') < good.find('{"a", [')),
@@ -52,6 +57,10 @@ for what, ok in [('columns bee_1, bee_2, a in that order', good.find('{"bee_1", 
                  ("channel GOOD", '{"hoist.good_t", "GOOD"}' in names),
                  ("enum class A : std::int8_t {X = -1, Y = 0}",
                   "enum class A : std::int8_t {\n  X = -1,\n  Y = 0\n};" in names),
+                 ("@group my_room: struct MyRoom {n, up} with fillInto",
+                  all(x in open(os.path.join(work, "out_good_t", "include", "hoist", "msg", "groups.hpp")).read()
+                      for x in ("struct MyRoom {", "std::int64_t n = 0;  ///< counted things", "bool up = false;",
+                                "void fillInto(::hoist::good_t& m) const {", "m.up = up;"))),
                  ("bus::kChannelGood", 'kChannelGood = "GOOD"' in open(os.path.join(
                      work, "out_good_t", "bus", "include", "hoist", "bus", "channels.hpp")).read())]:
     print(f"{'ok  ' if ok else 'FAIL'} good_t: {what}")

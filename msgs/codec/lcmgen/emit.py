@@ -1,5 +1,6 @@
 """Step 3: Structs -> OUT/include/hoist/msg/codec.hpp, OUT/src/codec.cpp,
-OUT/names/include/hoist/msg/names.hpp, OUT/bus/include/hoist/bus/channels.hpp
+OUT/include/hoist/msg/groups.hpp, OUT/names/include/hoist/msg/names.hpp,
+OUT/bus/include/hoist/bus/channels.hpp
 and OUT/js/hoist_msgs.js,
 rendered from the Jinja2 templates in msgs/codec/templates/.  This module
 only prepares what the templates read (TypeView, MemberView); the C++ is in
@@ -35,6 +36,9 @@ class MemberView:
         self.nested_min = body_min(m.struct) if m.nested else None
         self.prim_size = PRIM_SIZE.get(m.type)
         self.is_real = m.type in REAL_TYPES
+        self.desc = m.desc
+        self.group_ctype = {"boolean": "bool", "byte": "std::uint8_t", "float": "float",
+                            "double": "double"}.get(m.type, f"std::{m.type}")
         self.is_int = m.type in INT_RANGE
         if m.type in INT_RANGE:
             lo, hi = INT_RANGE[m.type]
@@ -62,12 +66,30 @@ class TypeView:
         counts = {m.dims[0][1] for m in st.members if m.var_array}
         self.members = [MemberView(st, m, counts) for m in st.members]
         self.enums = [EnumView(e) for e in st.enums]
+        self.groups = []
+        for mv in self.members:
+            if mv.m.group is None:
+                continue
+            g = next((g for g in self.groups if g.name == mv.m.group), None)
+            if g is None:
+                g = GroupView(mv.m.group)
+                self.groups.append(g)
+            g.members.append(mv)
         self.finite_checks = [FiniteCheck(m) for m in st.members if m.nested or m.type in REAL_TYPES]
         self.csv_columns = csv_columns(st, "", "m.")
         names = [c.name for c in self.csv_columns]
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise GenError(f"{st.path}: {st.full}: two CSV columns named {', '.join(dup)} (see @csv)")
+
+
+class GroupView:
+    """The members of one `@group name`: struct <Name> of groups.hpp."""
+
+    def __init__(self, name):
+        self.name = name
+        self.camel = "".join(w.capitalize() for w in name.split("_"))
+        self.members = []
 
 
 class EnumView:
@@ -170,6 +192,7 @@ def render(structs):
         os.path.join("include", "hoist", "msg", "codec.hpp"): env.get_template("codec.hpp.j2").render(ctx),
         os.path.join("src", "codec.cpp"): env.get_template("codec.cpp.j2").render(ctx),
         os.path.join("names", "include", "hoist", "msg", "names.hpp"): env.get_template("names.hpp.j2").render(ctx),
+        os.path.join("include", "hoist", "msg", "groups.hpp"): env.get_template("groups.hpp.j2").render(ctx),
         os.path.join("bus", "include", "hoist", "bus", "channels.hpp"):
             env.get_template("channels.hpp.j2").render(ctx),
         os.path.join("js", "hoist_msgs.js"): env.get_template("hoist_msgs.js.j2").render(ctx),

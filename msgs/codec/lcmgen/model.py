@@ -33,6 +33,7 @@ class Member:
         self.enum = None          # the Enum naming this member's values (@enum)
         self.csv_name = name      # CSV column (stem, for an array) (@csv)
         self.csv_first = 0        # index of an array's first CSV column (@csv)
+        self.group = None         # the writer's group of a counter (@group)
 
     @property
     def nested(self):

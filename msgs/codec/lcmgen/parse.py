@@ -16,6 +16,7 @@ ANNOTATIONS = {
     "csv": rf"@csv\s+({_ID})\s+({_ID})(?:\s+(\d+))?(?![\w])",
     "csvfirst": rf"@csvfirst\s+({_ID}(?:,{_ID})*)(?![\w,])",
     "channel": r"@channel\s+([A-Z][A-Z0-9_]*)(?![\w])",
+    "group": r"@group\s+([a-z][a-z0-9_]*)(?![\w])",
 }
 _WANT = {
     "max": "'@max COUNT N|CONST'",
@@ -24,6 +25,7 @@ _WANT = {
     "csv": "'@csv MEMBER COLUMN [FIRST]'",
     "csvfirst": "'@csvfirst MEMBER,MEMBER,...'",
     "channel": "'@channel NAME' (upper case)",
+    "group": "'@group name' (lower case, in the member's own line)",
 }
 _ANY_ANNOTATION = "|".join(f"(?:{p})" for p in ANNOTATIONS.values())
 
@@ -128,6 +130,22 @@ def read_annotations(st, comments, first_line, last_line):
             st.channel = a.group(1)
 
 
+def member_group(path, st, m, comments, comment_only, first, last):
+    """`// @group name` in the member's own line(s): the member is one of the
+    counters one writer keeps (a generated struct per group, emit.py)."""
+    found = None
+    for ln in range(first, last + 1):
+        if ln in comment_only:
+            continue
+        for a in re.finditer(ANNOTATIONS["group"], comments.get(ln, "")):
+            if found and found != a.group(1):
+                raise GenError(f"{path}:{ln}: {st.full}.{m.name}: two @group names")
+            found = a.group(1)
+    if found and (m.dims or m.type not in PRIMITIVES or m.type == "string"):
+        raise GenError(f"{path}:{first}: {st.full}.{m.name}: @group is for scalar numbers and booleans only")
+    return found
+
+
 def parse_file(path):
     with open(path, encoding="utf-8") as f:
         text = f.read()
@@ -186,12 +204,16 @@ def parse_file(path):
                     t2, lastln = take()
                     m = Member(mtype, mname, dims, mln,
                                describe(mln, lastln, comments, comment_only))
+                    m.group = member_group(path, st, m, comments, comment_only, mln, lastln)
                     st.members.append(m)
                     if t2 == ";":
                         break
                     if t2 != ",":
                         raise GenError(f"{path}:{mln}: expected ',' or ';' after member {mname}")
             _, eln = take("}")
+            for k in range(sln, eln + 1):
+                if k in comment_only and re.search(ANNOTATIONS["group"], comments.get(k, "")):
+                    raise GenError(f"{path}:{k}: {st.full}: @group belongs in its member's own line")
             read_annotations(st, comments, sln, eln)
             check_struct(st)
             structs.append(st)
