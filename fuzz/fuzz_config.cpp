@@ -9,7 +9,7 @@
 #include <string_view>
 
 #include "hoist/io/config.hpp"
-#include "hoist/service/config_file.hpp"
+#include "hoist/service/cfg/config_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
@@ -32,10 +32,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!(q == p))  // every field of hoist::kParamFields (ShaftParams::operator== is member-wise)
     std::abort();
   try {
-    hoist::svc::TwinConfig cfg;
+    hoist::service::TwinConfig cfg;
     cfg.shaft = p;
-    hoist::svc::parseServiceSections(tbl, "fuzz.toml", cfg);
-    (void)hoist::svc::toToml(cfg);
+    hoist::service::parseServiceSections(tbl, "fuzz.toml", cfg);
+    (void)hoist::service::toToml(cfg);
   } catch (const std::exception& e) {
     if (!*e.what()) std::abort();
   }

@@ -14,10 +14,10 @@
 #include <cstring>
 #include <vector>
 
-#include "hoist/service/twin_core.hpp"
-#include "hoist/service/winder_decode.hpp"
+#include "hoist/service/twin/twin_core.hpp"
+#include "hoist/service/lcm/winder_decode.hpp"
 
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -11,9 +11,9 @@
 #include <array>
 #include <cstddef>
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 inline constexpr std::size_t kConditionTextChars = 400;
 using ConditionText = std::array<char, kConditionTextChars>;
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -15,7 +15,7 @@
 #include "run_report.hpp"
 #include "hoist/version.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace asio = boost::asio;
 using std::chrono::duration;
@@ -39,7 +39,7 @@ Daemon::Daemon(DaemonOptions opt, std::shared_ptr<spdlog::logger> log)
     if (instance_id_ == 0) instance_id_ = 1;
   }
   if (!opt_.lcm_url_out.empty() && opt_.lcm_url_out != opt_.lcm_url)
-    lcm_out_ = std::make_unique<lcm::LCM>(opt_.lcm_url_out);
+    lcm_out_ = std::make_unique<::lcm::LCM>(opt_.lcm_url_out);
   opt_.labels.resize(opt_.shafts.size());
   // One ShaftTwin per configuration, one schedule (timer) per distinct rate.
   std::map<double, RateGroup*> by_rate;
@@ -477,4 +477,4 @@ bool Daemon::writeReport() const {
   return writeRunReport(opt_.report_path, f, *out_);
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -1,5 +1,5 @@
 // hoist-twind's event loop: one Boost.Asio io_context, on one thread, that owns
-//   * the LCM socket (lcm::LCM::getFileno() watched by a stream_descriptor,
+//   * the LCM socket (::lcm::LCM::getFileno() watched by a stream_descriptor,
 //     drained with handleTimeout(0): no polling, no extra thread of ours);
 //   * one steady_timer per distinct step rate among the hosted shafts, each on
 //     an absolute schedule deadline_k = start + k * period (a tick that starts
@@ -42,8 +42,8 @@
 #include "forecast_pool.hpp"
 #include "miss_recorder.hpp"
 #include "output_watch.hpp"
-#include "hoist/service/config.hpp"
-#include "hoist/service/history_config.hpp"
+#include "hoist/service/core/config.hpp"
+#include "hoist/service/cfg/history_config.hpp"
 #include "hoist/rt/realtime.hpp"
 #include "hoist/rt/rt_log.hpp"
 #include "shaft_twin.hpp"
@@ -52,7 +52,7 @@
 #include "keeper_worker.hpp"
 #include "watchdog.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 using rt::applyRealtime;
 using rt::parseCpuList;
@@ -157,7 +157,7 @@ class Daemon {
   std::shared_ptr<spdlog::logger> out_;
   RtLog log_;
   boost::asio::io_context io_;
-  lcm::LCM lcm_;
+  ::lcm::LCM lcm_;
   bus::Subscriber input_{lcm_};  ///< the receive path: own for udpm URLs (hoist/bus/subscriber.hpp), else LCM's
   std::int64_t ignored_ = 0;     ///< the udpm receiver's ignored + malformed, mirrored for the health reports
   static constexpr std::size_t kDrainEvery = 16;  ///< shafts stepped between two drains within a tick
@@ -166,7 +166,7 @@ class Daemon {
   std::int64_t ns_ticks_ = 0, ns_receive_ = 0, cpu0_ = 0;
   std::unique_ptr<UdpmSender> sender_;      ///< own publisher for udpm output URLs (udpm_sender.hpp); else LCM's
   std::int64_t ns_flush_ = 0;               ///< cost split: steady-clock ns in sender_->flush()
-  std::unique_ptr<lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
+  std::unique_ptr<::lcm::LCM> lcm_out_;  ///< [service] lcm_url_out, publish only (never subscribed: no receive socket)
   std::int64_t instance_id_ = 0;       ///< random per process (HOIST_CAGE/HOIST_HEALTH.instance_id)
   boost::asio::posix::stream_descriptor lcm_fd_;
   /// lcm_url_out elsewhere: our own HOIST_HEALTH watched there (output_watch.hpp)
@@ -200,4 +200,4 @@ class Daemon {
   Watchdog watchdog_{progress_, out_};
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -7,7 +7,7 @@
 
 #include "hoist/rt/realtime.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace {
 
@@ -141,4 +141,4 @@ void ForecastPool::workerMain() {
   }
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

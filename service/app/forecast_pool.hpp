@@ -29,11 +29,11 @@
 #include <vector>
 
 #include "hoist/forecast.hpp"
-#include "hoist/service/config.hpp"
-#include "hoist/service/twin_model.hpp"
+#include "hoist/service/core/config.hpp"
+#include "hoist/service/twin/twin_model.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 /// What the loop hands over: the twin's state at one instant, and the plan.
 struct ForecastSnapshot {
@@ -148,4 +148,4 @@ class ForecastPool {
   std::atomic<int> yielded_{0};
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "hoist/service/forecast_rules.hpp"
+#include "hoist/service/core/forecast_rules.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 ForecastScheduler::ForecastScheduler(const ShaftContext& ctx, TwinCore& core, ShaftClock& clock, ForecastStats& stats,
                                      ShaftOutputs& out)
@@ -134,4 +134,4 @@ void ForecastScheduler::onResult(const ForecastResult& r) {
   out_.publishAlarmEvents();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -18,7 +18,7 @@
 #include "shaft_outputs.hpp"
 #include "shaft_stats.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class ForecastScheduler {
  public:
@@ -74,4 +74,4 @@ class ForecastScheduler {
   double plan_t_ = 0.0;               ///< model time it was accepted [s]
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -7,7 +7,7 @@
 #include "hoist/rt/realtime.hpp"
 #include "shaft_twin.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 std::string stateFileName(const std::string& base, const std::string& label) {
   std::string f = base;
@@ -47,4 +47,4 @@ void KeeperWorker::main() {
   }
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -17,7 +17,7 @@
 
 #include <spdlog/logger.h>
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class ShaftTwin;
 
@@ -47,4 +47,4 @@ class KeeperWorker {
   std::thread thread_;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -31,7 +31,7 @@
 #include "hoist/cli/app.hpp"
 #include "startup_budget.hpp"
 #include "twind_options.hpp"
-#include "hoist/service/config_file.hpp"
+#include "hoist/service/cfg/config_file.hpp"
 
 namespace {
 /// True when stderr is the systemd journal's stream: systemd sets
@@ -59,7 +59,7 @@ class SyslogPriorityFlag : public spdlog::custom_flag_formatter {
 }  // namespace
 
 int main(int argc, char** argv) {
-  using namespace hoist::svc;
+  using namespace hoist::service;
   // ---- parse ----
   CLI::App app{
       "hoist-twind: real-time digital twin of a cable-guided mine-shaft hoist.\n"

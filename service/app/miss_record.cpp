@@ -1,7 +1,7 @@
 // The miss record: see miss_record.hpp.
 #include "miss_record.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 const MissRecord* MissLog::worst() const {
   const MissRecord* w = nullptr;
@@ -12,4 +12,4 @@ const MissRecord* MissLog::worst() const {
   return w;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

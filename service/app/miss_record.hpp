@@ -22,7 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 /// Cumulative steady-clock nanoseconds of the loop thread, by phase.
 struct LoopSplit {
@@ -103,4 +103,4 @@ class MissLog {
   std::int64_t total_ = 0;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

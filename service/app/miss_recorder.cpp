@@ -7,7 +7,7 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "shaft_twin.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 using std::chrono::duration;
 
@@ -104,4 +104,4 @@ void MissRecorder::onSecond(const boost::system::error_code& ec) {
   arm();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -27,7 +27,7 @@
 #include "hoist/rt/rt_log.hpp"
 #include "miss_record.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class ShaftTwin;
 
@@ -92,4 +92,4 @@ class MissRecorder {
   bool stopped_ = false;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -7,7 +7,7 @@
 
 #include "hoist/rt/realtime.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace {
 constexpr auto kWriterPeriod = std::chrono::milliseconds(200);
@@ -86,4 +86,4 @@ void OffsetKeeper::writePending() {
   }
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -31,9 +31,9 @@
 
 #include "hoist/io/accel_offset_file.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class OffsetKeeper {
  public:
@@ -72,4 +72,4 @@ class OffsetKeeper {
   std::thread writer_;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -7,7 +7,7 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "shaft_twin.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace asio = boost::asio;
 
@@ -71,4 +71,4 @@ void OutputWatch::onReadable(const boost::system::error_code& ec) {
   if (!stopped_) arm();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

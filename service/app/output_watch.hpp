@@ -30,7 +30,7 @@
 #include "hoist/bus/udpm_receiver.hpp"
 #include "hoist/rt/rt_log.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class ShaftTwin;
 
@@ -60,4 +60,4 @@ class OutputWatch {
   bool stopped_ = false;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

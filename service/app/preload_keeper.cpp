@@ -8,7 +8,7 @@
 #include "hoist/contract/alarm_command.hpp"
 #include "hoist/io/preload_file.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 PreloadKeeper::PreloadKeeper(const TwinConfig& nominal, std::string path, std::string tag,
                              std::shared_ptr<spdlog::logger> log, rt::RtLog& rt_log)
@@ -132,4 +132,4 @@ void PreloadKeeper::afterTick(TwinCore& core) {
   retired_.store(b, std::memory_order_release);
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -9,7 +9,7 @@
 //   - request(), on the loop: the validated command goes into a mailbox
 //     (a copy; no allocation, no lock, no I/O);
 //   - serve(), on a worker (the daemon's one keeper thread, SCHED_OTHER
-//     nice 10): builds the TwinModel (hoist/service/twin_model.hpp), keeps
+//     nice 10): builds the TwinModel (hoist/service/twin/twin_model.hpp), keeps
 //     the scale, the user and the time in the state file (atomically:
 //     temporary file, fsync, rename), logs, and hands the model to the loop;
 //     it also releases the models the loop retired;
@@ -40,9 +40,9 @@
 
 #include "hoist/rt/latest_mailbox.hpp"
 #include "hoist/rt/rt_log.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class PreloadKeeper {
  public:
@@ -99,4 +99,4 @@ class PreloadKeeper {
   bool waiting_logged_ = false;           // loop: "waits for rest" said once per adoption
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

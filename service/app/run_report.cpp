@@ -13,7 +13,7 @@
 #include "hoist/msg/codec.hpp"
 #include "hoist/version.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace {
 
@@ -194,4 +194,4 @@ bool writeRunReport(const std::string& path, const RunFacts& f, spdlog::logger& 
   return true;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

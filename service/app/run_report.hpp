@@ -11,7 +11,7 @@
 #include "hoist/rt/realtime.hpp"
 #include "shaft_twin.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 /// What the report says about one run.
 struct RunFacts {
@@ -34,4 +34,4 @@ struct RunFacts {
 /// `log`.  False if it could not be written.
 bool writeRunReport(const std::string& path, const RunFacts& f, spdlog::logger& log);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

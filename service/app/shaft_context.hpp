@@ -12,10 +12,10 @@
 
 #include "hoist/bus/channels.hpp"
 #include "hoist/rt/rt_log.hpp"
-#include "hoist/service/config.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/core/config.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 using rt::RtLog;
 
@@ -120,4 +120,4 @@ struct ShaftContext {
   }
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

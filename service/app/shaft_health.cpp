@@ -10,7 +10,7 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "trip_room.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 ShaftHealth::ShaftHealth(const ShaftContext& ctx, ShaftStatsView stats, const ShaftPeers& peers)
     : ctx_(ctx), st_(stats), peers_(peers) {
@@ -206,4 +206,4 @@ std::int64_t ShaftHealth::rssKb() const {
   return static_cast<std::int64_t>(resident) * (::sysconf(_SC_PAGESIZE) / 1024);
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

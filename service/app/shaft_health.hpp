@@ -16,7 +16,7 @@
 #include "shaft_context.hpp"
 #include "shaft_stats.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class ShaftHealth {
  public:
@@ -60,4 +60,4 @@ class ShaftHealth {
   const std::int64_t* ignored_counter_ = nullptr;  ///< the daemon's ignored-datagram count
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -14,15 +14,15 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/contract/alarm_command.hpp"
-#include "hoist/service/messages.hpp"
-#include "hoist/service/winder_decode.hpp"
+#include "hoist/service/lcm/messages.hpp"
+#include "hoist/service/lcm/winder_decode.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 using std::chrono::duration;
 
 ShaftInputs::ShaftInputs(const ShaftContext& ctx, TwinCore& core, InputStats& stats, const ShaftPeers& peers,
-                         lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast)
+                         ::lcm::LCM& in, ShaftOutputs& out, ForecastScheduler* forecast)
     : ctx_(ctx), core_(core), stats_(stats), peers_(peers), in_(in), out_(out), forecast_(forecast) {
   log_limit_.setLimit(ctx_.cfg.service.log_rate_limit);
   decode_budget_ = std::max(kMinDecodesPerTick, static_cast<int>(kDecodesPerSecond / ctx_.cfg.service.rate));
@@ -36,7 +36,7 @@ ShaftInputs::ShaftInputs(const ShaftContext& ctx, TwinCore& core, InputStats& st
   text_[0] = '\0';
 }
 
-void ShaftInputs::Route::onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
+void ShaftInputs::Route::onMessage(const ::lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/) {
   try {
     (self->*handle)(rbuf);
   } catch (const std::exception& e) {
@@ -48,10 +48,10 @@ void ShaftInputs::Route::onMessage(const lcm::ReceiveBuffer* rbuf, const std::st
 
 void ShaftInputs::add(bus::InputRouter* router, Route& r) {
   if (router) {
-    router->add(*r.channel, [&r](const lcm::ReceiveBuffer* rb, const std::string& c) { r.onMessage(rb, c); });
+    router->add(*r.channel, [&r](const ::lcm::ReceiveBuffer* rb, const std::string& c) { r.onMessage(rb, c); });
     return;
   }
-  // lcm::subscribe takes a regular expression: subscribe to the literal
+  // ::lcm::subscribe takes a regular expression: subscribe to the literal
   // names (a prefix "mine.1/" must not match "mineX1/").
   in_.subscribe(regexEscape(*r.channel), &Route::onMessage, &r);
 }
@@ -121,7 +121,7 @@ void ShaftInputs::rejectPlan(PlanReject r, const char* detail) {
 
 // ---- HOIST_WINDER ----------------------------------------------------------------
 
-void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
+void ShaftInputs::handleWinder(const ::lcm::ReceiveBuffer* rbuf) {
   TwinCore& core = core_;
   const double wall = ctx_.wallNow();
   WinderSample s;
@@ -159,7 +159,7 @@ void ShaftInputs::handleWinder(const lcm::ReceiveBuffer* rbuf) {
 
 // ---- HOIST_ALARM_ACK -------------------------------------------------------------
 
-void ShaftInputs::handleAck(const lcm::ReceiveBuffer* rbuf) {
+void ShaftInputs::handleAck(const ::lcm::ReceiveBuffer* rbuf) {
   // Operator commands are rare and outside the tick: decoding them into the
   // message's std::strings may allocate.  Anyone on the group can send
   // commands (docs/security.md), so junk must never take a genuine
@@ -305,7 +305,7 @@ void ShaftInputs::serviceReannounce() {
 
 // ---- HOIST_TRIP_PLAN -------------------------------------------------------------
 
-void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
+void ShaftInputs::handleTripPlan(const ::lcm::ReceiveBuffer* rbuf) {
   // Every byte is validated before anything is decoded (checked decoder);
   // trip_plan_t is flat (no string, no array): decoding allocates nothing.
   const auto size = static_cast<std::size_t>(rbuf->data_size);
@@ -317,7 +317,7 @@ void ShaftInputs::handleTripPlan(const lcm::ReceiveBuffer* rbuf) {
   const trip_plan_t& m = plan_in_;
   const double t = core_.modelTime();
   const double timeout = ctx_.cfg.forecast.plan_timeout;
-  // The sequence rule is per sender (hoist/service/plan_senders.hpp): another
+  // The sequence rule is per sender (hoist/service/core/plan_senders.hpp): another
   // sender's seq, however large, never makes this sender's plans old.
   std::int64_t last_seq = 0;
   double last_t = 0.0;
@@ -376,7 +376,7 @@ namespace {
 constexpr double kReplaySkew = 5.0;
 }  // namespace
 
-void ShaftInputs::handleOwnHealth(const lcm::ReceiveBuffer* rbuf) {
+void ShaftInputs::handleOwnHealth(const ::lcm::ReceiveBuffer* rbuf) {
   // instance_id is the first field after utime: read it without decoding
   // the whole message (8-byte fingerprint, int64 utime, int64 instance_id).
   if (rbuf->data_size < 24) return;
@@ -399,7 +399,7 @@ std::uint64_t readBe(const std::uint8_t* p, int n) {
 }
 }  // namespace
 
-void ShaftInputs::handleOwnAlarm(const lcm::ReceiveBuffer* rbuf) {
+void ShaftInputs::handleOwnAlarm(const ::lcm::ReceiveBuffer* rbuf) {
   // alarm_t's instance_id follows its strings: walk the encoding (no decode,
   // no allocation) -- fingerprint, utime, id, t (4 x 8), kind (int32 length
   // + bytes), level, event_type, active, acked, shelved, latched (6 x 1),
@@ -456,4 +456,4 @@ void ShaftInputs::otherPublisher(std::int64_t id, std::uint64_t ut, const std::s
   out_.publishAlarmEvents();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

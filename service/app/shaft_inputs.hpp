@@ -27,7 +27,7 @@
 
 #include "hoist/bus/udpm_receiver.hpp"
 #include "hoist/cage_imu_t.hpp"
-#include "hoist/service/plan_senders.hpp"
+#include "hoist/service/core/plan_senders.hpp"
 #include "hoist/rope_load_t.hpp"
 #include "hoist/trip_plan_t.hpp"
 #include "hoist/winder_t.hpp"
@@ -35,7 +35,7 @@
 #include "shaft_outputs.hpp"
 #include "shaft_stats.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class ForecastScheduler;
 
@@ -47,7 +47,7 @@ class ShaftInputs {
   /// work to `out`, `forecast` and the optional rooms in `peers` (read at
   /// each use: ShaftTwin sets them before the loop starts).  Every reference
   /// must outlive this room (all are ShaftTwin's, as this room is).
-  ShaftInputs(const ShaftContext& ctx, TwinCore& core, InputStats& stats, const ShaftPeers& peers, lcm::LCM& in,
+  ShaftInputs(const ShaftContext& ctx, TwinCore& core, InputStats& stats, const ShaftPeers& peers, ::lcm::LCM& in,
               ShaftOutputs& out, ForecastScheduler* forecast);
   ShaftInputs(const ShaftInputs&) = delete;
   ShaftInputs& operator=(const ShaftInputs&) = delete;
@@ -79,7 +79,7 @@ class ShaftInputs {
   void forgetSilentPublisher(double wall);
 
  private:
-  using Handle = void (ShaftInputs::*)(const lcm::ReceiveBuffer*);
+  using Handle = void (ShaftInputs::*)(const ::lcm::ReceiveBuffer*);
   /// One input channel: where it comes from and who handles it.
   struct Route {
     ShaftInputs* self = nullptr;       ///< the room
@@ -87,25 +87,25 @@ class ShaftInputs {
     Handle handle = nullptr;           ///< the handler
     const char* name = "";             ///< for log lines: "HOIST_WINDER", ...
     /// The guarded entry point (LCM's callback signature).
-    void onMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+    void onMessage(const ::lcm::ReceiveBuffer* rbuf, const std::string& channel);
   };
   enum RouteId { kWinder, kAck, kTripPlan, kOwnHealth, kOwnAlarm, kCageImu, kRopeLoad, kRoutes };
 
-  void handleWinder(const lcm::ReceiveBuffer* rbuf);
-  void handleAck(const lcm::ReceiveBuffer* rbuf);
-  void handleTripPlan(const lcm::ReceiveBuffer* rbuf);
-  void handleOwnHealth(const lcm::ReceiveBuffer* rbuf);
-  void handleOwnAlarm(const lcm::ReceiveBuffer* rbuf);  // alarm events of another instance on our HOIST_ALARM
+  void handleWinder(const ::lcm::ReceiveBuffer* rbuf);
+  void handleAck(const ::lcm::ReceiveBuffer* rbuf);
+  void handleTripPlan(const ::lcm::ReceiveBuffer* rbuf);
+  void handleOwnHealth(const ::lcm::ReceiveBuffer* rbuf);
+  void handleOwnAlarm(const ::lcm::ReceiveBuffer* rbuf);  // alarm events of another instance on our HOIST_ALARM
   /// Instance `id` (utime `ut` [us]) published on our output `channel`:
   /// unless it is us, raise DUPLICATE_PUBLISHER and log the first message.
   /// `unpublished`: an alarm event with our own id that we never published
   /// (its event id not yet used): a forger who copied the id.
   void otherPublisher(std::int64_t id, std::uint64_t ut, const std::string& channel, bool unpublished = false);
-  void handleCageImu(const lcm::ReceiveBuffer* rbuf);   // the load estimator's sensors ([estimator] enabled)
-  void handleRopeLoad(const lcm::ReceiveBuffer* rbuf);
+  void handleCageImu(const ::lcm::ReceiveBuffer* rbuf);   // the load estimator's sensors ([estimator] enabled)
+  void handleRopeLoad(const ::lcm::ReceiveBuffer* rbuf);
   void rejectSensor(const char* channel, const char* detail);
   template <class Msg>
-  bool decodeSensor(const lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel);  // checked decode, or reject
+  bool decodeSensor(const ::lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel);  // checked decode, or reject
   bool sensorSeqNewer(std::int64_t seq, SensorSequence& sq, const char* channel);  // SensorSequence, or reject
   bool sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* channel);     // TwinCore's time verdict, or reject
   void handlerFailed(const char* what, const char* channel);
@@ -127,7 +127,7 @@ class ShaftInputs {
   TwinCore& core_;                  ///< the model: fed the samples and commands
   InputStats& stats_;               ///< this room's statistics
   const ShaftPeers& peers_;         ///< the optional rooms (offset and preload keepers, trip room)
-  lcm::LCM& in_;                    ///< LCM's receive path (when the daemon has none of its own)
+  ::lcm::LCM& in_;                  ///< LCM's receive path (when the daemon has none of its own)
   ShaftOutputs& out_;               ///< publishes what an input causes (cage, shape, alarm events)
   ForecastScheduler* forecast_;     ///< the forecast room (nullptr without forecasts)
   std::array<Route, kRoutes> routes_{};  ///< the input channels and their handlers
@@ -158,4 +158,4 @@ class ShaftInputs {
   char text_[256];                  ///< the text of a rejection being logged
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

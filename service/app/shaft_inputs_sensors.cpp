@@ -10,7 +10,7 @@
 #include "hoist/msg/codec.hpp"
 #include "shaft_inputs.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 // ---- the load estimator's sensors ----------------------------------------------
 // Decoded into flat scratch messages (no allocation), checked (finite, within
@@ -32,7 +32,7 @@ void ShaftInputs::rejectSensor(const char* channel, const char* detail) {
 }
 
 template <class Msg>
-bool ShaftInputs::decodeSensor(const lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel) {
+bool ShaftInputs::decodeSensor(const ::lcm::ReceiveBuffer* rbuf, Msg& m, const char* channel) {
   const auto size = static_cast<std::size_t>(rbuf->data_size);
   const auto st = hoist::msg::checkedDecode(rbuf->data, size, m);
   if (st == hoist::msg::DecodeStatus::ok) return true;
@@ -63,7 +63,7 @@ bool ShaftInputs::sensorSeqNewer(std::int64_t seq, SensorSequence& sq, const cha
   return false;
 }
 
-void ShaftInputs::handleCageImu(const lcm::ReceiveBuffer* rbuf) {
+void ShaftInputs::handleCageImu(const ::lcm::ReceiveBuffer* rbuf) {
   if (!decodeSensor(rbuf, imu_in_, bus::kChannelCageImu.data())) return;
   const cage_imu_t& m = imu_in_;
   const bool a_ok = std::isfinite(m.f_y) && std::abs(m.f_y) <= kMaxSpecificForce;
@@ -109,7 +109,7 @@ bool ShaftInputs::sensorTimeOk(SensorVerdict v, std::int64_t utime, const char* 
   return false;
 }
 
-void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
+void ShaftInputs::handleRopeLoad(const ::lcm::ReceiveBuffer* rbuf) {
   if (!decodeSensor(rbuf, rope_in_, bus::kChannelRopeLoad.data())) return;
   const rope_load_t& m = rope_in_;
   if (!(std::isfinite(m.force) && std::abs(m.force) <= kMaxRopeLoad)) {
@@ -125,4 +125,4 @@ void ShaftInputs::handleRopeLoad(const lcm::ReceiveBuffer* rbuf) {
   ++stats_.sensor_accepted;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

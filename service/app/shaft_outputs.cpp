@@ -6,9 +6,9 @@
 
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/msg/codec.hpp"
-#include "hoist/service/messages.hpp"
+#include "hoist/service/lcm/messages.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace {
 
@@ -20,7 +20,7 @@ int divider(double rate, double sub_rate) {
 }  // namespace
 
 ShaftOutputs::ShaftOutputs(const ShaftContext& ctx, TwinCore& core, OutputStats& stats, const InputStats& inputs,
-                           lcm::LCM& out)
+                           ::lcm::LCM& out)
     : ctx_(ctx), core_(core), stats_(stats), inputs_(inputs), out_(out) {
   const ServiceConfig& s = ctx_.cfg.service;
   cage_div_ = divider(s.rate, s.cage_rate);
@@ -343,4 +343,4 @@ void ShaftOutputs::publishForecast(const ForecastResult& r) {
 
 void ShaftOutputs::publishHealth() { encodeAndPublish(ctx_.ch.health, health_msg_, health_buf_); }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

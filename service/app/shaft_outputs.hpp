@@ -29,7 +29,7 @@
 #include "shaft_stats.hpp"
 #include "hoist/bus/udpm_sender.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 using bus::UdpmSender;
 
@@ -63,7 +63,7 @@ class ShaftOutputs {
   /// evaluation and the taken alarm events; reads `inputs` (the sensors'
   /// latest sample times).  Every reference must outlive this room (all are
   /// ShaftTwin's, as this room is).
-  ShaftOutputs(const ShaftContext& ctx, TwinCore& core, OutputStats& stats, const InputStats& inputs, lcm::LCM& out);
+  ShaftOutputs(const ShaftContext& ctx, TwinCore& core, OutputStats& stats, const InputStats& inputs, ::lcm::LCM& out);
   ShaftOutputs(const ShaftOutputs&) = delete;
   ShaftOutputs& operator=(const ShaftOutputs&) = delete;
 
@@ -79,7 +79,7 @@ class ShaftOutputs {
     shape_phase_ = phase % shape_div_;
   }
   /// The LCM instance that publishes (the input one unless lcm_url_out is set).
-  const lcm::LCM& lcm() const { return out_; }
+  const ::lcm::LCM& lcm() const { return out_; }
 
   /// --clock wall, after the model stepped in tick k: HOIST_CAGE every
   /// cage_rate period and HOIST_GUIDE_SHAPE every shape_rate period, queued
@@ -134,7 +134,7 @@ class ShaftOutputs {
   OutputStats& stats_;           ///< this room's statistics
   const InputStats& inputs_;     ///< the inputs' statistics (the sensors' latest sample times)
   TripDetectability detect_;     ///< setDetectability()
-  lcm::LCM& out_;                ///< publishes (lcm_url_out, or the input instance) unless sender_ is set
+  ::lcm::LCM& out_;              ///< publishes (lcm_url_out, or the input instance) unless sender_ is set
   UdpmSender* sender_ = nullptr; ///< the daemon's own publisher, or nullptr
   int cage_div_ = 1;             ///< --clock wall: HOIST_CAGE every cage_div_ ticks
   int shape_div_ = 1;            ///< --clock wall: HOIST_GUIDE_SHAPE every shape_div_ ticks
@@ -166,4 +166,4 @@ class ShaftOutputs {
   char text_[kConditionTextChars + 112];    ///< the alarm text being published (a ConditionText and its frame)
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -19,12 +19,12 @@
 #include <cstdint>
 
 #include "hoist/msg/groups.hpp"
-#include "hoist/service/forecast_rules.hpp"
-#include "hoist/service/health.hpp"
-#include "hoist/service/input_validator.hpp"
-#include "hoist/service/sensor_sequence.hpp"
+#include "hoist/service/core/forecast_rules.hpp"
+#include "hoist/service/core/health.hpp"
+#include "hoist/service/core/input_validator.hpp"
+#include "hoist/service/core/sensor_sequence.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 /// HOIST_HEALTH's extra rejection reasons after the winder reasons (not in
 /// rejected_total, which counts winder inputs): undecodable alarm commands,
@@ -91,7 +91,7 @@ struct InputStats : msg::groups::health_t::Inputs {
   std::int64_t reannounces = 0;             ///< ... honoured (at most one a second)
   std::int64_t reannounce_merged = 0;       ///< ... merged into a pending one (arrived within the interval)
   std::array<std::int64_t, kPlanRejectReasons> plan_rejects{};  ///< trip plans rejected, per reason
-  SensorSequence imu_seq, rope_seq;         ///< each sensor's sequence rule (hoist/service/sensor_sequence.hpp)
+  SensorSequence imu_seq, rope_seq;         ///< each sensor's sequence rule (hoist/service/core/sensor_sequence.hpp)
   double last_imu_wall = -1.0, last_rope_wall = -1.0;  ///< when (wall clock [s]; < 0: never)
   WindowedHistogram step;                   ///< model step time [us] (--clock input: the inputs step the model)
 
@@ -139,4 +139,4 @@ struct ShaftStatsView {
   }
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -6,14 +6,14 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/rt/clock.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 using rt::nanos;
 using rt::ScopedSpan;
 using std::chrono::duration;
 
-ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks,
-                     std::int64_t instance_id, lcm::LCM* lcm_out)
+ShaftTwin::ShaftTwin(const TwinConfig& cfg, std::string label, ::lcm::LCM& lcm, RtLog& log, TestHooks hooks,
+                     std::int64_t instance_id, ::lcm::LCM* lcm_out)
     : ctx_(cfg, std::move(label), log, hooks, instance_id),
       in_(lcm),
       outputs_(ctx_, ctx_.core, output_stats_, input_stats_, lcm_out ? *lcm_out : lcm),
@@ -222,4 +222,4 @@ void ShaftTwin::tick(std::int64_t k, Clock::time_point deadline, std::int64_t sk
   st.ns_tick += nanos(Clock::now() - now);
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

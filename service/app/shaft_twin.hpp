@@ -34,7 +34,7 @@
 #include "trip_room.hpp"
 #include "hoist/bus/udpm_sender.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 using bus::InputRouter;
 using bus::parseUdpmUrl;
@@ -57,8 +57,8 @@ class ShaftTwin {
   /// `lcm` receives (and publishes unless `lcm_out` is given: the
   /// [service] lcm_url_out instance); `instance_id` is this process's random
   /// id, published in HOIST_CAGE and HOIST_HEALTH.
-  ShaftTwin(const TwinConfig& cfg, std::string label, lcm::LCM& lcm, RtLog& log, TestHooks hooks,
-            std::int64_t instance_id = 0, lcm::LCM* lcm_out = nullptr);
+  ShaftTwin(const TwinConfig& cfg, std::string label, ::lcm::LCM& lcm, RtLog& log, TestHooks hooks,
+            std::int64_t instance_id = 0, ::lcm::LCM* lcm_out = nullptr);
   ShaftTwin(const ShaftTwin&) = delete;
   ShaftTwin& operator=(const ShaftTwin&) = delete;
 
@@ -178,7 +178,7 @@ class ShaftTwin {
   ForecastStats forecast_stats_;                 ///< ForecastScheduler's (zero without forecasts)
   ShaftPeers peers_;                             ///< the optional rooms below, for the rooms that call them
   LoopSplit* split_ = nullptr;                   ///< the daemon's loop-time split (attachLoop; nullptr: none)
-  lcm::LCM& in_;                                 ///< receives (LCM's path) and, without lcm_out, publishes
+  ::lcm::LCM& in_;                               ///< receives (LCM's path) and, without lcm_out, publishes
   ShaftOutputs outputs_;                         ///< every outgoing message
   std::unique_ptr<ForecastScheduler> forecast_;  ///< look-ahead forecasts (nullptr without [forecast] enabled)
   std::unique_ptr<OffsetKeeper> offsets_;        ///< the kept accelerometer offset (nullptr: not kept)
@@ -197,4 +197,4 @@ class ShaftTwin {
   void slowTickHook(double wall);                ///< TestHooks::slow_tick_at
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -4,9 +4,9 @@
 #include <cstdio>
 
 #include "hoist/profile.hpp"
-#include "hoist/service/budget.hpp"
+#include "hoist/service/lcm/budget.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 StartupBudget measureStartupBudget(const DaemonOptions& opt, bool force) {
   StartupBudget r;
@@ -51,4 +51,4 @@ StartupBudget measureStartupBudget(const DaemonOptions& opt, bool force) {
   return r;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

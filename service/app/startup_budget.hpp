@@ -1,5 +1,5 @@
 // Can a configuration run in real time?  hoist-twind measures a tick of
-// each shaft on a scratch model at start-up (hoist/service/budget.hpp) and
+// each shaft on a scratch model at start-up (hoist/service/lcm/budget.hpp) and
 // sums them; this turns the measurements into the start-up log line and
 // the verdict main() acts on (refuse, exit 2, unless --force).  Before the
 // loop starts; nothing here runs in it.
@@ -9,7 +9,7 @@
 
 #include "daemon.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 struct StartupBudget {
   std::string line;   ///< "measured start-up budget: ..." (the log line; with the parts when warned)
@@ -23,4 +23,4 @@ struct StartupBudget {
 /// measurement cannot build (a configuration error).
 StartupBudget measureStartupBudget(const DaemonOptions& opt, bool force);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -6,7 +6,7 @@
 
 #include "hoist/rt/realtime.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 TripPool::TripPool(int workers) : max_workers_(workers) {
   if (workers < 1) throw std::invalid_argument("TripPool: workers must be >= 1");
@@ -46,4 +46,4 @@ void TripPool::workerMain(std::size_t k, std::size_t n) {
   for (TripWork* r : mine) r->workerClose();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

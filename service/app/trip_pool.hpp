@@ -28,7 +28,7 @@
 #include <thread>
 #include <vector>
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 /// One room's work, called by the one worker thread that serves it.
 class TripWork {
@@ -69,4 +69,4 @@ class TripPool {
   std::atomic<bool> quit_{false};
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -15,7 +15,7 @@
 #include "hoist/history/store.hpp"
 #include "hoist/trip_recorder.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace {
 
@@ -368,4 +368,4 @@ void TripRoom::finishTrip() {
   }
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

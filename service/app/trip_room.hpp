@@ -47,12 +47,12 @@
 #include "hoist/preload_verdict.hpp"
 #include "hoist/trip_accumulator.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
-#include "hoist/service/config.hpp"
-#include "hoist/service/history_config.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/core/config.hpp"
+#include "hoist/service/cfg/history_config.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 #include "trip_pool.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 /// What the loop copies per step.
 struct TripTick {
@@ -171,4 +171,4 @@ class TripRoom : public TripWork {
   std::string store_desc_;        // written by the worker before store_open is set
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

@@ -9,10 +9,10 @@
 #include "hoist/bus/lcm_util.hpp"
 #include "hoist/history/config.hpp"
 #include "hoist/io/checked_file.hpp"
-#include "hoist/service/config_file.hpp"
-#include "hoist/service/history_config.hpp"
+#include "hoist/service/cfg/config_file.hpp"
+#include "hoist/service/cfg/history_config.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 namespace {
 /// The error line of a configuration that cannot run: "hoist-twind:
@@ -191,4 +191,4 @@ void checkTwindRun(const TwindCommandLine& cl, const std::string& shaft_url, int
   for (int i = 0; i < argc; ++i) opt.command_line += (i ? " " : "") + std::string(argv[i]);
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

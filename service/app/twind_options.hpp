@@ -12,7 +12,7 @@
 
 #include "daemon.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 /// hoist-twind's options as given (defaults: none given).
 struct TwindCommandLine {
@@ -54,4 +54,4 @@ void loadTwindShafts(const TwindCommandLine& cl, DaemonOptions& opt, std::string
 void checkTwindRun(const TwindCommandLine& cl, const std::string& shaft_url, int argc, char** argv,
                    DaemonOptions& opt);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

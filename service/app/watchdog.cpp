@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <systemd/sd-daemon.h>
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 void Watchdog::start() {
   // WATCHDOG_USEC (set by systemd from WatchdogSec=) enables it; ping at half
@@ -48,4 +48,4 @@ void Watchdog::main(std::chrono::microseconds interval) {
   }
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

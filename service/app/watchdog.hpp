@@ -23,7 +23,7 @@
 #include <spdlog/spdlog.h>
 #include <thread>
 
-namespace hoist::svc {
+namespace hoist::service::inline app {
 
 class Watchdog {
  public:
@@ -51,4 +51,4 @@ class Watchdog {
   bool quit_ = false;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::app

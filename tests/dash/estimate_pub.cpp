@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hoist-test-estimate-pub: unknown MODE '%s'\n", mode.c_str());
     return 2;
   }
-  lcm::LCM lcm(argv[1]);
+  ::lcm::LCM lcm(argv[1]);
   if (!lcm.good()) {
     std::fprintf(stderr, "hoist-test-estimate-pub: cannot open LCM at %s\n", argv[1]);
     return 1;

@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
   const std::string prefix = argc > 2 ? argv[2] : "";
   const int count = argc > 3 ? std::atoi(argv[3]) : 20;
   const int period_ms = argc > 4 ? std::atoi(argv[4]) : 250;
-  lcm::LCM lcm(argv[1]);
+  ::lcm::LCM lcm(argv[1]);
   if (!lcm.good()) return 1;
   const std::string ch = prefix + "HOIST_FORECAST";
   DaemonVoice voice(lcm, prefix, 3000);  // the daemon's instance id, as hoist-twind's own forecasts carry

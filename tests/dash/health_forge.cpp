@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: hoist-test-health-forge LCM_URL PATTERN COUNT ROUNDS PERIOD_MS INSTANCE_ID\n");
     return 2;
   }
-  lcm::LCM lcm(argv[1]);
+  ::lcm::LCM lcm(argv[1]);
   if (!lcm.good()) {
     std::fprintf(stderr, "hoist-test-health-forge: cannot open LCM at %s\n", argv[1]);
     return 1;

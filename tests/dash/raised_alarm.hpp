@@ -38,9 +38,9 @@ inline hoist::alarm_t raisedAlarm(std::int64_t utime, double t, const std::strin
 /// event with its id that it never published).
 struct DaemonVoice {
   std::int64_t instance = 0;
-  DaemonVoice(lcm::LCM& lcm, const std::string& prefix, int wait_ms) {
+  DaemonVoice(::lcm::LCM& lcm, const std::string& prefix, int wait_ms) {
     auto* hs = lcm.subscribeFunction(prefix + "HOIST_HEALTH",
-                                     +[](const lcm::ReceiveBuffer*, const std::string&, const hoist::health_t* h,
+                                     +[](const ::lcm::ReceiveBuffer*, const std::string&, const hoist::health_t* h,
                                          DaemonVoice* v) { v->instance = h->instance_id; }, this);
     const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(wait_ms);
     while (instance == 0 && std::chrono::steady_clock::now() < end) lcm.handleTimeout(50);

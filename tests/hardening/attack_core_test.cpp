@@ -14,11 +14,11 @@
 #include <cmath>
 #include <cstring>
 
-#include "hoist/service/budget.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/lcm/budget.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

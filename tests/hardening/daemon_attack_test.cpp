@@ -12,7 +12,7 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
-#include "hoist/service/alarms.hpp"
+#include "hoist/service/core/alarms.hpp"
 #include "hoist/winder_t.hpp"
 #include "lcm_fixtures.hpp"
 
@@ -113,7 +113,7 @@ TEST_F(DaemonAttack, MillionDistinctChannelNamesKeepMemoryFlat) {
   while (sent < 3'000'000) {
     listener_.reset();
     {
-      lcm::LCM pub(url_);  // publish only: no receive socket
+      ::lcm::LCM pub(url_);  // publish only: no receive socket
       ASSERT_TRUE(pub.good());
       const char payload[8] = {1, 2, 3, 4, 5, 6, 7, 8};
       char name[40];
@@ -159,7 +159,7 @@ TEST_F(DaemonAttack, ChannelPrefixIsALiteralNotARegex) {
   EXPECT_LE(dot.accepted, 50) << "the mineX1/ feeder reached mine.1/";
   EXPECT_EQ(und.accepted, 0) << "mine_1/ followed another shaft's feeder";
   EXPECT_EQ(dot.alarms_shelved, 0);
-  EXPECT_EQ(und.alarms_shelved, hoist::svc::AlarmEngine::kSlots);  // every alarm of the shaft
+  EXPECT_EQ(und.alarms_shelved, hoist::service::AlarmEngine::kSlots);  // every alarm of the shaft
   stopDaemonCleanly(*d, (dir_ / "twind.log").string());
 }
 
@@ -343,7 +343,7 @@ TEST_F(DaemonAttack, EffectiveCommandsAreAuditedWithTheirUser) {
       EXPECT_NE(a.message.find("clamped to max_shelve = 3600 s"), std::string::npos) << a.message;
       EXPECT_NEAR(a.shelved_for, 3600.0, 1.0);
     }
-  EXPECT_EQ(shelves, hoist::svc::AlarmEngine::kSlots) << "one event per alarm, the repeats silent";
+  EXPECT_EQ(shelves, hoist::service::AlarmEngine::kSlots) << "one event per alarm, the repeats silent";
   stopDaemonCleanly(*d, (dir_ / "twind.log").string());
   const std::string log = readFile((dir_ / "twind.log").string());
   EXPECT_NE(log.find("AUDIT operator 'mallory': shelve */* for 3600 s (requested 99999 s, clamped to max_shelve)"),

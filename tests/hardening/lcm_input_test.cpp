@@ -14,12 +14,12 @@
 #include "hoist/alarm_ack_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/health_t.hpp"
-#include "hoist/service/twin_core.hpp"
-#include "hoist/service/winder_decode.hpp"
+#include "hoist/service/twin/twin_core.hpp"
+#include "hoist/service/lcm/winder_decode.hpp"
 #include "lcm_messages.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 using hoist::test::encode;
 using hoist::test::winder;
 

@@ -58,7 +58,7 @@ TEST_F(ToolAttack, ChannelNameSpamKeepsToolMemoryFlat) {
     ASSERT_GT(t.rss0, 0) << t.name;
   }
   {
-    lcm::LCM pub(url_);  // publish only: no receive socket
+    ::lcm::LCM pub(url_);  // publish only: no receive socket
     ASSERT_TRUE(pub.good());
     const char payload[8] = {1, 2, 3, 4, 5, 6, 7, 8};
     char name[40];

@@ -2,7 +2,7 @@
 // LCM 1.3.1 workaround against channel-name spam, used by hoist-twind, hoist-dash,
 // hoist-mqtt and hoist-monitor): URL parsing, exact and matching routes, and
 // what it drops.  Real multicast on loopback, ports 7866 and 7877 (the datagrams are
-// LCM's own, sent by lcm::LCM::publish, and hand-made ones).
+// LCM's own, sent by ::lcm::LCM::publish, and hand-made ones).
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -48,13 +48,13 @@ TEST(UdpmReceiverTest, ExactAndMatchingRoutesOthersCountedNothingStored) {
   int exact = 0, matched = 0;
   std::string last_matched;
   std::size_t last_size = 0;
-  rx.add("mine.1/HOIST_WINDER", [&](const lcm::ReceiveBuffer* rb, const std::string& ch) {
+  rx.add("mine.1/HOIST_WINDER", [&](const ::lcm::ReceiveBuffer* rb, const std::string& ch) {
     ++exact;
     last_size = rb->data_size;
     EXPECT_EQ(ch, "mine.1/HOIST_WINDER");
   });
   rx.addMatching([](std::string_view n) { return n.size() >= 11 && n.substr(n.size() - 11) == "HOIST_ALARM"; },
-                 [&](const lcm::ReceiveBuffer*, const std::string& ch) {
+                 [&](const ::lcm::ReceiveBuffer*, const std::string& ch) {
                    ++matched;
                    last_matched = ch;
                  });
@@ -65,7 +65,7 @@ TEST(UdpmReceiverTest, ExactAndMatchingRoutesOthersCountedNothingStored) {
     while (std::chrono::steady_clock::now() < until)
       if (rx.drain(256) == 0) std::this_thread::sleep_for(1ms);
   };
-  lcm::LCM pub(url);
+  ::lcm::LCM pub(url);
   ASSERT_TRUE(pub.good());
   const char payload[5] = {1, 2, 3, 4, 5};
   pub.publish("mine.1/HOIST_WINDER", payload, 5);   // exact
@@ -120,9 +120,9 @@ TEST(UdpmReceiverTest, KernelSuffixFilterQueuesOnlyTheWatchedChannels) {
   ASSERT_TRUE(rx.open(u, why)) << why;
   std::vector<std::string> got;
   rx.addMatching([](std::string_view) { return true; },
-                 [&](const lcm::ReceiveBuffer*, const std::string& ch) { got.push_back(ch); });
+                 [&](const ::lcm::ReceiveBuffer*, const std::string& ch) { got.push_back(ch); });
   ASSERT_TRUE(rx.acceptOnlySuffix("HOIST_HEALTH", {0, 6}, why)) << why;
-  lcm::LCM pub(url);
+  ::lcm::LCM pub(url);
   ASSERT_TRUE(pub.good());
   const char payload[24] = {};
   for (const char* ch : {"HOIST_CAGE", "HOIST_HEALTH", "north/HOIST_CAGE", "north/HOIST_HEALTH", "south/HOIST_HEALTH",

@@ -20,7 +20,7 @@
 #include "hoist/alarm_t.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 using namespace std::chrono_literals;
 
 namespace {
@@ -55,7 +55,7 @@ TEST_P(CommandStarvation, GenuineCommandsAreAppliedWithinATickUnderAJunkFlood) {
   const StarvationCase tc = GetParam();
   const std::string url = "udpm://239.255.76.67:" + std::to_string(tc.port) + "?ttl=0";
   {
-    lcm::LCM probe(url);
+    ::lcm::LCM probe(url);
     if (!probe.good())
       GTEST_FAIL() << "UDP multicast on loopback is off: run scripts/setup.sh or, as root, "
                       "ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo";
@@ -87,7 +87,7 @@ TEST_P(CommandStarvation, GenuineCommandsAreAppliedWithinATickUnderAJunkFlood) {
   std::atomic<bool> flooding{true};
   std::atomic<std::int64_t> junk_sent{0};
   std::thread flood([&] {
-    lcm::LCM out(url);
+    ::lcm::LCM out(url);
     const int per_ms = tc.junk_per_s / 1000;
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; flooding.load(); ++k) {
@@ -101,7 +101,7 @@ TEST_P(CommandStarvation, GenuineCommandsAreAppliedWithinATickUnderAJunkFlood) {
   });
 
   loopFor(0.3s);  // the flood is on
-  lcm::LCM genuine(url);
+  ::lcm::LCM genuine(url);
   ASSERT_TRUE(genuine.good());
   constexpr int kCommands = 40;
   int applied = 0;
@@ -170,7 +170,7 @@ INSTANTIATE_TEST_SUITE_P(JunkRates, CommandStarvation,
 TEST(ReannounceRequest, HonouredAtOnceThenAtMostOnceASecondAndChangesNothing) {
   const std::string url = "udpm://239.255.76.67:8002?ttl=0";
   {
-    lcm::LCM probe(url);
+    ::lcm::LCM probe(url);
     if (!probe.good()) GTEST_FAIL() << "UDP multicast on loopback is off: run scripts/setup.sh";
   }
   std::ostringstream logs;
@@ -186,7 +186,7 @@ TEST(ReannounceRequest, HonouredAtOnceThenAtMostOnceASecondAndChangesNothing) {
   Daemon d(std::move(opt), logger);
   struct Seen {
     std::vector<std::pair<hoist::alarm_t, std::chrono::steady_clock::time_point>> events;
-    void on(const lcm::ReceiveBuffer*, const std::string&, const hoist::alarm_t* m) {
+    void on(const ::lcm::ReceiveBuffer*, const std::string&, const hoist::alarm_t* m) {
       events.emplace_back(*m, std::chrono::steady_clock::now());
     }
     int count(std::int8_t type) const {
@@ -195,7 +195,7 @@ TEST(ReannounceRequest, HonouredAtOnceThenAtMostOnceASecondAndChangesNothing) {
       return n;
     }
   } seen;
-  lcm::LCM listen(url);
+  ::lcm::LCM listen(url);
   listen.subscribe("HOIST_ALARM", &Seen::on, &seen);
   ASSERT_TRUE(d.start());
   auto loopFor = [&](std::chrono::duration<double> span) {
@@ -212,7 +212,7 @@ TEST(ReannounceRequest, HonouredAtOnceThenAtMostOnceASecondAndChangesNothing) {
   ASSERT_EQ(seen.count(hoist::alarm_t::EVENT_RAISE), 1) << logs.str();
   loopFor(0.2s);
   const std::size_t before = seen.events.size();
-  lcm::LCM client(url);
+  ::lcm::LCM client(url);
   hoist::alarm_ack_t req = command(hoist::alarm_ack_t::ACTION_REANNOUNCE, "*");
   req.user = "hoist-mqtt-test";
   const auto t_sent = std::chrono::steady_clock::now();

@@ -2,7 +2,7 @@
 // loopback, ttl=0, one port per test in 7724..7735):
 //   * a crafted garbage LCM log played into the daemon with lcm-logplayer:
 //     every class counted under its reason, the daemon keeps publishing;
-//   * raw garbage published with lcm::LCM::publish and a 10 kHz flood;
+//   * raw garbage published with ::lcm::LCM::publish and a 10 kHz flood;
 //   * the input stops and resumes: INPUT_STALE raised within ~3 input
 //     periods and cleared when the input returns;
 //   * the daemon SIGKILLed mid-trip and restarted: re-initialized from the
@@ -96,11 +96,11 @@ TEST_F(DaemonHardening, GarbageLcmLogPlayedWithLogplayer) {
   const auto log_path = (dir_ / "garbage.lcmlog").string();
   int n_decode = 0;
   {
-    lcm::LogFile log(log_path, "w");
+    ::lcm::LogFile log(log_path, "w");
     ASSERT_TRUE(log.good());
     std::int64_t ts = 1'000'000, seq = 0, utime = 1'700'000'000'000'000;
     auto put = [&](const std::string& channel, const std::vector<std::uint8_t>& data) {
-      lcm::LogEvent ev;
+      ::lcm::LogEvent ev;
       ev.timestamp = ts;
       ev.channel = channel;
       ev.datalen = static_cast<int32_t>(data.size());
@@ -176,7 +176,7 @@ TEST_F(DaemonHardening, GarbageLcmLogPlayedWithLogplayer) {
 TEST_F(DaemonHardening, RawGarbageAndA10kHzFlood) {
   start(7725, "flood");
   auto d = startDaemon({"--config", steadyConfig(), "--clock", "wall", "--rate", "100"}, "twind.log");
-  lcm::LCM& lcm = listener_->lcm();
+  ::lcm::LCM& lcm = listener_->lcm();
   std::mt19937 rng(99);
   std::vector<std::uint8_t> junk(60000);
   for (int i = 0; i < 100; ++i) {
@@ -230,7 +230,7 @@ TEST_F(DaemonHardening, RawGarbageAndA10kHzFlood) {
 TEST_F(DaemonHardening, InputStopsAndResumes) {
   start(7726, "stale");
   auto d = startDaemon({"--clock", "wall", "--rate", "1000"}, "twind.log");
-  lcm::LCM& lcm = listener_->lcm();
+  ::lcm::LCM& lcm = listener_->lcm();
   std::int64_t seq = 0;
   std::int64_t last_sent_us = 0;
   auto stream = [&](int n) {
@@ -273,7 +273,7 @@ TEST_F(DaemonHardening, InputStopsAndResumes) {
 TEST_F(DaemonHardening, KilledAndRestartedMidTrip) {
   start(7727, "restart");
   auto d = startDaemon({"--clock", "wall"}, "twind1.log");
-  lcm::LCM& lcm = listener_->lcm();
+  ::lcm::LCM& lcm = listener_->lcm();
   std::int64_t seq = 0;
   double l = 100.0;
   const double v = 2.0;
@@ -306,7 +306,7 @@ TEST_F(DaemonHardening, KilledAndRestartedMidTrip) {
 TEST_F(DaemonHardening, InjectedModelFaultRecoversWithoutNaN) {
   start(7728, "fault");
   auto d = startDaemon({"--clock", "wall", "--test-inject-fault-at", "1.5"}, "twind.log");
-  lcm::LCM& lcm = listener_->lcm();
+  ::lcm::LCM& lcm = listener_->lcm();
   std::int64_t seq = 0;
   for (int i = 0; i < 350; ++i) {
     const auto b = encode(winder(seq++, nowUs(), 0.0, 120.0));

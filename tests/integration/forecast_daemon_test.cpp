@@ -33,7 +33,7 @@
 #include "process.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 using namespace hoist::test;
 using namespace std::chrono_literals;
 
@@ -87,7 +87,7 @@ class Rig {
     opt.hooks = hooks;
     daemon_ = std::make_unique<Daemon>(std::move(opt), captureLogger(sink_));
     listener_ = std::make_unique<Listener>(url_);
-    pub_ = std::make_unique<lcm::LCM>(url_);
+    pub_ = std::make_unique<::lcm::LCM>(url_);
   }
   bool multicast() const { return multicast_; }
   bool start(const std::vector<std::string>& channels) {
@@ -156,7 +156,7 @@ class Rig {
   std::shared_ptr<spdlog::sinks::ringbuffer_sink_mt> sink_;
   std::unique_ptr<Daemon> daemon_;
   std::unique_ptr<Listener> listener_;
-  std::unique_ptr<lcm::LCM> pub_;
+  std::unique_ptr<::lcm::LCM> pub_;
 };
 
 #define REQUIRE_MULTICAST(rig) \

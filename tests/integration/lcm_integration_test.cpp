@@ -230,7 +230,7 @@ TEST_F(LcmIntegration, HostileInputIsRejectedAndCounted) {
   start(7684, "hostile");
   listener_->subscribe("HOIST_CAGE");
   auto d = startDaemon({"--clock", "wall", "--rate", "100"}, "twind.log");
-  lcm::LCM& lcm = listener_->lcm();
+  ::lcm::LCM& lcm = listener_->lcm();
   const std::int64_t t0 = 1'700'000'000'000'000;
   std::int64_t seq = 0, utime = t0;
   auto send = [&](const hoist::winder_t& m) {

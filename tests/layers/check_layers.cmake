@@ -8,7 +8,7 @@
 #   3. nothing under tools/, msgs/ or rt/ includes a header from service/: no
 #      include path into service/ ("../../service/app/daemon.hpp"), and no
 #      include that resolves only to a header under service/ (e.g.
-#      "hoist/service/alarms.hpp", from any library folder service/<lib>/include,
+#      "hoist/service/core/alarms.hpp", from any library folder service/<lib>/include,
 #      or "shaft_twin.hpp").  What the tools share with the daemon is the
 #      contract in msgs/contract;
 #   4. msgs/, rt/ and history/ include nothing from tools/ either (as rule 2),
@@ -19,7 +19,12 @@
 #   6. service's own libraries follow their links (core <- cfg, core <-
 #      twin <- lcm <- app): each includes the hoist/service/ headers of
 #      itself and of what it links, none of service/app, and core and twin
-#      nothing of LCM (hoist/bus/, hoist/msg/, <lcm/...>, hoist/<type>_t.hpp).
+#      nothing of LCM (hoist/bus/, hoist/msg/, <lcm/...>, hoist/<type>_t.hpp);
+#   7. in service/, include path = folder = namespace: a public header of
+#      service/<lib> is include/hoist/service/<lib>/<name>.hpp, and every
+#      file of service/<lib> (and of service/app) opens its namespace as
+#      hoist::service::<lib> (`inline`: service's code names the other
+#      libraries' types unqualified; the qualified name says the folder).
 # Also: model/ includes only its own headers and system/Eigen headers.
 #   cmake -DROOT=<source dir> -DMODEL_LINKS='Eigen3::Eigen' -P check_layers.cmake
 # Prints "LAYER VIOLATION: ..." for each broken rule and fails.
@@ -194,6 +199,24 @@ foreach(lib IN LISTS _svc_libs)
   endforeach()
 endforeach()
 
+# ---- rule 7: include path = folder = namespace in service/ -----------------
+foreach(lib IN LISTS _svc_libs ITEMS app)
+  file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/service/${lib}/*.hpp" "${ROOT}/service/${lib}/*.cpp")
+  foreach(f IN LISTS _files)
+    file(RELATIVE_PATH _rel "${ROOT}" "${f}")
+    if(_rel MATCHES "^service/${lib}/include/" AND NOT _rel MATCHES "^service/${lib}/include/hoist/service/${lib}/")
+      _violation("${_rel}: a public header of service/${lib} belongs in include/hoist/service/${lib}/")
+    endif()
+    file(STRINGS "${f}" _opens REGEX "^namespace hoist[:a-z_ ]*\{")
+    foreach(line IN LISTS _opens)
+      if(NOT line MATCHES "^namespace hoist::service::(inline )?${lib} \\{")
+        string(REGEX REPLACE " *\\{.*" "" line "${line}")
+        _violation("${_rel} opens \"${line}\": service/${lib}'s namespace is hoist::service::${lib}")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+
 # ---- model/ includes only itself (and Eigen / the standard library) --------
 file(GLOB_RECURSE _files LIST_DIRECTORIES false "${ROOT}/model/*.hpp" "${ROOT}/model/*.cpp")
 foreach(f IN LISTS _files)
@@ -212,4 +235,5 @@ if(_violations GREATER 0)
 endif()
 message("check_layers: OK (hoist_model links: ${MODEL_LINKS}; no tools/ header in service/, io/, msgs/ or rt/; "
         "no service/ header in tools/, msgs/ or rt/; tools receive through hoist/bus/subscriber.hpp; "
-        "service's libraries follow their links, core and twin free of LCM)")
+        "service's libraries follow their links, core and twin free of LCM; service's include paths and "
+        "namespaces say the folder)")

@@ -262,7 +262,7 @@ class Twin {
     std::lock_guard<std::mutex> lk(mu_);
     sent_[what].push_back(u);
   }
-  lcm::LCM lcm_;
+  ::lcm::LCM lcm_;
   std::string prefix_;
   std::thread thread_;
   std::atomic<bool> stop_{false};

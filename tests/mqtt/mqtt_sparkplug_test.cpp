@@ -252,7 +252,7 @@ TEST_F(MqttSparkplug, IndependentHostChecksBirthsDataRebirthAckAndDeath) {
   ASSERT_NO_FATAL_FAILURE(start(18620, 8060, "[sparkplug.deadbands]\n\"Health/Uptime\" = 1000\n"));
   Listener acks(lcm_url_);
   acks.subscribe("north/HOIST_ALARM_ACK");
-  lcm::LCM pub(lcm_url_);
+  ::lcm::LCM pub(lcm_url_);
 
   // Births: NBIRTH (bdSeq, Rebirth) then the shaft's DBIRTH, before any LCM input.
   auto dbirth = waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 15s);
@@ -412,7 +412,7 @@ TEST_F(MqttSparkplug, BadCommandsAreRefusedAndCountedNothingLost) {
   ASSERT_NO_FATAL_FAILURE(start(18621, 8061));
   Listener acks(lcm_url_);
   acks.subscribe("north/HOIST_ALARM_ACK");
-  lcm::LCM pub(lcm_url_);
+  ::lcm::LCM pub(lcm_url_);
   ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 15s)) << tail(host_log_);
   hoist::health_t h77{};
   h77.instance_id = 77;  // alarm events pass only from the instance whose health the bridge follows
@@ -483,7 +483,7 @@ TEST_F(MqttSparkplug, NoCommandsRefusesAndCountsWrites) {
   ASSERT_NO_FATAL_FAILURE(start(18622, 8062, "", {"--no-commands"}));
   Listener acks(lcm_url_);
   acks.subscribe("north/HOIST_ALARM_ACK");
-  lcm::LCM pub(lcm_url_);
+  ::lcm::LCM pub(lcm_url_);
   ASSERT_TRUE(waitMsg([](const json& m) { return m.value("type", "") == "DBIRTH"; }, 15s)) << tail(host_log_);
   hoist::health_t h77{};
   h77.instance_id = 77;  // alarm events pass only from the instance whose health the bridge follows
@@ -503,7 +503,7 @@ TEST_F(MqttSparkplug, NoCommandsRefusesAndCountsWrites) {
 
 TEST_F(MqttSparkplug, PrimaryHostGatesBirthsAndStoredDataIsHistorical) {
   ASSERT_NO_FATAL_FAILURE(start(18623, 8063, "primary_host_id = \"scada\"\n"));
-  lcm::LCM pub(lcm_url_);
+  ::lcm::LCM pub(lcm_url_);
   auto cageDdata = [&](std::int64_t seq, bool historical) { return cageSeqData(seq, historical, 5s); };
   // No primary host yet: connected, but nothing is published; data is stored.
   const auto c1 = cage(1);
@@ -550,7 +550,7 @@ TEST_F(MqttSparkplug, PrimaryHostGatesBirthsAndStoredDataIsHistorical) {
 // last STATE" and ignored until the host started a new session.
 TEST_F(MqttSparkplug, ForgedOfflineCostsTheSessionNeverTheDataNorTheHostsReturn) {
   ASSERT_NO_FATAL_FAILURE(start(18624, 8064, "primary_host_id = \"scada\"\n"));
-  lcm::LCM pub(lcm_url_);
+  ::lcm::LCM pub(lcm_url_);
   const auto now_ms = [] {
     return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
         .count();

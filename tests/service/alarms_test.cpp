@@ -5,9 +5,9 @@
 #include <cmath>
 #include <limits>
 
-#include "hoist/service/alarms.hpp"
+#include "hoist/service/core/alarms.hpp"
 
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -5,9 +5,9 @@
 #include <cstdlib>
 
 #include "hoist/bus/channels.hpp"
-#include "hoist/service/config_file.hpp"
+#include "hoist/service/cfg/config_file.hpp"
 
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -27,7 +27,7 @@
 #include "lcm_fixtures.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 using namespace std::chrono_literals;
 
 namespace {
@@ -80,7 +80,7 @@ TEST(DaemonLateWake, QueuedInputsAreReadBeforeStalenessIsJudged) {
   constexpr double kV = 2.0;  // m/s, descending
   std::atomic<bool> stop_feed{false};
   std::thread feeder([&] {
-    lcm::LCM out(url);
+    ::lcm::LCM out(url);
     const std::int64_t u0 = nowUs();
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; !stop_feed; ++k) {

@@ -32,7 +32,7 @@
 #include "lcm_fixtures.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
@@ -133,7 +133,7 @@ TEST(DaemonStarts, ThirtyTwoFirstInputsInOnePeriodStartAtMostKPerTick) {
   // 1.2 s, and a twin whose input has stopped publishes no cage state.)
   std::atomic<bool> fed{false}, stop_feed{false};
   std::thread feeder([&] {
-    lcm::LCM out(url);
+    ::lcm::LCM out(url);
     const std::int64_t u0 = nowUs();
     const auto t0 = std::chrono::steady_clock::now();
     for (int k = 0; k < 2000 && !(k >= 120 && stop_feed); ++k) {
@@ -331,7 +331,7 @@ TEST(DaemonEnvelopes, LockstepShaftsOnAMovingTripShareTheExactEnvelopeBudget) {
   ASSERT_TRUE(d.start()) << logs.str();
   std::atomic<bool> fed{false};
   std::thread feeder([&] {
-    lcm::LCM out(url);
+    ::lcm::LCM out(url);
     const HoistProfile prof = HoistProfile::trapezoid();
     const std::int64_t u0 = nowUs();
     const auto t0 = std::chrono::steady_clock::now();

@@ -38,7 +38,7 @@ using hoist::test::AllocationWatch;
 using hoist::test::watchedAllocationCount;
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 using namespace std::chrono_literals;
 
 namespace {
@@ -135,12 +135,12 @@ class Feeder {
   std::int64_t sent() const { return sent_; }
 
  private:
-  lcm::LCM lcm_;
+  ::lcm::LCM lcm_;
   std::int64_t sent_ = 0;
 };
 
 bool multicastWorks() {
-  lcm::LCM l(kUrl);
+  ::lcm::LCM l(kUrl);
   return l.good();
 }
 

@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -27,7 +27,7 @@
 #include "hoist/rt/realtime.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -11,13 +11,13 @@
 #include <string>
 #include <thread>
 
-#include "hoist/service/forecast_rules.hpp"
+#include "hoist/service/core/forecast_rules.hpp"
 #include "hoist/rt/latest_mailbox.hpp"
-#include "hoist/service/messages.hpp"
-#include "hoist/service/plan_senders.hpp"
+#include "hoist/service/lcm/messages.hpp"
+#include "hoist/service/core/plan_senders.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 using hoist::rt::LatestMailbox;
 
 TEST(LatestMailbox, NewestWinsAndReplacedItemsAreCounted) {
@@ -192,7 +192,7 @@ TEST(PredictedAlarms, RaiseAtOnceClearAfterOffDelayNameScenarioAndSeconds) {
   EXPECT_EQ(parseAlarmKind("PREDICTED_SLACK"), AlarmKind::PredictedSlack);
 }
 
-// The trip-plan sequence rule is per sender (hoist/service/plan_senders.hpp):
+// The trip-plan sequence rule is per sender (hoist/service/core/plan_senders.hpp):
 // a forged INT64_MAX from one sender never makes another's plans old; a
 // sender's own old seq is refused until its last plan expired, then a
 // sequence reset is accepted; a full table forgets the sender heard longest ago.

@@ -12,9 +12,9 @@
 
 #include <limits>
 
-#include "hoist/service/health.hpp"
+#include "hoist/service/core/health.hpp"
 
-using namespace hoist::svc;
+using namespace hoist::service;
 
 TEST(LatencyHistogram, QuantilesWithinABin) {
   LatencyHistogram h;

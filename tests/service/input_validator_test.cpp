@@ -5,10 +5,10 @@
 #include <cstdint>
 #include <limits>
 
-#include "hoist/service/input_validator.hpp"
-#include "hoist/service/sensor_sequence.hpp"
+#include "hoist/service/core/input_validator.hpp"
+#include "hoist/service/core/sensor_sequence.hpp"
 
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -1,4 +1,4 @@
-// The pure parts of hoist-twind's LCM shell (hoist/service/messages.hpp):
+// The pure parts of hoist-twind's LCM shell (hoist/service/lcm/messages.hpp):
 // output -> cage_state_t mapping, alarm text, operator-command validation,
 // literal channel names for LCM's regex subscribe.
 #include <gtest/gtest.h>
@@ -9,10 +9,10 @@
 #include <cstring>
 #include <regex>
 
-#include "hoist/service/messages.hpp"
+#include "hoist/service/lcm/messages.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 TEST(Messages, CageMappingCopiesEveryField) {
   CageOutput o;

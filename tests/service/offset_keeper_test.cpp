@@ -14,11 +14,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
 namespace fs = std::filesystem;
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -23,11 +23,11 @@
 #include <sstream>
 
 #include "hoist/io/preload_file.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
 namespace fs = std::filesystem;
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "hoist/sensor_alignment.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -20,13 +20,13 @@ namespace {
 struct Seen {
   std::vector<std::string> channels;
   hoist::bus::RawHandler handler() {
-    return [this](const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    return [this](const ::lcm::ReceiveBuffer* rb, const std::string& ch) {
       channels.push_back(ch + ":" + std::string(static_cast<const char*>(rb->data), rb->data_size));
     };
   }
 };
 
-void publish(lcm::LCM& lcm, const std::string& channel, const std::string& text) {
+void publish(::lcm::LCM& lcm, const std::string& channel, const std::string& text) {
   ASSERT_EQ(lcm.publish(channel, text.data(), static_cast<unsigned>(text.size())), 0);
 }
 
@@ -38,7 +38,7 @@ void receive(Subscriber& rx, Seen& seen, std::size_t n) {
 }
 
 void exactNamesAndMatching(const std::string& url, bool expect_udpm) {
-  lcm::LCM lcm(url);
+  ::lcm::LCM lcm(url);
   ASSERT_TRUE(lcm.good()) << url;
   Subscriber rx(lcm);
   std::string why;
@@ -72,7 +72,7 @@ TEST(Subscriber, OtherProvidersTakeLcmsPathWithExactNames) { exactNamesAndMatchi
 
 TEST(Subscriber, ListenerWithoutLcmInstanceOpensItsOwn) {
   // A listener apart from the publisher (hoist-timing-test's): no LCM given.
-  lcm::LCM tx("udpm://239.255.76.67:8101?ttl=0");
+  ::lcm::LCM tx("udpm://239.255.76.67:8101?ttl=0");
   ASSERT_TRUE(tx.good());
   Subscriber rx;
   std::string why;
@@ -86,7 +86,7 @@ TEST(Subscriber, ListenerWithoutLcmInstanceOpensItsOwn) {
 }
 
 TEST(Subscriber, ProviderWithoutConnectionIsNamed) {
-  lcm::LCM lcm("tcpq://127.0.0.1:1");
+  ::lcm::LCM lcm("tcpq://127.0.0.1:1");
   Subscriber rx(lcm);
   std::string why;
   EXPECT_FALSE(rx.open("tcpq://127.0.0.1:1", why));

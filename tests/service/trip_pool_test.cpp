@@ -16,8 +16,8 @@
 
 #include "trip_pool.hpp"
 
-using hoist::svc::TripPool;
-using hoist::svc::TripWork;
+using hoist::service::TripPool;
+using hoist::service::TripWork;
 using namespace std::chrono_literals;
 
 namespace {

@@ -8,8 +8,8 @@
 
 #include "trip_room.hpp"
 
-using hoist::svc::TripRing;
-using hoist::svc::TripTick;
+using hoist::service::TripRing;
+using hoist::service::TripTick;
 
 namespace {
 TripTick tickAt(int k) {

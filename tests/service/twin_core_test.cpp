@@ -8,11 +8,11 @@
 #include <cstring>
 #include <limits>
 
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 #include "hoist/simulator.hpp"
 
 using namespace hoist;
-using namespace hoist::svc;
+using namespace hoist::service;
 
 namespace {
 

@@ -28,7 +28,7 @@ long rmemMax() {
 }
 
 bool multicastWorks() {
-  lcm::LCM l(kUrl);
+  ::lcm::LCM l(kUrl);
   return l.good();
 }
 
@@ -66,11 +66,11 @@ TEST(UdpmReceiver, KernelDropsAccountForEveryDatagramThatDidNotFit) {
   UdpmReceiver rx;
   ASSERT_TRUE(rx.open(url, why)) << why;
   int got = 0;
-  rx.add("DROPTEST", [&](const lcm::ReceiveBuffer* rb, const std::string&) {
+  rx.add("DROPTEST", [&](const ::lcm::ReceiveBuffer* rb, const std::string&) {
     EXPECT_EQ(rb->data_size, 200u);
     ++got;
   });
-  lcm::LCM tx(kUrlDrops);
+  ::lcm::LCM tx(kUrlDrops);
   ASSERT_TRUE(tx.good());
   std::vector<std::uint8_t> payload(200, 0x5a);
   constexpr int kSent = 300;
@@ -96,7 +96,7 @@ TEST(UdpmReceiver, KernelDropsAccountForEveryDatagramThatDidNotFit) {
 
 TEST(UdpmSender, LcmReceivesWhatItSendsAndQueues) {
   // The daemon's own publisher (udpm_sender.hpp) speaks LCM's wire format:
-  // an lcm::LCM subscriber gets every message, immediate and batched, in order.
+  // an ::lcm::LCM subscriber gets every message, immediate and batched, in order.
   if (!multicastWorks()) GTEST_FAIL() << "UDP multicast on loopback is off";
   UdpmUrl url;
   std::string why;
@@ -104,12 +104,12 @@ TEST(UdpmSender, LcmReceivesWhatItSendsAndQueues) {
   EXPECT_EQ(url.ttl, 0);
   UdpmSender tx;
   ASSERT_TRUE(tx.open(url, why)) << why;
-  lcm::LCM rx(std::string(kUrlSender) + "&recv_buf_size=4000000");
+  ::lcm::LCM rx(std::string(kUrlSender) + "&recv_buf_size=4000000");
   ASSERT_TRUE(rx.good());
   std::vector<int> seen;
   struct Sub {
     std::vector<int>* seen;
-    void on(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    void on(const ::lcm::ReceiveBuffer* rb, const std::string& ch) {
       ASSERT_EQ(ch, "SENDTEST");
       ASSERT_EQ(rb->data_size, 3000u);
       seen->push_back(static_cast<const std::uint8_t*>(rb->data)[0]);

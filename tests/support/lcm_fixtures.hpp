@@ -31,17 +31,17 @@ class Listener {
 
   explicit Listener(const std::string& url) : lcm_(url) {}
   bool good() { return lcm_.good(); }
-  lcm::LCM& lcm() { return lcm_; }
+  ::lcm::LCM& lcm() { return lcm_; }
 
   /// Every message is kept: LCM's per-subscription queue (30 messages by
   /// default, dropped beyond) is made unbounded -- at 10x real time the
   /// daemon publishes 2000 messages/s, and a test thread descheduled for
   /// 15 ms on a busy machine lost some.
   void subscribe(const std::string& regex) {
-    lcm::Subscription* s = lcm_.subscribe(regex, &Listener::onMessage, this);
+    ::lcm::Subscription* s = lcm_.subscribe(regex, &Listener::onMessage, this);
     if (s) s->setQueueCapacity(0);
   }
-  void logTo(const std::string& path) { log_ = std::make_unique<lcm::LogFile>(path, "w"); }
+  void logTo(const std::string& path) { log_ = std::make_unique<::lcm::LogFile>(path, "w"); }
   void closeLog() { log_.reset(); }
 
   /// Handle messages until pred() is true or the timeout passes.
@@ -80,14 +80,14 @@ class Listener {
   void clear() { by_channel_.clear(); }
 
  private:
-  void onMessage(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+  void onMessage(const ::lcm::ReceiveBuffer* rb, const std::string& channel) {
     Message m;
     m.channel = channel;
     const auto* p = static_cast<const std::uint8_t*>(rb->data);
     m.data.assign(p, p + rb->data_size);
     m.recv_utime = rb->recv_utime;
     if (log_) {
-      lcm::LogEvent ev;
+      ::lcm::LogEvent ev;
       ev.timestamp = rb->recv_utime;
       ev.channel = channel;
       ev.datalen = static_cast<int32_t>(rb->data_size);
@@ -97,8 +97,8 @@ class Listener {
     by_channel_[channel].push_back(std::move(m));
   }
 
-  lcm::LCM lcm_;
-  std::unique_ptr<lcm::LogFile> log_;
+  ::lcm::LCM lcm_;
+  std::unique_ptr<::lcm::LogFile> log_;
   std::map<std::string, std::vector<Message>> by_channel_;
 };
 
@@ -109,7 +109,7 @@ inline const char* kMulticastHelp =
 
 /// True if a message published on `url` comes back within one second.
 inline bool loopbackMulticastWorks(const std::string& url, std::string& why) {
-  lcm::LCM lcm(url);
+  ::lcm::LCM lcm(url);
   if (!lcm.good()) {
     why = "cannot open LCM at " + url;
     return false;
@@ -117,7 +117,7 @@ inline bool loopbackMulticastWorks(const std::string& url, std::string& why) {
   bool got = false;
   struct H {
     bool* got;
-    void on(const lcm::ReceiveBuffer*, const std::string&) { *got = true; }
+    void on(const ::lcm::ReceiveBuffer*, const std::string&) { *got = true; }
   } h{&got};
   lcm.subscribe("HOIST_TEST_PROBE", &H::on, &h);
   const char probe[4] = {'p', 'i', 'n', 'g'};

@@ -34,14 +34,14 @@ std::vector<std::uint8_t> winderBytes(std::int64_t seq, std::int64_t utime) {
 struct LogWriter {
   explicit LogWriter(const std::string& path) : log(path, "w") {}
   void put(const std::string& channel, std::int64_t ts, const std::vector<std::uint8_t>& data) {
-    lcm::LogEvent ev;
+    ::lcm::LogEvent ev;
     ev.timestamp = ts;
     ev.channel = channel;
     ev.datalen = static_cast<int32_t>(data.size());
     ev.data = const_cast<std::uint8_t*>(data.data());
     log.writeEvent(&ev);
   }
-  lcm::LogFile log;
+  ::lcm::LogFile log;
 };
 
 bool contains(const std::string& s, const std::string& what) { return s.find(what) != std::string::npos; }

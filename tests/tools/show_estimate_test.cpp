@@ -91,7 +91,7 @@ TEST(ShowEstimate, Log2csvWritesEveryEstimateField) {
   const fs::path d = testDir("show_estimate_log2csv");
   const fs::path log = d / "estimate.lcmlog";
   {
-    lcm::LogFile lf(log.string(), "w");
+    ::lcm::LogFile lf(log.string(), "w");
     for (int i = 0; i < 4; ++i) {
       auto e = realisticEstimate(i);
       if (i == 3) {  // the rope load cell dropped out: Fa and b not observed
@@ -102,7 +102,7 @@ TEST(ShowEstimate, Log2csvWritesEveryEstimateField) {
         e.sensors = 3;  // the IMU only
       }
       const auto b = bytesOf(e);
-      lcm::LogEvent ev;
+      ::lcm::LogEvent ev;
       ev.timestamp = e.utime;
       ev.channel = "north/HOIST_ESTIMATE";
       ev.datalen = static_cast<int32_t>(b.size());

@@ -1,7 +1,7 @@
 // hoist/clearance.hpp -- the cage's remaining clearance in the shaft, from the
 // model's outputs and the shaft's gaps given as plain numbers (no config, no
 // alarm state).  The same figures the daemon's alarms use
-// (service/core/include/hoist/service/alarms.hpp, computeClearance), so a forecast
+// (service/core/include/hoist/service/core/alarms.hpp, computeClearance), so a forecast
 // and the live twin measure alike:
 //   top-sleeve excursion      y_top    = y_c - h theta
 //   bottom-sleeve excursion   y_bottom = y_c + h theta

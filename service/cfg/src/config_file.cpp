@@ -1,5 +1,5 @@
-// Reading the daemon's configuration from TOML: see hoist/service/config_file.hpp.
-#include "hoist/service/config_file.hpp"
+// Reading the daemon's configuration from TOML: see hoist/service/cfg/config_file.hpp.
+#include "hoist/service/cfg/config_file.hpp"
 
 #include "hoist/io/estimator_config.hpp"
 #include "hoist/history/condition_config.hpp"
@@ -13,7 +13,7 @@
 #include "hoist/io/config.hpp"
 #include "hoist/io/toml_section.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline cfg {
 
 namespace {
 
@@ -283,4 +283,4 @@ std::string toToml(const TwinConfig& c) {
   return os.str();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::cfg

@@ -1,5 +1,5 @@
-// hoist-twind's [history] and [condition]: see hoist/service/history_config.hpp.
-#include "hoist/service/history_config.hpp"
+// hoist-twind's [history] and [condition]: see hoist/service/cfg/history_config.hpp.
+#include "hoist/service/cfg/history_config.hpp"
 
 #include <charconv>
 #include <filesystem>
@@ -9,7 +9,7 @@
 #include "hoist/io/config.hpp"
 #include "hoist/io/toml_section.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline cfg {
 
 TripHistoryConfig loadTripHistoryConfig(const std::string& path) {
   TripHistoryConfig c;
@@ -74,4 +74,4 @@ std::string toToml(const TripHistoryConfig& c) {
   return os.str();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::cfg

@@ -1,5 +1,5 @@
-// Clearance alarms: see hoist/service/alarms.hpp.
-#include "hoist/service/alarms.hpp"
+// Clearance alarms: see hoist/service/core/alarms.hpp.
+#include "hoist/service/core/alarms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 void AlarmConfig::validate() const {
   auto bad = [](const char* key, const std::string& why) {
@@ -485,4 +485,4 @@ const BinaryAlarm* AlarmEngine::find(AlarmKind kind, AlarmLevel level) const {
   return s < 0 ? nullptr : &alarms_[s];
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

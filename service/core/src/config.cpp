@@ -1,14 +1,14 @@
 // Daemon configuration (plain structs and their validation): see
-// hoist/service/config.hpp.  Reading and writing TOML
+// hoist/service/core/config.hpp.  Reading and writing TOML
 // lives in config_file.cpp.
-#include "hoist/service/config.hpp"
+#include "hoist/service/core/config.hpp"
 
 #include <cctype>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 const char* toString(ClockMode c) { return c == ClockMode::Wall ? "wall" : "input"; }
 
@@ -109,4 +109,4 @@ void EstimatorConfig::validate() const {
   checkRange("clear_hold", clear_hold, 0.0, 60.0, false, "estimator.");
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

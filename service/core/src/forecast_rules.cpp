@@ -1,9 +1,9 @@
-// The daemon's rules around the look-ahead engine: see hoist/service/forecast_rules.hpp.
-#include "hoist/service/forecast_rules.hpp"
+// The daemon's rules around the look-ahead engine: see hoist/service/core/forecast_rules.hpp.
+#include "hoist/service/core/forecast_rules.hpp"
 
 #include <cmath>
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 const char* toString(PlanReject r) {
   switch (r) {
@@ -75,4 +75,4 @@ ForecastVerdict judgeForecast(const ForecastSummary* const* scenarios, int n, do
   return v;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

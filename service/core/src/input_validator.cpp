@@ -1,5 +1,5 @@
-// Winder input validation: see hoist/service/input_validator.hpp.
-#include "hoist/service/input_validator.hpp"
+// Winder input validation: see hoist/service/core/input_validator.hpp.
+#include "hoist/service/core/input_validator.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "hoist/profile.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 const char* toString(RejectReason r) {
   switch (r) {
@@ -129,4 +129,4 @@ void InputValidator::accept(const WinderSample& s) {
   r.have_last_ = true;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

@@ -1,5 +1,5 @@
-// Start-up budget measurement: see hoist/service/budget.hpp.
-#include "hoist/service/budget.hpp"
+// Start-up budget measurement: see hoist/service/lcm/budget.hpp.
+#include "hoist/service/lcm/budget.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -10,11 +10,11 @@
 #include "hoist/cage_state_t.hpp"
 #include "hoist/estimate_t.hpp"
 #include "hoist/guide_shape_t.hpp"
-#include "hoist/service/messages.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/lcm/messages.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 #include "hoist/solver.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline lcm {
 
 namespace {
 
@@ -220,4 +220,4 @@ std::string describeBudget(const TickBudget& b, const TwinConfig& cfg) {
   return out;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::lcm

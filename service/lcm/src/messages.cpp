@@ -1,5 +1,5 @@
-// The pure parts of hoist-twind's LCM shell: see hoist/service/messages.hpp.
-#include "hoist/service/messages.hpp"
+// The pure parts of hoist-twind's LCM shell: see hoist/service/lcm/messages.hpp.
+#include "hoist/service/lcm/messages.hpp"
 #include "hoist/bus/lcm_util.hpp"
 
 #include <algorithm>
@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <cstring>
 
-namespace hoist::svc {
+namespace hoist::service::inline lcm {
 
 void toCageMessage(const CageOutput& o, hoist::cage_state_t& m) {
   m.input_seq = o.input_seq;
@@ -314,4 +314,4 @@ std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*
 
 std::string regexEscape(const std::string& name) { return bus::regexEscape(name); }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::lcm

@@ -1,9 +1,9 @@
-// Which state the alarms judge: see hoist/service/estimate_gate.hpp.
-#include "hoist/service/estimate_gate.hpp"
+// Which state the alarms judge: see hoist/service/twin/estimate_gate.hpp.
+#include "hoist/service/twin/estimate_gate.hpp"
 
 #include <algorithm>
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 void EstimateGate::pushLoad(GateEvent::Type type, double t, double Fa, double M) {
   GateEvent e;
@@ -86,4 +86,4 @@ const Judgement& EstimateGate::step(double t, bool usable, unsigned not_used, co
   return judged_;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

@@ -1,10 +1,10 @@
-// Sensor samples at their own time: see hoist/service/sensor_timing.hpp.
-#include "hoist/service/sensor_timing.hpp"
+// Sensor samples at their own time: see hoist/service/twin/sensor_timing.hpp.
+#include "hoist/service/twin/sensor_timing.hpp"
 
 #include <cmath>
 #include <limits>
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 const char* toString(SensorId s) {
   switch (s) {
@@ -120,4 +120,4 @@ DueSamples SensorTiming::take(const SensorPrediction& now, double dFa, double dM
   return d;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

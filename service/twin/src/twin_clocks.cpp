@@ -1,4 +1,4 @@
-// TwinCore's clocks (ClockPolicy, hoist/service/twin_core.hpp): what model
+// TwinCore's clocks (ClockPolicy, hoist/service/twin/twin_core.hpp): what model
 // time is and how an input and a tick move the twin.  InputClock (--clock
 // input): model time is the input's utime, one step per accepted input.
 // WallClock (--clock wall): model time is the daemon's timer; inputs only
@@ -9,9 +9,9 @@
 #include <cmath>
 #include <limits>
 
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 // ---- clock policies -------------------------------------------------------------
 
@@ -196,4 +196,4 @@ std::unique_ptr<ClockPolicy> makeClock(ClockMode mode) {
   return std::make_unique<WallClock>();
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

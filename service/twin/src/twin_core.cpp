@@ -1,5 +1,5 @@
-// The twin's logic without I/O: see hoist/service/twin_core.hpp.
-#include "hoist/service/twin_core.hpp"
+// The twin's logic without I/O: see hoist/service/twin/twin_core.hpp.
+#include "hoist/service/twin/twin_core.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -7,7 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 namespace {
 
@@ -480,4 +480,4 @@ int TwinCore::command(AlarmAction action, std::optional<AlarmKind> kind, AlarmLe
   return n;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

@@ -1,14 +1,14 @@
 // TwinCore's side of the load estimator's sensors: samples offered at their
 // own time (SensorTiming), SENSOR_FAULT, the estimator's step with the due
 // samples, whether the estimate may judge the alarms, the live calibration.
-// See hoist/service/twin_core.hpp; the rest of TwinCore is twin_core.cpp.
+// See hoist/service/twin/twin_core.hpp; the rest of TwinCore is twin_core.cpp.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 SensorVerdict TwinCore::onCageImu(std::int64_t utime, double f_y, double omega, double wall_now,
                                   std::int64_t wall_utime) {
@@ -136,4 +136,4 @@ unsigned TwinCore::estimateNotUsed(const LoadEstimate& e) {
   return why;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

@@ -1,12 +1,12 @@
-// The model a TwinCore runs: see hoist/service/twin_model.hpp.
-#include "hoist/service/twin_model.hpp"
+// The model a TwinCore runs: see hoist/service/twin/twin_model.hpp.
+#include "hoist/service/twin/twin_model.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 PlausibilityBounds twinPlausibilityBounds(const TwinConfig& cfg, const ShaftParams& shaft) {
   // The lateral limit: plausible_factor x the largest gap, but never below
@@ -36,4 +36,4 @@ std::unique_ptr<TwinModel> buildTwinModel(const TwinConfig& cfg, double scale) {
   return m;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

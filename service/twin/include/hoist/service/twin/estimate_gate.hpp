@@ -1,4 +1,4 @@
-// hoist/service/estimate_gate.hpp -- which state the clearance and
+// hoist/service/twin/estimate_gate.hpp -- which state the clearance and
 // rope-force alarms judge, the load estimate's or the open-loop twin's, and
 // the rule that a false sensor cannot silence an alarm.
 //
@@ -21,9 +21,9 @@
 #include <array>
 #include <cstdint>
 
-#include "hoist/service/alarms.hpp"
+#include "hoist/service/core/alarms.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 /// Why the estimate does not judge the alarms (estimate_t.not_used bits).
 enum NotUsedBits : unsigned {
@@ -99,4 +99,4 @@ class EstimateGate {
   std::int64_t n_events_ = 0;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

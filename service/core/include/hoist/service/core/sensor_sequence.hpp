@@ -1,4 +1,4 @@
-// hoist/service/sensor_sequence.hpp -- the sequence rule of one sensor
+// hoist/service/core/sensor_sequence.hpp -- the sequence rule of one sensor
 // channel (HOIST_CAGE_IMU, HOIST_ROPE_LOAD): a sample is accepted when its
 // seq comes after the last accepted one.  A seq that goes back is an old or
 // replayed sample and is rejected -- unless it goes back by kRestartJump or
@@ -12,7 +12,7 @@
 
 #include <cstdint>
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 struct SensorSequence {
   static constexpr std::int64_t kRestartJump = 1000;
@@ -38,4 +38,4 @@ struct SensorSequence {
   }
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

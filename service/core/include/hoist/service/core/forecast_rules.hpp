@@ -1,4 +1,4 @@
-// hoist/service/forecast_rules.hpp -- the daemon's rules around the model's
+// hoist/service/core/forecast_rules.hpp -- the daemon's rules around the model's
 // look-ahead engine (docs/lookahead.md), pure (no I/O, no
 // allocation): which trip plans are accepted, what a forecast predicts
 // (PREDICTED_CLEARANCE / PREDICTED_SLACK), and the slack threshold.
@@ -9,9 +9,9 @@
 #include "hoist/forecast.hpp"
 #include "hoist/params.hpp"
 #include "hoist/shaft_model.hpp"
-#include "hoist/service/config.hpp"
+#include "hoist/service/core/config.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 /// Reasons a HOIST_TRIP_PLAN message is rejected: undecodable, an old
 /// sequence number, then every hoist::PlanError (after None), in order, then
@@ -60,4 +60,4 @@ struct ForecastVerdict {
 /// predicts nothing (its figures are not a prediction of the shaft).
 ForecastVerdict judgeForecast(const ForecastSummary* const* scenarios, int n, double slack_threshold);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

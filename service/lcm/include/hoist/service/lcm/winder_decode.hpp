@@ -1,4 +1,4 @@
-// hoist/service/winder_decode.hpp -- raw HOIST_WINDER bytes -> WinderSample,
+// hoist/service/lcm/winder_decode.hpp -- raw HOIST_WINDER bytes -> WinderSample,
 // exactly as hoist-twind decodes them (header-only: needs the lcm-gen'd
 // hoist/winder_t.hpp, i.e. link hoist_msgs).
 //
@@ -11,11 +11,11 @@
 
 #include <cstdint>
 
-#include "hoist/service/input_validator.hpp"
+#include "hoist/service/core/input_validator.hpp"
 #include "hoist/msg/codec.hpp"
 #include "hoist/winder_t.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline lcm {
 
 enum class WinderDecode : std::uint8_t {
   Ok,
@@ -52,4 +52,4 @@ inline WinderDecode decodeWinder(const void* data, std::int64_t size, hoist::win
   return WinderDecode::Ok;
 }
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::lcm

@@ -1,4 +1,4 @@
-// hoist/service/sensor_timing.hpp -- the load estimator's sensor samples
+// hoist/service/twin/sensor_timing.hpp -- the load estimator's sensor samples
 // applied at their own time (utime), not at their arrival.
 //
 // Each sample of HOIST_CAGE_IMU / HOIST_ROPE_LOAD carries the time it was
@@ -29,7 +29,7 @@
 
 #include "hoist/sensor_alignment.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 /// The estimator's sensor channels (SENSOR_FAULT names one of them).
 enum class SensorId : std::uint8_t { CageImu = 1, RopeLoad = 2, Estimate = 3 };
@@ -119,4 +119,4 @@ class SensorTiming {
   SensorTimingCounters counts_;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

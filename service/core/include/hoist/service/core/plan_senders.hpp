@@ -1,4 +1,4 @@
-// hoist/service/plan_senders.hpp -- the trip-plan sequence rule, per sender
+// hoist/service/core/plan_senders.hpp -- the trip-plan sequence rule, per sender
 // (msgs/trip_plan_t.lcm: sender_id).  Pure, fixed size: no I/O, no
 // allocation (the daemon applies it in its receive path).
 //
@@ -18,7 +18,7 @@
 #include <cmath>
 #include <cstdint>
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 class PlanSenders {
  public:
@@ -70,4 +70,4 @@ class PlanSenders {
   std::uint64_t order_ = 0;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

@@ -1,4 +1,4 @@
-// hoist/service/messages.hpp -- the pure parts of hoist-twind's LCM shell:
+// hoist/service/lcm/messages.hpp -- the pure parts of hoist-twind's LCM shell:
 // TwinCore output -> LCM message mapping, alarm text, validation of operator
 // commands (alarm_ack_t), channel-name handling.  No I/O, no clock; the
 // mapping and the alarm text do not allocate (preallocated messages).
@@ -14,9 +14,9 @@
 #include "hoist/alarm_t.hpp"
 #include "hoist/cage_state_t.hpp"
 #include "hoist/estimate_t.hpp"
-#include "hoist/service/twin_core.hpp"
+#include "hoist/service/twin/twin_core.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline lcm {
 
 /// Fill `m` (preallocated) from the twin's output; utime, seq and
 /// instance_id are the caller's.
@@ -76,4 +76,4 @@ std::optional<AckCommand> validateAck(const hoist::alarm_ack_t& ack, const char*
 /// subscribe() takes a regex, so a literal channel name needs this.
 std::string regexEscape(const std::string& name);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::lcm

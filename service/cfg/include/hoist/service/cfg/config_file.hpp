@@ -1,5 +1,5 @@
-// hoist/service/config_file.hpp -- reading the daemon's configuration
-// (hoist/service/config.hpp) from a TOML file: the shaft sections through
+// hoist/service/cfg/config_file.hpp -- reading the daemon's configuration
+// (hoist/service/core/config.hpp) from a TOML file: the shaft sections through
 // hoist_io, [service] and [alarms] here.  Target hoist_service_cfg; the
 // I/O-free TwinCore (hoist_twin) does not link it.
 #pragma once
@@ -9,9 +9,9 @@
 #include <toml++/toml.h>
 
 #include "hoist/io/error.hpp"
-#include "hoist/service/config.hpp"
+#include "hoist/service/core/config.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline cfg {
 
 /// A configuration error; what() is "<file>:<line>: <key>: <message>" (the
 /// line is omitted when unknown).  The one type of hoist_io.
@@ -29,4 +29,4 @@ TwinConfig loadTwinConfig(const std::string& path);
 /// hoist::io::toToml writes it, then [service] and [alarms].
 std::string toToml(const TwinConfig& cfg);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::cfg

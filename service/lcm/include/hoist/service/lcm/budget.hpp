@@ -1,4 +1,4 @@
-// hoist/service/budget.hpp -- does a configuration fit its period?  The
+// hoist/service/lcm/budget.hpp -- does a configuration fit its period?  The
 // daemon measures the cost of one WHOLE tick of the actual configuration at
 // start-up, before it runs, on a scratch TwinCore fed a synthetic trip with
 // the cage moving (at [forecast] vmax, the acceleration swinging by
@@ -14,9 +14,9 @@
 
 #include <string>
 
-#include "hoist/service/config.hpp"
+#include "hoist/service/core/config.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline lcm {
 
 struct TickBudget {
   int ticks = 0;           ///< ticks measured
@@ -61,4 +61,4 @@ TickBudget measureTickBudget(const TwinConfig& cfg, int max_ticks = 200, double 
 /// us per tick ([service] shape_rate = 1000 Hz, shape_points = 101), ...".
 std::string describeBudget(const TickBudget& b, const TwinConfig& cfg);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::lcm

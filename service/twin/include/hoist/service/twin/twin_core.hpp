@@ -1,4 +1,4 @@
-// hoist/service/twin_core.hpp -- the twin's logic without any I/O: input
+// hoist/service/twin/twin_core.hpp -- the twin's logic without any I/O: input
 // validation, kinematics following, model stepping and fault recovery,
 // clearance alarms.  hoist-twind wraps it with LCM and timers; tests drive
 // it directly.
@@ -47,18 +47,18 @@
 #include <memory>
 
 #include "hoist/contract/alarm_command.hpp"
-#include "hoist/service/alarms.hpp"
-#include "hoist/service/config.hpp"
-#include "hoist/service/estimate_gate.hpp"
-#include "hoist/service/sensor_timing.hpp"
-#include "hoist/service/twin_model.hpp"
-#include "hoist/service/input_validator.hpp"
+#include "hoist/service/core/alarms.hpp"
+#include "hoist/service/core/config.hpp"
+#include "hoist/service/twin/estimate_gate.hpp"
+#include "hoist/service/twin/sensor_timing.hpp"
+#include "hoist/service/twin/twin_model.hpp"
+#include "hoist/service/core/input_validator.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/plausibility.hpp"
 #include "hoist/guide_rope_envelope.hpp"
 #include "hoist/solver.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 /// One published cage state (see msgs/cage_state_t.lcm).
 struct CageOutput {
@@ -294,7 +294,7 @@ class TwinCore {
 
   // ---- the model ---------------------------------------------------------
   /// Run `m` from now on (an operator adopted a guide-rope preload;
-  /// hoist/service/twin_model.hpp): the solver, the envelopes, the
+  /// hoist/service/twin/twin_model.hpp): the solver, the envelopes, the
   /// plausibility bounds and the estimator's solvers are swapped, and `m`
   /// receives the old ones (release them off the loop).  A started twin is
   /// re-initialized in the new model's equilibrium at the current
@@ -311,7 +311,7 @@ class TwinCore {
   /// A validated cage IMU sample (f_y [m/s^2], omega [rad/s]; NaN = that
   /// channel absent) stamped `utime` [us], arriving at `wall_now` [s] when the
   /// wall clock reads `wall_utime` [us]: applied at its own time
-  /// (hoist/service/sensor_timing.hpp) at the first model step at or after
+  /// (hoist/service/twin/sensor_timing.hpp) at the first model step at or after
   /// it.  A clock further off than [sensors] max_clock_offset or a utime
   /// going back is refused, counted and raises SENSOR_FAULT.  Disabled: NoClock.
   SensorVerdict onCageImu(std::int64_t utime, double f_y, double omega, double wall_now, std::int64_t wall_utime);
@@ -450,4 +450,4 @@ class TwinCore {
   double fault_value_ = 0.0, fault_limit_ = 0.0;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

@@ -1,4 +1,4 @@
-// hoist/service/alarms.hpp -- clearance alarms of the twin (pure: no I/O, no
+// hoist/service/core/alarms.hpp -- clearance alarms of the twin (pure: no I/O, no
 // clock, no allocation after construction).
 //
 // What is measured (docs/model.md conventions; y lateral, theta cage rotation, h
@@ -58,7 +58,7 @@
 
 #include "hoist/contract/alarm_vocabulary.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 // The alarm vocabulary (kinds, levels, event types, their names) is the
 // contract with the daemon's clients: hoist/contract/alarm_vocabulary.hpp.
@@ -334,4 +334,4 @@ class AlarmEngine {
   std::array<BinaryAlarm, kSlots> alarms_;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

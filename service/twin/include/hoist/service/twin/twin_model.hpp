@@ -1,4 +1,4 @@
-// hoist/service/twin_model.hpp -- the model a TwinCore runs, as one object
+// hoist/service/twin/twin_model.hpp -- the model a TwinCore runs, as one object
 // that can be built off the real-time loop and swapped in (issue 32: an
 // operator adopts the guide-rope preload the shaft's memory identified;
 // docs/condition.md "Adopting the identified preload").
@@ -18,10 +18,10 @@
 #include "hoist/guide_rope_envelope.hpp"
 #include "hoist/load_estimator.hpp"
 #include "hoist/plausibility.hpp"
-#include "hoist/service/config.hpp"
+#include "hoist/service/core/config.hpp"
 #include "hoist/solver.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline twin {
 
 struct TwinModel {
   TwinModel(double scale, std::unique_ptr<Solver> s, int envelope_points, int shape_points)
@@ -52,4 +52,4 @@ std::unique_ptr<TwinModel> buildTwinModel(const TwinConfig& cfg, double scale);
 /// The twin's plausibility bounds for `cfg` with shaft `shaft`.
 PlausibilityBounds twinPlausibilityBounds(const TwinConfig& cfg, const ShaftParams& shaft);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::twin

@@ -1,4 +1,4 @@
-// hoist/service/history_config.hpp -- hoist-twind's [history] and
+// hoist/service/cfg/history_config.hpp -- hoist-twind's [history] and
 // [condition]: whether and where the daemon records every trip (issue 32,
 // docs/condition.md "Live").
 //
@@ -24,7 +24,7 @@
 #include "hoist/history/config.hpp"
 #include "hoist/trip_pipeline.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline cfg {
 
 struct TripHistoryConfig {
   bool enabled = false;             ///< history.enabled
@@ -44,4 +44,4 @@ TripHistoryConfig loadTripHistoryConfig(const std::string& path);
 /// [history] (with enabled) and [condition] as TOML, for --print-config.
 std::string toToml(const TripHistoryConfig& c);
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::cfg

@@ -1,7 +1,7 @@
-// hoist/service/config.hpp -- the daemon's configuration as plain structs:
+// hoist/service/core/config.hpp -- the daemon's configuration as plain structs:
 // the shaft (ShaftParams) plus [service] and [alarms].  No parser here: the
 // I/O-free TwinCore sees only these structs.  Reading them from TOML is
-// hoist/service/config_file.hpp (target hoist_service_cfg, via hoist_io).
+// hoist/service/cfg/config_file.hpp (target hoist_service_cfg, via hoist_io).
 // Every key is optional; a missing key takes the default below (the shaft's
 // defaults are the paper's values).  Unknown keys, wrong types, non-finite or
 // out-of-range values are errors naming the file, line and dotted key.
@@ -13,9 +13,9 @@
 #include "hoist/load_estimator.hpp"
 #include "hoist/params.hpp"
 #include "hoist/profile.hpp"
-#include "hoist/service/alarms.hpp"
+#include "hoist/service/core/alarms.hpp"
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 enum class ClockMode { Wall, Input };
 /// Most substeps one model step may take (service.max_step is checked against it).
@@ -88,7 +88,7 @@ struct ServiceConfig {
   /// Once they are spent, a twin whose bounded envelope has drifted past
   /// envelope_tolerance keeps that wider, still rigorous bound for a tick or
   /// more -- only while it lies below the GUIDE_ROPE WARNING alarm's clear
-  /// level, so no alarm decides differently (EnvelopeBudget in hoist/service/twin_core.hpp);
+  /// level, so no alarm decides differently (EnvelopeBudget in hoist/service/twin/twin_core.hpp);
   /// near a threshold it is exact regardless.  Hundreds of twins in lockstep
   /// then refresh over a few ticks instead of in one.  The smallest value
   /// among a schedule's shafts; 0 = no budget, [0, 100000].
@@ -169,4 +169,4 @@ struct TwinConfig {
   EstimatorConfig estimator;
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core

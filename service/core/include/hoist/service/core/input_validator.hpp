@@ -1,4 +1,4 @@
-// hoist/service/input_validator.hpp -- checks every winder input before it
+// hoist/service/core/input_validator.hpp -- checks every winder input before it
 // can reach the model (pure: no I/O, no clock, no allocation).
 //
 // A winder sample (winder_t) carries utime [us], seq, v [m/s], a [m/s^2] and
@@ -13,7 +13,7 @@
 #include <array>
 #include <cstdint>
 
-namespace hoist::svc {
+namespace hoist::service::inline core {
 
 /// Why an input was rejected.  Names (toString) appear in HOIST_HEALTH and logs.
 enum class RejectReason : std::uint8_t {
@@ -141,4 +141,4 @@ struct InputCounters {
   std::int64_t count(RejectReason r) const { return rejected[static_cast<int>(r)]; }
 };
 
-}  // namespace hoist::svc
+}  // namespace hoist::service::core
