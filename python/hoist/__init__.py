@@ -23,11 +23,11 @@ import os as _os
 
 from . import _hoist
 from ._hoist import (Config, InputError, ConfigError, ProfileError, MeasurementError,  # noqa: F401
-                     RunError, HistoryError, __version__, ESTIMATE_COLUMNS)
+                     RunError, HistoryError, __version__, ESTIMATE_COLUMNS, DEFAULT_MAX_STEP)
 
 __all__ = ["Config", "Result", "simulate", "simulate_batch", "estimate", "ESTIMATE_COLUMNS", "read_log", "sweep", "trips", "trip", "record_trips",
            "TRIPS_COLUMNS", "HistoryError", "InputError", "ConfigError",
-           "ProfileError", "MeasurementError", "RunError", "__version__"]
+           "ProfileError", "MeasurementError", "RunError", "DEFAULT_MAX_STEP", "__version__"]
 
 
 class Result(_Mapping):
@@ -84,7 +84,7 @@ def _check_profile(profile):
     return _os.fspath(profile) if isinstance(profile, _os.PathLike) else profile
 
 
-def simulate(cfg, profile="paper", *, dt=0.01, max_step=0.0025, t_end=None, modes=None, initial=None,
+def simulate(cfg, profile="paper", *, dt=0.01, max_step=DEFAULT_MAX_STEP, t_end=None, modes=None, initial=None,
              method="fast", static_correction=None, rho_inf=None, shape_times=(), shape_points=401,
              estop_at=None, estop_decel=3.0, estop_jerk=10.0, progress=None):
     """Run the shaft model over a hoist profile: hoist-sim from Python.
@@ -151,7 +151,7 @@ def simulate(cfg, profile="paper", *, dt=0.01, max_step=0.0025, t_end=None, mode
     return Result(cols, shapes, info)
 
 
-def simulate_batch(configs, profile="paper", *, threads=0, progress=None, dt=0.01, max_step=0.0025,
+def simulate_batch(configs, profile="paper", *, threads=0, progress=None, dt=0.01, max_step=DEFAULT_MAX_STEP,
                    t_end=None, modes=None, initial=None, method="fast", static_correction=None,
                    rho_inf=None, shape_times=(), shape_points=401, estop_at=None, estop_decel=3.0,
                    estop_jerk=10.0):

@@ -8,6 +8,8 @@ import numpy.typing as npt
 
 __version__: str
 ESTIMATE_COLUMNS: list[str]
+#: The default largest integration step [s] (hoist-sim --max-step; the model's kDefaultMaxStep).
+DEFAULT_MAX_STEP: float
 TRIPS_COLUMNS: list[str]
 
 _Array = npt.NDArray[np.float64]

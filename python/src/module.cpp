@@ -7,6 +7,7 @@
 
 #include "config_py.hpp"
 #include "errors.hpp"
+#include "hoist/profile.hpp"
 #include "hoist/version.hpp"
 #include "estimate_py.hpp"
 #include "simulate_py.hpp"
@@ -15,6 +16,7 @@
 PYBIND11_MODULE(_hoist, m) {
   m.doc() = "hoist-twin's model and tools from Python (the C++ half; use the package `hoist`).";
   m.attr("__version__") = hoist::kVersionString;
+  m.attr("DEFAULT_MAX_STEP") = hoist::kDefaultMaxStep;  // the model's one default substep [s]
   hoist::python::bindErrors(m);
   hoist::python::bindConfig(m);
   hoist::python::bindSimulate(m);

@@ -107,9 +107,10 @@ TEST(ConditionSequence, NominalPreloadNeverLow) {
     const Load L = kLoads[k % 10];
     print(r, 1.0, L.Fa * L.b);
     EXPECT_EQ(r.direction, k % 2 == 0 ? TripDirection::Down : TripDirection::Up);
-    if (r.id.sigma_scale > 0.0)
+    if (r.id.sigma_scale > 0.0) {
       EXPECT_LT(std::abs(r.id.scale - 1.0), 3.0 * r.id.sigma_scale) << "trip " << r.trip;
-    if (std::abs(L.b) < 0.05) EXPECT_FALSE(r.id.informative) << "a load near the axis tells nothing: trip " << r.trip;
+    }
+    if (std::abs(L.b) < 0.05) { EXPECT_FALSE(r.id.informative) << "a load near the axis tells nothing: trip " << r.trip; }
     informative += r.id.informative;
     trend.add(r);
     const PreloadDecision d = trend.decision();
@@ -133,8 +134,9 @@ TEST(ConditionSequence, PreloadFallingByStepsRaisesTheAlarmWithinTwoTrips) {
   for (std::size_t k = 0; k < recs.size(); ++k) {
     const Load L = kLoads[k % 10];
     print(recs[k], s[k], L.Fa * L.b);
-    if (recs[k].id.sigma_scale > 0.0)
+    if (recs[k].id.sigma_scale > 0.0) {
       EXPECT_LT(std::abs(recs[k].id.scale - s[k]), 3.0 * recs[k].id.sigma_scale) << "trip " << recs[k].trip;
+    }
     trend.add(recs[k]);
     const PreloadDecision d = trend.decision();
     std::printf("    trend %.3f +- %.3f (upper %.3f) level %d\n", d.scale, d.sigma, d.upper95, int(d.level));

@@ -122,7 +122,7 @@ TEST(EnvelopeBound, DeferredBoundsStayAboveTheExactEnvelope) {
       if (first) cap = 2.0 * e + 1e-3;
       first = false;
       const double c = capped.evaluateBounded(s, tol, cap);
-      if (capped.lastDeferred()) ASSERT_LT(c, cap);
+      if (capped.lastDeferred()) { ASSERT_LT(c, cap); }
       ASSERT_GE(c, e - 1e-15);
     });
     EXPECT_EQ(never.exactEvaluations(), plain.exactEvaluations());

@@ -114,7 +114,7 @@ TEST(LoadEstimatorCheck, HealthyTripsWithVibrationNeverRaiseMismatch) {
       EXPECT_LT(std::abs(o.last.moment - tr.M.back()), 3.0 * o.last.sigma_moment) << c.what << " seed " << seed;
       // The learned noise sees the vibration (sqrt(1 + vib^2) times the white
       // noise, less the monitor's 3-sd discount: 1.14 at vib = 0.75).
-      if (vib >= 0.75) EXPECT_GT(o.last.noise_imu_accel, 0.002 * 1.05) << c.what << " seed " << seed;
+      if (vib >= 0.75) { EXPECT_GT(o.last.noise_imu_accel, 0.002 * 1.05) << c.what << " seed " << seed; }
     }
   }
   EXPECT_EQ(trips, 20);

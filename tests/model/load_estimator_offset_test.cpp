@@ -114,7 +114,7 @@ TEST(LoadEstimatorOffset, CalibrationTripThenLoadedTripWithinFivePercent) {
                 lb.last.moment, lb.last.sigma_moment, loaded.M.back(), 100.0 * err);
     // 5 % with the industrial IMU; a 0.01 IMU's white noise alone leaves
     // about 2.4 % (1 sigma) on this trip: there its band is what is asked.
-    if (white <= 0.002) EXPECT_LT(err, 0.05) << "IMU " << white;
+    if (white <= 0.002) { EXPECT_LT(err, 0.05) << "IMU " << white; }
     EXPECT_LT(std::abs(lb.last.moment - loaded.M.back()), 3.0 * lb.last.sigma_moment) << "IMU " << white;
     EXPECT_LT(lb.worst, 3.0);
   }

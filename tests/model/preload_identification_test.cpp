@@ -80,9 +80,9 @@ TEST(PreloadIdentification, ScaleInsideItsBandIndustrialAndCheapImu) {
                     accel, s, seed, id.scale, id.sigma_scale, (id.scale - s) / id.sigma_scale, id.moment,
                     id.sigma_moment, id.chi2 / id.dof, id.loss30_separation, id.cpu_seconds);
         ASSERT_TRUE(id.attempted);
-        if (accel < 0.005) ASSERT_GT(id.sigma_scale, 0.0) << "the industrial IMU identifies s at M = 1000 N m";
-        if (id.sigma_scale > 0.0) EXPECT_LT(std::abs(id.scale - s), 3.0 * id.sigma_scale) << "imu " << accel << " s " << s;
-        if (accel < 0.005) EXPECT_TRUE(id.informative);
+        if (accel < 0.005) { ASSERT_GT(id.sigma_scale, 0.0) << "the industrial IMU identifies s at M = 1000 N m"; }
+        if (id.sigma_scale > 0.0) { EXPECT_LT(std::abs(id.scale - s), 3.0 * id.sigma_scale) << "imu " << accel << " s " << s; }
+        if (accel < 0.005) { EXPECT_TRUE(id.informative); }
         EXPECT_NEAR(id.moment, 1000.0, 3.0 * id.sigma_moment);
         EXPECT_LT(id.sigma_imbalance, 0.0);
       }
@@ -106,7 +106,7 @@ TEST(PreloadIdentification, ObservabilityTable) {
       sig[g][k] = id.sigma_scale;
       if (id.sigma_scale > 0.0) std::printf("  %6.3f [%4.1f]", id.sigma_scale, id.loss30_separation);
       else std::printf("  not ident.   ");
-      if (offsets[k] < 0.1) EXPECT_FALSE(id.informative) << "M = 50 N m with IMU " << grades[g];
+      if (offsets[k] < 0.1) { EXPECT_FALSE(id.informative) << "M = 50 N m with IMU " << grades[g]; }
     }
     std::printf("\n");
   }
@@ -116,7 +116,7 @@ TEST(PreloadIdentification, ObservabilityTable) {
   EXPECT_TRUE(sig[2][3] < 0.0 || sig[2][3] > 0.1);
   // (sigma is not simply linear in the noise: the information on s grows
   // fast as s falls, and a noisier trip's minimum lies elsewhere.)
-  if (sig[2][3] > 0.0) EXPECT_GT(sig[2][3], sig[0][3]);
+  if (sig[2][3] > 0.0) { EXPECT_GT(sig[2][3], sig[0][3]); }
   // Falls with the moment.
   EXPECT_LT(sig[0][3], sig[0][2]);
   EXPECT_LT(sig[0][2], sig[0][1] > 0.0 ? sig[0][1] : 1e9);

@@ -196,7 +196,7 @@ TEST(RecordTrips, TwoTripsOfOurOwnModel) {
     EXPECT_NEAR(r.peak_speed, 8.0, 0.05);
     EXPECT_TRUE(r.id.attempted);
     EXPECT_LT(std::abs(r.id.moment - M[k]), 3.0 * r.id.sigma_moment);
-    if (r.id.sigma_scale > 0.0) EXPECT_LT(std::abs(r.id.scale - 1.0), 3.0 * r.id.sigma_scale);
+    if (r.id.sigma_scale > 0.0) { EXPECT_LT(std::abs(r.id.scale - 1.0), 3.0 * r.id.sigma_scale); }
     EXPECT_EQ(r.bins.size(), 16u);  // 50 .. 200 m in 10 m bins, the end depth's bin included
     for (const DepthBinStats& b : r.bins) {
       EXPECT_GT(b.samples, 0);

@@ -34,3 +34,11 @@ def test_stubs_name_every_public_function_with_the_same_keywords():
         if node.args.kwarg:
             stub_names.append(node.args.kwarg.arg)
         assert stub_names == list(real.parameters), name
+
+
+def test_default_max_step_is_the_models():
+    # One default substep: the C++ model's kDefaultMaxStep, the keyword
+    # default of simulate and simulate_batch (hoist-sim --max-step's).
+    assert hoist.DEFAULT_MAX_STEP == 0.0025
+    for fn in (hoist.simulate, hoist.simulate_batch):
+        assert inspect.signature(fn).parameters["max_step"].default == hoist.DEFAULT_MAX_STEP, fn.__name__
