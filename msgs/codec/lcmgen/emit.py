@@ -8,7 +8,7 @@ the templates."""
 import os
 
 from .fingerprint import fingerprint
-from .model import INT_RANGE, PRIM_SIZE, REAL_TYPES, GenError
+from .model import INT_RANGE, PRIM_SIZE, REAL_TYPES, GenError, camel
 from .schema import schema
 from .sizes import body_min, max_size
 
@@ -61,7 +61,7 @@ class TypeView:
         words = (st.channel or "").split("_")
         if words and words[0] == st.package.upper() and len(words) > 1:
             words = words[1:]
-        self.channel_stem = "".join(w.capitalize() for w in words)
+        self.channel_stem = camel("_".join(words))
         self.channel_member = "_".join(w.lower() for w in words)
         counts = {m.dims[0][1] for m in st.members if m.var_array}
         self.members = [MemberView(st, m, counts) for m in st.members]
@@ -88,7 +88,7 @@ class GroupView:
 
     def __init__(self, name):
         self.name = name
-        self.camel = "".join(w.capitalize() for w in name.split("_"))
+        self.camel = camel(name)
         self.members = []
 
 

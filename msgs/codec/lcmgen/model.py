@@ -20,6 +20,12 @@ class GenError(Exception):
     pass
 
 
+def camel(name):
+    """The C++ spelling the generated names share: CAGE_POS_Y, cage_pos_y ->
+    CagePosY (enumerators, enum and table stems, group structs, channels)."""
+    return "".join(w.capitalize() for w in name.strip("_").split("_"))
+
+
 class Member:
     def __init__(self, type_, name, dims, line, desc):
         self.type = type_
@@ -58,12 +64,12 @@ class Enum:
     @property
     def camel(self):
         """The enumerators of enum class <Stem>: CAGE_POS_Y -> CagePosY."""
-        return ["".join(w.capitalize() for w in n.split("_")) for n in self.names]
+        return [camel(n) for n in self.names]
 
     @property
     def stem(self):
         """LEVEL_ -> Level, EVENT_ -> Event, RUN_MODE_ -> RunMode."""
-        return "".join(p.capitalize() for p in self.prefix.strip("_").split("_"))
+        return camel(self.prefix)
 
 
 class Struct:
