@@ -12,12 +12,6 @@
 
 namespace hoist::estimate {
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
 Input check(const Options& o) {
   // ---- input ------------------------------------------------------------
   const toml::table tbl = hoist::io::loadTomlFile(o.config);

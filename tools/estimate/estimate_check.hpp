@@ -3,6 +3,7 @@
 // offset file are read and checked before anything is estimated or written.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "estimate_options.hpp"
@@ -27,8 +28,5 @@ struct Input {
 /// stderr unless --quiet).  Throws UsageError (an option's value) or
 /// hoist::io::InputError (a file, naming line and column): exit status 2.
 Input check(const Options& o);
-
-/// printf-style formatting of one number ("%.2f", v).
-std::string fmt(const char* f, double v);
 
 }  // namespace hoist::estimate

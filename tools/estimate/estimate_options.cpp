@@ -9,13 +9,11 @@
 
 namespace hoist::estimate {
 
-namespace {
-std::string fmtDefaultStep() {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", hoist::kDefaultMaxStep);
-  return b;
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
 }
-}  // namespace
 
 void addOptions(CLI::App& app, Options& o) {
   app.add_option("--config", o.config,
@@ -28,8 +26,8 @@ void addOptions(CLI::App& app, Options& o) {
   app.add_option("--modes", o.modes, "assumed modes per rope n (overrides model.modes)")
       ->check(CLI::Range(1, hoist::kMaxModes));
   app.add_option("--max-step", o.max_step,
-                 "largest integration step [s] (default: the config's [service] max_step, else " + fmtDefaultStep() +
-                     " as in hoist-twind; 0: one step per row)")
+                 "largest integration step [s] (default: the config's [service] max_step, else " +
+                     fmt("%g", hoist::kDefaultMaxStep) + " as in hoist-twind; 0: one step per row)")
       ->check(CLI::Range(0.0, 10.0));
   app.add_option("--known-load", o.known_load,
                  "T0,T1,FA,B: the load is known to be FA [N] at B [m] from T0 to T1 [s] (the calibration: the "

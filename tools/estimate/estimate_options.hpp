@@ -30,6 +30,10 @@ struct UsageError : std::runtime_error {
 /// must outlive the parse).
 void addOptions(CLI::App& app, Options& o);
 
+/// printf-style formatting of one number (fmt("%.2f", v)), for the
+/// messages, the help and the summary.
+std::string fmt(const char* f, double v);
+
 /// The first required option not given ("--config", ...), or nullopt.
 /// Checked after parsing: CLI11 reports a missing option before an unknown
 /// one, and an unknown option must be named.
